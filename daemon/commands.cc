@@ -1,0 +1,18 @@
+#include "daemon/commands.h"
+
+namespace pvtwin::cli {
+
+namespace {
+int g_exit_code = kExitOk;
+}  // namespace
+
+int ExitCode() { return g_exit_code; }
+void SetExitCode(int code) { g_exit_code = code; }
+
+void RegisterCommands(CLI::App& app) {
+  RegisterCheckConfig(app);
+  RegisterSimulate(app);
+  RegisterBench(app);
+}
+
+}  // namespace pvtwin::cli

@@ -1,0 +1,24 @@
+// Registration of the pvtwin subcommands. Each cmd_*.cc defines one
+// Register<Verb>() that adds its CLI11 subcommand and callback.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace pvtwin::cli {
+
+// Exit codes (DESIGN.md): 0 success, 1 runtime failure, 2 bad input or config.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitRuntime = 1;
+inline constexpr int kExitBadInput = 2;
+
+void RegisterCommands(CLI::App& app);
+
+// The exit code chosen by the subcommand that ran.
+int ExitCode();
+void SetExitCode(int code);
+
+void RegisterCheckConfig(CLI::App& app);
+void RegisterSimulate(CLI::App& app);
+void RegisterBench(CLI::App& app);
+
+}  // namespace pvtwin::cli

@@ -1,0 +1,185 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/irradiance.h"
+#include "core/solar_position.h"
+#include "core/units.h"
+
+namespace pvtwin {
+namespace {
+
+IsotropicSkyInput ClearNoon() {
+  IsotropicSkyInput in;
+  in.ghi_w_m2 = 800.0;
+  in.dhi_w_m2 = 120.0;
+  in.zenith_rad = DegToRad(30.0);
+  in.aoi_rad = DegToRad(30.0);
+  in.tilt_rad = 0.0;
+  in.ground_albedo = 0.2;
+  return in;
+}
+
+TEST(Irradiance, HorizontalPlaneReturnsGhi) {
+  IsotropicSkyInput in = ClearNoon();
+  for (double zenith_deg : {0.0, 30.0, 60.0, 85.0}) {
+    for (double azimuth_deg : {90.0, 180.0, 250.0}) {
+      in.zenith_rad = DegToRad(zenith_deg);
+      in.aoi_rad = AngleOfIncidenceRad(in.zenith_rad, DegToRad(azimuth_deg), 0.0, kPi);
+      const PoaComponents poa = TransposeIsotropicSky(in);
+      EXPECT_NEAR(poa.global_w_m2(), in.ghi_w_m2, 1e-9) << zenith_deg;
+      EXPECT_DOUBLE_EQ(poa.sky_diffuse_w_m2, in.dhi_w_m2);
+      EXPECT_EQ(poa.ground_diffuse_w_m2, 0.0);
+    }
+  }
+}
+
+// β = 90°: I_dsky = DHI/2, I_dgd = ρ/2 · GHI.
+TEST(Irradiance, VerticalPlaneSeesHalfTheSkyAndHalfTheGround) {
+  IsotropicSkyInput in = ClearNoon();
+  in.tilt_rad = DegToRad(90.0);
+  in.aoi_rad = DegToRad(60.0);
+  const PoaComponents poa = TransposeIsotropicSky(in);
+  EXPECT_NEAR(poa.ground_diffuse_w_m2, 0.2 / 2.0 * 800.0, 1e-9);
+  EXPECT_NEAR(poa.sky_diffuse_w_m2, 120.0 / 2.0, 1e-9);
+  // Beam normal (800 − 120)/cos 30° = 785.196 W/m², times cos 60°.
+  EXPECT_NEAR(poa.beam_w_m2, 680.0 / std::cos(DegToRad(30.0)) * 0.5, 1e-9);
+}
+
+TEST(Irradiance, PlaneFacingTheSunReceivesBeamNormalIrradiance) {
+  IsotropicSkyInput in = ClearNoon();
+  in.zenith_rad = DegToRad(50.0);
+  in.tilt_rad = in.zenith_rad;
+  in.aoi_rad = 0.0;
+  const PoaComponents poa = TransposeIsotropicSky(in);
+  EXPECT_NEAR(poa.beam_w_m2, 680.0 / std::cos(DegToRad(50.0)), 1e-9);
+}
+
+// Beam rule: no beam with cos θ_z < 0.0175 (θ_z > 89.0°), below the
+// horizon, or with the sun behind the plane.
+TEST(Irradiance, NoBeamNearOrBelowTheHorizonOrFromBehind) {
+  IsotropicSkyInput in = ClearNoon();
+  in.ghi_w_m2 = 30.0;
+  in.dhi_w_m2 = 20.0;
+  in.tilt_rad = DegToRad(90.0);
+  in.aoi_rad = DegToRad(10.0);
+  in.zenith_rad = DegToRad(88.9);  // cos = 0.0192: beam kept
+  EXPECT_GT(TransposeIsotropicSky(in).beam_w_m2, 0.0);
+  in.zenith_rad = DegToRad(89.2);  // cos = 0.0140: beam dropped
+  EXPECT_EQ(TransposeIsotropicSky(in).beam_w_m2, 0.0);
+  in.zenith_rad = DegToRad(95.0);
+  EXPECT_EQ(TransposeIsotropicSky(in).beam_w_m2, 0.0);
+  in.zenith_rad = DegToRad(40.0);
+  in.aoi_rad = DegToRad(100.0);
+  const PoaComponents behind = TransposeIsotropicSky(in);
+  EXPECT_EQ(behind.beam_w_m2, 0.0);
+  EXPECT_GT(behind.sky_diffuse_w_m2, 0.0);
+}
+
+TEST(Irradiance, DiffuseAboveGlobalAndNegativeValuesAreClipped) {
+  IsotropicSkyInput in = ClearNoon();
+  in.ghi_w_m2 = 100.0;
+  in.dhi_w_m2 = 104.0;
+  EXPECT_EQ(TransposeIsotropicSky(in).beam_w_m2, 0.0);
+  in.ghi_w_m2 = -3.0;
+  in.dhi_w_m2 = -2.0;
+  const PoaComponents night = TransposeIsotropicSky(in);
+  EXPECT_EQ(night.global_w_m2(), 0.0);
+  in.ghi_w_m2 = std::nan("");
+  EXPECT_TRUE(std::isnan(TransposeIsotropicSky(in).global_w_m2()));
+}
+
+// Hand values: β = 45°: θ_sky = 59.68 − 0.1388·45 + 0.001497·2025
+// = 59.68 − 6.246 + 3.031425 = 56.465425°; θ_gnd = 90 − 0.5788·45 +
+// 0.002693·2025 = 90 − 26.046 + 5.453325 = 69.407325°. β = 90°: θ_sky =
+// 59.68 − 12.492 + 12.1257 = 59.3137°, θ_gnd = 90 − 52.092 + 21.8133 =
+// 59.7213°. β = 0: 59.68° and 90°.
+TEST(Irradiance, BrandemuehlBeckmanPublishedValues) {
+  const EffectiveDiffuseAngles at45 = BrandemuehlBeckmanAngles(DegToRad(45.0));
+  EXPECT_NEAR(RadToDeg(at45.sky_rad), 56.465425, 1e-9);
+  EXPECT_NEAR(RadToDeg(at45.ground_rad), 69.407325, 1e-9);
+  const EffectiveDiffuseAngles at90 = BrandemuehlBeckmanAngles(DegToRad(90.0));
+  EXPECT_NEAR(RadToDeg(at90.sky_rad), 59.3137, 1e-9);
+  EXPECT_NEAR(RadToDeg(at90.ground_rad), 59.7213, 1e-9);
+  const EffectiveDiffuseAngles at0 = BrandemuehlBeckmanAngles(0.0);
+  EXPECT_NEAR(RadToDeg(at0.sky_rad), 59.68, 1e-12);
+  EXPECT_NEAR(RadToDeg(at0.ground_rad), 90.0, 1e-12);
+}
+
+// 900 W/m² global and 200 W/m² diffuse in a 30° plane, GHI 850 W/m²:
+// I_dgd = 0.2·(1 − cos 30°)/2·850 = 0.2·0.0669873·850 = 11.38784 W/m².
+TEST(Irradiance, SplitMeasuredPoaWithInPlaneDiffuse) {
+  MeasuredPoaInput in;
+  in.g_poa_w_m2 = 900.0;
+  in.g_poa_diffuse_w_m2 = 200.0;
+  in.ghi_w_m2 = 850.0;
+  in.tilt_rad = DegToRad(30.0);
+  in.ground_albedo = 0.2;
+  const PoaComponents poa = SplitMeasuredPoa(in);
+  EXPECT_NEAR(poa.beam_w_m2, 700.0, 1e-9);
+  EXPECT_NEAR(poa.ground_diffuse_w_m2, 11.387841, 1e-6);
+  EXPECT_NEAR(poa.sky_diffuse_w_m2, 200.0 - 11.387841, 1e-6);
+  EXPECT_NEAR(poa.global_w_m2(), 900.0, 1e-9);
+
+  // Without GHI the in-plane global stands in: 0.2·0.0669873·900 = 12.05771.
+  in.ghi_w_m2 = std::nan("");
+  EXPECT_NEAR(SplitMeasuredPoa(in).ground_diffuse_w_m2, 12.057714, 1e-6);
+}
+
+TEST(Irradiance, SplitMeasuredPoaFallsBackToAllBeamWithoutDiffuse) {
+  MeasuredPoaInput in;
+  in.g_poa_w_m2 = 640.0;
+  in.ghi_w_m2 = 600.0;
+  in.tilt_rad = DegToRad(20.0);
+  const PoaComponents poa = SplitMeasuredPoa(in);
+  EXPECT_EQ(poa.beam_w_m2, 640.0);
+  EXPECT_EQ(poa.sky_diffuse_w_m2, 0.0);
+  EXPECT_EQ(poa.ground_diffuse_w_m2, 0.0);
+}
+
+TEST(Irradiance, SplitMeasuredPoaKeepsPartsNonNegativeAndSummingToGlobal) {
+  MeasuredPoaInput in;
+  in.tilt_rad = DegToRad(60.0);
+  in.ground_albedo = 0.8;  // snow
+  in.ghi_w_m2 = 500.0;
+  // Ground estimate 0.8·0.25·500 = 100 W/m² exceeds the measured diffuse.
+  in.g_poa_w_m2 = 400.0;
+  in.g_poa_diffuse_w_m2 = 60.0;
+  PoaComponents poa = SplitMeasuredPoa(in);
+  EXPECT_NEAR(poa.ground_diffuse_w_m2, 60.0, 1e-12);
+  EXPECT_EQ(poa.sky_diffuse_w_m2, 0.0);
+  EXPECT_NEAR(poa.global_w_m2(), 400.0, 1e-9);
+  // Diffuse reading above global (sensor mismatch): no beam.
+  in.g_poa_diffuse_w_m2 = 420.0;
+  poa = SplitMeasuredPoa(in);
+  EXPECT_EQ(poa.beam_w_m2, 0.0);
+  EXPECT_NEAR(poa.global_w_m2(), 400.0, 1e-9);
+  // Night offset.
+  in.g_poa_w_m2 = -2.0;
+  in.g_poa_diffuse_w_m2 = -1.0;
+  EXPECT_EQ(SplitMeasuredPoa(in).global_w_m2(), 0.0);
+  in.g_poa_w_m2 = std::nan("");
+  EXPECT_TRUE(std::isnan(SplitMeasuredPoa(in).beam_w_m2));
+}
+
+// Transposing GHI/DHI and splitting the resulting in-plane global with its
+// in-plane diffuse gives the same parts back.
+TEST(Irradiance, SplitInvertsTransposition) {
+  IsotropicSkyInput sky = ClearNoon();
+  sky.tilt_rad = DegToRad(35.0);
+  sky.aoi_rad = DegToRad(12.0);
+  const PoaComponents forward = TransposeIsotropicSky(sky);
+  MeasuredPoaInput measured;
+  measured.g_poa_w_m2 = forward.global_w_m2();
+  measured.g_poa_diffuse_w_m2 = forward.sky_diffuse_w_m2 + forward.ground_diffuse_w_m2;
+  measured.ghi_w_m2 = sky.ghi_w_m2;
+  measured.tilt_rad = sky.tilt_rad;
+  measured.ground_albedo = sky.ground_albedo;
+  const PoaComponents back = SplitMeasuredPoa(measured);
+  EXPECT_NEAR(back.beam_w_m2, forward.beam_w_m2, 1e-9);
+  EXPECT_NEAR(back.sky_diffuse_w_m2, forward.sky_diffuse_w_m2, 1e-9);
+  EXPECT_NEAR(back.ground_diffuse_w_m2, forward.ground_diffuse_w_m2, 1e-9);
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -1,0 +1,31 @@
+// Wind dependence of the front heat-loss coefficient.
+#pragma once
+
+#include <cmath>
+
+namespace pvtwin {
+
+// v^n for v ≥ 0 from a precomputed ln(v) (−inf for calm), so that the hot loop
+// pays one exp() instead of a pow().
+inline double WindPower(double ln_wind, double n_wind) { return std::exp(n_wind * ln_wind); }
+
+// Paper eq. 2.8, as printed (variant letter 'w'):
+//   U_front,w = 1 / (1/U_front + r_refwind·v^n_wind)
+// U in W/(m²K), v = wind speed (m/s), r_refwind in (m²K/W)/(m/s)^n.
+// Note: this form makes the front loss FALL as wind rises, the opposite of
+// forced convection; it is kept so that the paper's variants reproduce the
+// paper. Use FrontConductanceConvective (effect "wind") for the physical form.
+inline double FrontConductancePaperWM2K(double u_front_w_m2k, double r_refwind,
+                                        double wind_pow) {
+  return 1.0 / (1.0 / u_front_w_m2k + r_refwind * wind_pow);
+}
+
+// Physical form (effect "wind", after ISO 9806's c3·u term):
+//   U_front,w = U_front + c_wind·v^n_wind
+// c_wind = u_wind_w_m2k in W/(m²K)/(m/s)^n; loss grows with wind speed.
+inline double FrontConductanceConvectiveWM2K(double u_front_w_m2k, double u_wind_w_m2k,
+                                             double wind_pow) {
+  return u_front_w_m2k + u_wind_w_m2k * wind_pow;
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,55 @@
+#include "daemon/inputs.h"
+
+#include <iostream>
+
+#include "io/csv.h"
+#include "io/time_format.h"
+
+namespace pvtwin::cli {
+
+namespace {
+void Report(const Diagnostics& diagnostics) {
+  for (const Diagnostic& d : diagnostics) std::cerr << d.ToString() << "\n";
+}
+}  // namespace
+
+bool LoadConfigOrReport(const std::string& path, Config* config) {
+  Diagnostics errors;
+  if (LoadConfig(path, config, &errors)) return true;
+  Report(errors);
+  return false;
+}
+
+bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series) {
+  Diagnostics errors, warnings;
+  CsvReadOptions options;
+  options.fluid_density_kg_m3 = config.plant.fluid_density_kg_m3;
+  const bool ok = ReadCanonicalCsv(path, options, series, &errors, &warnings);
+  for (const Diagnostic& w : warnings) std::cerr << "warning: " << w.ToString() << "\n";
+  Report(errors);
+  return ok;
+}
+
+bool ParseVariantOrReport(const std::string& name, ModelSpec* spec) {
+  std::string error;
+  if (ParseVariant(name, spec, &error)) return true;
+  std::cerr << "--variant = " << name << ": " << error << "\n";
+  return false;
+}
+
+bool PrepareDriversOrReport(const Series& series, const std::string& csv_path,
+                            const Config& config, const ModelSpec& spec, Drivers* drivers) {
+  std::string error;
+  if (PrepareDrivers(series, config.plant, spec, drivers, &error)) return true;
+  std::cerr << csv_path << ": " << error << "\n";
+  return false;
+}
+
+bool ParseTimeOrReport(const std::string& option, const std::string& text, std::int64_t* unix_s) {
+  std::string error;
+  if (ParseTime(text, unix_s, &error)) return true;
+  std::cerr << option << " = " << text << ": " << error << "\n";
+  return false;
+}
+
+}  // namespace pvtwin::cli

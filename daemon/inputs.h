@@ -1,0 +1,26 @@
+// Loading of the inputs shared by the data-driven subcommands (simulate,
+// calibrate, backtest): config, CSV, variant. Each loader prints every problem
+// to stderr as "file:line: field = value: rule" and returns false, and the
+// caller exits with code 2.
+#pragma once
+
+#include <string>
+
+#include "config/plant_config.h"
+#include "core/series.h"
+#include "core/thermal_model.h"
+#include "core/variant.h"
+
+namespace pvtwin::cli {
+
+bool LoadConfigOrReport(const std::string& path, Config* config);
+bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series);
+bool ParseVariantOrReport(const std::string& name, ModelSpec* spec);
+// Drivers of `spec` for `series`; reports the missing columns naming the CSV.
+bool PrepareDriversOrReport(const Series& series, const std::string& csv_path,
+                            const Config& config, const ModelSpec& spec, Drivers* drivers);
+
+// Parses a time given on the command line (ISO 8601 or unix seconds).
+bool ParseTimeOrReport(const std::string& option, const std::string& text, std::int64_t* unix_s);
+
+}  // namespace pvtwin::cli

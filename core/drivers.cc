@@ -58,8 +58,7 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
   out.usable.assign(n, 1);
   out.restart[0] = 1;
   for (std::size_t i = 0; i < n; ++i) {
-    const double to_next =
-        i + 1 < n ? static_cast<double>(s.time_s[i + 1] - s.time_s[i]) : step_s;
+    const double to_next = i + 1 < n ? static_cast<double>(s.time_s[i + 1] - s.time_s[i]) : step_s;
     if (to_next > max_gap_s) {
       out.dt_s[i] = step_s;
       if (i + 1 < n) out.restart[i + 1] = 1;
@@ -77,6 +76,11 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
     if (std::isnan(out.t_back_c[i])) out.t_back_c[i] = out.t_amb_c[i];
     // Paper Table 1: small negative flows mean no flow.
     if (out.mdot_kg_s[i] < 0.0) out.mdot_kg_s[i] = 0.0;
+  }
+
+  out.capacity_flow_w_k.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.capacity_flow_w_k[i] = out.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
   }
 
   ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2);
@@ -103,12 +107,15 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
-    const double inputs[] = {out.t_in_c[i],     out.mdot_kg_s[i], out.t_amb_c[i],
-                             out.t_back_c[i],   out.g_poa_w_m2[i], out.g_abs_w_m2[i],
-                             out.ln_wind[i] == -std::numeric_limits<double>::infinity()
-                                 ? 0.0
-                                 : out.ln_wind[i],
-                             out.t_sky_k4[i]};
+    const double inputs[] = {
+        out.t_in_c[i],
+        out.mdot_kg_s[i],
+        out.t_amb_c[i],
+        out.t_back_c[i],
+        out.g_poa_w_m2[i],
+        out.g_abs_w_m2[i],
+        out.ln_wind[i] == -std::numeric_limits<double>::infinity() ? 0.0 : out.ln_wind[i],
+        out.t_sky_k4[i]};
     out.usable[i] = std::all_of(std::begin(inputs), std::end(inputs),
                                 [](double v) { return std::isfinite(v); });
   }

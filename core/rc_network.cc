@@ -4,15 +4,26 @@
 
 namespace pvtwin {
 
-double ExpPhi1(double x) {
-  if (std::fabs(x) < 1e-8) return 1.0 - 0.5 * x;
-  return -std::expm1(-x) / x;
+namespace {
+
+struct Phi {
+  double phi1;  // (1 − e^(−x))/x
+  double phi2;  // (x − 1 + e^(−x))/x²
+};
+
+// Both φ functions from one expm1; Taylor series near 0 where the closed
+// forms cancel.
+Phi ExpPhis(double x) {
+  if (std::fabs(x) < 1e-3) {
+    return {1.0 - x / 2.0 + x * x / 6.0 - x * x * x / 24.0,
+            0.5 - x / 6.0 + x * x / 24.0 - x * x * x / 120.0};
+  }
+  const double em1 = std::expm1(-x);
+  const double inv_x = 1.0 / x;
+  return {-em1 * inv_x, (x + em1) * inv_x * inv_x};
 }
 
-double ExpPhi2(double x) {
-  if (std::fabs(x) < 1e-3) return 0.5 - x / 6.0 + x * x / 24.0 - x * x * x / 120.0;
-  return (x + std::expm1(-x)) / (x * x);
-}
+}  // namespace
 
 namespace {
 
@@ -20,10 +31,11 @@ namespace {
 //   T(dt) = T0 + (S − G·T0)·dt/C·φ1(G·dt/C),   mean = T0 + (S − G·T0)·dt/C·φ2(·)
 void AdvanceOne(double c, double g, double s, double t0, double dt_s, double* t_end,
                 double* t_mean) {
-  const double rate = (s - g * t0) * dt_s / c;
-  const double x = g * dt_s / c;
-  *t_end = t0 + rate * ExpPhi1(x);
-  *t_mean = t0 + rate * ExpPhi2(x);
+  const double dt_over_c = dt_s / c;
+  const double rate = (s - g * t0) * dt_over_c;
+  const Phi phi = ExpPhis(g * dt_over_c);
+  *t_end = t0 + rate * phi.phi1;
+  *t_mean = t0 + rate * phi.phi2;
 }
 
 // Two capacitive nodes. With y = C^(1/2)·T the system matrix becomes the
@@ -51,10 +63,12 @@ void AdvanceTwo(const RcNetwork& net, const double t0[2], double dt_s, RcStepRes
   const double f1 = (net.node[1].source_w - k11 * t0[1] + g * t0[0]) * sc1;
   const double fa = c * f0 + s * f1;
   const double fb = -s * f0 + c * f1;
-  const double end_a = fa * dt_s * ExpPhi1(lambda_a * dt_s);
-  const double end_b = fb * dt_s * ExpPhi1(lambda_b * dt_s);
-  const double mean_a = fa * dt_s * ExpPhi2(lambda_a * dt_s);
-  const double mean_b = fb * dt_s * ExpPhi2(lambda_b * dt_s);
+  const Phi phi_a = ExpPhis(lambda_a * dt_s);
+  const Phi phi_b = ExpPhis(lambda_b * dt_s);
+  const double end_a = fa * dt_s * phi_a.phi1;
+  const double end_b = fb * dt_s * phi_b.phi1;
+  const double mean_a = fa * dt_s * phi_a.phi2;
+  const double mean_b = fb * dt_s * phi_b.phi2;
   r->t_end_c[0] = t0[0] + (c * end_a - s * end_b) * sc0;
   r->t_end_c[1] = t0[1] + (s * end_a + c * end_b) * sc1;
   r->t_mean_c[0] = t0[0] + (c * mean_a - s * mean_b) * sc0;
@@ -89,13 +103,13 @@ RcStepResult AdvanceRc(const RcNetwork& net, const double t_start_c[2], double d
   const int a = cap0 ? 1 : 0;
   const int b = 1 - a;
   const double g = net.coupling_w_k;
-  const double denom_a = net.node[a].conductance_w_k + g;
-  const double s_red = net.node[b].source_w + g * net.node[a].source_w / denom_a;
-  const double g_red = net.node[b].conductance_w_k + g * net.node[a].conductance_w_k / denom_a;
+  const double inv_denom_a = 1.0 / (net.node[a].conductance_w_k + g);
+  const double s_red = net.node[b].source_w + g * net.node[a].source_w * inv_denom_a;
+  const double g_red = net.node[b].conductance_w_k + g * net.node[a].conductance_w_k * inv_denom_a;
   AdvanceOne(net.node[b].capacitance_j_k, g_red, s_red, t_start_c[b], dt_s, &r.t_end_c[b],
              &r.t_mean_c[b]);
-  r.t_end_c[a] = (net.node[a].source_w + g * r.t_end_c[b]) / denom_a;
-  r.t_mean_c[a] = (net.node[a].source_w + g * r.t_mean_c[b]) / denom_a;
+  r.t_end_c[a] = (net.node[a].source_w + g * r.t_end_c[b]) * inv_denom_a;
+  r.t_mean_c[a] = (net.node[a].source_w + g * r.t_mean_c[b]) * inv_denom_a;
   return r;
 }
 

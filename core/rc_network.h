@@ -44,8 +44,4 @@ RcStepResult AdvanceRc(const RcNetwork& net, const double t_start_c[2], double d
 // initial node temperatures.
 RcStepResult SteadyRc(const RcNetwork& net);
 
-// (1 − e^(−x))/x and (x − 1 + e^(−x))/x², continuous through x = 0.
-double ExpPhi1(double x);
-double ExpPhi2(double x);
-
 }  // namespace pvtwin

@@ -33,7 +33,8 @@ struct RunConstants {
   double u_wind_w_m2k;
   double n_wind;
   double eps_pvt;
-  double r0_fluid_m2k_w;
+  double r0_fluid_per_area;  // r0_fluid / A_PVT
+  double r_front_m2k_w;      // 1 / U_front
   double r1_fluid;
   double fluid_cp_j_kgk;
   bool wind_paper;
@@ -58,7 +59,8 @@ RunConstants MakeConstants(const Drivers& d, const ParamVector& p) {
   k.u_wind_w_m2k = P(p, Param::kUWindWM2K);
   k.n_wind = P(p, Param::kNWind);
   k.eps_pvt = spec.sky ? P(p, Param::kEpsPvt) : 0.0;
-  k.r0_fluid_m2k_w = P(p, Param::kR0FluidM2KW);
+  k.r0_fluid_per_area = P(p, Param::kR0FluidM2KW) / k.area_m2;
+  k.r_front_m2k_w = 1.0 / k.u_front_w_m2k;
   k.r1_fluid = P(p, Param::kR1Fluid);
   k.fluid_cp_j_kgk = d.plant.fluid_cp_j_kgk;
   k.wind_paper = spec.wind_paper;
@@ -82,15 +84,14 @@ RowTerms MakeRowTerms(const RunConstants& k, const Drivers& d, std::size_t i) {
   RowTerms r;
   double u_front = k.u_front_w_m2k;
   if (k.wind_paper) {
-    u_front = FrontConductancePaperWM2K(u_front, k.r_refwind, WindPower(d.ln_wind[i], k.n_wind));
+    u_front =
+        FrontConductancePaperWM2K(k.r_front_m2k_w, k.r_refwind, WindPower(d.ln_wind[i], k.n_wind));
   } else if (k.wind_convective) {
     u_front =
         FrontConductanceConvectiveWM2K(u_front, k.u_wind_w_m2k, WindPower(d.ln_wind[i], k.n_wind));
   }
   r.g_front_w_k = u_front * k.area_m2;
-  r.g_fluid_w_k = UFluidWM2K(d.mdot_kg_s[i], k.fluid_cp_j_kgk, k.area_m2, k.r0_fluid_m2k_w,
-                             k.r1_fluid) *
-                  k.area_m2;
+  r.g_fluid_w_k = GFluidWK(d.capacity_flow_w_k[i], k.r0_fluid_per_area, k.r1_fluid);
   r.q_sun_w = k.f_th * k.area_m2 * d.g_abs_w_m2[i];
   r.eta = PvEfficiencyAt(k.pv, d.g_poa_w_m2[i]);
   r.t_amb_c = d.t_amb_c[i];
@@ -151,9 +152,10 @@ Linearised Linearise(const RunConstants& k, const RowTerms& r, double t_lin_c) {
   return l;
 }
 
-// Temperature error that the linearisation leaves at T_PV = t_pv_c.
-double LinearisationErrorK(const RunConstants& k, const RowTerms& r, const Linearised& l,
-                           double t_pv_c) {
+// True when the flux error that the linearisation leaves at T_PV = t_pv_c
+// moves the PV node by less than kNodeToleranceK (error / own conductance).
+bool LinearisationConverged(const RunConstants& k, const RowTerms& r, const Linearised& l,
+                            double t_pv_c) {
   const double dt = t_pv_c - l.t_lin_c;
   double flux_error_w = 0.0;
   if (k.sky) {
@@ -161,7 +163,7 @@ double LinearisationErrorK(const RunConstants& k, const RowTerms& r, const Linea
     flux_error_w += SkyLossW(k, r, t_pv_c, &unused) - (l.q_rad_lin_w + l.dq_rad_w_k * dt);
   }
   flux_error_w -= r.q_sun_w * (1.0 - r.eta.At(t_pv_c)) - (l.q_abs_lin_w + l.dq_abs_w_k * dt);
-  return std::fabs(flux_error_w) / std::fmax(l.g_pv_own_w_k, 1e-12);
+  return std::fabs(flux_error_w) < kNodeToleranceK * l.g_pv_own_w_k;
 }
 
 // Solves one row: the steady state when `steady`, else one step from `start`.
@@ -175,7 +177,7 @@ Linearised SolveRow(const RunConstants& k, const RowTerms& r, const double start
     l = Linearise(k, r, t_lin);
     *result = steady ? SteadyRc(l.net) : AdvanceRc(l.net, start, dt_s);
     const double t_pv = result->t_mean_c[0];
-    if (!std::isfinite(t_pv) || LinearisationErrorK(k, r, l, t_pv) < kNodeToleranceK) break;
+    if (!std::isfinite(t_pv) || LinearisationConverged(k, r, l, t_pv)) break;
     t_lin = t_pv;
   }
   return l;
@@ -184,8 +186,8 @@ Linearised SolveRow(const RunConstants& k, const RowTerms& r, const double start
 void SetRowNaN(SimOutputs* out, std::size_t i, bool energy) {
   out->p_el_w[i] = out->q_th_w[i] = out->t_pv_c[i] = out->t_coll_c[i] = out->t_out_c[i] = kNaN;
   if (energy) {
-    out->q_abs_w[i] = out->q_front_w[i] = out->q_back_w[i] = out->q_rad_w[i] =
-        out->q_store_w[i] = kNaN;
+    out->q_abs_w[i] = out->q_front_w[i] = out->q_back_w[i] = out->q_rad_w[i] = out->q_store_w[i] =
+        kNaN;
   }
 }
 
@@ -222,14 +224,18 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
     v->resize(n);
   }
   if (energy) {
-    for (auto* v : {&out->q_abs_w, &out->q_front_w, &out->q_back_w, &out->q_rad_w,
-                    &out->q_store_w}) {
+    for (auto* v :
+         {&out->q_abs_w, &out->q_front_w, &out->q_back_w, &out->q_rad_w, &out->q_store_w}) {
       v->resize(n);
     }
   }
   const RunConstants k = MakeConstants(d, params);
   double state[2] = {0.0, 0.0};  // node temperatures at the start of the row
-  double t_pv_prev = kNaN;       // last step-mean PV temperature (linearisation guess)
+  // Step-mean PV temperatures of the last two rows: their linear
+  // extrapolation is the first linearisation point, which usually meets the
+  // tolerance in one pass.
+  double t_pv_prev = kNaN;
+  double t_pv_prev2 = kNaN;
   bool need_restart = true;
   for (std::size_t i = 0; i < n; ++i) {
     if (!d.usable[i]) {
@@ -244,15 +250,17 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
       SolveRow(k, r, state, 0.0, /*steady=*/true, r.t_amb_c, &res);
       state[0] = res.t_end_c[0];
       state[1] = res.t_end_c[1];
-      t_pv_prev = res.t_mean_c[0];
+      t_pv_prev = t_pv_prev2 = res.t_mean_c[0];
       need_restart = false;
     }
     const double start[2] = {state[0], state[1]};
-    const Linearised l = SolveRow(k, r, start, d.dt_s[i], /*steady=*/false, t_pv_prev, &res);
+    const double guess = 2.0 * t_pv_prev - t_pv_prev2;
+    const Linearised l = SolveRow(k, r, start, d.dt_s[i], /*steady=*/false, guess, &res);
     state[0] = res.t_end_c[0];
     state[1] = res.t_end_c[1];
     const double t_pv = res.t_mean_c[0];
     const double t_fluid_node = res.t_mean_c[k.fluid_node];
+    t_pv_prev2 = t_pv_prev;
     t_pv_prev = t_pv;
 
     const double q_u = r.g_fluid_w_k * (t_fluid_node - r.t_in_c);
@@ -261,9 +269,7 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
     out->q_th_w[i] = q_u;
     out->p_el_w[i] = r.eta.At(t_pv) * k.area_m2 * d.g_abs_w_m2[i];
     // Without flow the fluid rests in the collector at the node temperature.
-    out->t_out_c[i] = d.mdot_kg_s[i] > 0.0
-                          ? r.t_in_c + q_u / (d.mdot_kg_s[i] * k.fluid_cp_j_kgk)
-                          : t_fluid_node;
+    out->t_out_c[i] = d.mdot_kg_s[i] > 0.0 ? r.t_in_c + q_u / d.capacity_flow_w_k[i] : t_fluid_node;
     if (energy) {
       const double dev = t_pv - l.t_lin_c;
       out->q_abs_w[i] = l.q_abs_lin_w + l.dq_abs_w_k * dev;

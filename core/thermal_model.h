@@ -54,6 +54,7 @@ struct Drivers {
   std::vector<std::uint8_t> usable;  // 0: an input is missing, outputs are NaN
   std::vector<double> t_in_c;
   std::vector<double> mdot_kg_s;
+  std::vector<double> capacity_flow_w_k;  // ṁ·c_p
   std::vector<double> g_poa_w_m2;    // I_gt, global in plane (efficiency correction)
   std::vector<double> g_abs_w_m2;    // I_at, IAM-weighted in plane (= I_gt without 'I')
   std::vector<double> t_amb_c;

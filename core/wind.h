@@ -15,9 +15,10 @@ inline double WindPower(double ln_wind, double n_wind) { return std::exp(n_wind 
 // Note: this form makes the front loss FALL as wind rises, the opposite of
 // forced convection; it is kept so that the paper's variants reproduce the
 // paper. Use FrontConductanceConvective (effect "wind") for the physical form.
-inline double FrontConductancePaperWM2K(double u_front_w_m2k, double r_refwind,
-                                        double wind_pow) {
-  return 1.0 / (1.0 / u_front_w_m2k + r_refwind * wind_pow);
+// Takes the still-air resistance 1/U_front (m²K/W) so that a run can
+// precompute it.
+inline double FrontConductancePaperWM2K(double r_front_m2k_w, double r_refwind, double wind_pow) {
+  return 1.0 / (r_front_m2k_w + r_refwind * wind_pow);
 }
 
 // Physical form (effect "wind", after ISO 9806's c3·u term):

@@ -1,7 +1,107 @@
+// pvtwin bench: speed figures of the model and of identification, printed
+// as medians over repeated runs on synthetic data with a recorded seed.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <vector>
+
+#include "core/synthetic_plant.h"
+#include "core/thermal_model.h"
+#include "core/units.h"
+#include "daemon/bench.h"
 #include "daemon/commands.h"
 
 namespace pvtwin::cli {
 
-void RegisterBench(CLI::App& app) { (void)app; }
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Plant BenchPlant() {
+  Plant plant;  // DESIGN.md's example site: 47.358°N 16.128°E, 20° tilt, south
+  plant.latitude_rad = DegToRad(47.358);
+  plant.longitude_rad = DegToRad(16.128);
+  plant.tilt_rad = DegToRad(20.0);
+  plant.azimuth_rad = DegToRad(180.0);
+  return plant;
+}
+
+namespace {
+
+struct BenchArgs {
+  std::vector<std::string> what = {"sim"};
+  int repeats = 21;
+  std::uint64_t seed = 1;
+};
+
+// One 14-day, 1-min simulation (20 160 rows) of each variant.
+void BenchSimulation(const BenchArgs& a) {
+  const Plant plant = BenchPlant();
+  WeatherOptions weather;
+  weather.num_days = 14;
+  weather.step_s = 60.0;
+  weather.seed = a.seed;
+  const Series series = GenerateWeather(plant, weather);
+  std::printf("simulation: 14 days at 1 min (%zu rows), weather seed %llu, median of %d runs\n",
+              series.size(), static_cast<unsigned long long>(a.seed), a.repeats);
+  std::printf("  %-24s %12s %14s\n", "variant", "median (ms)", "per row (ns)");
+  std::vector<std::string> variants = PaperVariants();
+  variants.push_back("1N1Cwr+transport_delay");
+  for (const std::string& name : variants) {
+    ModelSpec spec;
+    std::string error;
+    ParseVariant(name, &spec, &error);
+    Drivers drivers;
+    if (!PrepareDrivers(series, plant, spec, &drivers, &error)) {
+      std::printf("  %-24s %s\n", name.c_str(), error.c_str());
+      continue;
+    }
+    const ParamVector params = ReferenceTruthParams(plant);
+    SimOutputs out;
+    Simulate(drivers, params, &out);  // warm-up, sizes the buffers
+    std::vector<double> times;
+    for (int r = 0; r < a.repeats; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      Simulate(drivers, params, &out);
+      times.push_back(SecondsSince(start));
+    }
+    const double median = Median(times);
+    std::printf("  %-24s %12.3f %14.1f\n", name.c_str(), median * 1e3,
+                median * 1e9 / static_cast<double>(series.size()));
+  }
+}
+
+}  // namespace
+
+void RegisterBench(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench",
+      "Print speed figures (medians over repeated runs, one core) on synthetic data:\n"
+      "  sim    one 14-day 1-min simulation of each variant\n"
+      "  ident  identification of 2N1Ccolwr: 14 days at 1 min and at 5 s, and the\n"
+      "         algorithm comparison behind the default\n"
+      "  table6 the paper's Table 6 protocol (9 variants x 29 test days) on both cores");
+  cmd->add_option("what", args->what, "what to benchmark: sim, ident, table6")
+      ->check(CLI::IsMember({"sim", "ident", "table6"}));
+  cmd->add_option("--repeats", args->repeats, "runs per figure (median)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
+  cmd->callback([args] {
+    for (const std::string& w : args->what) {
+      if (w == "sim") BenchSimulation(*args);
+      if (w == "ident") BenchIdentification(args->repeats, args->seed);
+      if (w == "table6") BenchTable6(args->seed);
+    }
+    SetExitCode(kExitOk);
+  });
+}
 
 }  // namespace pvtwin::cli

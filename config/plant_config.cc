@@ -1,1 +1,394 @@
-#include "core/plant.h"
+#include "config/plant_config.h"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cassert>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "core/units.h"
+
+namespace pvtwin {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Shortest text that reads back as x.
+std::string FormatNumber(double x) {
+  char buf[32];
+  const auto result = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, result.ptr);
+}
+
+// The allowed values of a number: an interval whose ends are open or closed;
+// an infinite end means no bound on that side.
+struct Interval {
+  double lo = -kInf;
+  bool lo_closed = true;
+  double hi = kInf;
+  bool hi_closed = true;
+
+  bool Contains(double x) const {
+    if (!std::isfinite(x)) return false;
+    const bool above_lo = lo_closed ? x >= lo : x > lo;
+    const bool below_hi = hi_closed ? x <= hi : x < hi;
+    return above_lo && below_hi;
+  }
+
+  std::string Rule() const {
+    if (std::isinf(hi)) return (lo_closed ? "must be >= " : "must be > ") + FormatNumber(lo);
+    return std::string("must be within ") + (lo_closed ? "[" : "(") + FormatNumber(lo) + ", " +
+           FormatNumber(hi) + (hi_closed ? "]" : ")");
+  }
+};
+
+constexpr Interval Closed(double lo, double hi) { return {lo, true, hi, true}; }
+constexpr Interval HalfOpen(double lo, double hi) { return {lo, true, hi, false}; }
+constexpr Interval LeftOpen(double lo, double hi) { return {lo, false, hi, true}; }
+constexpr Interval Above(double lo) { return {lo, false, kInf, true}; }
+constexpr Interval AtLeast(double lo) { return {lo, true, kInf, true}; }
+
+// The config text split into lines, to quote values as they were written.
+class SourceText {
+ public:
+  explicit SourceText(std::string_view text) {
+    std::size_t start = 0;
+    while (start <= text.size()) {
+      std::size_t end = text.find('\n', start);
+      if (end == std::string_view::npos) end = text.size();
+      std::string_view line = text.substr(start, end - start);
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      lines_.push_back(line);
+      start = end + 1;
+    }
+  }
+
+  // The node's text as written when it sits on one line; empty otherwise.
+  std::string Quote(const toml::source_region& region) const {
+    if (region.begin.line == 0 || region.begin.line != region.end.line ||
+        region.begin.line > lines_.size()) {
+      return "";
+    }
+    const std::string_view line = lines_[region.begin.line - 1];
+    const std::size_t begin = ByteOffset(line, region.begin.column);
+    const std::size_t end = ByteOffset(line, region.end.column);
+    if (begin >= end) return "";
+    return std::string(line.substr(begin, end - begin));
+  }
+
+ private:
+  // toml++ counts columns in code points, from 1.
+  static std::size_t ByteOffset(std::string_view line, std::size_t column) {
+    std::size_t offset = 0;
+    for (std::size_t cp = 1; cp < column && offset < line.size(); ++cp) {
+      ++offset;
+      while (offset < line.size() && (static_cast<unsigned char>(line[offset]) & 0xC0) == 0x80) {
+        ++offset;
+      }
+    }
+    return offset;
+  }
+
+  std::vector<std::string_view> lines_;
+};
+
+// Reads the keys of one table, records which were seen, and reports each
+// problem as a Diagnostic at the line of the offending value.
+class SectionReader {
+ public:
+  SectionReader(const toml::table& table, const SourceText& source, const std::string& file,
+                Diagnostics* errors)
+      : table_(table), source_(source), file_(file), errors_(errors) {}
+
+  // Reads a number (TOML integer or float) into *out. Returns true if a valid
+  // value was stored; a missing optional key leaves *out untouched.
+  bool Number(std::string_view key, bool required, const Interval& range, double* out) {
+    const toml::node* node = Find(key, required);
+    if (node == nullptr) return false;
+    double value = 0.0;
+    if (const auto* i = node->as_integer()) {
+      value = static_cast<double>(i->get());
+    } else if (const auto* f = node->as_floating_point()) {
+      value = f->get();
+    } else {
+      Report(key, *node, "expected a number");
+      return false;
+    }
+    if (!std::isfinite(value)) {
+      Report(key, *node, "must be a finite number");
+      return false;
+    }
+    if (!range.Contains(value)) {
+      Report(key, *node, range.Rule());
+      return false;
+    }
+    *out = value;
+    return true;
+  }
+
+  // Reads a TOML integer into *out (floats are rejected).
+  bool Integer(std::string_view key, bool required, const Interval& range, int* out) {
+    const toml::node* node = Find(key, required);
+    if (node == nullptr) return false;
+    const auto* i = node->as_integer();
+    if (i == nullptr) {
+      Report(key, *node, "expected an integer");
+      return false;
+    }
+    const std::int64_t value = i->get();
+    if (!range.Contains(static_cast<double>(value))) {
+      Report(key, *node, range.Rule());
+      return false;
+    }
+    if (value > std::numeric_limits<int>::max() || value < std::numeric_limits<int>::min()) {
+      Report(key, *node, "too large");
+      return false;
+    }
+    *out = static_cast<int>(value);
+    return true;
+  }
+
+  // Reads a non-empty string into *out.
+  bool String(std::string_view key, bool required, std::string* out,
+              std::string_view type_rule = "expected a string") {
+    const toml::node* node = Find(key, required);
+    if (node == nullptr) return false;
+    const auto* s = node->as_string();
+    if (s == nullptr) {
+      Report(key, *node, type_rule);
+      return false;
+    }
+    if (s->get().empty()) {
+      Report(key, *node, "must not be empty");
+      return false;
+    }
+    *out = s->get();
+    return true;
+  }
+
+  // Reports a value that was read but breaks a rule only its caller knows.
+  void Reject(std::string_view key, std::string_view rule) {
+    if (const toml::node* node = table_.get(key)) Report(key, *node, rule);
+  }
+
+  // One "unknown key" error for every key no reader asked for.
+  void ReportUnknownKeys() {
+    for (const auto& [key, node] : table_) {
+      if (std::find(seen_.begin(), seen_.end(), key.str()) == seen_.end()) {
+        Report(key.str(), node, "unknown key");
+      }
+    }
+  }
+
+ private:
+  const toml::node* Find(std::string_view key, bool required) {
+    seen_.emplace_back(key);
+    const toml::node* node = table_.get(key);
+    if (node == nullptr && required) {
+      errors_->push_back({file_, static_cast<int>(table_.source().begin.line), std::string(key), "",
+                          "required key missing"});
+    }
+    return node;
+  }
+
+  void Report(std::string_view key, const toml::node& node, std::string_view rule) {
+    const std::string value = node.is_table() ? "" : source_.Quote(node.source());
+    errors_->push_back({file_, static_cast<int>(node.source().begin.line), std::string(key), value,
+                        std::string(rule)});
+  }
+
+  const toml::table& table_;
+  const SourceText& source_;
+  const std::string& file_;
+  Diagnostics* errors_;
+  std::vector<std::string> seen_;
+};
+
+constexpr bool kRequired = true;
+constexpr bool kOptional = false;
+
+// [plant]: one row per number key. Angles are converted to radians.
+struct PlantKey {
+  std::string_view key;
+  bool required;
+  Interval range;
+  double Plant::*member;
+  bool degrees;
+};
+
+constexpr PlantKey kPlantKeys[] = {
+    {"latitude_deg", kRequired, Closed(-90, 90), &Plant::latitude_rad, true},
+    {"longitude_deg", kRequired, Closed(-180, 180), &Plant::longitude_rad, true},
+    {"elevation_m", kOptional, Closed(-500, 9000), &Plant::elevation_m, false},
+    {"tilt_deg", kRequired, Closed(0, 90), &Plant::tilt_rad, true},
+    {"azimuth_deg", kRequired, HalfOpen(0, 360), &Plant::azimuth_rad, true},
+    {"area_m2", kRequired, Above(0), &Plant::area_m2, false},
+    {"fluid_cp_j_kgk", kOptional, Above(0), &Plant::fluid_cp_j_kgk, false},
+    {"fluid_density_kg_m3", kOptional, Above(0), &Plant::fluid_density_kg_m3, false},
+    {"ground_albedo", kOptional, Closed(0, 1), &Plant::ground_albedo, false},
+    {"iam_b0", kOptional, HalfOpen(0, 1), &Plant::iam_b0, false},
+    {"pv_t_ref_c", kOptional, Closed(-50, 100), &Plant::pv_t_ref_c, false},
+    {"pv_g_ref_w_m2", kOptional, Above(0), &Plant::pv_g_ref_w_m2, false},
+    {"pv_temp_coeff_per_k", kOptional, Closed(-0.02, 0.01), &Plant::pv_temp_coeff_per_k, false},
+    {"pv_irr_coeff_m2_w", kOptional, Closed(-1e-3, 1e-3), &Plant::pv_irr_coeff_m2_w, false},
+};
+
+void ReadPlant(SectionReader& r, Plant* plant) {
+  for (const PlantKey& k : kPlantKeys) {
+    double value = 0.0;
+    if (r.Number(k.key, k.required, k.range, &value)) {
+      plant->*k.member = k.degrees ? DegToRad(value) : value;
+    }
+  }
+}
+
+void ReadStorage(SectionReader& r, StorageConfig* storage) {
+  r.String("path", kOptional, &storage->path);
+  r.Integer("raw_retention_days", kOptional, AtLeast(1), &storage->raw_retention_days);
+}
+
+void ReadPoll(SectionReader& r, PollConfig* poll) {
+  r.Number("period_s", kOptional, Above(0), &poll->period_s);
+}
+
+// "HH:MM" with 00 <= HH <= 23 and 00 <= MM <= 59.
+bool IsClockTime(std::string_view s) {
+  const auto digit = [&](std::size_t i) { return s[i] >= '0' && s[i] <= '9'; };
+  if (s.size() != 5 || s[2] != ':' || !digit(0) || !digit(1) || !digit(3) || !digit(4)) {
+    return false;
+  }
+  const int hours = (s[0] - '0') * 10 + (s[1] - '0');
+  const int minutes = (s[3] - '0') * 10 + (s[4] - '0');
+  return hours <= 23 && minutes <= 59;
+}
+
+void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
+  // The variant grammar (paper Table 6 names plus "+effect") belongs to the
+  // model layer; here it only has to be a non-empty string.
+  r.String("variant", kOptional, &calibration->variant);
+  r.Integer("window_days", kOptional, Closed(1, 60), &calibration->window_days);
+  double step_s = calibration->step_s;
+  if (r.Number("step_s", kOptional, Closed(5, 900), &step_s)) {
+    if (step_s != std::floor(step_s) || std::fmod(86400.0, step_s) != 0.0) {
+      r.Reject("step_s", "must be a whole number of seconds that divides 86400");
+    } else {
+      calibration->step_s = step_s;
+    }
+  }
+  constexpr std::string_view kClockRule = "expected a local time \"HH:MM\" (00:00 to 23:59)";
+  std::string at;
+  if (r.String("at", kOptional, &at, kClockRule)) {
+    if (IsClockTime(at)) {
+      calibration->at = at;
+    } else {
+      r.Reject("at", kClockRule);
+    }
+  }
+  r.String("timezone", kOptional, &calibration->timezone);
+}
+
+void ReadForecast(SectionReader& r, ForecastConfig* forecast) {
+  r.Number("horizon_h", kOptional, LeftOpen(0, 168), &forecast->horizon_h);
+  r.Number("refresh_min", kOptional, Above(0), &forecast->refresh_min);
+}
+
+void ReadDocument(const toml::table& root, const SourceText& source, const std::string& file,
+                  Config* config, Diagnostics* errors) {
+  using SectionFn = void (*)(SectionReader&, Config*);
+  struct Section {
+    std::string_view name;
+    SectionFn read;
+  };
+  static constexpr Section kSections[] = {
+      {"plant", [](SectionReader& r, Config* c) { ReadPlant(r, &c->plant); }},
+      {"storage", [](SectionReader& r, Config* c) { ReadStorage(r, &c->storage); }},
+      {"poll", [](SectionReader& r, Config* c) { ReadPoll(r, &c->poll); }},
+      {"calibration", [](SectionReader& r, Config* c) { ReadCalibration(r, &c->calibration); }},
+      {"forecast", [](SectionReader& r, Config* c) { ReadForecast(r, &c->forecast); }},
+  };
+
+  if (!root.contains("plant")) {
+    errors->push_back({file, 0, "plant", "", "required section missing"});
+  }
+
+  for (const auto& [key, node] : root) {
+    const std::string_view name = key.str();
+    // [[modbus.device]] and [[modbus.point]] are the register map. Its schema
+    // (types, word orders, overlapping addresses) is validated where the map
+    // is parsed, in the Modbus layer under io/; here it passes unchecked.
+    if (name == "modbus") continue;
+    const auto* section = std::find_if(std::begin(kSections), std::end(kSections),
+                                       [&](const Section& s) { return s.name == name; });
+    const int line = static_cast<int>(node.source().begin.line);
+    if (section == std::end(kSections)) {
+      const std::string value = node.is_table() ? "" : source.Quote(node.source());
+      errors->push_back({file, line, std::string(name), value,
+                         node.is_table() ? "unknown section" : "unknown key"});
+      continue;
+    }
+    const toml::table* table = node.as_table();
+    if (table == nullptr) {
+      errors->push_back({file, line, std::string(name), source.Quote(node.source()),
+                         "expected a table ([" + std::string(name) + "])"});
+      continue;
+    }
+    SectionReader reader(*table, source, file, errors);
+    section->read(reader, config);
+    reader.ReportUnknownKeys();
+  }
+}
+
+}  // namespace
+
+bool ParseConfig(std::string_view toml_text, const std::string& path_for_messages, Config* out,
+                 Diagnostics* errors) {
+  assert(out != nullptr && errors != nullptr);
+  Diagnostics found;
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, std::string_view(path_for_messages));
+  } catch (const toml::parse_error& e) {
+    const toml::source_position where = e.source().begin;
+    errors->push_back({path_for_messages, static_cast<int>(where.line), "", "",
+                       "TOML syntax error at column " + std::to_string(where.column) + ": " +
+                           std::string(e.description())});
+    return false;
+  }
+  Config config;
+  config.source_path = path_for_messages;
+  ReadDocument(root, SourceText(toml_text), path_for_messages, &config, &found);
+  // toml++ keeps keys sorted by name; report in file order instead.
+  std::stable_sort(found.begin(), found.end(),
+                   [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });
+  if (!found.empty()) {
+    errors->insert(errors->end(), found.begin(), found.end());
+    return false;
+  }
+  *out = std::move(config);
+  return true;
+}
+
+bool LoadConfig(const std::string& path, Config* out, Diagnostics* errors) {
+  assert(out != nullptr && errors != nullptr);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    errors->push_back({path, 0, "", "", std::string("cannot open: ") + std::strerror(errno)});
+    return false;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    errors->push_back({path, 0, "", "", "read error"});
+    return false;
+  }
+  return ParseConfig(text.str(), path, out, errors);
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,149 @@
+// Config values: units converted at the edge, defaults as documented, the
+// shipped examples and error handling that golden folders cannot express.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "config/plant_config.h"
+#include "core/units.h"
+
+namespace pvtwin {
+namespace {
+
+const std::string kGoldenConfigDir = std::string(PVTWIN_GOLDEN_DIR) + "/config/";
+const std::string kExamplesDir = std::string(PVTWIN_GOLDEN_DIR) + "/../../config/examples/";
+
+constexpr char kMinimalPlant[] =
+    "[plant]\nlatitude_deg = 47.358\nlongitude_deg = 16.128\ntilt_deg = 20\n"
+    "azimuth_deg = 180\narea_m2 = 1.8\n";
+
+TEST(ConfigLoad, FullConfigValuesAreReadAndAnglesConvertedToRadians) {
+  const std::string path = kGoldenConfigDir + "ok_full/config.toml";
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(LoadConfig(path, &config, &errors)) << errors.front().ToString();
+  const Plant& p = config.plant;
+  EXPECT_DOUBLE_EQ(p.latitude_rad, DegToRad(-33.9));
+  EXPECT_DOUBLE_EQ(p.longitude_rad, DegToRad(-70.6));
+  EXPECT_DOUBLE_EQ(p.elevation_m, 520);
+  EXPECT_DOUBLE_EQ(p.tilt_rad, DegToRad(35));
+  EXPECT_DOUBLE_EQ(p.azimuth_rad, 0.0);
+  EXPECT_DOUBLE_EQ(p.area_m2, 16.2);
+  EXPECT_DOUBLE_EQ(p.fluid_cp_j_kgk, 3800);
+  EXPECT_DOUBLE_EQ(p.fluid_density_kg_m3, 1030);
+  EXPECT_DOUBLE_EQ(p.ground_albedo, 0.25);
+  EXPECT_DOUBLE_EQ(p.iam_b0, 0.1);
+  EXPECT_DOUBLE_EQ(p.pv_t_ref_c, 25);
+  EXPECT_DOUBLE_EQ(p.pv_g_ref_w_m2, 1000);
+  EXPECT_DOUBLE_EQ(p.pv_temp_coeff_per_k, -0.0041);
+  EXPECT_DOUBLE_EQ(p.pv_irr_coeff_m2_w, 3.6e-5);
+  EXPECT_EQ(config.storage.path, "/srv/pvtwin/field.db");
+  EXPECT_EQ(config.storage.raw_retention_days, 7);
+  EXPECT_DOUBLE_EQ(config.poll.period_s, 2.5);
+  EXPECT_EQ(config.calibration.variant, "1N1Cwr+transport_delay");
+  EXPECT_EQ(config.calibration.window_days, 21);
+  EXPECT_DOUBLE_EQ(config.calibration.step_s, 120);
+  EXPECT_EQ(config.calibration.at, "03:30");
+  EXPECT_EQ(config.calibration.timezone, "America/Santiago");
+  EXPECT_DOUBLE_EQ(config.forecast.horizon_h, 48);
+  EXPECT_DOUBLE_EQ(config.forecast.refresh_min, 15);
+  EXPECT_EQ(config.source_path, path);
+}
+
+TEST(ConfigLoad, OmittedKeysTakeTheDocumentedDefaults) {
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseConfig(kMinimalPlant, "config.toml", &config, &errors));
+  const Plant defaults;
+  const Plant& p = config.plant;
+  EXPECT_DOUBLE_EQ(p.latitude_rad, 47.358 * kPi / 180);
+  EXPECT_DOUBLE_EQ(p.azimuth_rad, kPi);
+  EXPECT_EQ(p.elevation_m, 0.0);
+  // DESIGN.md's [plant] example values, which core/plant.h also uses.
+  EXPECT_EQ(p.fluid_cp_j_kgk, 3650);
+  EXPECT_EQ(p.fluid_density_kg_m3, 1040);
+  EXPECT_EQ(p.ground_albedo, 0.2);
+  EXPECT_EQ(p.iam_b0, 0.05);
+  EXPECT_EQ(p.pv_t_ref_c, 25);
+  EXPECT_EQ(p.pv_g_ref_w_m2, 1000);
+  EXPECT_EQ(p.pv_temp_coeff_per_k, -0.004);
+  EXPECT_EQ(p.pv_irr_coeff_m2_w, 3.6e-5);
+  EXPECT_EQ(p.fluid_cp_j_kgk, defaults.fluid_cp_j_kgk);
+  EXPECT_EQ(p.pv_irr_coeff_m2_w, defaults.pv_irr_coeff_m2_w);
+  // DESIGN.md's daemon section defaults.
+  EXPECT_EQ(config.storage.path, "/var/lib/pvtwin/pvtwin.db");
+  EXPECT_EQ(config.storage.raw_retention_days, 30);
+  EXPECT_EQ(config.poll.period_s, 5);
+  EXPECT_EQ(config.calibration.variant, "2N1Ccolwr");
+  EXPECT_EQ(config.calibration.window_days, 14);
+  EXPECT_EQ(config.calibration.step_s, 60);
+  EXPECT_EQ(config.calibration.at, "02:00");
+  EXPECT_EQ(config.calibration.timezone, "Europe/Vienna");
+  EXPECT_EQ(config.forecast.horizon_h, 24);
+  EXPECT_EQ(config.forecast.refresh_min, 60);
+}
+
+TEST(ConfigLoad, ShippedExamplesAreValid) {
+  for (const char* name : {"plant.toml", "pvtwin.toml"}) {
+    Config config;
+    Diagnostics errors;
+    EXPECT_TRUE(LoadConfig(kExamplesDir + name, &config, &errors))
+        << name << ": " << (errors.empty() ? "" : errors.front().ToString());
+    EXPECT_DOUBLE_EQ(config.plant.area_m2, 1.8);
+  }
+}
+
+TEST(ConfigLoad, MissingFileIsOneErrorNamingThePath) {
+  Config config;
+  Diagnostics errors;
+  EXPECT_FALSE(LoadConfig("/nonexistent/pvtwin.toml", &config, &errors));
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].ToString(),
+            "/nonexistent/pvtwin.toml: cannot open: No such file or directory");
+}
+
+TEST(ConfigLoad, FailedParseLeavesOutputAndEarlierErrorsAlone) {
+  Config config;
+  config.calibration.variant = "kept";
+  Diagnostics errors = {Diagnostic{"earlier.toml", 1, "", "", "earlier problem"}};
+  EXPECT_FALSE(ParseConfig(std::string(kMinimalPlant) + "[poll]\nperiod_s = -1\n", "config.toml",
+                           &config, &errors));
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].rule, "earlier problem");
+  EXPECT_EQ(errors[1].ToString(), "config.toml:8: period_s = -1: must be > 0");
+  EXPECT_EQ(config.calibration.variant, "kept");
+}
+
+TEST(ConfigLoad, NonFiniteNumbersAreRejected) {
+  Config config;
+  Diagnostics errors;
+  EXPECT_FALSE(ParseConfig(
+      "[plant]\nlatitude_deg = nan\nlongitude_deg = 16\ntilt_deg = 20\nazimuth_deg = 180\n"
+      "area_m2 = inf\n",
+      "config.toml", &config, &errors));
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].ToString(), "config.toml:2: latitude_deg = nan: must be a finite number");
+  EXPECT_EQ(errors[1].ToString(), "config.toml:6: area_m2 = inf: must be a finite number");
+}
+
+TEST(ConfigLoad, BoundariesOfTheRanges) {
+  const auto errors_for = [](const std::string& extra) {
+    Config config;
+    Diagnostics errors;
+    ParseConfig(std::string(kMinimalPlant) + extra, "config.toml", &config, &errors);
+    return errors.size();
+  };
+  EXPECT_EQ(errors_for("iam_b0 = 0\nground_albedo = 1\n"), 0u);
+  EXPECT_EQ(errors_for("pv_temp_coeff_per_k = -0.02\npv_irr_coeff_m2_w = -1e-3\n"), 0u);
+  EXPECT_EQ(errors_for("[calibration]\nstep_s = 5\nat = \"23:59\"\nwindow_days = 60\n"), 0u);
+  EXPECT_EQ(errors_for("[calibration]\nstep_s = 900\n[forecast]\nhorizon_h = 168\n"), 0u);
+  EXPECT_EQ(errors_for("[calibration]\nstep_s = 60.5\n"), 1u);
+  EXPECT_EQ(errors_for("[calibration]\nstep_s = 4\n"), 1u);
+  EXPECT_EQ(errors_for("[calibration]\nat = \"02:00 \"\n"), 1u);
+  EXPECT_EQ(errors_for("[forecast]\nhorizon_h = 0\n"), 1u);
+  // A value out of the int range must not wrap around.
+  EXPECT_EQ(errors_for("[storage]\nraw_retention_days = 9999999999\n"), 1u);
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -1,1 +1,353 @@
-#include "core/series.h"
+#include "io/csv.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <istream>
+#include <optional>
+#include <ostream>
+#include <string_view>
+#include <vector>
+
+#include "core/qc.h"
+#include "core/units.h"
+#include "io/time_format.h"
+
+namespace pvtwin {
+namespace {
+
+constexpr std::string_view kTimeColumn = "time";
+constexpr std::string_view kFlowLitrePerHourColumn = "flow_l_h";
+constexpr double kLitrePerHourTimesDensityToKgS = 1.0 / 3.6e6;  // (L/h)·(kg/m³) → kg/s
+
+std::string FormatNumber(double x) {
+  char buf[32];
+  const auto result = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, result.ptr);
+}
+
+std::string_view Trim(std::string_view s) {
+  const auto is_space = [](char c) { return c == ' ' || c == '\t'; };
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+void SplitFields(std::string_view line, std::vector<std::string_view>* fields) {
+  fields->clear();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      fields->push_back(Trim(line.substr(start)));
+      return;
+    }
+    fields->push_back(Trim(line.substr(start, comma - start)));
+    start = comma + 1;
+  }
+}
+
+// How a column's cells become a channel's values.
+enum class Conversion {
+  kNone,
+  kLitrePerHourToKgS,  // flow_l_h
+  kDegToRad,           // aoi_deg
+};
+
+struct Column {
+  std::string name;                // as written in the header
+  std::optional<Channel> channel;  // nullopt: the time column or an ignored one
+  Conversion conversion = Conversion::kNone;
+};
+
+class CsvParser {
+ public:
+  CsvParser(const std::string& path, const CsvReadOptions& options)
+      : path_(path), options_(options) {}
+
+  bool Parse(std::istream& in, Series* out, Diagnostics* errors, Diagnostics* warnings) {
+    std::string line;
+    if (!std::getline(in, line)) {
+      Error(0, "", "", "empty file: a header row is expected");
+    } else {
+      std::string_view header = line;
+      if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // UTF-8 BOM
+      if (header.ends_with('\r')) header.remove_suffix(1);
+      ReadHeader(header);
+      int line_no = 1;
+      while (errors_.size() < kMaxCsvErrors && std::getline(in, line)) {
+        ++line_no;
+        std::string_view row = line;
+        if (row.ends_with('\r')) row.remove_suffix(1);
+        if (Trim(row).empty()) continue;
+        ReadRow(line_no, row);
+      }
+      if (errors_.size() >= kMaxCsvErrors) {
+        Error(line_no, "", "", "too many errors; reading stopped here");
+      }
+    }
+    if (in.bad()) Error(0, "", "", "read error");
+    if (warnings != nullptr) warnings->insert(warnings->end(), warnings_.begin(), warnings_.end());
+    if (!errors_.empty()) {
+      errors->insert(errors->end(), errors_.begin(), errors_.end());
+      return false;
+    }
+    series_.step_s = MedianStep(series_.time_s);
+    const QcCorrections corrected = ApplyPaperCorrections(&series_);
+    if (warnings != nullptr) {
+      if (corrected.irradiance_zeroed > 0) {
+        warnings->push_back({path_, 0, "", "",
+                             std::to_string(corrected.irradiance_zeroed) +
+                                 " irradiance values above 5000 W/m² set to 0 (paper Table 2)"});
+      }
+      if (corrected.flow_zeroed > 0) {
+        warnings->push_back({path_, 0, "", "",
+                             std::to_string(corrected.flow_zeroed) +
+                                 " small negative flow values set to 0 (paper Table 1)"});
+      }
+    }
+    *out = std::move(series_);
+    return true;
+  }
+
+ private:
+  void Error(int line, std::string_view field, std::string_view value, std::string rule) {
+    errors_.push_back({path_, line, std::string(field), std::string(value), std::move(rule)});
+  }
+
+  void ReadHeader(std::string_view header) {
+    std::vector<std::string_view> names;
+    SplitFields(header, &names);
+    std::array<std::string_view, kNumChannels> seen_as{};  // header name that gave a channel
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      Column column;
+      column.name = std::string(names[i]);
+      const std::string_view name = names[i];
+      if (name == kTimeColumn) {
+        if (time_index_) {
+          Error(1, name, "", "duplicate column");
+        } else {
+          time_index_ = i;
+        }
+        columns_.push_back(std::move(column));
+        continue;
+      }
+      std::optional<Channel> channel = ChannelFromName(name);
+      if (name == kFlowLitrePerHourColumn) {
+        channel = Channel::kMdotKgS;
+        column.conversion = Conversion::kLitrePerHourToKgS;
+      } else if (channel == Channel::kAoiRad) {
+        column.conversion = Conversion::kDegToRad;
+      }
+      if (!channel) {
+        warnings_.push_back({path_, 1,
+                             name.empty() ? "column " + std::to_string(i + 1) : std::string(name),
+                             "", "unknown column ignored"});
+      } else {
+        std::string_view& first = seen_as[static_cast<std::size_t>(*channel)];
+        if (first.empty()) {
+          first = name;
+          column.channel = channel;
+        } else if (first == name) {
+          Error(1, name, "", "duplicate column");
+        } else {
+          Error(1, name, "",
+                "duplicate column (" + std::string(first) + " gives the same channel)");
+        }
+      }
+      columns_.push_back(std::move(column));
+    }
+
+    const auto has = [&](Channel c) { return !seen_as[static_cast<std::size_t>(c)].empty(); };
+    const auto missing = [&](std::string_view name, const char* alternative) {
+      Error(1, name, "", std::string("required column missing") + alternative);
+    };
+    if (!time_index_) missing(kTimeColumn, "");
+    if (!has(Channel::kQThW)) {
+      if (!has(Channel::kTInC)) missing("t_in_c", " (or give q_th_w)");
+      if (!has(Channel::kTOutC)) missing("t_out_c", " (or give q_th_w)");
+    }
+    if (!has(Channel::kMdotKgS)) missing("flow_kg_s", " (or give flow_l_h)");
+    if (!has(Channel::kGPoaWM2)) {
+      const bool ghi = has(Channel::kGhiWM2);
+      const bool dhi = has(Channel::kDhiWM2);
+      if (!ghi && !dhi) {
+        missing("g_poa_w_m2", " (or give ghi_w_m2 and dhi_w_m2)");
+      } else if (!ghi) {
+        missing("ghi_w_m2", " (dhi_w_m2 needs it when g_poa_w_m2 is absent)");
+      } else if (!dhi) {
+        missing("dhi_w_m2", " (ghi_w_m2 needs it when g_poa_w_m2 is absent)");
+      }
+    }
+    if (!has(Channel::kTAmbC)) missing("t_amb_c", "");
+    if (!has(Channel::kPElW)) missing("p_el_w", "");
+
+    for (const Column& column : columns_) {
+      if (column.channel) series_[*column.channel].clear();
+    }
+  }
+
+  void ReadRow(int line_no, std::string_view row) {
+    SplitFields(row, &fields_);
+    if (fields_.size() != columns_.size()) {
+      Error(line_no, "", "",
+            "expected " + std::to_string(columns_.size()) + " fields, found " +
+                std::to_string(fields_.size()));
+      return;
+    }
+    if (time_index_) {
+      const std::string_view cell = fields_[*time_index_];
+      std::int64_t time_s = 0;
+      std::string rule;
+      if (!ParseTime(cell, &time_s, &rule)) {
+        Error(line_no, kTimeColumn, cell, rule);
+        return;
+      }
+      if (!series_.time_s.empty() && time_s <= series_.time_s.back()) {
+        Error(line_no, kTimeColumn, cell,
+              "must be later than the time of the row before (line " +
+                  std::to_string(previous_line_) + ")");
+        return;
+      }
+      series_.time_s.push_back(time_s);
+      previous_line_ = line_no;
+    }
+    for (std::size_t i = 0; i < columns_.size(); ++i) {
+      const Column& column = columns_[i];
+      if (column.channel) series_[*column.channel].push_back(ReadCell(line_no, column, fields_[i]));
+    }
+  }
+
+  // One value in its channel's unit; NaN if missing or malformed.
+  double ReadCell(int line_no, const Column& column, std::string_view cell) {
+    const double kMissing = std::nan("");
+    if (cell.empty()) return kMissing;
+    // from_chars takes no leading '+'; accept one, but not "+-1".
+    std::string_view number = cell;
+    if (number.starts_with('+') && !number.starts_with("+-")) number.remove_prefix(1);
+    double value = 0.0;
+    const char* const number_end = number.data() + number.size();
+    const auto [end, ec] = std::from_chars(number.data(), number_end, value);
+    if (ec != std::errc() || end != number_end) {
+      Error(line_no, column.name, cell, "expected a number");
+      return kMissing;
+    }
+    if (std::isnan(value)) return kMissing;
+    if (std::isinf(value)) {
+      Error(line_no, column.name, cell, "expected a finite number");
+      return kMissing;
+    }
+    switch (column.conversion) {
+      case Conversion::kNone:
+        break;
+      case Conversion::kLitrePerHourToKgS:
+        value *= options_.fluid_density_kg_m3 * kLitrePerHourTimesDensityToKgS;
+        break;
+      case Conversion::kDegToRad:
+        value = DegToRad(value);
+        break;
+    }
+    if (column.channel == Channel::kValid && value != 0.0 && value != 1.0) {
+      Error(line_no, column.name, cell, "must be 0 or 1");
+      return kMissing;
+    }
+    if (column.channel == Channel::kMdotKgS && value < -kNegativeFlowToleranceKgS) {
+      std::string limit = "-" + FormatNumber(kNegativeFlowToleranceKgS) + " kg/s";
+      if (column.conversion == Conversion::kLitrePerHourToKgS) {
+        char litre_per_hour[32];
+        std::snprintf(litre_per_hour, sizeof litre_per_hour, "%.3g",
+                      kNegativeFlowToleranceKgS / options_.fluid_density_kg_m3 /
+                          kLitrePerHourTimesDensityToKgS);
+        limit = "-" + std::string(litre_per_hour) + " L/h (" + limit + ")";
+      }
+      Error(line_no, column.name, cell,
+            "must not be below " + limit +
+                "; only small negative readings of a stopped pump are set to 0");
+      return kMissing;
+    }
+    return value;
+  }
+
+  static double MedianStep(const std::vector<std::int64_t>& time_s) {
+    if (time_s.size() < 2) return 0.0;
+    std::vector<std::int64_t> steps(time_s.size() - 1);
+    for (std::size_t i = 0; i + 1 < time_s.size(); ++i) steps[i] = time_s[i + 1] - time_s[i];
+    const auto middle = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+    std::nth_element(steps.begin(), middle, steps.end());
+    return static_cast<double>(*middle);
+  }
+
+  const std::string& path_;
+  const CsvReadOptions& options_;
+  std::vector<Column> columns_;
+  std::optional<std::size_t> time_index_;
+  std::vector<std::string_view> fields_;  // the current row, split
+  int previous_line_ = 0;                 // line of the last row read
+  Series series_;
+  Diagnostics errors_;
+  Diagnostics warnings_;
+};
+
+}  // namespace
+
+bool ParseCanonicalCsv(std::istream& in, const std::string& path_for_messages,
+                       const CsvReadOptions& options, Series* out, Diagnostics* errors,
+                       Diagnostics* warnings) {
+  assert(out != nullptr && errors != nullptr);
+  CsvParser parser(path_for_messages, options);
+  return parser.Parse(in, out, errors, warnings);
+}
+
+bool ReadCanonicalCsv(const std::string& path, const CsvReadOptions& options, Series* out,
+                      Diagnostics* errors, Diagnostics* warnings) {
+  assert(out != nullptr && errors != nullptr);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    errors->push_back({path, 0, "", "", std::string("cannot open: ") + std::strerror(errno)});
+    return false;
+  }
+  return ParseCanonicalCsv(in, path, options, out, errors, warnings);
+}
+
+void WriteCsv(std::ostream& out, const Series& series, std::span<const Channel> channels) {
+  std::string line(kTimeColumn);
+  for (const Channel c : channels) {
+    line += ',';
+    line += ChannelName(c);
+  }
+  out << line << '\n';
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    line = FormatIsoUtc(series.time_s[i]);
+    for (const Channel c : channels) {
+      line += ',';
+      double value = series.At(c, i);
+      if (std::isnan(value)) continue;
+      if (c == Channel::kAoiRad) value = RadToDeg(value);
+      line += FormatNumber(value);
+    }
+    out << line << '\n';
+  }
+}
+
+bool WriteCsv(const std::string& path, const Series& series, std::span<const Channel> channels,
+              std::string* error) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) {
+    *error = "cannot open " + path + " for writing: " + std::strerror(errno);
+    return false;
+  }
+  WriteCsv(out, series, channels);
+  out.flush();
+  if (!out) {
+    *error = "cannot write " + path + ": " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace pvtwin

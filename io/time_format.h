@@ -1,0 +1,25 @@
+// Time stamps as text, at the I/O edge: the `time` column of the canonical
+// CSV (DESIGN.md). Inside pvtwin a time is unix seconds UTC (int64).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace pvtwin {
+
+// Parses one time cell. Accepted forms, decided per cell:
+//   * ISO 8601 date-time with a UTC designator or offset:
+//       YYYY-MM-DDTHH:MM[:SS[.fff]](Z|±HH:MM|±HHMM|±HH)
+//     ('T' may also be 't' or a space; ',' may separate the fraction).
+//     A time without Z or offset is ambiguous and rejected.
+//   * unix seconds: [-+]digits[.digits]
+// Fractions of a second are dropped towards the past (floor), so a time
+// stamp keeps marking the start of its interval. On failure returns false and
+// sets *error to the rule that was broken; *unix_s is untouched.
+bool ParseTime(std::string_view text, std::int64_t* unix_s, std::string* error);
+
+// "YYYY-MM-DDTHH:MM:SSZ".
+std::string FormatIsoUtc(std::int64_t unix_s);
+
+}  // namespace pvtwin

@@ -1,0 +1,275 @@
+// Canonical CSV: time text, round trip through WriteCsv and the reader, and
+// the real htw saar test-bench days (../shared/data/htwsaar-pvt, PROVENANCE.md).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "config/plant_config.h"
+#include "core/units.h"
+#include "io/csv.h"
+#include "io/time_format.h"
+
+namespace pvtwin {
+namespace {
+
+const std::string kRealDataDir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
+
+std::int64_t Parsed(std::string_view text) {
+  std::int64_t unix_s = -1;
+  std::string error;
+  EXPECT_TRUE(ParseTime(text, &unix_s, &error)) << text << ": " << error;
+  return unix_s;
+}
+
+std::string ParseError(std::string_view text) {
+  std::int64_t unix_s = 12345;
+  std::string error;
+  EXPECT_FALSE(ParseTime(text, &unix_s, &error)) << text;
+  EXPECT_EQ(unix_s, 12345) << "output written on failure";
+  return error;
+}
+
+TEST(CsvTimeFormat, ParsesIsoUtcOffsetsAndUnixSeconds) {
+  // 2017-08-07T08:24:01Z, checked with `date -u -d 2017-08-07T08:24:01Z +%s`.
+  constexpr std::int64_t kT = 1502094241;
+  EXPECT_EQ(Parsed("2017-08-07T08:24:01Z"), kT);
+  EXPECT_EQ(Parsed("2017-08-07T10:24:01+02:00"), kT);
+  EXPECT_EQ(Parsed("2017-08-07T03:54:01-04:30"), kT);
+  EXPECT_EQ(Parsed("2017-08-07T10:24:01+0200"), kT);
+  EXPECT_EQ(Parsed("2017-08-07T10:24:01+02"), kT);
+  EXPECT_EQ(Parsed("2017-08-07 08:24:01z"), kT);
+  EXPECT_EQ(Parsed("2017-08-07T08:24:01.999Z"), kT);  // fractions floor
+  EXPECT_EQ(Parsed("2017-08-07T08:24:01,5Z"), kT);
+  EXPECT_EQ(Parsed("2017-08-07T08:24Z"), kT - 1);
+  EXPECT_EQ(Parsed("1502094241"), kT);
+  EXPECT_EQ(Parsed("1502094241.75"), kT);
+  EXPECT_EQ(Parsed("+1502094241"), kT);
+  EXPECT_EQ(Parsed("0"), 0);
+  EXPECT_EQ(Parsed("-1.5"), -2);
+  EXPECT_EQ(Parsed("1970-01-01T00:00:00Z"), 0);
+  EXPECT_EQ(Parsed("1969-12-31T23:59:59Z"), -1);
+  EXPECT_EQ(Parsed("2016-02-29T00:00:00Z"), 1456704000);
+  EXPECT_EQ(Parsed("2000-03-01T00:00:00+00:00"), 951868800);
+}
+
+TEST(CsvTimeFormat, RejectsAmbiguousOrMalformedTimes) {
+  EXPECT_EQ(ParseError("2017-08-07T08:24:01"),
+            "time needs Z or a ±HH:MM offset (local time is ambiguous)");
+  EXPECT_EQ(ParseError("2017-02-29T00:00:00Z"), "no such date");
+  EXPECT_EQ(ParseError("2017-13-01T00:00:00Z"), "no such date");
+  EXPECT_EQ(ParseError("2017-08-07T24:00:00Z"), "time of day out of range");
+  EXPECT_EQ(ParseError("2017-08-07T08:24:60Z"), "time of day out of range");
+  EXPECT_EQ(ParseError("2017-08-07T08:24:00+25:00"), "UTC offset out of range");
+  EXPECT_EQ(ParseError(""), "must not be empty");
+  for (const char* bad : {"2017-08-07", "2017-8-7T08:24:00Z", "2017-08-07T08:24:00ZZ",
+                          "2017-08-07T08:24:00.Z", "1.5e9", "12:00", "-", "1502094241x"}) {
+    EXPECT_FALSE(ParseError(bad).empty()) << bad;
+  }
+}
+
+TEST(CsvTimeFormat, FormatsUtcWithZAndRoundTrips) {
+  EXPECT_EQ(FormatIsoUtc(1502094241), "2017-08-07T08:24:01Z");
+  EXPECT_EQ(FormatIsoUtc(0), "1970-01-01T00:00:00Z");
+  EXPECT_EQ(FormatIsoUtc(-1), "1969-12-31T23:59:59Z");
+  EXPECT_EQ(FormatIsoUtc(1456704000), "2016-02-29T00:00:00Z");
+  for (std::int64_t t = -100000000; t < 4000000000; t += 7777777) {
+    EXPECT_EQ(Parsed(FormatIsoUtc(t)), t);
+  }
+}
+
+Series MakeSeries() {
+  Series s;
+  s.step_s = 60;
+  for (int i = 0; i < 5; ++i) s.time_s.push_back(1502094240 + 60 * i);
+  for (const ChannelInfo& info : kChannels) {
+    std::vector<double>& col = s.Ensure(info.channel);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      col[i] = 0.1 * static_cast<double>(i + 1) + 1.0 / 3.0 + static_cast<double>(info.channel);
+    }
+  }
+  s[Channel::kValid] = {1, 0, 1, 1, 0};
+  s[Channel::kAoiRad] = {0.1, 0.2, 1.0 / 3.0, kPi / 4, 1.5};
+  s[Channel::kMdotKgS][3] = 0.0;
+  s[Channel::kTAmbC][2] = std::nan("");  // missing cell
+  s[Channel::kPElW][4] = -1e-300;        // tiny and negative
+  s[Channel::kQThW][1] = 123456789.123456789;
+  return s;
+}
+
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("pvtwin_test_" + std::to_string(getpid()) + "_" + name))
+      .string();
+}
+
+TEST(CsvRoundTrip, WriteThenReadGivesTheSameSeries) {
+  const Series written = MakeSeries();
+  std::vector<Channel> all;
+  for (const ChannelInfo& info : kChannels) all.push_back(info.channel);
+  const std::string path = TempPath("roundtrip.csv");
+  std::string error;
+  ASSERT_TRUE(WriteCsv(path, written, all, &error)) << error;
+
+  Series read;
+  Diagnostics errors;
+  Diagnostics warnings;
+  ASSERT_TRUE(ReadCanonicalCsv(path, CsvReadOptions{}, &read, &errors, &warnings))
+      << errors.front().ToString();
+  std::filesystem::remove(path);
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(read.time_s, written.time_s);
+  EXPECT_EQ(read.step_s, 60);
+  for (const ChannelInfo& info : kChannels) {
+    ASSERT_TRUE(read.Has(info.channel)) << info.name;
+    for (std::size_t i = 0; i < written.size(); ++i) {
+      const double expected = written.At(info.channel, i);
+      const double actual = read.At(info.channel, i);
+      if (std::isnan(expected)) {
+        EXPECT_TRUE(std::isnan(actual)) << info.name << " row " << i;
+      } else if (info.channel == Channel::kAoiRad) {
+        // Degrees in the file: one multiplication each way.
+        EXPECT_NEAR(actual, expected, 4e-16 * expected) << "row " << i;
+      } else {
+        EXPECT_EQ(actual, expected) << info.name << " row " << i;  // exact
+      }
+    }
+  }
+}
+
+TEST(CsvRoundTrip, WritesOnlyTheRequestedChannelsInOrder) {
+  Series s = MakeSeries();
+  s[Channel::kWindMS].clear();  // absent: written as an empty column
+  const std::vector<Channel> channels = {Channel::kPElW, Channel::kWindMS, Channel::kAoiRad};
+  std::ostringstream out;
+  WriteCsv(out, s.Slice(0, 1), channels);
+  EXPECT_EQ(out.str(),
+            "time,p_el_w,wind_m_s,aoi_deg\n"
+            "2017-08-07T08:24:00Z,14.433333333333334,,5.729577951308233\n");
+}
+
+TEST(CsvRoundTrip, UnwritablePathIsAnError) {
+  std::string error;
+  EXPECT_FALSE(WriteCsv("/nonexistent/dir/out.csv", MakeSeries(), {}, &error));
+  EXPECT_NE(error.find("/nonexistent/dir/out.csv"), std::string::npos) << error;
+}
+
+bool ParseText(const std::string& text, Series* series, Diagnostics* errors,
+               const CsvReadOptions& options = {}) {
+  std::istringstream in(text);
+  Diagnostics warnings;
+  return ParseCanonicalCsv(in, "in.csv", options, series, errors, &warnings);
+}
+
+TEST(CsvRead, AcceptsCrlfByteOrderMarkSpacesAndEmptyLines) {
+  const std::string text =
+      "\xEF\xBB\xBFtime, t_in_c ,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\r\n"
+      "0,1,2,0.03,500, 20 ,+100\r\n"
+      "\r\n"
+      "60,1,2,0.03,,20,nan\r\n";
+  Series s;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseText(text, &s, &errors)) << errors.front().ToString();
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s.time_s[1], 60);
+  EXPECT_EQ(s[Channel::kTInC][0], 1.0);
+  EXPECT_EQ(s[Channel::kTAmbC][0], 20.0);
+  EXPECT_EQ(s[Channel::kPElW][0], 100.0);
+  EXPECT_TRUE(std::isnan(s[Channel::kGPoaWM2][1]));
+  EXPECT_TRUE(std::isnan(s[Channel::kPElW][1]));
+  EXPECT_FALSE(s.Has(Channel::kWindMS));
+}
+
+TEST(CsvRead, FlowInLitresPerHourUsesTheConfiguredDensity) {
+  const std::string text =
+      "time,t_in_c,t_out_c,flow_l_h,g_poa_w_m2,t_amb_c,p_el_w\n0,1,2,360,500,20,100\n";
+  Series s;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseText(text, &s, &errors, CsvReadOptions{.fluid_density_kg_m3 = 1000}));
+  EXPECT_DOUBLE_EQ(s[Channel::kMdotKgS][0], 0.1);  // 360 L/h of water
+}
+
+TEST(CsvRead, StopsAfterTooManyErrors) {
+  std::string text = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
+  for (int i = 0; i < 1000; ++i) text += std::to_string(i) + ",x,2,0.03,500,20,100\n";
+  Series s;
+  Diagnostics errors;
+  EXPECT_FALSE(ParseText(text, &s, &errors));
+  ASSERT_EQ(errors.size(), kMaxCsvErrors + 1);
+  EXPECT_EQ(errors.back().ToString(), "in.csv:101: too many errors; reading stopped here");
+}
+
+TEST(CsvRead, MissingFileIsAnError) {
+  Series s;
+  Diagnostics errors;
+  EXPECT_FALSE(ReadCanonicalCsv("/nonexistent.csv", CsvReadOptions{}, &s, &errors, nullptr));
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].ToString(), "/nonexistent.csv: cannot open: No such file or directory");
+}
+
+struct RealDay {
+  const char* file;
+  std::size_t rows;
+  std::int64_t first_time_s;
+  double first_aoi_deg;
+};
+
+class CsvRealData : public testing::TestWithParam<RealDay> {};
+
+TEST_P(CsvRealData, LoadsCleanlyWithAllColumns) {
+  const RealDay& day = GetParam();
+  Series s;
+  Diagnostics errors;
+  Diagnostics warnings;
+  ASSERT_TRUE(ReadCanonicalCsv(kRealDataDir + day.file, CsvReadOptions{.fluid_density_kg_m3 = 1000},
+                               &s, &errors, &warnings))
+      << errors.front().ToString();
+  EXPECT_TRUE(warnings.empty()) << warnings.front().ToString();
+  EXPECT_EQ(s.size(), day.rows);
+  EXPECT_EQ(s.step_s, 120);
+  EXPECT_EQ(s.time_s.front(), day.first_time_s);
+  for (const Channel c :
+       {Channel::kTInC, Channel::kTOutC, Channel::kMdotKgS, Channel::kGPoaWM2,
+        Channel::kGPoaDiffuseWM2, Channel::kAoiRad, Channel::kTAmbC, Channel::kWindMS,
+        Channel::kLwDownWM2, Channel::kPElW, Channel::kQThW, Channel::kValid}) {
+    ASSERT_TRUE(s.Has(c)) << ChannelName(c);
+    EXPECT_EQ(s[c].size(), day.rows);
+  }
+  EXPECT_FALSE(s.Has(Channel::kGhiWM2));
+  EXPECT_DOUBLE_EQ(s[Channel::kAoiRad][0], DegToRad(day.first_aoi_deg));
+  std::size_t n_valid = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_GE(s[Channel::kAoiRad][i], 0.0);
+    EXPECT_LE(s[Channel::kAoiRad][i], kPi / 2);  // daylight, sun in front of the collector
+    EXPECT_NEAR(s[Channel::kMdotKgS][i], 0.033, 0.003);
+    n_valid += s[Channel::kValid][i] == 1.0;
+  }
+  EXPECT_GT(n_valid, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(HtwSaar, CsvRealData,
+                         testing::Values(RealDay{"day1_clear_low_dT.csv", 306, 1502094241, 43.9403},
+                                         RealDay{"day3_clear_medium_dT.csv", 341, 1500969360,
+                                                 60.9237}),
+                         [](const testing::TestParamInfo<RealDay>& info) {
+                           return std::string(info.param.file).substr(0, 4);
+                         });
+
+TEST(CsvRealData, PlantConfigOfTheTestBenchLoads) {
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(LoadConfig(kRealDataDir + "plant.toml", &config, &errors))
+      << errors.front().ToString();
+  EXPECT_DOUBLE_EQ(config.plant.area_m2, 1.66);
+  EXPECT_DOUBLE_EQ(config.plant.tilt_rad, DegToRad(45));
+  EXPECT_DOUBLE_EQ(config.plant.fluid_density_kg_m3, 1000);
+  EXPECT_DOUBLE_EQ(config.plant.pv_temp_coeff_per_k, -0.0041);
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -13,6 +13,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterCheckConfig(app);
   RegisterSimulate(app);
   RegisterBench(app);
+  RegisterBacktest(app);
 }
 
 }  // namespace pvtwin::cli

@@ -20,5 +20,6 @@ void SetExitCode(int code);
 void RegisterCheckConfig(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
 void RegisterBench(CLI::App& app);
+void RegisterBacktest(CLI::App& app);
 
 }  // namespace pvtwin::cli

@@ -1,0 +1,211 @@
+// pvtwin backtest: the paper's rolling evaluation (section 3.3) on a CSV.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/backtest.h"
+#include "core/variant.h"
+#include "daemon/commands.h"
+#include "daemon/inputs.h"
+#include "io/backtest_report.h"
+#include "io/params_json.h"
+
+namespace pvtwin::cli {
+
+namespace {
+
+struct BacktestArgs {
+  std::string config;
+  std::string csv;
+  std::vector<std::string> variants;
+  std::vector<int> train_days;
+  std::vector<double> steps_s;
+  std::string first_test_day;
+  int test_days = 29;
+  std::string json;
+  int threads = 0;
+};
+
+// "YYYY-MM-DD" → year, month, day. False unless it is a calendar date.
+bool ParseDate(const std::string& text, int* year, int* month, int* day) {
+  if (text.size() != 10 || text[4] != '-' || text[7] != '-') return false;
+  for (std::size_t i : {0, 1, 2, 3, 5, 6, 8, 9}) {
+    if (text[i] < '0' || text[i] > '9') return false;
+  }
+  *year = std::stoi(text.substr(0, 4));
+  *month = std::stoi(text.substr(5, 2));
+  *day = std::stoi(text.substr(8, 2));
+  if (*month < 1 || *month > 12 || *day < 1) return false;
+  static constexpr int kDaysInMonth[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  const bool leap = (*year % 4 == 0 && *year % 100 != 0) || *year % 400 == 0;
+  const int last = kDaysInMonth[*month - 1] + (*month == 2 && leap ? 1 : 0);
+  return *day <= last;
+}
+
+// "paper" stands for the nine variants of Table 6.
+std::vector<std::string> ExpandVariants(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  for (const std::string& name : names) {
+    if (name == "paper") {
+      out.insert(out.end(), PaperVariants().begin(), PaperVariants().end());
+    } else {
+      out.push_back(name);
+    }
+  }
+  return out;
+}
+
+void PrintProgress(int done, int total, const BacktestDay& day, std::int64_t solar_offset_s) {
+  const std::string date = SolarDate(day.day_start_s, solar_offset_s);
+  if (day.ok) {
+    std::fprintf(stderr, "[%d/%d] %s %s n=%d: MAE Pel %.2f W/m², Qu %.1f W/m² (%.2f s)\n", done,
+                 total, date.c_str(), day.variant.c_str(), day.train_days, day.test.mae_p_el_w_m2,
+                 day.test.mae_q_th_w_m2, day.runtime_s);
+  } else {
+    std::fprintf(stderr, "[%d/%d] %s %s n=%d: FAILED: %s\n", done, total, date.c_str(),
+                 day.variant.c_str(), day.train_days, day.failure_reason.c_str());
+  }
+}
+
+int RunBacktestCommand(const BacktestArgs& a) {
+  // Every variant name first, each bad one reported.
+  Config config;
+  const std::vector<std::string> variants = ExpandVariants(a.variants);
+  bool names_ok = true;
+  for (const std::string& name : variants) {
+    ModelSpec spec;
+    std::string error;
+    if (!ParseVariant(name, &spec, &error)) {
+      std::cerr << "--variants = " << name << ": " << error << "\n";
+      names_ok = false;
+    }
+  }
+  int year = 0, month = 0, day = 0;
+  if (!a.first_test_day.empty() && !ParseDate(a.first_test_day, &year, &month, &day)) {
+    std::cerr << "--first-test-day = " << a.first_test_day
+              << ": expected a calendar date YYYY-MM-DD (the local solar day of that date)\n";
+    names_ok = false;
+  }
+  if (!names_ok) return kExitBadInput;
+  if (!LoadConfigOrReport(a.config, &config)) return kExitBadInput;
+
+  BacktestOptions options;
+  options.variants =
+      variants.empty() ? std::vector<std::string>{config.calibration.variant} : variants;
+  options.train_days =
+      a.train_days.empty() ? std::vector<int>{config.calibration.window_days} : a.train_days;
+  options.test_days = a.test_days;
+  options.threads = a.threads;
+  if (!a.first_test_day.empty()) {
+    options.first_test_day_s =
+        SolarDayStartOfDateS(year, month, day, SolarDayOffsetS(config.plant));
+  }
+  const std::vector<double> steps_s =
+      a.steps_s.empty() ? std::vector<double>{config.calibration.step_s} : a.steps_s;
+  bool options_ok = true;
+  for (double step_s : steps_s) {
+    options.step_s = step_s;
+    std::string why;
+    if (!options.IsValid(&why)) {
+      std::cerr << "backtest: " << why << "\n";
+      options_ok = false;
+    }
+  }
+  if (!options_ok) return kExitBadInput;
+
+  Series series;
+  if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
+
+  std::vector<BacktestResult> results;
+  for (double step_s : steps_s) {
+    options.step_s = step_s;
+    if (steps_s.size() > 1) std::fprintf(stderr, "backtest at a step of %g s\n", step_s);
+    const std::int64_t offset_s = SolarDayOffsetS(config.plant);
+    BacktestResult result;
+    std::string error;
+    const bool ok = RunBacktest(series, config.plant, options, &result, &error,
+                                [offset_s](int done, int total, const BacktestDay& d) {
+                                  PrintProgress(done, total, d, offset_s);
+                                });
+    if (!ok) {
+      std::cerr << a.csv << ": " << error << "\n";
+      return kExitBadInput;
+    }
+    std::cout << FormatBacktestTables(result) << "\n";
+    results.push_back(std::move(result));
+  }
+  if (results.size() > 1) std::cout << FormatStepTable(results);
+  std::cout.flush();
+
+  if (!a.json.empty()) {
+    std::string error;
+    if (!WriteTextFileAtomically(a.json, BacktestReportJson(results), &error)) {
+      std::cerr << error << "\n";
+      return kExitRuntime;
+    }
+    std::cerr << "wrote " << a.json << "\n";
+  }
+
+  int jobs = 0, ok_jobs = 0, too_little_data = 0;
+  for (const BacktestResult& r : results) {
+    for (const BacktestDay& d : r.days) {
+      ++jobs;
+      ok_jobs += d.ok;
+      too_little_data += d.failure == BacktestFailure::kTooLittleData;
+    }
+  }
+  if (too_little_data > 0) {
+    std::cerr << a.csv << ": " << too_little_data << " of " << jobs
+              << " jobs had too little data (see \"Failed days\"); fewer than "
+              << options.ident.min_rows << " usable rows in the test day or training window\n";
+    return kExitBadInput;
+  }
+  if (ok_jobs == 0) {
+    std::cerr << "backtest: no identification succeeded\n";
+    return kExitRuntime;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void RegisterBacktest(CLI::App& app) {
+  auto args = std::make_shared<BacktestArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "backtest",
+      "The paper's rolling evaluation (section 3.3): for each test day, identify each variant\n"
+      "on the n days before it, predict the test day from its measured inputs and score it.\n"
+      "Days are local mean solar days (midnight at 00:00 UTC - longitude/15 h). Progress on\n"
+      "stderr, tables shaped like the paper's Tables 4, 5 and 6 on stdout.\n"
+      "Exit 0 success, 2 bad input (bad variant, missing columns, too little data in a test\n"
+      "day or training window: the tables are still printed), 1 no identification succeeded\n"
+      "or the report could not be written.");
+  cmd->add_option("--config", args->config, "TOML config with the [plant] section")->required();
+  cmd->add_option("--csv", args->csv, "canonical CSV with the measurements")->required();
+  cmd->add_option("--variants", args->variants,
+                  "comma-separated variants, or 'paper' for the nine of Table 6 "
+                  "(default: [calibration] variant)")
+      ->delimiter(',');
+  cmd->add_option("--train-days", args->train_days,
+                  "comma-separated training periods n in days, e.g. 7,14,21,28 "
+                  "(default: [calibration] window_days)")
+      ->delimiter(',');
+  cmd->add_option("--step", args->steps_s,
+                  "time step in s (5 ... 900, a multiple of the data step); several, comma-"
+                  "separated, add a Table 5-shaped comparison (default: [calibration] step_s)")
+      ->delimiter(',');
+  cmd->add_option("--first-test-day", args->first_test_day,
+                  "first test day YYYY-MM-DD, the local solar day of that date (default: the "
+                  "first day with max(n) days of data before it)");
+  cmd->add_option("--test-days", args->test_days,
+                  "number of consecutive test days; fewer if the data end (default 29)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--json", args->json, "write the report (every job and the means) as JSON");
+  cmd->add_option("--threads", args->threads, "worker threads, 0 = all cores (default 0)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([args] { SetExitCode(RunBacktestCommand(*args)); });
+}
+
+}  // namespace pvtwin::cli

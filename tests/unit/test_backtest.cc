@@ -1,0 +1,488 @@
+// The rolling backtest of the paper (section 3.3) on synthetic data with a
+// known answer: 5 days at 5 min from the weather generator (seed kSeed),
+// outputs from a 2N1Ccolwr truth with ReferenceTruthParams, no sensor noise
+// unless a test says so. And `pvtwin backtest` as a real process.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/backtest.h"
+#include "core/synthetic_plant.h"
+#include "core/units.h"
+#include "io/csv.h"
+
+namespace pvtwin {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::uint64_t kSeed = 20240601;
+constexpr std::int64_t kJune1_2024 = 1717200000;  // 00:00 UTC, the data's first row
+
+// DESIGN.md's example plant: 47.358° N, 16.128° E, 20° tilt, facing south.
+Plant ExamplePlant() {
+  Plant plant;
+  plant.latitude_rad = DegToRad(47.358);
+  plant.longitude_rad = DegToRad(16.128);
+  plant.tilt_rad = DegToRad(20.0);
+  plant.azimuth_rad = DegToRad(180.0);
+  plant.area_m2 = 1.8;
+  return plant;
+}
+
+ModelSpec Spec(const std::string& name) {
+  ModelSpec spec;
+  std::string error;
+  EXPECT_TRUE(ParseVariant(name, &spec, &error)) << error;
+  return spec;
+}
+
+// 5 days at 5 min from 2024-06-01 00:00 UTC, truth 2N1Ccolwr.
+Series FiveDays(const Plant& plant, const SensorNoise& noise = {}) {
+  WeatherOptions weather;
+  weather.start_time_s = kJune1_2024;
+  weather.num_days = 5;
+  weather.step_s = 300.0;
+  weather.seed = kSeed;
+  return MakeSyntheticPlantData(plant, weather, Spec("2N1Ccolwr"), ReferenceTruthParams(plant),
+                                noise);
+}
+
+BacktestOptions TwoDaysTwoVariants() {
+  BacktestOptions options;
+  options.variants = {"1N1Cwr", "2N1Ccolwr"};
+  options.train_days = {2};
+  options.step_s = 300.0;
+  options.test_days = 2;
+  return options;
+}
+
+// ---------------------------------------------------------------------------
+// Days.
+
+TEST(BacktestDays, BoundariesAreLocalMeanSolarMidnights) {
+  const Plant plant = ExamplePlant();
+  // 16.128° E: local mean solar time = UTC + 16.128/15 h = UTC + 3870.72 s.
+  const std::int64_t offset_s = SolarDayOffsetS(plant);
+  EXPECT_EQ(offset_s, 3871);
+  // Noon UTC on 2024-06-15 is in the solar day that started on 2024-06-14 at
+  // 22:55:29 UTC and is labelled 2024-06-15.
+  const std::int64_t noon_s = kJune1_2024 + 14 * 86400 + 12 * 3600;
+  const std::int64_t start_s = SolarDayStartS(noon_s, offset_s);
+  EXPECT_EQ(start_s, kJune1_2024 + 13 * 86400 + 22 * 3600 + 55 * 60 + 29);
+  EXPECT_EQ(SolarDate(start_s, offset_s), "2024-06-15");
+  EXPECT_EQ(SolarDate(start_s - 1, offset_s), "2024-06-14");
+  EXPECT_EQ(SolarDayStartOfDateS(2024, 6, 15, offset_s), start_s);
+  // 70.6° W: local midnight at 04:42:24 UTC.
+  Plant west = plant;
+  west.longitude_rad = DegToRad(-70.6);
+  const std::int64_t west_offset_s = SolarDayOffsetS(west);
+  EXPECT_EQ(west_offset_s, -16944);
+  EXPECT_EQ(SolarDayStartS(noon_s, west_offset_s), kJune1_2024 + 14 * 86400 + 16944);
+  EXPECT_EQ(SolarDate(kJune1_2024 + 14 * 86400 + 16943, west_offset_s), "2024-06-14");
+  // Calendar edge cases of the date conversion.
+  EXPECT_EQ(SolarDate(SolarDayStartOfDateS(2024, 2, 29, 0), 0), "2024-02-29");
+  EXPECT_EQ(SolarDate(SolarDayStartOfDateS(1969, 12, 31, 0), 0), "1969-12-31");
+  EXPECT_EQ(SolarDayStartOfDateS(1970, 1, 1, 0), 0);
+}
+
+// ---------------------------------------------------------------------------
+// Runs on synthetic data. The reference run is shared by several tests.
+
+class Backtest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    plant_ = new Plant(ExamplePlant());
+    data_ = new Series(FiveDays(*plant_));
+    BacktestOptions options = TwoDaysTwoVariants();
+    options.threads = 1;
+    one_thread_ = new BacktestResult;
+    std::string error;
+    ASSERT_TRUE(RunBacktest(*data_, *plant_, options, one_thread_, &error)) << error;
+  }
+  static void TearDownTestSuite() {
+    delete plant_;
+    delete data_;
+    delete one_thread_;
+  }
+  static Plant* plant_;
+  static Series* data_;
+  static BacktestResult* one_thread_;
+};
+
+Plant* Backtest::plant_ = nullptr;
+Series* Backtest::data_ = nullptr;
+BacktestResult* Backtest::one_thread_ = nullptr;
+
+TEST_F(Backtest, TestDaysStartAtSolarMidnightAfterTheTrainingDays) {
+  const BacktestResult& r = *one_thread_;
+  ASSERT_EQ(r.days.size(), 4u);
+  EXPECT_EQ(r.test_days, 2);
+  const std::int64_t offset_s = SolarDayOffsetS(*plant_);
+  EXPECT_EQ(r.solar_offset_s, offset_s);
+  // The first row (00:00 UTC) is in solar day 2024-06-01 (from 05-31
+  // 22:55:29 UTC); two training days later the first test day is 06-03.
+  EXPECT_EQ(SolarDate(r.days[0].day_start_s, offset_s), "2024-06-03");
+  EXPECT_EQ(r.days[0].day_start_s, kJune1_2024 + 86400 + 22 * 3600 + 55 * 60 + 29);
+  EXPECT_EQ(r.days[2].day_start_s, r.days[0].day_start_s + 86400);
+  for (const BacktestDay& d : r.days) {
+    EXPECT_EQ((d.day_start_s + offset_s) % 86400, 0);
+    // The boundary falls at night: no irradiance in the rows around it.
+    for (std::size_t i = 0; i < data_->size(); ++i) {
+      if (std::llabs(data_->time_s[i] - d.day_start_s) <= 1800) {
+        EXPECT_EQ((*data_)[Channel::kGPoaWM2][i], 0.0) << "row at " << data_->time_s[i];
+      }
+    }
+  }
+}
+
+TEST_F(Backtest, FourJobsInDayVariantOrderAndSameNumbersOnTwoThreads) {
+  const BacktestResult& r1 = *one_thread_;
+  ASSERT_EQ(r1.days.size(), 4u);
+  const char* expected_variants[] = {"1N1Cwr", "2N1Ccolwr", "1N1Cwr", "2N1Ccolwr"};
+  for (std::size_t j = 0; j < 4; ++j) {
+    EXPECT_EQ(r1.days[j].variant, expected_variants[j]);
+    EXPECT_EQ(r1.days[j].train_days, 2);
+    EXPECT_TRUE(r1.days[j].ok) << r1.days[j].failure_reason;
+    EXPECT_GT(r1.days[j].test.rows, 100u);
+    EXPECT_GT(r1.days[j].evaluations, 0);
+  }
+  EXPECT_LT(r1.days[0].day_start_s, r1.days[2].day_start_s);
+
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.threads = 2;
+  BacktestResult r2;
+  std::string error;
+  int calls = 0;
+  ASSERT_TRUE(RunBacktest(*data_, *plant_, options, &r2, &error,
+                          [&calls](int done, int total, const BacktestDay&) {
+                            ++calls;
+                            EXPECT_EQ(done, calls);
+                            EXPECT_EQ(total, 4);
+                          }))
+      << error;
+  EXPECT_EQ(calls, 4);
+  ASSERT_EQ(r2.days.size(), r1.days.size());
+  for (std::size_t j = 0; j < r1.days.size(); ++j) {
+    EXPECT_EQ(r2.days[j].day_start_s, r1.days[j].day_start_s);
+    EXPECT_EQ(r2.days[j].variant, r1.days[j].variant);
+    EXPECT_EQ(r2.days[j].test.mae_p_el_w_m2, r1.days[j].test.mae_p_el_w_m2);
+    EXPECT_EQ(r2.days[j].test.mae_q_th_w_m2, r1.days[j].test.mae_q_th_w_m2);
+    EXPECT_EQ(r2.days[j].evaluations, r1.days[j].evaluations);
+    EXPECT_EQ(r2.days[j].params, r1.days[j].params);
+  }
+  ASSERT_EQ(r2.averages.size(), 2u);
+  EXPECT_EQ(r2.averages[0].mae_q_th_w_m2, r1.averages[0].mae_q_th_w_m2);
+}
+
+TEST_F(Backtest, TruthVariantPredictsNoiseFreeTestDaysWithinThreeWattsPerSquareMetre) {
+  for (const BacktestDay& d : one_thread_->days) {
+    if (d.variant != "2N1Ccolwr") continue;
+    ASSERT_TRUE(d.ok) << d.failure_reason;
+    EXPECT_LT(d.test.mae_p_el_w_m2, 3.0) << SolarDate(d.day_start_s, one_thread_->solar_offset_s);
+    EXPECT_LT(d.test.mae_q_th_w_m2, 3.0) << SolarDate(d.day_start_s, one_thread_->solar_offset_s);
+  }
+}
+
+TEST_F(Backtest, AveragesAreMeansOverTheTestDays) {
+  const BacktestResult& r = *one_thread_;
+  ASSERT_EQ(r.averages.size(), 2u);
+  for (std::size_t v = 0; v < 2; ++v) {
+    const BacktestAverage& a = r.averages[v];
+    EXPECT_EQ(a.variant, r.days[v].variant);
+    EXPECT_EQ(a.train_days, 2);
+    EXPECT_EQ(a.days_ok, 2);
+    EXPECT_EQ(a.days_failed, 0);
+    const BacktestDay& d0 = r.days[v];
+    const BacktestDay& d1 = r.days[2 + v];
+    EXPECT_DOUBLE_EQ(a.mae_p_el_w_m2, 0.5 * (d0.test.mae_p_el_w_m2 + d1.test.mae_p_el_w_m2));
+    EXPECT_DOUBLE_EQ(a.mae_q_th_w_m2, 0.5 * (d0.test.mae_q_th_w_m2 + d1.test.mae_q_th_w_m2));
+    EXPECT_DOUBLE_EQ(a.nmae_q_th, 0.5 * (d0.test.nmae_q_th + d1.test.nmae_q_th));
+    EXPECT_DOUBLE_EQ(a.runtime_s, 0.5 * (d0.runtime_s + d1.runtime_s));
+  }
+  const std::string tables = FormatBacktestTables(r);
+  EXPECT_NE(tables.find("2024-06-03 … 2024-06-04"), std::string::npos) << tables;
+  EXPECT_NE(tables.find("\n  1N1Cwr "), std::string::npos) << tables;
+  EXPECT_NE(tables.find("\n  2N1Ccolwr "), std::string::npos) << tables;
+}
+
+TEST_F(Backtest, TestDayWithoutDataIsAFailedDayWithItsReason) {
+  // Drop all but 10 rows of the second test day (solar day 2024-06-04).
+  const std::int64_t offset_s = SolarDayOffsetS(*plant_);
+  const std::int64_t day_s = SolarDayStartOfDateS(2024, 6, 4, offset_s);
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < data_->size(); ++i) {
+    const std::int64_t t = data_->time_s[i];
+    if (t < day_s + 10 * 300 || t >= day_s + 86400) keep.push_back(i);
+  }
+  Series holed;
+  holed.step_s = data_->step_s;
+  for (std::size_t i : keep) holed.time_s.push_back(data_->time_s[i]);
+  for (std::size_t c = 0; c < kNumChannels; ++c) {
+    for (std::size_t i : keep) {
+      if (!data_->columns[c].empty()) holed.columns[c].push_back(data_->columns[c][i]);
+    }
+  }
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.variants = {"1N1Cwr"};
+  BacktestResult r;
+  std::string error;
+  ASSERT_TRUE(RunBacktest(holed, *plant_, options, &r, &error)) << error;
+  ASSERT_EQ(r.days.size(), 2u);
+  EXPECT_TRUE(r.days[0].ok) << r.days[0].failure_reason;
+  EXPECT_FALSE(r.days[1].ok);
+  EXPECT_EQ(r.days[1].failure, BacktestFailure::kTooLittleData);
+  EXPECT_EQ(r.days[1].failure_reason,
+            "test day 2024-06-04 has 10 objective rows, fewer than ident.min_rows = 30");
+  ASSERT_EQ(r.averages.size(), 1u);
+  EXPECT_EQ(r.averages[0].days_ok, 1);
+  EXPECT_EQ(r.averages[0].days_failed, 1);
+  EXPECT_EQ(r.averages[0].mae_q_th_w_m2, r.days[0].test.mae_q_th_w_m2);
+  EXPECT_NE(FormatBacktestTables(r).find("2024-06-04 1N1Cwr n=2: test day 2024-06-04 has 10"),
+            std::string::npos);
+}
+
+TEST_F(Backtest, TrainingWindowBeforeTheDataIsAFailedDay) {
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.variants = {"1N1Cwr"};
+  options.test_days = 1;
+  options.first_test_day_s = kJune1_2024 + 12 * 3600;  // solar day 2024-06-01: nothing before it
+  BacktestResult r;
+  std::string error;
+  ASSERT_TRUE(RunBacktest(*data_, *plant_, options, &r, &error)) << error;
+  ASSERT_EQ(r.days.size(), 1u);
+  EXPECT_EQ(r.days[0].failure, BacktestFailure::kTooLittleData);
+  EXPECT_EQ(r.days[0].failure_reason,
+            "training window 2024-05-30 … 2024-05-31 (2 days) has 0 objective rows, fewer than "
+            "ident.min_rows = 30");
+}
+
+TEST_F(Backtest, MissingColumnFailsTheWholeRunUpFront) {
+  Series no_wind = *data_;
+  no_wind[Channel::kWindMS].clear();
+  BacktestResult r;
+  std::string error;
+  EXPECT_FALSE(RunBacktest(no_wind, *plant_, TwoDaysTwoVariants(), &r, &error));
+  EXPECT_TRUE(r.days.empty());
+  // One message per variant that needs the column, as PrepareDrivers words it.
+  EXPECT_NE(error.find("variant 1N1Cwr needs columns the data lacks"), std::string::npos) << error;
+  EXPECT_NE(error.find("variant 2N1Ccolwr needs columns the data lacks"), std::string::npos)
+      << error;
+  EXPECT_NE(error.find("wind_m_s"), std::string::npos) << error;
+}
+
+TEST_F(Backtest, StepFinerThanTheDataOrNotAMultipleIsAnError) {
+  BacktestOptions options = TwoDaysTwoVariants();
+  BacktestResult r;
+  std::string error;
+  options.step_s = 60.0;
+  EXPECT_FALSE(RunBacktest(*data_, *plant_, options, &r, &error));
+  EXPECT_EQ(error, "step_s = 60: finer than the data step 300 s");
+  options.step_s = 450.0;
+  EXPECT_FALSE(RunBacktest(*data_, *plant_, options, &r, &error));
+  EXPECT_NE(error.find("step_s = 450: "), std::string::npos) << error;
+  EXPECT_NE(error.find("multiple"), std::string::npos) << error;
+}
+
+TEST_F(Backtest, CoarserStepAveragesTheData) {
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.variants = {"1N1Cwr"};
+  options.test_days = 1;
+  options.step_s = 900.0;
+  BacktestResult r;
+  std::string error;
+  ASSERT_TRUE(RunBacktest(*data_, *plant_, options, &r, &error)) << error;
+  EXPECT_EQ(r.step_s, 900.0);
+  ASSERT_EQ(r.days.size(), 1u);
+  ASSERT_TRUE(r.days[0].ok) << r.days[0].failure_reason;
+  EXPECT_LE(r.days[0].test.rows, 96u);  // a day of 15-min rows
+  EXPECT_GT(r.days[0].test.rows, 40u);
+}
+
+TEST_F(Backtest, NoCompleteTestDayIsAnError) {
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.train_days = {5};
+  BacktestResult r;
+  std::string error;
+  EXPECT_FALSE(RunBacktest(*data_, *plant_, options, &r, &error));
+  EXPECT_NE(error.find("no complete test day"), std::string::npos) << error;
+  EXPECT_NE(error.find("5 training days + 1 test day"), std::string::npos) << error;
+}
+
+// ---------------------------------------------------------------------------
+// Options.
+
+TEST(BacktestOptions, IsValidNamesFieldValueAndRule) {
+  BacktestOptions ok;
+  ok.variants = {"1N", "2N1Ccolwr"};
+  std::string why;
+  EXPECT_TRUE(ok.IsValid(&why)) << why;
+
+  auto problem = [](BacktestOptions o) {
+    std::string w;
+    EXPECT_FALSE(o.IsValid(&w));
+    return w;
+  };
+  BacktestOptions o = ok;
+  o.variants = {"3N", "1N", "4X"};
+  const std::string names = problem(o);
+  EXPECT_NE(names.find("variants = 3N: "), std::string::npos) << names;
+  EXPECT_NE(names.find("variants = 4X: "), std::string::npos) << names;
+  EXPECT_EQ(names.find("variants = 1N"), std::string::npos) << names;
+  o = ok;
+  o.variants = {};
+  EXPECT_EQ(problem(o), "variants = (none): give at least one variant");
+  o = ok;
+  o.variants = {"1N", "1N"};
+  EXPECT_EQ(problem(o), "variants = 1N: listed twice");
+  o = ok;
+  o.train_days = {7, 0};
+  EXPECT_EQ(problem(o), "train_days = 0: must be within [1, 365]");
+  o = ok;
+  o.step_s = 1000;
+  EXPECT_EQ(problem(o), "step_s = 1000: must be whole seconds within [5, 900] dividing 86400");
+  o.step_s = 7;
+  EXPECT_EQ(problem(o), "step_s = 7: must be whole seconds within [5, 900] dividing 86400");
+  o = ok;
+  o.test_days = 0;
+  EXPECT_EQ(problem(o), "test_days = 0: must be >= 1");
+  o = ok;
+  o.threads = -1;
+  EXPECT_EQ(problem(o), "threads = -1: must be >= 0 (0 = all cores)");
+  o = ok;
+  o.ident.min_rows = -5;
+  o.test_days = 0;
+  const std::string two = problem(o);
+  EXPECT_EQ(two.find("test_days = 0: must be >= 1; ident."), 0u) << two;
+}
+
+// ---------------------------------------------------------------------------
+// The binary.
+
+struct ProcessResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+ProcessResult RunPvtwin(const fs::path& dir, const std::string& args) {
+  const fs::path err_path = dir / "stderr.txt";
+  const std::string command = "cd '" + dir.string() + "' && '" + PVTWIN_BINARY + "' " + args +
+                              " 2>'" + err_path.string() + "'";
+  ProcessResult run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buf;
+  std::size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
+  const int status = pclose(pipe);
+  if (WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
+  run.err = ReadFile(err_path);
+  return run;
+}
+
+// A temporary folder with config.toml and data.csv (5 days at 5 min).
+class BacktestCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("pvtwin_backtest_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    std::ofstream(dir_ / "config.toml") << "[plant]\n"
+                                           "latitude_deg = 47.358\n"
+                                           "longitude_deg = 16.128\n"
+                                           "tilt_deg = 20\n"
+                                           "azimuth_deg = 180\n"
+                                           "area_m2 = 1.8\n";
+    const Series data = FiveDays(ExamplePlant());
+    std::vector<Channel> channels;
+    for (std::size_t c = 0; c < kNumChannels; ++c) {
+      if (data.Has(static_cast<Channel>(c))) channels.push_back(static_cast<Channel>(c));
+    }
+    std::string error;
+    ASSERT_TRUE(WriteCsv((dir_ / "data.csv").string(), data, channels, &error)) << error;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(BacktestCli, RunsOnACsvAndPrintsOneRowPerVariant) {
+  const ProcessResult run =
+      RunPvtwin(dir_,
+                "backtest --config config.toml --csv data.csv --variants 1N1C,1N1Cwr "
+                "--train-days 2 --step 300 --first-test-day 2024-06-04 --test-days 1 "
+                "--threads 2 --json out.json");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  EXPECT_NE(run.out.find("1 test day(s) 2024-06-04 … 2024-06-04"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("\n  1N1C "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("\n  1N1Cwr "), std::string::npos) << run.out;
+  EXPECT_NE(run.err.find("[2/2] 2024-06-04 "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(" n=2: MAE Pel "), std::string::npos) << run.err;
+  const auto report = nlohmann::json::parse(ReadFile(dir_ / "out.json"));
+  EXPECT_EQ(report["format"], "pvtwin-backtest-1");
+  ASSERT_EQ(report["runs"].size(), 1u);
+  ASSERT_EQ(report["runs"][0]["days"].size(), 2u);
+  EXPECT_EQ(report["runs"][0]["days"][0]["day"], "2024-06-04");
+  EXPECT_EQ(report["runs"][0]["days"][0]["variant"], "1N1C");
+  EXPECT_TRUE(report["runs"][0]["days"][1]["params"].contains("u_front_w_m2k"));
+}
+
+TEST_F(BacktestCli, BadVariantNameExitsTwoAndNamesIt) {
+  const ProcessResult run = RunPvtwin(
+      dir_, "backtest --config config.toml --csv data.csv --variants 3N,1N --train-days 2");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.out, "");
+  EXPECT_EQ(run.err.rfind("--variants = 3N: ", 0), 0u) << run.err;
+  EXPECT_EQ(run.err.find("--variants = 1N"), std::string::npos) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+}
+
+TEST_F(BacktestCli, MissingColumnExitsTwoNamingTheVariantAndColumn) {
+  Series data = FiveDays(ExamplePlant());
+  const Channel channels[] = {Channel::kTInC,    Channel::kTOutC, Channel::kMdotKgS,
+                              Channel::kGPoaWM2, Channel::kTAmbC, Channel::kLwDownWM2,
+                              Channel::kPElW,    Channel::kQThW};
+  std::string error;
+  ASSERT_TRUE(WriteCsv((dir_ / "no_wind.csv").string(), data, channels, &error)) << error;
+  const ProcessResult run =
+      RunPvtwin(dir_,
+                "backtest --config config.toml --csv no_wind.csv --variants 1N1C,1N1Cwr "
+                "--train-days 2 --step 300");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.out, "");
+  EXPECT_NE(run.err.find("no_wind.csv: variant 1N1Cwr needs columns the data lacks"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("wind_m_s"), std::string::npos) << run.err;
+}
+
+TEST_F(BacktestCli, DataShorterThanTrainingPlusTestDayExitsTwo) {
+  const ProcessResult run = RunPvtwin(dir_,
+                                      "backtest --config config.toml --csv data.csv --variants "
+                                      "1N1C --train-days 9 --step 300");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("data.csv: no complete test day"), std::string::npos) << run.err;
+}
+
+}  // namespace
+}  // namespace pvtwin

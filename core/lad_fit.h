@@ -1,0 +1,61 @@
+// Least-absolute-deviation fit by Levenberg–Marquardt on iteratively
+// reweighted least squares (IRLS).
+//
+// Minimises   O(z) = Σ_i |r_i(z)| / N_scale + prior_weight · Σ_j (z_j − z_ref,j)²
+// over the unit box 0 ≤ z ≤ 1, for a residual function r(z) of many rows and
+// few parameters — the paper's MAE objective (3.2.2) in the identification's
+// unit coordinates. Each iteration replaces |r_i| by its quadratic majoriser
+// r_i²/(2|r̂_i|) + |r̂_i|/2 at the current residuals r̂ (IRLS weights
+// 1/max(|r̂_i|, δ)), builds the forward-difference Jacobian (one residual
+// evaluation per free parameter) and takes damped Gauss–Newton steps
+// (Levenberg–Marquardt, projected onto the box) that must lower O itself.
+// This uses the residual structure that a derivative-free method cannot see,
+// the same idea as the paper's lsqnonlin on √|r_i|, without the singularity
+// of √|r| at zero.
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace pvtwin {
+
+struct LadFitOptions {
+  int max_iterations = 500;        // Jacobian evaluations at most
+  int max_evaluations = 2000;      // residual evaluations in total
+  double ftol_rel = 1e-7;          // stop when an accepted step lowers O by less than this fraction
+  double xtol = 1e-7;              // … or moves z by less than this (max norm)
+  double jacobian_step = 1e-4;     // forward-difference step in unit coordinates
+  // δ = this × mean |r|: caps the IRLS weights 1/max(|r̂|, δ). A floor near
+  // the typical residual keeps the majoriser well conditioned; it shapes the
+  // steps only, since every step must lower the true O(z). 0.3 needed about
+  // 25 % fewer evaluations than 1e-6 on synthetic 14-day data with noise.
+  double weight_floor_rel = 0.3;
+  double prior_weight = 0.0;       // see O(z)
+  double n_scale = 1.0;            // N_scale in O(z)
+};
+
+struct LadFitResult {
+  Eigen::VectorXd z;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;
+  int evaluations = 0;
+  bool converged = false;
+  std::string message;
+  // J at the returned point (rows × free parameters), for the caller's
+  // identifiability analysis; empty if the last step moved away from where
+  // it was computed.
+  Eigen::MatrixXd jacobian;
+  Eigen::VectorXd weights;  // IRLS weights used with that Jacobian
+};
+
+// residuals(z, r) fills r (resized by the callee) and returns false if the
+// residuals are not finite.
+using ResidualFunction = std::function<bool(const Eigen::VectorXd& z, Eigen::VectorXd* r)>;
+
+LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0,
+                    const Eigen::VectorXd& z_ref, const LadFitOptions& options);
+
+}  // namespace pvtwin

@@ -11,6 +11,7 @@ void SetExitCode(int code) { g_exit_code = code; }
 
 void RegisterCommands(CLI::App& app) {
   RegisterCheckConfig(app);
+  RegisterCalibrate(app);
   RegisterSimulate(app);
   RegisterBench(app);
   RegisterBacktest(app);

@@ -19,6 +19,7 @@ void SetExitCode(int code);
 
 void RegisterCheckConfig(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
+void RegisterCalibrate(CLI::App& app);
 void RegisterBench(CLI::App& app);
 void RegisterBacktest(CLI::App& app);
 

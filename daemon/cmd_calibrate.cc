@@ -1,0 +1,273 @@
+// pvtwin calibrate: identify a variant's parameters from operation data.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "core/identification.h"
+#include "core/resample.h"
+#include "daemon/commands.h"
+#include "daemon/inputs.h"
+#include "io/params_json.h"
+#include "io/time_format.h"
+
+namespace pvtwin::cli {
+
+namespace {
+
+struct CalibrateArgs {
+  std::string config;
+  std::string csv;
+  std::string variant;
+  std::string out;
+  std::string train_start;
+  std::string train_end;
+  std::string start_params;
+  std::string test_csv;
+  std::string algorithm = "lad_lm";
+  std::vector<std::string> free;
+  std::vector<std::string> fix;
+  double step_s = 0.0;
+  int max_evaluations = 0;
+  bool use_t_pv = false;
+};
+
+// Rows of `s` with start ≤ time < end.
+Series Window(const Series& s, std::int64_t start, std::int64_t end) {
+  std::size_t b = 0;
+  while (b < s.size() && s.time_s[b] < start) ++b;
+  std::size_t e = b;
+  while (e < s.size() && s.time_s[e] < end) ++e;
+  return s.Slice(b, e);
+}
+
+bool ResampleOrReport(const std::string& path, double step_s, Series* s) {
+  if (step_s <= 0.0 || step_s == s->step_s) return true;
+  Series out;
+  std::string error;
+  if (!Resample(*s, step_s, &out, &error)) {
+    std::cerr << "--step = " << step_s << ": " << path << ": " << error << "\n";
+    return false;
+  }
+  *s = std::move(out);
+  return true;
+}
+
+std::string Percent(double fraction) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.1f %%", 100.0 * fraction);
+  return std::isfinite(fraction) ? buf : "n/a";
+}
+
+void PrintErrors(const char* label, const ErrorMetrics& e) {
+  std::printf("%-26s MAE P_el %7.3f W/m2 (nMAE %s), MAE Q_u %7.3f W/m2 (nMAE %s), %zu rows\n",
+              label, e.mae_p_el_w_m2, Percent(e.nmae_p_el).c_str(), e.mae_q_th_w_m2,
+              Percent(e.nmae_q_th).c_str(), e.rows);
+}
+
+std::string StatusOf(const ParamEstimate& e) {
+  if (!e.free) return "fixed";
+  if (e.undetermined) return "fixed: not determined by the data";
+  if (e.at_bound) return e.value - e.lower < e.upper - e.value ? "at lower bound" : "at upper bound";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%s (se %.3g)", e.weak ? "weakly determined" : "identified",
+                e.se_unit);
+  return buf;
+}
+
+std::string FitJson(const IdentSummary& s, const ErrorMetrics* held_out) {
+  std::ostringstream j;
+  auto metrics = [&j](const ErrorMetrics& e) {
+    j << "{\"rows\": " << e.rows << ", \"mae_p_el_w_m2\": " << e.mae_p_el_w_m2
+      << ", \"mae_q_th_w_m2\": " << e.mae_q_th_w_m2 << ", \"nmae_p_el\": "
+      << (std::isfinite(e.nmae_p_el) ? e.nmae_p_el : 0.0)
+      << ", \"nmae_q_th\": " << (std::isfinite(e.nmae_q_th) ? e.nmae_q_th : 0.0) << "}";
+  };
+  j.precision(10);
+  j << "{\"algorithm\": \"" << s.algorithm << "\", \"termination\": \""
+    << ToString(s.termination) << "\", \"initial_cost_w_m2\": " << s.initial_cost_w_m2
+    << ", \"final_cost_w_m2\": " << s.final_cost_w_m2 << ", \"simulations\": " << s.evaluations
+    << ", \"runtime_s\": " << s.runtime_s << ", \"train\": ";
+  metrics(s.train);
+  if (held_out) {
+    j << ", \"held_out\": ";
+    metrics(*held_out);
+  }
+  j << ", \"undetermined\": [";
+  bool first = true;
+  for (const ParamEstimate& e : s.estimates) {
+    if (!e.undetermined) continue;
+    j << (first ? "" : ", ") << "\"" << kParamTable[static_cast<std::size_t>(e.param)].name << "\"";
+    first = false;
+  }
+  j << "]}";
+  return j.str();
+}
+
+bool ParamSetOrReport(const std::string& option, const std::vector<std::string>& names,
+                      std::bitset<kNumParams>* set) {
+  bool ok = true;
+  for (const std::string& n : names) {
+    const std::optional<Param> p = ParamFromName(n);
+    if (!p) {
+      std::cerr << option << " = " << n << ": unknown parameter (see params.h or params.json)\n";
+      ok = false;
+      continue;
+    }
+    set->set(static_cast<std::size_t>(*p));
+  }
+  return ok;
+}
+
+int RunCalibrate(const CalibrateArgs& a) {
+  Config config;
+  if (!LoadConfigOrReport(a.config, &config)) return kExitBadInput;
+  ModelSpec spec;
+  if (!ParseVariantOrReport(a.variant, &spec)) return kExitBadInput;
+  IdentOptions options;
+  if (!SetIdentAlgorithm(a.algorithm, &options)) {
+    std::cerr << "--algorithm = " << a.algorithm
+              << ": unknown (lad_lm, bobyqa, sbplx, nelder_mead, cobyla, lbfgs, mma, crs2_bobyqa, "
+                 "multistart_bobyqa, mlsl_bobyqa)\n";
+    return kExitBadInput;
+  }
+  if (a.max_evaluations > 0) options.optimizer.max_evaluations = a.max_evaluations;
+  options.use_t_pv = a.use_t_pv;
+  std::bitset<kNumParams> free_set, fix_set;
+  if (!ParamSetOrReport("--free", a.free, &free_set) ||
+      !ParamSetOrReport("--fix", a.fix, &fix_set)) {
+    return kExitBadInput;
+  }
+  options.free = (free_set.any() ? free_set : DefaultFreeParams(spec)) & ~fix_set;
+  if (options.free.none()) options.free = DefaultFreeParams(spec) & ~fix_set;
+
+  ParamVector start = StartParams(config.plant);
+  if (!a.start_params.empty()) {
+    ParamsFile file;
+    Diagnostics errors;
+    if (!ReadParamsJson(a.start_params, config.plant, &file, &errors)) {
+      for (const Diagnostic& d : errors) std::cerr << d.ToString() << "\n";
+      return kExitBadInput;
+    }
+    start = file.values;
+  }
+
+  Series series;
+  if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
+  std::int64_t t_begin = series.time_s.empty() ? 0 : series.time_s.front();
+  std::int64_t t_end = series.time_s.empty() ? 0 : series.time_s.back() + 1;
+  if (!a.train_start.empty() && !ParseTimeOrReport("--train-start", a.train_start, &t_begin)) {
+    return kExitBadInput;
+  }
+  if (!a.train_end.empty() && !ParseTimeOrReport("--train-end", a.train_end, &t_end)) {
+    return kExitBadInput;
+  }
+  Series train = Window(series, t_begin, t_end);
+  if (!ResampleOrReport(a.csv, a.step_s, &train)) return kExitBadInput;
+  Drivers drivers;
+  if (!PrepareDriversOrReport(train, a.csv, config, spec, &drivers)) return kExitBadInput;
+  const Measurements meas = MakeMeasurements(train, drivers);
+  if (static_cast<int>(meas.rows.size()) < options.min_rows) {
+    std::cerr << a.csv << ": training window " << FormatIsoUtc(t_begin) << " .. "
+              << FormatIsoUtc(t_end) << " has " << meas.rows.size()
+              << " usable rows (valid, with flow, irradiance, p_el_w and q_th_w or t_out_c); at "
+                 "least "
+              << options.min_rows << " are needed\n";
+    return kExitBadInput;
+  }
+
+  // Held-out data, checked before the (long) fit.
+  Series test;
+  Drivers test_drivers;
+  if (!a.test_csv.empty()) {
+    if (!LoadCsvOrReport(a.test_csv, config, &test)) return kExitBadInput;
+    if (!ResampleOrReport(a.test_csv, a.step_s, &test)) return kExitBadInput;
+    if (!PrepareDriversOrReport(test, a.test_csv, config, spec, &test_drivers)) {
+      return kExitBadInput;
+    }
+  }
+
+  std::fprintf(stderr, "calibrating %s on %zu rows (%zu in the objective) of %s ...\n",
+               spec.Name().c_str(), train.size(), meas.rows.size(), a.csv.c_str());
+  const IdentSummary summary = Identify(drivers, meas, start, options);
+  std::printf("%s\n", summary.BriefReport().c_str());
+  std::printf("training data: %s, %s .. %s, step %.0f s\n", a.csv.c_str(),
+              FormatIsoUtc(train.time_s.front()).c_str(),
+              FormatIsoUtc(train.time_s.back()).c_str(), train.step_s);
+  PrintErrors("errors (training):", summary.train);
+  ErrorMetrics held_out;
+  if (!a.test_csv.empty()) {
+    SimOutputs sim;
+    Simulate(test_drivers, summary.params, &sim);
+    held_out = ComputeErrors(MakeMeasurements(test, test_drivers), sim, config.plant.area_m2);
+    PrintErrors(("errors (held out):"), held_out);
+  }
+  std::printf("parameters:\n  %-22s %12s  %-16s %12s  %-22s %s\n", "name", "value", "unit", "start",
+              "range", "status");
+  for (const ParamEstimate& e : summary.estimates) {
+    const ParamInfo& info = Info(e.param);
+    char range[48];
+    std::snprintf(range, sizeof(range), "[%.3g, %.3g]", e.lower, e.upper);
+    std::printf("  %-22s %12.5g  %-16s %12.5g  %-22s %s\n", std::string(info.name).c_str(), e.value,
+                std::string(info.unit).c_str(), e.start, range, StatusOf(e).c_str());
+  }
+  for (const std::string& note : summary.notes) std::printf("note: %s\n", note.c_str());
+  if (!summary.ok) {
+    std::fprintf(stderr, "calibration failed: %s\n", summary.failure_reason.c_str());
+    return kExitRuntime;
+  }
+  if (!a.out.empty()) {
+    std::string error;
+    const std::string text = FormatParamsJson(spec.Name(), summary.params, UsedParams(spec),
+                                              FitJson(summary, a.test_csv.empty() ? nullptr : &held_out));
+    if (!WriteTextFileAtomically(a.out, text, &error)) {
+      std::cerr << error << "\n";
+      return kExitRuntime;
+    }
+    std::fprintf(stderr, "wrote %s\n", a.out.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void RegisterCalibrate(CLI::App& app) {
+  auto args = std::make_shared<CalibrateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate",
+      "Identify the parameters of a model variant from operation data (paper 3.2): minimise\n"
+      "MAE(P_el) + MAE(Q_u) per m2 over the valid rows with flow, irradiance and outputs.\n"
+      "Prints the fit, the errors and each parameter with its status (identified, at a bound,\n"
+      "fixed because the data do not determine it); writes params.json for `pvtwin simulate`.\n"
+      "Exit code 1 when the fit fails (the reason is printed and no file is written).");
+  cmd->add_option("--config", args->config, "TOML config with the [plant] section")->required();
+  cmd->add_option("--csv", args->csv, "canonical CSV with inputs and measured outputs")
+      ->required();
+  cmd->add_option("--variant", args->variant, "model variant, e.g. 2N1Ccolwr")->required();
+  cmd->add_option("--out", args->out, "write the identified parameters to this params.json");
+  cmd->add_option("--train-start", args->train_start,
+                  "first time of the training window (ISO 8601 or unix s; default: first row)");
+  cmd->add_option("--train-end", args->train_end,
+                  "end of the training window, exclusive (default: after the last row)");
+  cmd->add_option("--step", args->step_s,
+                  "average the data to this step in seconds first (a multiple of the data step)");
+  cmd->add_option("--test-csv", args->test_csv,
+                  "held-out data: print the errors of the identified model on it");
+  cmd->add_option("--start", args->start_params,
+                  "params.json with start values (e.g. the last calibration); default Table 3");
+  cmd->add_option("--algorithm", args->algorithm,
+                  "lad_lm (default: Levenberg-Marquardt on IRLS) or an NLopt method: bobyqa, "
+                  "sbplx, nelder_mead, cobyla, lbfgs, mma, crs2_bobyqa, multistart_bobyqa, "
+                  "mlsl_bobyqa");
+  cmd->add_option("--free", args->free,
+                  "parameters to identify (default: all the variant uses except area_m2 and the "
+                  "PV correction coefficients)")
+      ->delimiter(',');
+  cmd->add_option("--fix", args->fix, "parameters to keep at their start values")->delimiter(',');
+  cmd->add_option("--max-evaluations", args->max_evaluations, "simulation budget of the fit");
+  cmd->add_flag("--use-t-pv", args->use_t_pv,
+                "add the measured PV temperature (t_pv_c) to the objective");
+  cmd->callback([args] { SetExitCode(RunCalibrate(*args)); });
+}
+
+}  // namespace pvtwin::cli

@@ -1,0 +1,194 @@
+// Identification on data with a known answer (synthetic, seeds recorded) and
+// on real data with provenance (../shared/data/htwsaar-pvt).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "config/plant_config.h"
+#include "core/identification.h"
+#include "core/synthetic_plant.h"
+#include "core/units.h"
+#include "io/csv.h"
+
+namespace pvtwin {
+namespace {
+
+Plant SyntheticPlant() {
+  Plant plant;
+  plant.latitude_rad = DegToRad(47.358);
+  plant.longitude_rad = DegToRad(16.128);
+  plant.tilt_rad = DegToRad(20.0);
+  plant.azimuth_rad = DegToRad(180.0);
+  return plant;
+}
+
+ModelSpec Spec(const std::string& name) {
+  ModelSpec spec;
+  std::string error;
+  EXPECT_TRUE(ParseVariant(name, &spec, &error)) << error;
+  return spec;
+}
+
+struct Case {
+  Series series;
+  Drivers drivers;
+  Measurements meas;
+};
+
+Case MakeCase(const Plant& plant, const std::string& variant, int days, double step_s,
+              std::uint64_t seed, const SensorNoise& noise) {
+  WeatherOptions weather;
+  weather.num_days = days;
+  weather.step_s = step_s;
+  weather.seed = seed;
+  weather.flow_mode = FlowMode::kVariable;  // varying flow separates r0 from r1
+  Case c;
+  c.series = MakeSyntheticPlantData(plant, weather, Spec(variant), ReferenceTruthParams(plant), noise);
+  std::string error;
+  EXPECT_TRUE(PrepareDrivers(c.series, plant, Spec(variant), &c.drivers, &error)) << error;
+  c.meas = MakeMeasurements(c.series, c.drivers);
+  return c;
+}
+
+// Noise-free data from the model itself: the identifiable parameters come
+// back within 1 % and the MAE falls below 0.5 W/m².
+TEST(IdentifySynthetic, NoiseFreeRecoversIdentifiableParameters) {
+  const Plant plant = SyntheticPlant();
+  const ParamVector truth = ReferenceTruthParams(plant);
+  for (const std::string variant : {"1N1Cwr", "2N1Ccolwr"}) {
+    const Case c = MakeCase(plant, variant, 7, 120.0, /*seed=*/11, SensorNoise{});
+    // Converge fully: the default tolerance stops where noise would dominate.
+    IdentOptions options;
+    options.optimizer.ftol_rel = 1e-10;
+    options.optimizer.xtol_rel = 1e-10;
+    options.prior_weight_w_m2 = 0.0;
+    const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), options);
+    ASSERT_TRUE(s.ok) << s.BriefReport();
+    EXPECT_LT(s.train.objective_w_m2(), 0.5) << s.BriefReport();
+    int checked = 0;
+    for (const ParamEstimate& e : s.estimates) {
+      if (!e.free || e.undetermined || e.weak) continue;
+      const double t = truth[static_cast<std::size_t>(e.param)];
+      EXPECT_NEAR(e.value, t, 0.01 * std::fabs(t))
+          << variant << " " << kParamTable[static_cast<std::size_t>(e.param)].name << " se "
+          << e.se_unit << ": " << s.BriefReport();
+      ++checked;
+    }
+    EXPECT_GE(checked, 8) << variant << ": too few parameters identified";
+  }
+}
+
+// With realistic sensor noise the fit reaches the noise floor (the MAE of the
+// true parameters on the same noisy data) within 10 %.
+TEST(IdentifySynthetic, NoisyDataReachTheNoiseFloor) {
+  const Plant plant = SyntheticPlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
+  SimOutputs truth_out;
+  Simulate(c.drivers, ReferenceTruthParams(plant), &truth_out);
+  const double floor = ComputeErrors(c.meas, truth_out, plant.area_m2).objective_w_m2();
+  ASSERT_GT(floor, 0.1);  // the noise is there
+  const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), IdentOptions{});
+  ASSERT_TRUE(s.ok) << s.BriefReport();
+  EXPECT_LT(std::fabs(s.train.objective_w_m2() - floor), 0.1 * floor)
+      << "fit " << s.train.objective_w_m2() << " W/m2, noise floor " << floor << " W/m2";
+}
+
+// A_PVT multiplies every flux: freed together with the others it spans a flat
+// direction, which must be reported and resolved by fixing a parameter at its
+// reference value instead of returning an arbitrary point on the ridge.
+TEST(IdentifySynthetic, FlatDirectionIsReportedAndFixed) {
+  const Plant plant = SyntheticPlant();
+  const Case c = MakeCase(plant, "1N1C", 5, 300.0, /*seed=*/14, SensorNoise{});
+  IdentOptions options;
+  options.free = DefaultFreeParams(Spec("1N1C"));
+  options.free.set(static_cast<std::size_t>(Param::kAreaM2));
+  const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), options);
+  ASSERT_TRUE(s.ok) << s.BriefReport();
+  EXPECT_LT(s.train.objective_w_m2(), 0.5);
+  int undetermined = 0;
+  for (const ParamEstimate& e : s.estimates) {
+    if (!e.undetermined) continue;
+    ++undetermined;
+    EXPECT_EQ(e.value, e.start) << "an undetermined parameter stays at its reference value";
+  }
+  EXPECT_GE(undetermined, 1);
+  ASSERT_FALSE(s.notes.empty());
+  EXPECT_NE(s.notes.front().find("not determined"), std::string::npos) << s.notes.front();
+}
+
+TEST(IdentifyFailures, TooLittleDataIsAFailureWithReason) {
+  const Plant plant = SyntheticPlant();
+  Case c = MakeCase(plant, "1N1C", 1, 600.0, 15, SensorNoise{});
+  c.meas.rows.resize(5);
+  const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), IdentOptions{});
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.failure_reason.find("too little data"), std::string::npos) << s.failure_reason;
+}
+
+TEST(IdentifyFailures, EvaluationCapNeverReturnsAWorseFit) {
+  const Plant plant = SyntheticPlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 2, 600.0, 16, RealisticSensorNoise(17));
+  for (const char* algorithm : {"lad_lm", "sbplx", "bobyqa"}) {
+    IdentOptions options;
+    ASSERT_TRUE(SetIdentAlgorithm(algorithm, &options));
+    options.optimizer.max_evaluations = 15;
+    const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), options);
+    EXPECT_LE(s.final_cost_w_m2, s.initial_cost_w_m2) << s.BriefReport();
+    EXPECT_LE(s.evaluations, 15 + 2) << s.BriefReport();  // + the start and the final check
+    if (s.ok) {
+      EXPECT_TRUE(std::isfinite(s.final_cost_w_m2));
+    }
+  }
+}
+
+TEST(IdentOptions, IsValidNamesFieldValueAndRule) {
+  IdentOptions o;
+  std::string why;
+  EXPECT_TRUE(o.IsValid(&why)) << why;
+  o.prior_weight_w_m2 = -1.0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why, "prior_weight_w_m2 = -1: must be >= 0");
+  o = IdentOptions{};
+  o.optimizer.max_evaluations = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("max_evaluations = 0"), std::string::npos) << why;
+  EXPECT_TRUE(SetIdentAlgorithm("sbplx", &o));
+  EXPECT_EQ(IdentAlgorithmName(o), "sbplx");
+  EXPECT_TRUE(SetIdentAlgorithm("lad_lm", &o));
+  EXPECT_EQ(IdentAlgorithmName(o), "lad_lm");
+  EXPECT_FALSE(SetIdentAlgorithm("gradient_descent", &o));
+}
+
+// Real data (htw saar, PROVENANCE.md): identify on the day with the fluid
+// ~8 K above ambient, predict the day near ambient. Thresholds are about
+// 1.5 × what this model reaches (README, "Real data"), so a regression in
+// the physics or the fit fails here.
+TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
+  const std::string dir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(LoadConfig(dir + "plant.toml", &config, &errors));
+  Series train, test;
+  CsvReadOptions csv;
+  csv.fluid_density_kg_m3 = config.plant.fluid_density_kg_m3;
+  ASSERT_TRUE(ReadCanonicalCsv(dir + "day3_clear_medium_dT.csv", csv, &train, &errors, nullptr));
+  ASSERT_TRUE(ReadCanonicalCsv(dir + "day1_clear_low_dT.csv", csv, &test, &errors, nullptr));
+  const ModelSpec spec = Spec("2N1CcolwrI");
+  Drivers dtrain, dtest;
+  std::string error;
+  ASSERT_TRUE(PrepareDrivers(train, config.plant, spec, &dtrain, &error)) << error;
+  ASSERT_TRUE(PrepareDrivers(test, config.plant, spec, &dtest, &error)) << error;
+  const IdentSummary s =
+      Identify(dtrain, MakeMeasurements(train, dtrain), StartParams(config.plant), IdentOptions{});
+  ASSERT_TRUE(s.ok) << s.BriefReport();
+  EXPECT_LT(s.train.nmae_p_el, 0.015);
+  EXPECT_LT(s.train.nmae_q_th, 0.06);
+  SimOutputs sim;
+  Simulate(dtest, s.params, &sim);
+  const ErrorMetrics held_out = ComputeErrors(MakeMeasurements(test, dtest), sim, config.plant.area_m2);
+  EXPECT_LT(held_out.nmae_p_el, 0.02);
+  EXPECT_LT(held_out.nmae_q_th, 0.18);
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -36,6 +36,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   Eigen::MatrixXd jac(r.size(), n);
   Eigen::VectorXd w;
   bool jac_at_z = false;  // jac was computed at the current z
+  double floor_rel = o.weight_floor_rel;
   for (int it = 0; it < o.max_iterations; ++it) {
     if (res.evaluations + n + 1 > o.max_evaluations) {
       res.message = "evaluation budget reached";
@@ -43,7 +44,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     }
     ++res.iterations;
     // IRLS weights at the current residuals.
-    const double delta = std::max(o.weight_floor_rel * r.cwiseAbs().mean(), 1e-12);
+    const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
     w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
     // Forward-difference Jacobian, stepping inwards at the upper bound.
     for (Eigen::Index j = 0; j < n; ++j) {
@@ -79,12 +80,21 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
         z = z_new;
         r.swap(r_trial);
         accepted = true;
-        lambda = std::max(lambda / 3.0, 1e-9);
+        // Trust the Gauss–Newton model quickly again after a success: ÷10
+        // needed ~25 % fewer simulations than ÷3 on synthetic 14-day fits.
+        lambda = std::max(lambda / 10.0, 1e-9);
         break;
       }
       lambda *= 4.0;
     }
     if (!accepted) {
+      // The smoothed model found no descent of the true objective: sharpen
+      // it (continuation on the weight floor) before giving up.
+      if (floor_rel > 1e-6) {
+        floor_rel *= 0.1;
+        lambda = 1e-3;
+        continue;
+      }
       res.converged = true;
       res.message = "no further descent (damping " + std::to_string(lambda) + ")";
       break;
@@ -92,6 +102,11 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     jac_at_z = false;
     const double decrease = cost - new_cost;
     cost = new_cost;
+    if (step_norm <= o.xtol && floor_rel > 1e-6) {  // stalled on the smoothing
+      floor_rel *= 0.1;
+      lambda = 1e-3;
+      continue;
+    }
     if (decrease <= o.ftol_rel * cost || step_norm <= o.xtol) {
       res.converged = true;
       res.message =

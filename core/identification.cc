@@ -520,7 +520,9 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
       coarse.optimizer.max_evaluations = options.optimizer.max_evaluations / 4;
       const IdentSummary cs = Identify(cd, cm, base, coarse);
       coarse_simulations = cs.evaluations;
-      if (cs.ok) best = cs.params;
+      // A misspecified model can have its coarse optimum far from the fine
+      // one: keep it only if it also beats the start on the data as given.
+      if (cs.ok && obj.DataCost(cs.params) < initial_cost) best = cs.params;
     }
   }
   FitOutcome fit;
@@ -540,7 +542,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   // Fits the parameters marked in `act_mask` from `from` (the others held at
   // their reference values); returns the outcome and the data cost.
   auto fit_active = [&](const std::vector<bool>& act_mask, const ParamVector& from_point,
-                        double* data_cost) {
+                        double* data_cost, int max_budget = std::numeric_limits<int>::max()) {
     std::vector<Param> act;
     std::vector<ParamInfo> act_infos;
     std::vector<double> z_ref;
@@ -564,7 +566,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
       out.termination = Termination::kConverged;
     } else {
       // One simulation stays reserved for the final check of the result.
-      const int budget = remaining() - 1;
+      const int budget = std::min(remaining() - 1, max_budget);
       if (budget >= 2) {
         out = RunFit(obj, act_infos, z_ref, from, options, budget, n_rows, plant.area_m2);
       } else {
@@ -586,74 +588,164 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   best = fit.params;
   // Identifiability: standard errors of the free parameters at the fit. A
   // parameter whose standard error exceeds undetermined_se of its range is
-  // fixed at its reference value, one at a time and worst first, provided
-  // the re-fit without it costs at most fix_cost_tolerance more: a parameter
-  // the data really do not determine costs nothing to fix.
-  for (int round = 0; fit.ok && options.fix_unidentifiable && round < 4; ++round) {
+  // fixed at its reference value, worst first, provided that costs at most
+  // fix_cost_tolerance more: a parameter the data really do not determine
+  // costs nothing to fix. The cost of fixing is first predicted with one
+  // simulation (the other parameters follow the weighted least-squares
+  // response of the linearised residuals); only a borderline prediction
+  // pays for a full re-fit.
+  std::vector<bool> rejected(free.size(), false);
+  bool any_fixed = false;
+  Eigen::MatrixXd jac;  // columns: active parameters, in `free` order
+  Eigen::VectorXd r;
+  auto active_infos = [&] {
+    std::vector<ParamInfo> v;
+    for (std::size_t j = 0; j < free.size(); ++j) {
+      if (active[j]) v.push_back(infos[j]);
+    }
+    return v;
+  };
+  for (int round = 0; fit.ok && options.fix_unidentifiable && round < 8; ++round) {
     std::vector<std::size_t> act_index;  // positions in `free` of the active ones
     for (std::size_t j = 0; j < free.size(); ++j) {
       if (active[j]) act_index.push_back(j);
     }
-    if (act_index.size() <= 1) break;
-    // The analysis needs one simulation per parameter (and a re-fit).
-    if (remaining() < static_cast<int>(act_index.size()) + 10) break;
-    Eigen::VectorXd r;
-    Eigen::MatrixXd jac = fit.jacobian;
-    if (jac.cols() == static_cast<Eigen::Index>(act_index.size())) {
-      obj.Residuals(best, &r);
-    } else {
-      jac = SensitivityMatrix(
-          obj,
-          [&] {
-            std::vector<ParamInfo> v;
-            for (std::size_t j : act_index) v.push_back(infos[j]);
-            return v;
-          }(),
-          best, &r);
+    const auto m = static_cast<Eigen::Index>(act_index.size());
+    if (m <= 1 || remaining() < static_cast<int>(m) + 10) break;
+    if (jac.cols() != m) {
+      jac = fit.jacobian.cols() == m ? fit.jacobian : Eigen::MatrixXd();
+      if (jac.cols() == m) {
+        obj.Residuals(best, &r);
+      } else {
+        std::vector<Param> act;
+        for (std::size_t j : act_index) act.push_back(free[j]);
+        obj.SetFree(act, active_infos(), std::vector<double>(act.size(), 0.0));
+        jac = SensitivityMatrix(obj, active_infos(), best, &r);
+      }
     }
     const Eigen::VectorXd act_se =
         StandardErrors(jac, r, std::vector<bool>(act_index.size(), true), sigma_floor);
-    for (std::size_t a = 0; a < act_index.size(); ++a) {
-      se[act_index[a]] = act_se(static_cast<Eigen::Index>(a));
+    Eigen::Index worst = -1;
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const std::size_t j = act_index[static_cast<std::size_t>(a)];
+      se[j] = act_se(a);
+      if (rejected[j] || !(act_se(a) > options.undetermined_se)) continue;
+      if (worst < 0 || act_se(a) > act_se(worst)) worst = a;
     }
-    std::vector<std::size_t> candidates;
-    for (std::size_t a = 0; a < act_index.size(); ++a) {
-      if (act_se(static_cast<Eigen::Index>(a)) > options.undetermined_se) candidates.push_back(a);
+    if (worst < 0) break;
+    const std::size_t j = act_index[static_cast<std::size_t>(worst)];
+    const auto idx = static_cast<std::size_t>(free[j]);
+
+    // Predicted point: parameter j at its reference, the others following.
+    Eigen::VectorXd z(m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const std::size_t k = act_index[static_cast<std::size_t>(a)];
+      z(a) = ToUnit(infos[k], best[static_cast<std::size_t>(free[k])]);
     }
-    std::sort(candidates.begin(), candidates.end(), [&act_se](std::size_t x, std::size_t y) {
-      return act_se(static_cast<Eigen::Index>(x)) > act_se(static_cast<Eigen::Index>(y));
-    });
-    bool fixed_one = false;
-    for (std::size_t c = 0; c < candidates.size() && c < 3 && !fixed_one; ++c) {
-      const std::size_t j = act_index[candidates[c]];
+    const double dz_j = ToUnit(infos[j], base[idx]) - z(worst);
+    Eigen::MatrixXd j_others(jac.rows(), m - 1);
+    for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+      if (a != worst) j_others.col(c++) = jac.col(a);
+    }
+    const double delta = std::max(0.3 * r.cwiseAbs().mean(), sigma_floor);
+    const Eigen::VectorXd w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
+    const Eigen::VectorXd b = r + jac.col(worst) * dz_j;
+    // Candidate points, one simulation each: the others unchanged, and the
+    // others following the damped (Levenberg) weighted least-squares
+    // response of the linearised residuals for two dampings, each step
+    // limited to the size of the move of parameter j (the linearisation holds
+    // only that far). The cheapest predicts the cost of fixing j.
+    const Eigen::MatrixXd wj = j_others.array().colwise() * w.array();
+    const Eigen::MatrixXd h = j_others.transpose() * wj;
+    const Eigen::VectorXd g = wj.transpose() * b;
+    const double mean_diag = std::max(h.diagonal().mean(), 1e-300);
+    const double limit_dz = std::max(std::fabs(dz_j), 0.02);
+    double cost = kNaN;
+    ParamVector predicted = best;
+    Eigen::VectorXd r_pred;
+    for (double damping : {-1.0, 1e-4, 1e-2}) {
+      Eigen::VectorXd dz_o = Eigen::VectorXd::Zero(m - 1);
+      if (damping > 0.0) {
+        Eigen::MatrixXd hd = h;
+        hd.diagonal().array() += damping * mean_diag;
+        dz_o = -hd.ldlt().solve(g);
+        const double norm = dz_o.cwiseAbs().maxCoeff();
+        if (norm > limit_dz) dz_o *= limit_dz / norm;
+      }
+      ParamVector candidate = best;
+      candidate[idx] = base[idx];
+      for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+        if (a == worst) continue;
+        const std::size_t k = act_index[static_cast<std::size_t>(a)];
+        candidate[static_cast<std::size_t>(free[k])] =
+            FromUnit(infos[k], std::clamp(z(a) + dz_o(c++), 0.0, 1.0));
+      }
+      Eigen::VectorXd r_cand;
+      obj.Residuals(candidate, &r_cand);
+      const double c_cost = r_cand.cwiseAbs().sum() / n_rows;
+      if (std::isfinite(c_cost) && !(c_cost >= cost)) {
+        cost = c_cost;
+        predicted = candidate;
+        r_pred = r_cand;
+      }
+    }
+    ParamVector point = predicted;
+    // Relative tolerance, with an absolute floor (the 0.1 % of the measured
+    // power used for sigma_floor) so that noise-free fits can fix too.
+    const double limit = best_cost * (1.0 + options.fix_cost_tolerance) + 2.0 * sigma_floor;
+    // The linear prediction is poor for large moves on a log scale: when it
+    // is inconclusive (close to the limit, or the parameter is not bounded
+    // by the data at all, se > 1) a short re-fit decides.
+    if (std::isfinite(cost) && cost > limit &&
+        (cost <= 10.0 * limit - 9.0 * best_cost || se[j] > 1.0)) {
       std::vector<bool> trial_mask = active;
       trial_mask[j] = false;
-      double trial_cost = 0.0;
-      const FitOutcome trial = fit_active(trial_mask, best, &trial_cost);
-      const auto idx = static_cast<std::size_t>(free[j]);
-      char note[240];
-      if (trial.ok && trial_cost <= best_cost * (1.0 + options.fix_cost_tolerance) + 1e-12) {
-        active = trial_mask;
-        fit = trial;
-        best = trial.params;
-        best_cost = trial_cost;
-        fixed_one = true;
-        std::snprintf(note, sizeof(note),
-                      "%s is not determined by these data (standard error %.2g of its %s range); "
-                      "fixed at its reference value %.4g",
-                      Name(free[j]).c_str(), se[j],
-                      infos[j].scale == ParamScale::kLog ? "log" : "search", base[idx]);
-      } else {
-        std::snprintf(note, sizeof(note),
-                      "%s is only weakly determined (standard error %.2g of its %s range); kept "
-                      "free because fixing it at %.4g raises the MAE by %.1f %%",
-                      Name(free[j]).c_str(), se[j],
-                      infos[j].scale == ParamScale::kLog ? "log" : "search", base[idx],
-                      100.0 * (trial_cost / best_cost - 1.0));
-      }
-      summary.notes.push_back(note);
+      const FitOutcome trial =
+          fit_active(trial_mask, predicted, &cost, 8 * (static_cast<int>(m) + 2));
+      point = trial.params;
+      if (!trial.ok) cost = kNaN;
     }
-    if (!fixed_one) break;
+    char note[240];
+    if (std::isfinite(cost) && cost <= limit) {
+      active[j] = false;
+      best = point;
+      best_cost = cost;
+      any_fixed = true;
+      // The old Jacobian without the fixed column serves the next round.
+      Eigen::MatrixXd reduced(jac.rows(), m - 1);
+      for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+        if (a != worst) reduced.col(c++) = jac.col(a);
+      }
+      jac = reduced;
+      if (point == predicted)
+        r = r_pred;
+      else
+        obj.Residuals(best, &r);
+      std::snprintf(note, sizeof(note),
+                    "%s is not determined by these data (standard error %.2g of its %s range); "
+                    "fixed at its reference value %.4g",
+                    Name(free[j]).c_str(), se[j],
+                    infos[j].scale == ParamScale::kLog ? "log" : "search", base[idx]);
+    } else {
+      rejected[j] = true;
+      std::snprintf(note, sizeof(note),
+                    "%s is only weakly determined (standard error %.2g of its %s range); kept "
+                    "free because fixing it at %.4g raises the MAE by %.1f %%",
+                    Name(free[j]).c_str(), se[j],
+                    infos[j].scale == ParamScale::kLog ? "log" : "search", base[idx],
+                    100.0 * (cost / best_cost - 1.0));
+    }
+    summary.notes.push_back(note);
+  }
+  if (any_fixed && remaining() > 20) {
+    // Polish the remaining parameters once with the fixed ones in place.
+    double polished_cost = 0.0;
+    const FitOutcome polished = fit_active(active, best, &polished_cost);
+    if (polished.ok && polished_cost <= best_cost) {
+      best = polished.params;
+      best_cost = polished_cost;
+      fit.termination = polished.termination;
+    }
   }
   summary.termination = fit.termination;
   summary.params = best;

@@ -523,6 +523,35 @@ std::string FormatBacktestTables(const BacktestResult& result) {
     }
   }
 
+  // Stability of the identified parameters over the test days: the paper
+  // saw U_front spread over three decades (its Fig. 8).
+  for (const BacktestAverage& a : result.averages) {
+    ModelSpec spec;
+    std::string error;
+    if (!ParseVariant(a.variant, &spec, &error) || a.days_ok < 2) continue;
+    const auto used = UsedParams(spec);
+    std::vector<std::vector<std::string>> t(1);
+    t[0] = {"parameter", "unit", "median", "min", "max", "max/min"};
+    for (std::size_t i = 0; i < kNumParams; ++i) {
+      if (!used.test(i)) continue;
+      std::vector<double> v;
+      for (const BacktestDay& d : result.days) {
+        if (d.ok && d.variant == a.variant && d.train_days == a.train_days)
+          v.push_back(d.params[i]);
+      }
+      std::sort(v.begin(), v.end());
+      if (v.empty() || v.front() == v.back()) continue;  // fixed
+      const double median = v[v.size() / 2];
+      t.push_back({std::string(kParamTable[i].name), std::string(kParamTable[i].unit),
+                   FormatNumber(median), FormatNumber(v.front()), FormatNumber(v.back()),
+                   v.front() > 0.0 ? Fixed(v.back() / v.front(), 2) : "-"});
+    }
+    if (t.size() > 1) {
+      out += "\n" + a.variant + " n=" + std::to_string(a.train_days) +
+             ": identified parameters over the test days\n" + RenderTable(t);
+    }
+  }
+
   // Failed jobs, one line each.
   bool header = false;
   for (const BacktestDay& d : result.days) {

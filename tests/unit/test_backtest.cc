@@ -22,6 +22,7 @@
 #include "core/synthetic_plant.h"
 #include "core/units.h"
 #include "io/csv.h"
+#include "tests/support/run_pvtwin.h"
 
 namespace pvtwin {
 namespace {
@@ -371,34 +372,9 @@ TEST(BacktestOptions, IsValidNamesFieldValueAndRule) {
 // ---------------------------------------------------------------------------
 // The binary.
 
-struct ProcessResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-ProcessResult RunPvtwin(const fs::path& dir, const std::string& args) {
-  const fs::path err_path = dir / "stderr.txt";
-  const std::string command = "cd '" + dir.string() + "' && '" + PVTWIN_BINARY + "' " + args +
-                              " 2>'" + err_path.string() + "'";
-  ProcessResult run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buf;
-  std::size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
-  const int status = pclose(pipe);
-  if (WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
-  run.err = ReadFile(err_path);
-  return run;
-}
+using testing::ProcessResult;
+using testing::ReadFile;
+using testing::RunPvtwin;
 
 // A temporary folder with config.toml and data.csv (5 days at 5 min).
 class BacktestCli : public ::testing::Test {

@@ -11,42 +11,16 @@
 #include <sstream>
 #include <string>
 
+#include "tests/support/run_pvtwin.h"
+
 namespace pvtwin {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct ProcessResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// Runs `pvtwin <args>` in directory `dir` through the shell.
-ProcessResult RunPvtwin(const fs::path& dir, const std::string& args) {
-  const fs::path err_path =
-      fs::temp_directory_path() / ("pvtwin_check_config_" + std::to_string(getpid()) + ".err");
-  const std::string command = "cd '" + dir.string() + "' && '" + PVTWIN_BINARY + "' " + args +
-                              " 2>'" + err_path.string() + "'";
-  ProcessResult run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buf;
-  std::size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
-  const int status = pclose(pipe);
-  if (WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
-  run.err = ReadFile(err_path);
-  fs::remove(err_path);
-  return run;
-}
+using testing::ProcessResult;
+using testing::ReadFile;
+using testing::RunPvtwin;
 
 const fs::path kCases = fs::path(PVTWIN_GOLDEN_DIR) / "config";
 

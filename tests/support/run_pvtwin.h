@@ -1,0 +1,51 @@
+// Runs the real pvtwin binary (PVTWIN_BINARY, set by tests/CMakeLists.txt) as
+// a child process and captures its exit code, stdout and stderr.
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace pvtwin::testing {
+
+struct ProcessResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+inline std::string ReadFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// `pvtwin <args>` run through the shell in directory `dir`.
+inline ProcessResult RunPvtwin(const std::filesystem::path& dir, const std::string& args) {
+  namespace fs = std::filesystem;
+  static int counter = 0;
+  const fs::path err_path = fs::temp_directory_path() / ("pvtwin_test_" + std::to_string(getpid()) +
+                                                        "_" + std::to_string(counter++) + ".err");
+  const std::string command = "cd '" + dir.string() + "' && '" + PVTWIN_BINARY + "' " + args +
+                              " 2>'" + err_path.string() + "'";
+  ProcessResult run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buf;
+  std::size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
+  const int status = pclose(pipe);
+  if (WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
+  run.err = ReadFile(err_path);
+  fs::remove(err_path);
+  return run;
+}
+
+}  // namespace pvtwin::testing

@@ -1,0 +1,152 @@
+// pvtwin simulate and calibrate, run as real processes on the htw saar data.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "tests/support/run_pvtwin.h"
+
+namespace pvtwin {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ProcessResult;
+using testing::ReadFile;
+using testing::RunPvtwin;
+
+const fs::path kData = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+
+class CliModel : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("pvtwin_cli_model_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Data(const char* name) const { return "'" + (kData / name).string() + "'"; }
+  fs::path dir_;
+};
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST_F(CliModel, SimulateWritesTheCanonicalPredictionColumns) {
+  const ProcessResult run =
+      RunPvtwin(dir_, "simulate --config " + Data("plant.toml") + " --csv " +
+                          Data("day1_clear_low_dT.csv") + " --variant 2N1CcolwrI --out pred.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::vector<std::string> lines = Lines(ReadFile(dir_ / "pred.csv"));
+  ASSERT_EQ(lines.size(), 307u);  // header + 306 rows
+  EXPECT_EQ(lines[0], "time,p_el_w,q_th_w,t_pv_c,t_out_c");
+  EXPECT_EQ(lines[1].substr(0, 21), "2017-08-07T08:24:01Z,");
+}
+
+TEST_F(CliModel, SimulateNamesMissingColumnsAndBadVariants) {
+  // A copy of the data without wind: the 'w' variants cannot run.
+  std::ifstream in(kData / "day1_clear_low_dT.csv");
+  std::ofstream out(dir_ / "no_wind.csv");
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::istringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    cells.erase(cells.begin() + 8);  // wind_m_s
+    for (std::size_t i = 0; i < cells.size(); ++i) out << (i ? "," : "") << cells[i];
+    out << "\n";
+  }
+  out.close();
+  ProcessResult run = RunPvtwin(
+      dir_, "simulate --config " + Data("plant.toml") + " --csv no_wind.csv --variant 1N1Cwr");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("no_wind.csv: variant 1N1Cwr needs columns the data lacks: wind speed (w) "
+                         "(wind_m_s)"),
+            std::string::npos)
+      << run.err;
+  run = RunPvtwin(dir_, "simulate --config " + Data("plant.toml") +
+                            " --csv no_wind.csv --variant 1N1Cr");  // no wind needed
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  run = RunPvtwin(dir_,
+                  "simulate --config " + Data("plant.toml") + " --csv no_wind.csv --variant 2N1C");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--variant = 2N1C: '2N1C': a two-node model needs the capacitance's node"),
+            std::string::npos)
+      << run.err;
+}
+
+TEST_F(CliModel, ParamsFileErrorsNameFileLineAndKey) {
+  std::ofstream(dir_ / "params.json") << "{\n  \"u_front_w_m2k\": 12,\n  \"u_frnt\": 3\n}\n";
+  const ProcessResult run =
+      RunPvtwin(dir_, "simulate --config " + Data("plant.toml") + " --csv " +
+                          Data("day1_clear_low_dT.csv") + " --variant 1N --params params.json");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.err, "params.json:3: u_frnt = 3: unknown parameter\n");
+}
+
+// calibrate writes params.json; simulate reads it and reproduces the fit.
+TEST_F(CliModel, CalibrateThenSimulateRoundTrip) {
+  ProcessResult run =
+      RunPvtwin(dir_, "calibrate --config " + Data("plant.toml") + " --csv " +
+                          Data("day3_clear_medium_dT.csv") + " --variant 1N1Cwr --out params.json");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  EXPECT_NE(run.out.find("1N1Cwr: ok, lad_lm"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("errors (training):"), std::string::npos);
+  const std::string params = ReadFile(dir_ / "params.json");
+  EXPECT_NE(params.find("\"variant\": \"1N1Cwr\""), std::string::npos) << params;
+  EXPECT_NE(params.find("\"c_pv_j_m2k\""), std::string::npos);
+  EXPECT_EQ(params.find("\"c_coll_j_m2k\""), std::string::npos);  // not used by 1N1Cwr
+
+  run = RunPvtwin(dir_, "simulate --config " + Data("plant.toml") + " --csv " +
+                            Data("day3_clear_medium_dT.csv") +
+                            " --variant 1N1Cwr --params params.json --out pred.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  // The training MAE of P_el printed by calibrate is reproduced from pred.csv
+  // over the valid rows.
+  const std::vector<std::string> meas = Lines(ReadFile(kData / "day3_clear_medium_dT.csv"));
+  const std::vector<std::string> pred = Lines(ReadFile(dir_ / "pred.csv"));
+  ASSERT_EQ(meas.size(), pred.size());
+  double sum = 0.0;
+  int rows = 0;
+  for (std::size_t i = 1; i < meas.size(); ++i) {
+    std::vector<double> m, p;
+    std::istringstream ms(meas[i]), ps(pred[i]);
+    std::string cell;
+    std::getline(ms, cell, ',');
+    while (std::getline(ms, cell, ',')) m.push_back(std::stod(cell));
+    std::getline(ps, cell, ',');
+    while (std::getline(ps, cell, ',')) p.push_back(std::stod(cell));
+    if (m.back() != 1.0) continue;  // valid
+    sum += std::fabs(p[0] - m[9]);  // p_el_w
+    ++rows;
+  }
+  const double mae_w_m2 = sum / rows / 1.66;
+  char expected[32];
+  std::snprintf(expected, sizeof(expected), "MAE P_el %7.3f", mae_w_m2);
+  const std::string calib =
+      RunPvtwin(dir_, "calibrate --config " + Data("plant.toml") + " --csv " +
+                          Data("day3_clear_medium_dT.csv") + " --variant 1N1Cwr")
+          .out;
+  EXPECT_NE(calib.find(expected), std::string::npos) << expected << "\n" << calib;
+}
+
+TEST_F(CliModel, CalibrateOnTooLittleDataExitsTwo) {
+  const ProcessResult run = RunPvtwin(
+      dir_,
+      "calibrate --config " + Data("plant.toml") + " --csv " + Data("day1_clear_low_dT.csv") +
+          " --variant 1N --train-start 2017-08-07T10:00:00Z --train-end 2017-08-07T10:30:00Z");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("training window 2017-08-07T10:00:00Z .. 2017-08-07T10:30:00Z has 15 "
+                         "usable rows"),
+            std::string::npos)
+      << run.err;
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -117,8 +117,10 @@ double SkyLossW(const RunConstants& k, const RowTerms& r, double t_pv_c, double*
   return loss.q_w_m2 * k.area_m2;
 }
 
-Linearised Linearise(const RunConstants& k, const RowTerms& r, double t_lin_c) {
-  Linearised l;
+// Fills *out (in place: no struct copies in the row loop).
+void Linearise(const RunConstants& k, const RowTerms& r, double t_lin_c, Linearised* out) {
+  Linearised& l = *out;
+  l.net = RcNetwork{};
   l.t_lin_c = t_lin_c;
   l.net.nodes = k.nodes;
   l.net.coupling_w_k = k.g_coll_w_k;
@@ -149,7 +151,6 @@ Linearised Linearise(const RunConstants& k, const RowTerms& r, double t_lin_c) {
   pv.conductance_w_k -= l.dq_abs_w_k;
   pv.source_w += l.q_abs_lin_w - l.dq_abs_w_k * t_lin_c;
   l.g_pv_own_w_k = pv.conductance_w_k;
-  return l;
 }
 
 // True when the flux error that the linearisation leaves at T_PV = t_pv_c
@@ -169,18 +170,16 @@ bool LinearisationConverged(const RunConstants& k, const RowTerms& r, const Line
 // Solves one row: the steady state when `steady`, else one step from `start`.
 // Re-linearises about the step-mean PV temperature until the linearisation
 // error is below kNodeToleranceK.
-Linearised SolveRow(const RunConstants& k, const RowTerms& r, const double start[2], double dt_s,
-                    bool steady, double t_guess_c, RcStepResult* result) {
+void SolveRow(const RunConstants& k, const RowTerms& r, const double start[2], double dt_s,
+              bool steady, double t_guess_c, Linearised* l, RcStepResult* result) {
   double t_lin = t_guess_c;
-  Linearised l;
   for (int it = 0; it < kMaxNodeIterations; ++it) {
-    l = Linearise(k, r, t_lin);
-    *result = steady ? SteadyRc(l.net) : AdvanceRc(l.net, start, dt_s);
+    Linearise(k, r, t_lin, l);
+    *result = steady ? SteadyRc(l->net) : AdvanceRc(l->net, start, dt_s);
     const double t_pv = result->t_mean_c[0];
-    if (!std::isfinite(t_pv) || LinearisationConverged(k, r, l, t_pv)) break;
+    if (!std::isfinite(t_pv) || LinearisationConverged(k, r, *l, t_pv)) break;
     t_lin = t_pv;
   }
-  return l;
 }
 
 void SetRowNaN(SimOutputs* out, std::size_t i, bool energy) {
@@ -245,9 +244,10 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
     }
     const RowTerms r = MakeRowTerms(k, d, i);
     RcStepResult res;
+    Linearised l;
     if (need_restart || d.restart[i]) {
       // Paper 2.2: start from the steady state of this row's inputs.
-      SolveRow(k, r, state, 0.0, /*steady=*/true, r.t_amb_c, &res);
+      SolveRow(k, r, state, 0.0, /*steady=*/true, r.t_amb_c, &l, &res);
       state[0] = res.t_end_c[0];
       state[1] = res.t_end_c[1];
       t_pv_prev = t_pv_prev2 = res.t_mean_c[0];
@@ -255,7 +255,7 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
     }
     const double start[2] = {state[0], state[1]};
     const double guess = 2.0 * t_pv_prev - t_pv_prev2;
-    const Linearised l = SolveRow(k, r, start, d.dt_s[i], /*steady=*/false, guess, &res);
+    SolveRow(k, r, start, d.dt_s[i], /*steady=*/false, guess, &l, &res);
     state[0] = res.t_end_c[0];
     state[1] = res.t_end_c[1];
     const double t_pv = res.t_mean_c[0];

@@ -29,8 +29,6 @@
 
 namespace pvtwin::cli {
 
-void BenchTable6Protocol(std::uint64_t seed);  // bench_table6.cc
-
 namespace {
 
 constexpr int kTrainDays = 14;
@@ -294,7 +292,5 @@ void BenchIdentification(int repeats, std::uint64_t seed) {
   }
   std::printf("\nident: done in %.1f s\n", SecondsSince(bench_start));
 }
-
-void BenchTable6(std::uint64_t seed) { BenchTable6Protocol(seed); }
 
 }  // namespace pvtwin::cli

@@ -14,7 +14,7 @@
 
 namespace pvtwin::cli {
 
-void BenchTable6Protocol(std::uint64_t seed) {
+void BenchTable6(std::uint64_t seed) {
   const Plant plant = BenchPlant();
   WeatherOptions weather;
   weather.num_days = 14 + 29;

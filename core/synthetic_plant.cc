@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/thermal_model.h"
+#include "core/units.h"
 
 namespace pvtwin {
 
@@ -21,6 +22,16 @@ double Normal(std::mt19937_64& rng) {
 }
 
 }  // namespace
+
+Plant DesignExamplePlant() {
+  Plant plant;  // fluid and PV defaults are the example's values
+  plant.latitude_rad = DegToRad(47.358);
+  plant.longitude_rad = DegToRad(16.128);
+  plant.tilt_rad = DegToRad(20.0);
+  plant.azimuth_rad = DegToRad(180.0);
+  plant.area_m2 = 1.8;
+  return plant;
+}
 
 ParamVector ReferenceTruthParams(const Plant& plant) {
   ParamVector p = StartParams(plant);

@@ -17,15 +17,17 @@ namespace pvtwin {
 // typical monitoring sensors: a class-A Pt100 pair on the fluid, a power
 // meter on the PV, a heat meter on the fluid.
 struct SensorNoise {
-  double t_out_c = 0.0;       // K
-  double p_el_rel = 0.0;      // fraction of the reading
-  double q_th_w = 0.0;        // W
+  double t_out_c = 0.0;   // K
+  double p_el_rel = 0.0;  // fraction of the reading
+  double q_th_w = 0.0;    // W
   std::uint64_t seed = 1;
 };
 
-inline SensorNoise RealisticSensorNoise(std::uint64_t seed) {
-  return {0.05, 0.005, 5.0, seed};
-}
+inline SensorNoise RealisticSensorNoise(std::uint64_t seed) { return {0.05, 0.005, 5.0, seed}; }
+
+// The plant of DESIGN.md's example [plant] section: 47.358° N, 16.128° E,
+// 20° tilt facing south, 1.8 m², the paper's fluid and PV reference data.
+Plant DesignExamplePlant();
 
 // A plausible uncovered PVT collector, inside Table 3's bounds, used as the
 // known answer of synthetic tests.

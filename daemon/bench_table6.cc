@@ -15,7 +15,7 @@
 namespace pvtwin::cli {
 
 void BenchTable6(std::uint64_t seed) {
-  const Plant plant = BenchPlant();
+  const Plant plant = DesignExamplePlant();
   WeatherOptions weather;
   weather.num_days = 14 + 29;
   weather.step_s = 60.0;

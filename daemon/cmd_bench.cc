@@ -24,15 +24,6 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-Plant BenchPlant() {
-  Plant plant;  // DESIGN.md's example site: 47.358°N 16.128°E, 20° tilt, south
-  plant.latitude_rad = DegToRad(47.358);
-  plant.longitude_rad = DegToRad(16.128);
-  plant.tilt_rad = DegToRad(20.0);
-  plant.azimuth_rad = DegToRad(180.0);
-  return plant;
-}
-
 namespace {
 
 struct BenchArgs {
@@ -43,7 +34,7 @@ struct BenchArgs {
 
 // One 14-day, 1-min simulation (20 160 rows) of each variant.
 void BenchSimulation(const BenchArgs& a) {
-  const Plant plant = BenchPlant();
+  const Plant plant = DesignExamplePlant();
   WeatherOptions weather;
   weather.num_days = 14;
   weather.step_s = 60.0;

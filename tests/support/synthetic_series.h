@@ -2,9 +2,13 @@
 // inputs unless a test overrides a column.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
+#include <string>
 
 #include "core/series.h"
+#include "core/variant.h"
 
 namespace pvtwin::testing {
 
@@ -36,6 +40,14 @@ inline Series MakeConstantSeries(std::size_t rows, double step_s, const Constant
   fill(Channel::kTBackC, in.t_back_c);
   fill(Channel::kValid, 1.0);
   return s;
+}
+
+// The parsed variant; a bad name fails the calling test.
+inline ModelSpec SpecOf(const std::string& name) {
+  ModelSpec spec;
+  std::string error;
+  EXPECT_TRUE(ParseVariant(name, &spec, &error)) << name << ": " << error;
+  return spec;
 }
 
 }  // namespace pvtwin::testing

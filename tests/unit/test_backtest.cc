@@ -23,6 +23,7 @@
 #include "core/units.h"
 #include "io/csv.h"
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
@@ -32,24 +33,6 @@ namespace fs = std::filesystem;
 constexpr std::uint64_t kSeed = 20240601;
 constexpr std::int64_t kJune1_2024 = 1717200000;  // 00:00 UTC, the data's first row
 
-// DESIGN.md's example plant: 47.358° N, 16.128° E, 20° tilt, facing south.
-Plant ExamplePlant() {
-  Plant plant;
-  plant.latitude_rad = DegToRad(47.358);
-  plant.longitude_rad = DegToRad(16.128);
-  plant.tilt_rad = DegToRad(20.0);
-  plant.azimuth_rad = DegToRad(180.0);
-  plant.area_m2 = 1.8;
-  return plant;
-}
-
-ModelSpec Spec(const std::string& name) {
-  ModelSpec spec;
-  std::string error;
-  EXPECT_TRUE(ParseVariant(name, &spec, &error)) << error;
-  return spec;
-}
-
 // 5 days at 5 min from 2024-06-01 00:00 UTC, truth 2N1Ccolwr.
 Series FiveDays(const Plant& plant, const SensorNoise& noise = {}) {
   WeatherOptions weather;
@@ -57,8 +40,8 @@ Series FiveDays(const Plant& plant, const SensorNoise& noise = {}) {
   weather.num_days = 5;
   weather.step_s = 300.0;
   weather.seed = kSeed;
-  return MakeSyntheticPlantData(plant, weather, Spec("2N1Ccolwr"), ReferenceTruthParams(plant),
-                                noise);
+  return MakeSyntheticPlantData(plant, weather, testing::SpecOf("2N1Ccolwr"),
+                                ReferenceTruthParams(plant), noise);
 }
 
 BacktestOptions TwoDaysTwoVariants() {
@@ -74,7 +57,7 @@ BacktestOptions TwoDaysTwoVariants() {
 // Days.
 
 TEST(BacktestDays, BoundariesAreLocalMeanSolarMidnights) {
-  const Plant plant = ExamplePlant();
+  const Plant plant = DesignExamplePlant();
   // 16.128° E: local mean solar time = UTC + 16.128/15 h = UTC + 3870.72 s.
   const std::int64_t offset_s = SolarDayOffsetS(plant);
   EXPECT_EQ(offset_s, 3871);
@@ -105,7 +88,7 @@ TEST(BacktestDays, BoundariesAreLocalMeanSolarMidnights) {
 class Backtest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    plant_ = new Plant(ExamplePlant());
+    plant_ = new Plant(DesignExamplePlant());
     data_ = new Series(FiveDays(*plant_));
     BacktestOptions options = TwoDaysTwoVariants();
     options.threads = 1;
@@ -390,7 +373,7 @@ class BacktestCli : public ::testing::Test {
                                            "tilt_deg = 20\n"
                                            "azimuth_deg = 180\n"
                                            "area_m2 = 1.8\n";
-    const Series data = FiveDays(ExamplePlant());
+    const Series data = FiveDays(DesignExamplePlant());
     std::vector<Channel> channels;
     for (std::size_t c = 0; c < kNumChannels; ++c) {
       if (data.Has(static_cast<Channel>(c))) channels.push_back(static_cast<Channel>(c));
@@ -434,7 +417,7 @@ TEST_F(BacktestCli, BadVariantNameExitsTwoAndNamesIt) {
 }
 
 TEST_F(BacktestCli, MissingColumnExitsTwoNamingTheVariantAndColumn) {
-  Series data = FiveDays(ExamplePlant());
+  Series data = FiveDays(DesignExamplePlant());
   const Channel channels[] = {Channel::kTInC,    Channel::kTOutC, Channel::kMdotKgS,
                               Channel::kGPoaWM2, Channel::kTAmbC, Channel::kLwDownWM2,
                               Channel::kPElW,    Channel::kQThW};

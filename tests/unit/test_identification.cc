@@ -9,25 +9,10 @@
 #include "core/synthetic_plant.h"
 #include "core/units.h"
 #include "io/csv.h"
+#include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
-
-Plant SyntheticPlant() {
-  Plant plant;
-  plant.latitude_rad = DegToRad(47.358);
-  plant.longitude_rad = DegToRad(16.128);
-  plant.tilt_rad = DegToRad(20.0);
-  plant.azimuth_rad = DegToRad(180.0);
-  return plant;
-}
-
-ModelSpec Spec(const std::string& name) {
-  ModelSpec spec;
-  std::string error;
-  EXPECT_TRUE(ParseVariant(name, &spec, &error)) << error;
-  return spec;
-}
 
 struct Case {
   Series series;
@@ -43,9 +28,11 @@ Case MakeCase(const Plant& plant, const std::string& variant, int days, double s
   weather.seed = seed;
   weather.flow_mode = FlowMode::kVariable;  // varying flow separates r0 from r1
   Case c;
-  c.series = MakeSyntheticPlantData(plant, weather, Spec(variant), ReferenceTruthParams(plant), noise);
+  c.series = MakeSyntheticPlantData(plant, weather, testing::SpecOf(variant),
+                                    ReferenceTruthParams(plant), noise);
   std::string error;
-  EXPECT_TRUE(PrepareDrivers(c.series, plant, Spec(variant), &c.drivers, &error)) << error;
+  EXPECT_TRUE(PrepareDrivers(c.series, plant, testing::SpecOf(variant), &c.drivers, &error))
+      << error;
   c.meas = MakeMeasurements(c.series, c.drivers);
   return c;
 }
@@ -53,7 +40,7 @@ Case MakeCase(const Plant& plant, const std::string& variant, int days, double s
 // Noise-free data from the model itself: the identifiable parameters come
 // back within 1 % and the MAE falls below 0.5 W/m².
 TEST(IdentifySynthetic, NoiseFreeRecoversIdentifiableParameters) {
-  const Plant plant = SyntheticPlant();
+  const Plant plant = DesignExamplePlant();
   const ParamVector truth = ReferenceTruthParams(plant);
   for (const std::string variant : {"1N1Cwr", "2N1Ccolwr"}) {
     const Case c = MakeCase(plant, variant, 7, 120.0, /*seed=*/11, SensorNoise{});
@@ -81,7 +68,7 @@ TEST(IdentifySynthetic, NoiseFreeRecoversIdentifiableParameters) {
 // With realistic sensor noise the fit reaches the noise floor (the MAE of the
 // true parameters on the same noisy data) within 10 %.
 TEST(IdentifySynthetic, NoisyDataReachTheNoiseFloor) {
-  const Plant plant = SyntheticPlant();
+  const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
   SimOutputs truth_out;
   Simulate(c.drivers, ReferenceTruthParams(plant), &truth_out);
@@ -97,10 +84,10 @@ TEST(IdentifySynthetic, NoisyDataReachTheNoiseFloor) {
 // direction, which must be reported and resolved by fixing a parameter at its
 // reference value instead of returning an arbitrary point on the ridge.
 TEST(IdentifySynthetic, FlatDirectionIsReportedAndFixed) {
-  const Plant plant = SyntheticPlant();
+  const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "1N1C", 5, 300.0, /*seed=*/14, SensorNoise{});
   IdentOptions options;
-  options.free = DefaultFreeParams(Spec("1N1C"));
+  options.free = DefaultFreeParams(testing::SpecOf("1N1C"));
   options.free.set(static_cast<std::size_t>(Param::kAreaM2));
   const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), options);
   ASSERT_TRUE(s.ok) << s.BriefReport();
@@ -118,7 +105,7 @@ TEST(IdentifySynthetic, FlatDirectionIsReportedAndFixed) {
 }
 
 TEST(IdentifyFailures, TooLittleDataIsAFailureWithReason) {
-  const Plant plant = SyntheticPlant();
+  const Plant plant = DesignExamplePlant();
   Case c = MakeCase(plant, "1N1C", 1, 600.0, 15, SensorNoise{});
   c.meas.rows.resize(5);
   const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), IdentOptions{});
@@ -127,7 +114,7 @@ TEST(IdentifyFailures, TooLittleDataIsAFailureWithReason) {
 }
 
 TEST(IdentifyFailures, EvaluationCapNeverReturnsAWorseFit) {
-  const Plant plant = SyntheticPlant();
+  const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 2, 600.0, 16, RealisticSensorNoise(17));
   for (const char* algorithm : {"lad_lm", "sbplx", "bobyqa"}) {
     IdentOptions options;
@@ -174,7 +161,7 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
   csv.fluid_density_kg_m3 = config.plant.fluid_density_kg_m3;
   ASSERT_TRUE(ReadCanonicalCsv(dir + "day3_clear_medium_dT.csv", csv, &train, &errors, nullptr));
   ASSERT_TRUE(ReadCanonicalCsv(dir + "day1_clear_low_dT.csv", csv, &test, &errors, nullptr));
-  const ModelSpec spec = Spec("2N1CcolwrI");
+  const ModelSpec spec = testing::SpecOf("2N1CcolwrI");
   Drivers dtrain, dtest;
   std::string error;
   ASSERT_TRUE(PrepareDrivers(train, config.plant, spec, &dtrain, &error)) << error;
@@ -186,7 +173,8 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
   EXPECT_LT(s.train.nmae_q_th, 0.06);
   SimOutputs sim;
   Simulate(dtest, s.params, &sim);
-  const ErrorMetrics held_out = ComputeErrors(MakeMeasurements(test, dtest), sim, config.plant.area_m2);
+  const ErrorMetrics held_out =
+      ComputeErrors(MakeMeasurements(test, dtest), sim, config.plant.area_m2);
   EXPECT_LT(held_out.nmae_p_el, 0.02);
   EXPECT_LT(held_out.nmae_q_th, 0.18);
 }

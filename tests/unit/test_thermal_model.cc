@@ -16,17 +16,10 @@ namespace {
 using testing::ConstantInputs;
 using testing::MakeConstantSeries;
 
-ModelSpec Spec(const char* name) {
-  ModelSpec s;
-  std::string e;
-  EXPECT_TRUE(ParseVariant(name, &s, &e)) << e;
-  return s;
-}
-
 Drivers MakeDrivers(const Series& s, const char* variant, const Plant& plant = {}) {
   Drivers d;
   std::string error;
-  EXPECT_TRUE(PrepareDrivers(s, plant, Spec(variant), &d, &error)) << error;
+  EXPECT_TRUE(PrepareDrivers(s, plant, testing::SpecOf(variant), &d, &error)) << error;
   return d;
 }
 
@@ -121,8 +114,8 @@ TEST(ThermalModel, IrradianceStepGivesFirstOrderResponse) {
   At(p, Param::kR1Fluid) = 1.0;
   At(p, Param::kCPvJM2K) = 3.0e4;
   At(p, Param::kCCollJM2K) = 5.0e4;
-  const double eta = At(p, Param::kEtaPvRef) *
-                     (1.0 + plant.pv_irr_coeff_m2_w * (800.0 - plant.pv_g_ref_w_m2));
+  const double eta =
+      At(p, Param::kEtaPvRef) * (1.0 + plant.pv_irr_coeff_m2_w * (800.0 - plant.pv_g_ref_w_m2));
   const double q_abs_w_m2 = (1.0 - eta) * At(p, Param::kFTh) * 800.0;
   const double w = 0.04 * 4000.0 / 2.0;  // specific capacity flow, W/m²K
   const double u_fluid = 1.0 / (1.0 / (2.0 * w) + 0.01);
@@ -160,7 +153,8 @@ TEST(ThermalModel, EnergyBalanceClosesForEveryVariant) {
   Series s = MakeConstantSeries(600, 60.0, in);
   for (std::size_t i = 0; i < s.size(); ++i) {
     const double hour = static_cast<double>(i) / 60.0;
-    s[Channel::kGPoaWM2][i] = std::max(0.0, 900.0 * std::sin(hour / 10.0 * kPi)) * (0.6 + 0.4 * u01(rng));
+    s[Channel::kGPoaWM2][i] =
+        std::max(0.0, 900.0 * std::sin(hour / 10.0 * kPi)) * (0.6 + 0.4 * u01(rng));
     s[Channel::kTInC][i] = 25.0 + 10.0 * u01(rng);
     s[Channel::kMdotKgS][i] = u01(rng) < 0.1 ? 0.0 : 0.05 * u01(rng);
     s[Channel::kWindMS][i] = 6.0 * u01(rng);
@@ -176,7 +170,8 @@ TEST(ThermalModel, EnergyBalanceClosesForEveryVariant) {
     for (std::size_t i = 0; i < s.size(); ++i) {
       const double rhs =
           out.q_th_w[i] + out.q_front_w[i] + out.q_back_w[i] + out.q_rad_w[i] + out.q_store_w[i];
-      ASSERT_NEAR(out.q_abs_w[i], rhs, 1e-9 * (1.0 + std::fabs(out.q_abs_w[i]))) << v << " row " << i;
+      ASSERT_NEAR(out.q_abs_w[i], rhs, 1e-9 * (1.0 + std::fabs(out.q_abs_w[i])))
+          << v << " row " << i;
     }
   }
 }

@@ -37,8 +37,8 @@ bool ParseVariantOrReport(const std::string& name, ModelSpec* spec) {
   return false;
 }
 
-bool PrepareDriversOrReport(const Series& series, const std::string& csv_path,
-                            const Config& config, const ModelSpec& spec, Drivers* drivers) {
+bool PrepareDriversOrReport(const Series& series, const std::string& csv_path, const Config& config,
+                            const ModelSpec& spec, Drivers* drivers) {
   std::string error;
   if (PrepareDrivers(series, config.plant, spec, drivers, &error)) return true;
   std::cerr << csv_path << ": " << error << "\n";

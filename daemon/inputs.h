@@ -17,8 +17,8 @@ bool LoadConfigOrReport(const std::string& path, Config* config);
 bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series);
 bool ParseVariantOrReport(const std::string& name, ModelSpec* spec);
 // Drivers of `spec` for `series`; reports the missing columns naming the CSV.
-bool PrepareDriversOrReport(const Series& series, const std::string& csv_path,
-                            const Config& config, const ModelSpec& spec, Drivers* drivers);
+bool PrepareDriversOrReport(const Series& series, const std::string& csv_path, const Config& config,
+                            const ModelSpec& spec, Drivers* drivers);
 
 // Parses a time given on the command line (ISO 8601 or unix seconds).
 bool ParseTimeOrReport(const std::string& option, const std::string& text, std::int64_t* unix_s);

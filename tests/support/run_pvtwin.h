@@ -32,7 +32,7 @@ inline ProcessResult RunPvtwin(const std::filesystem::path& dir, const std::stri
   namespace fs = std::filesystem;
   static int counter = 0;
   const fs::path err_path = fs::temp_directory_path() / ("pvtwin_test_" + std::to_string(getpid()) +
-                                                        "_" + std::to_string(counter++) + ".err");
+                                                         "_" + std::to_string(counter++) + ".err");
   const std::string command = "cd '" + dir.string() + "' && '" + PVTWIN_BINARY + "' " + args +
                               " 2>'" + err_path.string() + "'";
   ProcessResult run;

@@ -12,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include "tests/support/files.h"
+
 namespace pvtwin::testing {
 
 struct ProcessResult {
@@ -19,13 +21,6 @@ struct ProcessResult {
   std::string out;
   std::string err;
 };
-
-inline std::string ReadFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // `pvtwin <args>` run through the shell in directory `dir`.
 inline ProcessResult RunPvtwin(const std::filesystem::path& dir, const std::string& args) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "config/plant_config.h"
+#include "tests/support/files.h"
 
 namespace pvtwin {
 namespace {
@@ -24,23 +25,11 @@ namespace fs = std::filesystem;
 
 const fs::path kCasesDir = fs::path(PVTWIN_GOLDEN_DIR) / "config";
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using pvtwin::testing::ReadFile;
 
-std::vector<std::string> CaseNames() {
-  std::vector<std::string> names;
-  for (const fs::directory_entry& entry : fs::directory_iterator(kCasesDir)) {
-    if (entry.is_directory()) names.push_back(entry.path().filename().string());
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
+std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kCasesDir); }
 
-class ConfigGoldenTest : public testing::TestWithParam<std::string> {};
+class ConfigGoldenTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ConfigGoldenTest, MessagesMatchExpected) {
   const fs::path dir = kCasesDir / GetParam();
@@ -58,8 +47,8 @@ TEST_P(ConfigGoldenTest, MessagesMatchExpected) {
   EXPECT_EQ(actual, ReadFile(dir / "expected.txt"));
 }
 
-INSTANTIATE_TEST_SUITE_P(Config, ConfigGoldenTest, testing::ValuesIn(CaseNames()),
-                         [](const testing::TestParamInfo<std::string>& info) {
+INSTANTIATE_TEST_SUITE_P(Config, ConfigGoldenTest, ::testing::ValuesIn(CaseNames()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param;
                          });
 

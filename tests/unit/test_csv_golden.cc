@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "io/csv.h"
+#include "tests/support/files.h"
 
 namespace pvtwin {
 namespace {
@@ -28,21 +29,9 @@ namespace fs = std::filesystem;
 
 const fs::path kCasesDir = fs::path(PVTWIN_GOLDEN_DIR) / "csv";
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using pvtwin::testing::ReadFile;
 
-std::vector<std::string> CaseNames() {
-  std::vector<std::string> names;
-  for (const fs::directory_entry& entry : fs::directory_iterator(kCasesDir)) {
-    if (entry.is_directory()) names.push_back(entry.path().filename().string());
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
+std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kCasesDir); }
 
 // The report described at the top of this file.
 std::string Report(const fs::path& input, bool* ok) {
@@ -65,7 +54,7 @@ std::string Report(const fs::path& input, bool* ok) {
   return out.str();
 }
 
-class CsvGoldenTest : public testing::TestWithParam<std::string> {};
+class CsvGoldenTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CsvGoldenTest, ReportMatchesExpected) {
   const fs::path dir = kCasesDir / GetParam();
@@ -78,8 +67,8 @@ TEST_P(CsvGoldenTest, ReportMatchesExpected) {
   EXPECT_EQ(actual, ReadFile(dir / "expected.txt"));
 }
 
-INSTANTIATE_TEST_SUITE_P(Csv, CsvGoldenTest, testing::ValuesIn(CaseNames()),
-                         [](const testing::TestParamInfo<std::string>& info) {
+INSTANTIATE_TEST_SUITE_P(Csv, CsvGoldenTest, ::testing::ValuesIn(CaseNames()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param;
                          });
 

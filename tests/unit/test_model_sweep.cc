@@ -33,6 +33,13 @@ Series VaryingSeries(double step_s) {
   return s;
 }
 
+Drivers DriversOf(const Series& s, const Plant& plant, const ModelSpec& spec) {
+  Drivers d;
+  std::string error;
+  EXPECT_TRUE(PrepareDrivers(s, plant, spec, &d, &error)) << error;
+  return d;
+}
+
 std::vector<std::string> AllTestedVariants() {
   std::vector<std::string> v = PaperVariants();
   v.erase(std::remove(v.begin(), v.end(), "2N1CcolwrI"), v.end());  // needs sun geometry
@@ -69,11 +76,8 @@ TEST(ModelSweep, FiniteAndBoundedAcrossBoundsAndSteps) {
     }
     for (double g : s[Channel::kGPoaWM2]) g_max = std::max(g_max, g);
     for (const std::string& v : AllTestedVariants()) {
-      ModelSpec spec;
-      std::string error;
-      ASSERT_TRUE(ParseVariant(v, &spec, &error));
-      Drivers d;
-      ASSERT_TRUE(PrepareDrivers(s, plant, spec, &d, &error)) << error;
+      const ModelSpec spec = testing::SpecOf(v);
+      const Drivers d = DriversOf(s, plant, spec);
       SimOutputs out;
       for (int sample = 0; sample < 12; ++sample) {
         const ParamVector p = Sample(plant, rng, std::min(sample, 2));
@@ -85,9 +89,9 @@ TEST(ModelSweep, FiniteAndBoundedAcrossBoundsAndSteps) {
         auto at = [&p](Param x) { return p[static_cast<std::size_t>(x)]; };
         const double u_front_min = 1.0 / (1.0 / at(Param::kUFrontWM2K) +
                                           at(Param::kRRefWind) * std::pow(5.5, at(Param::kNWind)));
-        const double u_path = spec.nodes == 2
-                                  ? 1.0 / (1.0 / at(Param::kUCollWM2K) + 1.0 / at(Param::kUBackWM2K))
-                                  : at(Param::kUBackWM2K);
+        const double u_path =
+            spec.nodes == 2 ? 1.0 / (1.0 / at(Param::kUCollWM2K) + 1.0 / at(Param::kUBackWM2K))
+                            : at(Param::kUBackWM2K);
         const double t_upper = t_max + at(Param::kFTh) * g_max / (u_front_min + u_path) + 1.0;
         for (std::size_t i = 0; i < s.size(); ++i) {
           for (double t : {out.t_pv_c[i], out.t_coll_c[i]}) {
@@ -109,11 +113,8 @@ TEST(ModelSweep, OutputsDependOnExactlyTheUsedParameters) {
   const Plant plant;
   const Series s = VaryingSeries(60.0);
   for (const std::string& v : AllTestedVariants()) {
-    ModelSpec spec;
-    std::string error;
-    ASSERT_TRUE(ParseVariant(v, &spec, &error));
-    Drivers d;
-    ASSERT_TRUE(PrepareDrivers(s, plant, spec, &d, &error)) << error;
+    const ModelSpec spec = testing::SpecOf(v);
+    const Drivers d = DriversOf(s, plant, spec);
     const ParamVector base = StartParams(plant);
     SimOutputs ref, out;
     Simulate(d, base, &ref);
@@ -125,7 +126,8 @@ TEST(ModelSweep, OutputsDependOnExactlyTheUsedParameters) {
       Simulate(d, p, &out);
       double change = 0.0;
       for (std::size_t r = 0; r < s.size(); ++r) {
-        change += std::fabs(out.p_el_w[r] - ref.p_el_w[r]) + std::fabs(out.q_th_w[r] - ref.q_th_w[r]);
+        change +=
+            std::fabs(out.p_el_w[r] - ref.p_el_w[r]) + std::fabs(out.q_th_w[r] - ref.q_th_w[r]);
       }
       if (used.test(i)) {
         EXPECT_GT(change, 1e-6) << v << " should depend on " << kParamTable[i].name;

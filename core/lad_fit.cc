@@ -80,8 +80,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
         z = z_new;
         r.swap(r_trial);
         accepted = true;
-        // Trust the Gauss–Newton model quickly again after a success: ÷10
-        // needed ~25 % fewer simulations than ÷3 on synthetic 14-day fits.
+        // Trust the Gauss–Newton model quickly again after a success: near
+        // the optimum its steps are the fast ones.
         lambda = std::max(lambda / 10.0, 1e-9);
         break;
       }

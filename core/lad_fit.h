@@ -22,20 +22,21 @@
 namespace pvtwin {
 
 struct LadFitOptions {
-  int max_iterations = 500;        // Jacobian evaluations at most
-  int max_evaluations = 2000;      // residual evaluations in total
-  double ftol_rel = 1e-7;          // stop when an accepted step lowers O by less than this fraction
-  double xtol = 1e-7;              // … or moves z by less than this (max norm)
-  double jacobian_step = 1e-4;     // forward-difference step in unit coordinates
+  int max_iterations = 500;     // Jacobian evaluations at most
+  int max_evaluations = 2000;   // residual evaluations in total
+  double ftol_rel = 1e-7;       // stop when an accepted step lowers O by less than this fraction
+  double xtol = 1e-7;           // … or moves z by less than this (max norm)
+  double jacobian_step = 1e-4;  // forward-difference step in unit coordinates
   // δ = this × mean |r|: caps the IRLS weights 1/max(|r̂|, δ). A floor near
   // the typical residual keeps the majoriser well conditioned; it shapes the
-  // steps only, since every step must lower the true O(z). 0.3 needed about
-  // 25 % fewer evaluations than 1e-6 on synthetic 14-day data with noise.
-  // When no step lowers O, the floor is divided by 10 (down to 1e-6) before
-  // the fit is declared converged, so the exact L1 optimum is reached.
+  // steps only, since every step must lower the true O(z). A floor far
+  // below the residuals makes the weights, and so the steps, follow the few
+  // rows that happen to sit near zero. When no step lowers O, or steps fall
+  // below xtol, the floor is divided by 10 (down to 1e-6) before the fit is
+  // declared converged, so the exact L1 optimum is reached.
   double weight_floor_rel = 0.3;
-  double prior_weight = 0.0;       // see O(z)
-  double n_scale = 1.0;            // N_scale in O(z)
+  double prior_weight = 0.0;  // see O(z)
+  double n_scale = 1.0;       // N_scale in O(z)
 };
 
 struct LadFitResult {

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <sstream>
+#include <nlohmann/json.hpp>
 
 #include "core/identification.h"
 #include "core/resample.h"
@@ -77,33 +77,33 @@ std::string StatusOf(const ParamEstimate& e) {
   return buf;
 }
 
+// The "fit" object of params.json. An undefined nMAE (no output to
+// normalise by) is written as null.
 std::string FitJson(const IdentSummary& s, const ErrorMetrics* held_out) {
-  std::ostringstream j;
-  auto metrics = [&j](const ErrorMetrics& e) {
-    j << "{\"rows\": " << e.rows << ", \"mae_p_el_w_m2\": " << e.mae_p_el_w_m2
-      << ", \"mae_q_th_w_m2\": " << e.mae_q_th_w_m2
-      << ", \"nmae_p_el\": " << (std::isfinite(e.nmae_p_el) ? e.nmae_p_el : 0.0)
-      << ", \"nmae_q_th\": " << (std::isfinite(e.nmae_q_th) ? e.nmae_q_th : 0.0) << "}";
+  auto metrics = [](const ErrorMetrics& e) {
+    nlohmann::ordered_json m;
+    m["rows"] = e.rows;
+    m["mae_p_el_w_m2"] = e.mae_p_el_w_m2;
+    m["mae_q_th_w_m2"] = e.mae_q_th_w_m2;
+    m["nmae_p_el"] = e.nmae_p_el;  // NaN is written as null
+    m["nmae_q_th"] = e.nmae_q_th;
+    return m;
   };
-  j.precision(10);
-  j << "{\"algorithm\": \"" << s.algorithm << "\", \"termination\": \"" << ToString(s.termination)
-    << "\", \"initial_cost_w_m2\": " << s.initial_cost_w_m2
-    << ", \"final_cost_w_m2\": " << s.final_cost_w_m2 << ", \"simulations\": " << s.evaluations
-    << ", \"runtime_s\": " << s.runtime_s << ", \"train\": ";
-  metrics(s.train);
-  if (held_out) {
-    j << ", \"held_out\": ";
-    metrics(*held_out);
-  }
-  j << ", \"undetermined\": [";
-  bool first = true;
+  nlohmann::ordered_json j;
+  j["algorithm"] = s.algorithm;
+  j["termination"] = std::string(ToString(s.termination));
+  j["initial_cost_w_m2"] = s.initial_cost_w_m2;
+  j["final_cost_w_m2"] = s.final_cost_w_m2;
+  j["simulations"] = s.evaluations;
+  j["runtime_s"] = s.runtime_s;
+  j["train"] = metrics(s.train);
+  if (held_out) j["held_out"] = metrics(*held_out);
+  j["undetermined"] = nlohmann::ordered_json::array();
   for (const ParamEstimate& e : s.estimates) {
-    if (!e.undetermined) continue;
-    j << (first ? "" : ", ") << "\"" << kParamTable[static_cast<std::size_t>(e.param)].name << "\"";
-    first = false;
+    if (e.undetermined)
+      j["undetermined"].push_back(kParamTable[static_cast<std::size_t>(e.param)].name);
   }
-  j << "]}";
-  return j.str();
+  return j.dump();
 }
 
 bool ParamSetOrReport(const std::string& option, const std::vector<std::string>& names,

@@ -102,6 +102,8 @@ TEST_F(CliModel, CalibrateThenSimulateRoundTrip) {
   EXPECT_NE(params.find("\"variant\": \"1N1Cwr\""), std::string::npos) << params;
   EXPECT_NE(params.find("\"c_pv_j_m2k\""), std::string::npos);
   EXPECT_EQ(params.find("\"c_coll_j_m2k\""), std::string::npos);  // not used by 1N1Cwr
+  EXPECT_NE(params.find("\"algorithm\": \"lad_lm\""), std::string::npos) << params;
+  EXPECT_NE(params.find("\"train\": {"), std::string::npos) << params;
 
   run = RunPvtwin(dir_, "simulate --config " + Data("plant.toml") + " --csv " +
                             Data("day3_clear_medium_dT.csv") +

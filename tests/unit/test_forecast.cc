@@ -1,0 +1,130 @@
+// Forecasts (core/forecast.h): with perfect inputs a forecast of the true
+// model reproduces the truth; without a weather forecast it persists the last
+// measured day; without a plan it runs the window's typical day.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/forecast.h"
+#include "core/synthetic_plant.h"
+#include "core/thermal_model.h"
+#include "tests/support/synthetic_series.h"
+
+namespace pvtwin {
+namespace {
+
+constexpr std::int64_t kDay = 86400;
+
+struct Case {
+  Plant plant = DesignExamplePlant();
+  ModelSpec spec = testing::SpecOf("2N1Ccolwr");
+  ParamVector truth = ReferenceTruthParams(DesignExamplePlant());
+  Series data;  // 15 days, noise-free truth outputs
+  std::int64_t t_forecast = 0;
+
+  Case() {
+    WeatherOptions weather;
+    weather.num_days = 15;
+    weather.seed = 5;
+    weather.flow_mode = FlowMode::kVariable;
+    data = MakeSyntheticPlantData(plant, weather, spec, truth, SensorNoise{});
+    t_forecast = weather.start_time_s + 14 * kDay;
+  }
+  std::size_t RowOf(std::int64_t t) const {
+    return static_cast<std::size_t>((t - data.time_s.front()) / 60);
+  }
+  Series Before(std::int64_t t) const { return data.Slice(0, RowOf(t)); }
+  Series From(std::int64_t t) const { return data.Slice(RowOf(t), data.size()); }
+};
+
+double MaxAbsDiff(const std::vector<double>& a, const std::vector<double>& b, std::size_t offset) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::isnan(a[i]) || std::isnan(b[offset + i])) return INFINITY;
+    m = std::max(m, std::fabs(a[i] - b[offset + i]));
+  }
+  return m;
+}
+
+TEST(Forecast, PerfectInputsReproduceTheTruthModel) {
+  const Case c;
+  const Series future = c.From(c.t_forecast);
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  Forecast f;
+  std::string error;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), future, future,
+                           request, &f, &error))
+      << error;
+  ASSERT_EQ(f.rows.size(), 1440u);
+  EXPECT_EQ(f.rows.time_s.front(), c.t_forecast);
+  EXPECT_EQ(f.inputs.weather_forecast, 1440u);
+  EXPECT_EQ(f.inputs.operation_plan, 1440u);
+  EXPECT_EQ(f.inputs.weather_persistence, 0u);
+  // The truth ran without a break; the forecast restarts a day earlier from a
+  // steady state, which the collector forgets within hours (τ = C/U).
+  const std::size_t offset = c.RowOf(c.t_forecast);
+  EXPECT_LT(MaxAbsDiff(f.rows[Channel::kPElW], c.data[Channel::kPElW], offset), 1e-6);
+  EXPECT_LT(MaxAbsDiff(f.rows[Channel::kQThW], c.data[Channel::kQThW], offset), 1e-6);
+  EXPECT_LT(MaxAbsDiff(f.rows[Channel::kTOutC], c.data[Channel::kTOutC], offset), 1e-6);
+}
+
+TEST(Forecast, WithoutWeatherForecastPersistsTheLastDay) {
+  const Case c;
+  const Series plan = c.From(c.t_forecast);
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  Forecast f;
+  std::string error;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), Series{}, plan,
+                           request, &f, &error))
+      << error;
+  EXPECT_EQ(f.inputs.weather_forecast, 0u);
+  EXPECT_EQ(f.inputs.weather_persistence, 1440u);
+  EXPECT_EQ(f.inputs.weather_missing, 0u);
+  const std::size_t yesterday = c.RowOf(c.t_forecast - kDay);
+  for (Channel ch : {Channel::kGPoaWM2, Channel::kTAmbC, Channel::kWindMS}) {
+    if (!c.data.Has(ch)) continue;
+    for (std::size_t i = 0; i < 1440; i += 97) {
+      EXPECT_EQ(f.inputs_used[ch][i], c.data[ch][yesterday + i]) << ChannelName(ch) << " row " << i;
+    }
+  }
+  EXPECT_NE(f.inputs.Describe().find("persistence 1440/1440"), std::string::npos);
+}
+
+TEST(Forecast, WithoutPlanRunsTheMedianDayOfTheWindow) {
+  const Case c;
+  Series history = c.Before(c.t_forecast);
+  // Inlet temperature: 30 °C on most days, 50 °C on a minority; the typical
+  // day is the median, not the mean.
+  auto& t_in = history[Channel::kTInC];
+  for (std::size_t i = 0; i < history.size(); ++i) {
+    const std::int64_t day = (history.time_s[i] - history.time_s.front()) / kDay;
+    t_in[i] = day % 3 == 0 ? 50.0 : 30.0;
+  }
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  Forecast f;
+  std::string error;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, history, c.From(c.t_forecast), Series{},
+                           request, &f, &error))
+      << error;
+  EXPECT_EQ(f.inputs.operation_plan, 0u);
+  EXPECT_EQ(f.inputs.operation_typical, 1440u);
+  for (double v : f.inputs_used[Channel::kTInC]) ASSERT_EQ(v, 30.0);
+}
+
+TEST(Forecast, RefusesHistoryShorterThanADay) {
+  const Case c;
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  const Series short_history = c.data.Slice(c.RowOf(c.t_forecast) - 600, c.RowOf(c.t_forecast));
+  Forecast f;
+  std::string error;
+  EXPECT_FALSE(MakeForecast(c.plant, c.spec, c.truth, short_history, Series{}, Series{}, request,
+                            &f, &error));
+  EXPECT_NE(error.find("less than one day"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -1,5 +1,6 @@
 #include "config/plant_config.h"
 
+#include <sys/stat.h>
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -258,17 +260,6 @@ void ReadPoll(SectionReader& r, PollConfig* poll) {
   r.Number("period_s", kOptional, Above(0), &poll->period_s);
 }
 
-// "HH:MM" with 00 <= HH <= 23 and 00 <= MM <= 59.
-bool IsClockTime(std::string_view s) {
-  const auto digit = [&](std::size_t i) { return s[i] >= '0' && s[i] <= '9'; };
-  if (s.size() != 5 || s[2] != ':' || !digit(0) || !digit(1) || !digit(3) || !digit(4)) {
-    return false;
-  }
-  const int hours = (s[0] - '0') * 10 + (s[1] - '0');
-  const int minutes = (s[3] - '0') * 10 + (s[4] - '0');
-  return hours <= 23 && minutes <= 59;
-}
-
 void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
   // The variant grammar (paper Table 6 names plus "+effect") belongs to the
   // model layer; here it only has to be a non-empty string.
@@ -285,13 +276,21 @@ void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
   constexpr std::string_view kClockRule = "expected a local time \"HH:MM\" (00:00 to 23:59)";
   std::string at;
   if (r.String("at", kOptional, &at, kClockRule)) {
-    if (IsClockTime(at)) {
+    if (int h = 0, m = 0; ParseClockTime(at, &h, &m)) {
       calibration->at = at;
     } else {
       r.Reject("at", kClockRule);
     }
   }
-  r.String("timezone", kOptional, &calibration->timezone);
+  constexpr std::string_view kZoneRule = "expected a zone of the tz database, e.g. \"Europe/Vienna\"";
+  std::string zone;
+  if (r.String("timezone", kOptional, &zone, kZoneRule)) {
+    if (TimeZoneExists(zone)) {
+      calibration->timezone = zone;
+    } else {
+      r.Reject("timezone", kZoneRule);
+    }
+  }
 }
 
 void ReadForecast(SectionReader& r, ForecastConfig* forecast) {
@@ -346,6 +345,27 @@ void ReadDocument(const toml::table& root, const SourceText& source, const std::
 }
 
 }  // namespace
+
+bool ParseClockTime(std::string_view text, int* hour, int* minute) {
+  const auto digit = [&](std::size_t i) { return text[i] >= '0' && text[i] <= '9'; };
+  if (text.size() != 5 || text[2] != ':' || !digit(0) || !digit(1) || !digit(3) || !digit(4)) {
+    return false;
+  }
+  const int h = (text[0] - '0') * 10 + (text[1] - '0');
+  const int m = (text[3] - '0') * 10 + (text[4] - '0');
+  if (h > 23 || m > 59) return false;
+  *hour = h;
+  *minute = m;
+  return true;
+}
+
+bool TimeZoneExists(const std::string& iana) {
+  if (iana.empty() || iana.front() == '/' || iana.find("..") != std::string::npos) return false;
+  const char* dir = std::getenv("TZDIR");
+  const std::string path = std::string(dir && *dir ? dir : "/usr/share/zoneinfo") + "/" + iana;
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
 
 bool ParseConfig(std::string_view toml_text, const std::string& path_for_messages, Config* out,
                  Diagnostics* errors) {

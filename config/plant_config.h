@@ -57,6 +57,13 @@ struct Config {
   std::string source_path;  // the file it was read from
 };
 
+// "HH:MM" (00:00 … 23:59) → hour, minute; false otherwise.
+bool ParseClockTime(std::string_view text, int* hour, int* minute);
+
+// True if `iana` names a zone of the system's tz database (TZDIR or
+// /usr/share/zoneinfo), e.g. "Europe/Vienna" or "UTC".
+bool TimeZoneExists(const std::string& iana);
+
 // Reads and validates the whole file. Returns true when there is no error;
 // every problem found is appended to *errors (all at once, in file order).
 // *out is written only on success. errors must not be null.

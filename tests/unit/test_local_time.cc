@@ -1,0 +1,81 @@
+// The nightly schedule (io/local_time.h) in Europe/Vienna across both DST
+// changes of 2024 (EU rule: last Sunday of March and October, 01:00 UTC).
+// Expected instants are written as UTC calendar times.
+#include "io/local_time.h"
+
+#include <gtest/gtest.h>
+
+#include <ctime>
+
+#include "config/plant_config.h"
+
+namespace pvtwin {
+namespace {
+
+std::int64_t Utc(int year, int month, int day, int hour, int minute = 0) {
+  std::tm tm{};
+  tm.tm_year = year - 1900;
+  tm.tm_mon = month - 1;
+  tm.tm_mday = day;
+  tm.tm_hour = hour;
+  tm.tm_min = minute;
+  return static_cast<std::int64_t>(::timegm(&tm));
+}
+
+class LocalTime : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string error;
+    ASSERT_TRUE(UseTimeZone("Europe/Vienna", &error)) << error;
+  }
+};
+
+TEST_F(LocalTime, SummerNightIsTwoHoursAheadOfUtc) {
+  EXPECT_EQ(NextLocalTime(Utc(2024, 6, 1, 12), 2, 0), Utc(2024, 6, 2, 0));
+}
+
+TEST_F(LocalTime, WinterNightIsOneHourAheadOfUtc) {
+  EXPECT_EQ(NextLocalTime(Utc(2024, 1, 10, 12), 2, 0), Utc(2024, 1, 11, 1));
+}
+
+TEST_F(LocalTime, StrictlyAfterNow) {
+  EXPECT_EQ(NextLocalTime(Utc(2024, 6, 2, 0), 2, 0), Utc(2024, 6, 3, 0));
+}
+
+TEST_F(LocalTime, SpringForwardRunsRightAfterTheSkippedHour) {
+  // 31 March 2024: 02:00 CET does not exist, the clock jumps to 03:00 CEST
+  // at 01:00 UTC. The run happens then, once.
+  EXPECT_EQ(NextLocalTime(Utc(2024, 3, 30, 23), 2, 0), Utc(2024, 3, 31, 1));
+  EXPECT_EQ(NextLocalTime(Utc(2024, 3, 31, 1), 2, 0), Utc(2024, 4, 1, 0));
+}
+
+TEST_F(LocalTime, FallBackRunsOnlyAtTheFirstOccurrence) {
+  // 27 October 2024: 02:00–02:59 happens twice (CEST, then CET from 01:00 UTC).
+  EXPECT_EQ(NextLocalTime(Utc(2024, 10, 26, 22), 2, 0), Utc(2024, 10, 27, 0));
+  EXPECT_EQ(NextLocalTime(Utc(2024, 10, 27, 0, 30), 2, 0), Utc(2024, 10, 28, 1));
+}
+
+TEST_F(LocalTime, Midnight) {
+  EXPECT_EQ(NextLocalTime(Utc(2024, 6, 1, 12), 0, 0), Utc(2024, 6, 1, 22));
+}
+
+TEST(TimeZone, UnknownZonesAreRejected) {
+  std::string error;
+  EXPECT_FALSE(UseTimeZone("Europe/Atlantis", &error));
+  EXPECT_NE(error.find("Europe/Atlantis"), std::string::npos);
+  EXPECT_FALSE(TimeZoneExists("../etc/passwd"));
+  EXPECT_TRUE(TimeZoneExists("UTC"));
+}
+
+TEST(ClockTime, ParsesOnlyValidTimes) {
+  int h = -1, m = -1;
+  EXPECT_TRUE(ParseClockTime("02:30", &h, &m));
+  EXPECT_EQ(h, 2);
+  EXPECT_EQ(m, 30);
+  EXPECT_FALSE(ParseClockTime("24:00", &h, &m));
+  EXPECT_FALSE(ParseClockTime("2:30", &h, &m));
+  EXPECT_FALSE(ParseClockTime("02:60", &h, &m));
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -13,6 +13,9 @@ namespace pvtwin {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// During the warm-up a missing minute (e.g. the one not yet aggregated when
+// the forecast is issued) holds the last measured value this long.
+constexpr double kWarmupHoldS = 600.0;
 
 // Weather channels a forecast carries into the horizon (the model's inputs
 // other than the operation). The measured angle of incidence is left out:
@@ -143,7 +146,7 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
     for (std::size_t k = 0; k < n; ++k) {
       const std::int64_t t = in.time_s[k];
       if (k < n_warm) {
-        col[k] = measured.Exact(t);
+        col[k] = measured.Held(t, kWarmupHoldS);
         continue;
       }
       const std::size_t h = k - n_warm;
@@ -177,7 +180,7 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
     for (std::size_t k = 0; k < n; ++k) {
       const std::int64_t t = in.time_s[k];
       if (k < n_warm) {
-        col[k] = measured.Exact(t);
+        col[k] = measured.Held(t, kWarmupHoldS);
         continue;
       }
       const std::size_t h = k - n_warm;

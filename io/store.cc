@@ -214,6 +214,21 @@ struct Store::Impl {
     return rc == SQLITE_DONE ? DbStatus{} : Fail(rc, what);
   }
 
+  // Runs the query sql, whose two parameters are a time range [from, to),
+  // and hands each row to on_row.
+  DbStatus SelectRange(const std::string& sql, std::int64_t from, std::int64_t to,
+                       const std::function<void(sqlite3_stmt*)>& on_row, const std::string& what) {
+    sqlite3_stmt* stmt = nullptr;
+    DbStatus s = Prepare(sql, &stmt);
+    if (!s.ok()) return s;
+    sqlite3_bind_int64(stmt, 1, from);
+    sqlite3_bind_int64(stmt, 2, to);
+    int rc;
+    while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) on_row(stmt);
+    sqlite3_reset(stmt);
+    return rc == SQLITE_DONE ? DbStatus{} : Fail(rc, what);
+  }
+
   // Writes the rows of `minutes` into measurement_1min (inside a transaction).
   DbStatus WriteMinuteRows(const MinuteRows& minutes, bool replace, bool imported);
   // Reads the samples of [from, to) whose minute has no 1-min row yet (all of
@@ -399,16 +414,10 @@ bool Store::ReadSamples(std::int64_t from_ts, std::int64_t to_ts, std::vector<Sa
       false, "read samples",
       [&]() -> DbStatus {
         samples.clear();
-        sqlite3_stmt* stmt = nullptr;
-        DbStatus s = db.Prepare(SelectSamplesSql(), &stmt);
-        if (!s.ok()) return s;
-        sqlite3_bind_int64(stmt, 1, from_ts);
-        sqlite3_bind_int64(stmt, 2, to_ts);
-        int rc;
-        while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
-          ReadSampleRow(stmt, &samples.emplace_back());
-        }
-        return rc == SQLITE_DONE ? DbStatus{} : db.Fail(rc, "read samples");
+        return db.SelectRange(
+            SelectSamplesSql(), from_ts, to_ts,
+            [&samples](sqlite3_stmt* stmt) { ReadSampleRow(stmt, &samples.emplace_back()); },
+            "read samples");
       },
       error);
   if (ok) *out = std::move(samples);
@@ -454,16 +463,12 @@ DbStatus Store::Impl::AggregateRange(std::int64_t from_ts, std::int64_t to_ts, b
       ", s.rejected_mask FROM sample_5s s WHERE s.ts >= ? AND s.ts < ? AND NOT EXISTS ("
       "SELECT 1 FROM measurement_1min m WHERE m.ts = s.ts - ((s.ts % 60) + 60) % 60) "
       "ORDER BY s.ts";
-  sqlite3_stmt* stmt = nullptr;
-  DbStatus s = db.Prepare(all ? SelectSamplesSql() : pending_sql, &stmt);
-  if (!s.ok()) return s;
-  sqlite3_bind_int64(stmt, 1, from_ts);
-  sqlite3_bind_int64(stmt, 2, to_ts);
   std::vector<Sample> samples;
-  int rc;
-  while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) ReadSampleRow(stmt, &samples.emplace_back());
-  sqlite3_reset(stmt);
-  if (rc != SQLITE_DONE) return db.Fail(rc, "read samples to aggregate");
+  DbStatus s = db.SelectRange(
+      all ? SelectSamplesSql() : pending_sql, from_ts, to_ts,
+      [&samples](sqlite3_stmt* stmt) { ReadSampleRow(stmt, &samples.emplace_back()); },
+      "read samples to aggregate");
+  if (!s.ok()) return s;
   MinuteRows minutes;
   std::string error;
   if (!AggregateSamples(samples, db.options.aggregate, &minutes, &error)) {
@@ -542,13 +547,7 @@ bool Store::ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows*
         result = MinuteRows{};
         Series& rows = result.rows;
         rows.step_s = static_cast<double>(kMinuteS);
-        sqlite3_stmt* stmt = nullptr;
-        DbStatus s = db.Prepare(sql, &stmt);
-        if (!s.ok()) return s;
-        sqlite3_bind_int64(stmt, 1, from_ts);
-        sqlite3_bind_int64(stmt, 2, to_ts);
-        int rc;
-        while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+        auto on_row = [&result, &rows](sqlite3_stmt* stmt) {
           rows.time_s.push_back(sqlite3_column_int64(stmt, 0));
           for (std::size_t c = 0; c < kNumChannels; ++c) {
             rows.columns[c].push_back(
@@ -558,8 +557,8 @@ bool Store::ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows*
           result.n_samples.push_back(sqlite3_column_int(stmt, n_index));
           result.qc_flags.push_back(
               static_cast<std::uint32_t>(sqlite3_column_int64(stmt, n_index + 1)));
-        }
-        return rc == SQLITE_DONE ? DbStatus{} : db.Fail(rc, "read 1-min rows");
+        };
+        return db.SelectRange(sql, from_ts, to_ts, on_row, "read 1-min rows");
       },
       error);
   if (!ok) return false;
@@ -726,20 +725,14 @@ bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Chann
       false, "read " + table,
       [&]() -> DbStatus {
         result = Series{};
-        sqlite3_stmt* stmt = nullptr;
-        DbStatus s = db.Prepare(sql, &stmt);
-        if (!s.ok()) return s;
-        sqlite3_bind_int64(stmt, 1, from);
-        sqlite3_bind_int64(stmt, 2, to);
-        int rc;
-        while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+        auto on_row = [&result, channels](sqlite3_stmt* stmt) {
           result.time_s.push_back(sqlite3_column_int64(stmt, 0));
           for (std::size_t k = 0; k < channels.size(); ++k) {
             result[channels[k]].push_back(
                 FromSql(channels[k], ColumnReal(stmt, static_cast<int>(k) + 1)));
           }
-        }
-        return rc == SQLITE_DONE ? DbStatus{} : db.Fail(rc, "read " + table);
+        };
+        return db.SelectRange(sql, from, to, on_row, "read " + table);
       },
       error);
   if (!ok) return false;

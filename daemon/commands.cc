@@ -15,6 +15,8 @@ void RegisterCommands(CLI::App& app) {
   RegisterSimulate(app);
   RegisterBench(app);
   RegisterBacktest(app);
+  RegisterImport(app);
+  RegisterExport(app);
 }
 
 }  // namespace pvtwin::cli

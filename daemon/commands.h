@@ -22,5 +22,7 @@ void RegisterSimulate(CLI::App& app);
 void RegisterCalibrate(CLI::App& app);
 void RegisterBench(CLI::App& app);
 void RegisterBacktest(CLI::App& app);
+void RegisterImport(CLI::App& app);
+void RegisterExport(CLI::App& app);
 
 }  // namespace pvtwin::cli

@@ -1,0 +1,23 @@
+#include "daemon/store_cli.h"
+
+#include <iostream>
+
+namespace pvtwin::cli {
+
+StoreOptions StoreOptionsFor(const Config& config) {
+  StoreOptions options;
+  options.aggregate.sample_period_s = config.poll.period_s;
+  options.aggregate.fluid_cp_j_kgk = config.plant.fluid_cp_j_kgk;
+  return options;
+}
+
+bool OpenStoreOrReport(const std::string& path, const StoreOptions& options,
+                       std::unique_ptr<Store>* store) {
+  std::string error;
+  *store = Store::Open(path, options, &error);
+  if (*store != nullptr) return true;
+  std::cerr << error << "\n";
+  return false;
+}
+
+}  // namespace pvtwin::cli

@@ -1,0 +1,788 @@
+// The SQLite store; the design (schema, units, time, WAL and crash behaviour,
+// retention) is described at the head of io/store.h.
+#include "io/store.h"
+
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <unordered_map>
+
+#include "core/units.h"
+
+namespace pvtwin {
+namespace {
+
+constexpr std::int64_t kSecondsPerDay = 86400;
+constexpr std::int64_t kNoLowerBound = std::numeric_limits<std::int64_t>::min();
+
+std::int64_t MinuteStart(std::int64_t t_s) {
+  std::int64_t k = t_s / kMinuteS;
+  if (t_s % kMinuteS < 0) --k;
+  return k * kMinuteS;
+}
+
+// SQL value of channel c: degrees for the aoi_deg column, else as in core.
+double ToSql(Channel c, double core_value) {
+  return c == Channel::kAoiRad ? RadToDeg(core_value) : core_value;
+}
+double FromSql(Channel c, double sql_value) {
+  return c == Channel::kAoiRad ? DegToRad(sql_value) : sql_value;
+}
+
+// "c1, c2, ..." of every canonical channel, and "?, ?, ..." of the same count.
+std::string ChannelColumns(const std::string& prefix = "") {
+  std::string s;
+  for (const ChannelInfo& info : kChannels) {
+    if (!s.empty()) s += ", ";
+    s += prefix + std::string(info.name);
+  }
+  return s;
+}
+std::string Placeholders(std::size_t n) {
+  std::string s;
+  for (std::size_t i = 0; i < n; ++i) s += i ? ", ?" : "?";
+  return s;
+}
+std::string ChannelColumnDefs() {
+  std::string s;
+  for (const ChannelInfo& info : kChannels) s += ", " + std::string(info.name) + " REAL";
+  return s;
+}
+
+// Channels of the forecast input tables (columns in this order).
+constexpr Channel kWeatherChannels[] = {
+    Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2,
+    Channel::kTAmbC,   Channel::kWindMS, Channel::kTSkyC,  Channel::kLwDownWM2};
+constexpr Channel kOperationChannels[] = {Channel::kTInC, Channel::kMdotKgS};
+
+std::string ColumnDefs(std::span<const Channel> channels) {
+  std::string s;
+  for (const Channel c : channels) s += ", " + std::string(ChannelName(c)) + " REAL";
+  return s;
+}
+
+// Schema version 1 (io/store.h). Each later version appends one Migration
+// whose statements turn version N-1 into N; Open runs the missing ones in
+// order, each in its own transaction together with the user_version update.
+std::vector<std::string> SchemaV1() {
+  return {
+      "CREATE TABLE sample_5s(ts INTEGER PRIMARY KEY" + ChannelColumnDefs() +
+          ", rejected_mask INTEGER NOT NULL DEFAULT 0)",
+      "CREATE TABLE measurement_1min(ts INTEGER PRIMARY KEY" + ChannelColumnDefs() +
+          ", n_samples INTEGER, qc_flags INTEGER NOT NULL DEFAULT 0)",
+      "CREATE TABLE calibration(id INTEGER PRIMARY KEY, run_at INTEGER NOT NULL, variant TEXT, "
+      "window_start INTEGER, window_end INTEGER, status TEXT NOT NULL, mae_p_el_w REAL, "
+      "mae_q_th_w REAL, runtime_s REAL, n_evals INTEGER, params_json TEXT, reason TEXT, "
+      "heldout_mae_w REAL, accepted INTEGER NOT NULL DEFAULT 0)",
+      "CREATE INDEX calibration_accepted ON calibration(accepted, run_at)",
+      "CREATE TABLE forecast(issued_at INTEGER NOT NULL, ts INTEGER NOT NULL, "
+      "calibration_id INTEGER REFERENCES calibration(id), p_el_w REAL, q_th_w REAL, "
+      "t_pv_c REAL, t_out_c REAL, inputs TEXT, PRIMARY KEY(issued_at, ts)) WITHOUT ROWID",
+      "CREATE INDEX forecast_by_ts ON forecast(ts, issued_at)",
+      "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c) AS "
+      "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c FROM forecast f "
+      "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)",
+      // Day-ahead pairs: per ts, the newest forecast issued at or before
+      // 00:00 UTC of ts's day, joined with the valid measurement at ts.
+      "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th) AS "
+      "WITH pairs AS ("
+      " SELECT f.ts - ((f.ts % 86400) + 86400) % 86400 AS day,"
+      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q"
+      " FROM forecast f JOIN measurement_1min m ON m.ts = f.ts"
+      " WHERE (m.valid IS NULL OR m.valid != 0)"
+      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts"
+      "   AND g.issued_at <= f.ts - ((f.ts % 86400) + 86400) % 86400))"
+      " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
+      "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
+      "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END))"
+      " FROM pairs GROUP BY day",
+      "CREATE TABLE weather_forecast(ts INTEGER PRIMARY KEY" + ColumnDefs(kWeatherChannels) + ")",
+      "CREATE TABLE operation_plan(ts INTEGER PRIMARY KEY" + ColumnDefs(kOperationChannels) + ")",
+  };
+}
+
+struct Migration {
+  int to_version;
+  std::vector<std::string> (*statements)();
+};
+const Migration kMigrations[] = {{1, &SchemaV1}};
+static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
+              "one migration per schema version");
+
+// The outcome of one database step: an SQLite result code and what was done.
+struct DbStatus {
+  int rc = SQLITE_OK;
+  std::string what;
+  std::string message;  // sqlite3_errmsg at the failure
+  bool ok() const { return rc == SQLITE_OK; }
+  bool busy() const { return rc == SQLITE_BUSY || rc == SQLITE_LOCKED; }
+};
+
+}  // namespace
+
+struct Store::Impl {
+  sqlite3* db = nullptr;
+  std::string path;
+  StoreOptions options;
+  std::mutex mutex;
+  std::unordered_map<std::string, sqlite3_stmt*> statements;
+  // AggregateMinutes looks for unaggregated samples from here on: the start
+  // of the first minute not yet known to be done in this process (the whole
+  // table after Open).
+  std::int64_t aggregate_scan_from = kNoLowerBound;
+
+  ~Impl() {
+    for (auto& [sql, stmt] : statements) sqlite3_finalize(stmt);
+    if (db != nullptr) sqlite3_close_v2(db);
+  }
+
+  DbStatus Fail(int rc, const std::string& what) const {
+    return {rc == SQLITE_OK ? SQLITE_ERROR : rc, what, db ? sqlite3_errmsg(db) : "out of memory"};
+  }
+
+  std::string Describe(const DbStatus& s) const {
+    std::string text = path + ": " + s.what;
+    if (!s.message.empty()) text += ": " + s.message;
+    return text + " (SQLite code " + std::to_string(s.rc) + ")";
+  }
+
+  DbStatus Exec(const std::string& sql) {
+    const int rc = sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr);
+    return rc == SQLITE_OK ? DbStatus{} : Fail(rc, sql.substr(0, 60));
+  }
+
+  // The cached prepared statement for sql, reset and unbound.
+  DbStatus Prepare(const std::string& sql, sqlite3_stmt** stmt) {
+    auto it = statements.find(sql);
+    if (it == statements.end()) {
+      sqlite3_stmt* fresh = nullptr;
+      const int rc =
+          sqlite3_prepare_v3(db, sql.c_str(), -1, SQLITE_PREPARE_PERSISTENT, &fresh, nullptr);
+      if (rc != SQLITE_OK) return Fail(rc, "prepare " + sql.substr(0, 60));
+      it = statements.emplace(sql, fresh).first;
+    }
+    sqlite3_reset(it->second);
+    sqlite3_clear_bindings(it->second);
+    *stmt = it->second;
+    return {};
+  }
+
+  // Runs body in a BEGIN IMMEDIATE transaction (write) or as is (read);
+  // retries the whole of it after SQLITE_BUSY. Returns true, or false with
+  // *error set and the transaction rolled back.
+  bool Run(bool write, const std::string& what, const std::function<DbStatus()>& body,
+           std::string* error) {
+    assert(error != nullptr);
+    DbStatus status;
+    for (int attempt = 0; attempt <= options.busy_retries; ++attempt) {
+      if (attempt > 0) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10 << std::min(attempt, 6)));
+      }
+      if (write) {
+        status = Exec("BEGIN IMMEDIATE");
+        if (!status.ok()) {
+          status.what = what + ": begin transaction";
+          if (status.busy()) continue;
+          break;
+        }
+      }
+      status = body();
+      if (status.ok() && write) {
+        status = Exec("COMMIT");
+        if (!status.ok()) status.what = what + ": commit";
+      }
+      if (status.ok()) return true;
+      if (write && !sqlite3_get_autocommit(db)) Exec("ROLLBACK");
+      if (!status.busy()) break;
+    }
+    if (status.busy()) status.what += " (database busy, gave up after retries)";
+    *error = Describe(status);
+    return false;
+  }
+
+  // Steps stmt to completion (no rows expected).
+  DbStatus StepDone(sqlite3_stmt* stmt, const std::string& what) {
+    const int rc = sqlite3_step(stmt);
+    return rc == SQLITE_DONE ? DbStatus{} : Fail(rc, what);
+  }
+
+  // Runs the query sql, whose two parameters are a time range [from, to),
+  // and hands each row to on_row.
+  DbStatus SelectRange(const std::string& sql, std::int64_t from, std::int64_t to,
+                       const std::function<void(sqlite3_stmt*)>& on_row, const std::string& what) {
+    sqlite3_stmt* stmt = nullptr;
+    DbStatus s = Prepare(sql, &stmt);
+    if (!s.ok()) return s;
+    sqlite3_bind_int64(stmt, 1, from);
+    sqlite3_bind_int64(stmt, 2, to);
+    int rc;
+    while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) on_row(stmt);
+    sqlite3_reset(stmt);
+    return rc == SQLITE_DONE ? DbStatus{} : Fail(rc, what);
+  }
+
+  // Writes the rows of `minutes` into measurement_1min (inside a transaction).
+  DbStatus WriteMinuteRows(const MinuteRows& minutes, bool replace, bool imported);
+  // Reads the samples of [from, to) whose minute has no 1-min row yet (all of
+  // them if `all`), aggregates and writes them (inside a transaction).
+  DbStatus AggregateRange(std::int64_t from_ts, std::int64_t to_ts, bool all, int* minutes_written);
+  bool ReadInputTable(const std::string& table, std::span<const Channel> channels,
+                      std::int64_t from, std::int64_t to, Series* out, std::string* error);
+};
+
+namespace {
+
+void BindReal(sqlite3_stmt* stmt, int index, double x) {
+  if (std::isfinite(x)) {
+    sqlite3_bind_double(stmt, index, x);
+  } else {
+    sqlite3_bind_null(stmt, index);
+  }
+}
+
+double ColumnReal(sqlite3_stmt* stmt, int index) {
+  return sqlite3_column_type(stmt, index) == SQLITE_NULL ? std::nan("")
+                                                         : sqlite3_column_double(stmt, index);
+}
+
+std::string ColumnText(sqlite3_stmt* stmt, int index) {
+  const unsigned char* text = sqlite3_column_text(stmt, index);
+  return text == nullptr ? std::string() : reinterpret_cast<const char*>(text);
+}
+
+// Drops the columns that are NaN in every row.
+void DropEmptyColumns(Series* s) {
+  for (auto& col : s->columns) {
+    if (std::all_of(col.begin(), col.end(), [](double x) { return std::isnan(x); })) col.clear();
+  }
+}
+
+const std::string& SelectSamplesSql() {
+  static const std::string sql = "SELECT ts, " + ChannelColumns() +
+                                 ", rejected_mask FROM sample_5s WHERE ts >= ? AND ts < ? "
+                                 "ORDER BY ts";
+  return sql;
+}
+
+void ReadSampleRow(sqlite3_stmt* stmt, Sample* s) {
+  s->ts_s = sqlite3_column_int64(stmt, 0);
+  for (std::size_t c = 0; c < kNumChannels; ++c) {
+    s->value[c] = FromSql(static_cast<Channel>(c), ColumnReal(stmt, static_cast<int>(c) + 1));
+  }
+  s->rejected_mask =
+      static_cast<std::uint32_t>(sqlite3_column_int64(stmt, static_cast<int>(kNumChannels) + 1));
+}
+
+}  // namespace
+
+Store::Store(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Store::~Store() = default;
+
+const std::string& Store::path() const { return impl_->path; }
+
+std::unique_ptr<Store> Store::Open(const std::string& path, std::string* error) {
+  return Open(path, StoreOptions{}, error);
+}
+
+std::unique_ptr<Store> Store::Open(const std::string& path, const StoreOptions& options,
+                                   std::string* error) {
+  assert(error != nullptr);
+  auto impl = std::make_unique<Impl>();
+  impl->path = path;
+  impl->options = options;
+  const int rc =
+      sqlite3_open_v2(path.c_str(), &impl->db,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr);
+  if (rc != SQLITE_OK) {
+    *error = impl->Describe(impl->Fail(rc, "cannot open database"));
+    return nullptr;
+  }
+  sqlite3_extended_result_codes(impl->db, 0);
+  sqlite3_busy_timeout(impl->db, options.busy_timeout_ms);
+
+  // WAL is persistent in the file; switching needs a moment without other
+  // writers, so it is retried like a transaction.
+  std::string mode;
+  const bool wal_ok = impl->Run(
+      false, "set journal_mode = WAL",
+      [&impl, &mode]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        const int prc =
+            sqlite3_prepare_v2(impl->db, "PRAGMA journal_mode = WAL", -1, &stmt, nullptr);
+        if (prc != SQLITE_OK) return impl->Fail(prc, "PRAGMA journal_mode");
+        const int src = sqlite3_step(stmt);
+        if (src == SQLITE_ROW) mode = ColumnText(stmt, 0);
+        sqlite3_finalize(stmt);
+        return src == SQLITE_ROW ? DbStatus{} : impl->Fail(src, "PRAGMA journal_mode");
+      },
+      error);
+  if (!wal_ok) return nullptr;
+  if (mode != "wal") {
+    *error = path + ": journal_mode = " + mode +
+             ": the store needs WAL (is it on a network "
+             "file system?)";
+    return nullptr;
+  }
+  if (!impl->Run(
+          false, "set synchronous = NORMAL",
+          [&impl] { return impl->Exec("PRAGMA synchronous = NORMAL"); }, error)) {
+    return nullptr;
+  }
+
+  for (const Migration& migration : kMigrations) {
+    Impl& db = *impl;
+    const bool migrated = db.Run(
+        true, "migrate to schema version " + std::to_string(migration.to_version),
+        [&db, &migration]() -> DbStatus {
+          sqlite3_stmt* stmt = nullptr;
+          DbStatus s = db.Prepare("PRAGMA user_version", &stmt);
+          if (!s.ok()) return s;
+          const int src = sqlite3_step(stmt);
+          if (src != SQLITE_ROW) return db.Fail(src, "PRAGMA user_version");
+          const int version = sqlite3_column_int(stmt, 0);
+          sqlite3_reset(stmt);
+          if (version > kStoreSchemaVersion) {
+            return {SQLITE_ERROR,
+                    "schema version " + std::to_string(version) +
+                        " is newer than this pvtwin knows (" + std::to_string(kStoreSchemaVersion) +
+                        "); use a newer pvtwin",
+                    ""};
+          }
+          if (version >= migration.to_version) return {};
+          if (version != migration.to_version - 1) {
+            return {SQLITE_ERROR, "schema version " + std::to_string(version) + " is unknown", ""};
+          }
+          for (const std::string& sql : migration.statements()) {
+            s = db.Exec(sql);
+            if (!s.ok()) return s;
+          }
+          return db.Exec("PRAGMA user_version = " + std::to_string(migration.to_version));
+        },
+        error);
+    if (!migrated) return nullptr;
+  }
+  return std::unique_ptr<Store>(new Store(std::move(impl)));
+}
+
+bool Store::InsertSamples(const std::vector<Sample>& batch, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  static const std::string sql = "INSERT OR REPLACE INTO sample_5s(ts, " + ChannelColumns() +
+                                 ", rejected_mask) VALUES(" + Placeholders(kNumChannels + 2) + ")";
+  const bool ok = db.Run(
+      true, "insert " + std::to_string(batch.size()) + " samples",
+      [&db, &batch]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(sql, &stmt);
+        if (!s.ok()) return s;
+        for (const Sample& sample : batch) {
+          sqlite3_reset(stmt);
+          sqlite3_bind_int64(stmt, 1, sample.ts_s);
+          for (std::size_t c = 0; c < kNumChannels; ++c) {
+            BindReal(stmt, static_cast<int>(c) + 2,
+                     ToSql(static_cast<Channel>(c), sample.value[c]));
+          }
+          sqlite3_bind_int64(stmt, static_cast<int>(kNumChannels) + 2, sample.rejected_mask);
+          s = db.StepDone(stmt, "insert sample ts " + std::to_string(sample.ts_s));
+          if (!s.ok()) return s;
+        }
+        return {};
+      },
+      error);
+  if (ok) {
+    for (const Sample& sample : batch) {
+      db.aggregate_scan_from = std::min(db.aggregate_scan_from, MinuteStart(sample.ts_s));
+    }
+  }
+  return ok;
+}
+
+bool Store::ReadSamples(std::int64_t from_ts, std::int64_t to_ts, std::vector<Sample>* out,
+                        std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::vector<Sample> samples;
+  const bool ok = db.Run(
+      false, "read samples",
+      [&]() -> DbStatus {
+        samples.clear();
+        return db.SelectRange(
+            SelectSamplesSql(), from_ts, to_ts,
+            [&samples](sqlite3_stmt* stmt) { ReadSampleRow(stmt, &samples.emplace_back()); },
+            "read samples");
+      },
+      error);
+  if (ok) *out = std::move(samples);
+  return ok;
+}
+
+DbStatus Store::Impl::WriteMinuteRows(const MinuteRows& minutes, bool replace, bool imported) {
+  Impl& db = *this;
+  static const std::string tail = " INTO measurement_1min(ts, " + ChannelColumns() +
+                                  ", n_samples, qc_flags) VALUES(" +
+                                  Placeholders(kNumChannels + 3) + ")";
+  static const std::string insert_sql = "INSERT" + tail;
+  static const std::string replace_sql = "INSERT OR REPLACE" + tail;
+  sqlite3_stmt* stmt = nullptr;
+  DbStatus s = db.Prepare(replace ? replace_sql : insert_sql, &stmt);
+  if (!s.ok()) return s;
+  const Series& rows = minutes.rows;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    sqlite3_reset(stmt);
+    sqlite3_bind_int64(stmt, 1, rows.time_s[i]);
+    for (std::size_t c = 0; c < kNumChannels; ++c) {
+      const auto channel = static_cast<Channel>(c);
+      BindReal(stmt, static_cast<int>(c) + 2, ToSql(channel, rows.At(channel, i)));
+    }
+    const int n_index = static_cast<int>(kNumChannels) + 2;
+    if (imported) {
+      sqlite3_bind_null(stmt, n_index);
+    } else {
+      sqlite3_bind_int(stmt, n_index, minutes.n_samples[i]);
+    }
+    sqlite3_bind_int64(stmt, n_index + 1, minutes.qc_flags[i]);
+    s = db.StepDone(stmt, "write 1-min row ts " + std::to_string(rows.time_s[i]));
+    if (!s.ok()) return s;
+  }
+  return {};
+}
+
+DbStatus Store::Impl::AggregateRange(std::int64_t from_ts, std::int64_t to_ts, bool all,
+                                     int* minutes_written) {
+  Impl& db = *this;
+  static const std::string pending_sql =
+      "SELECT s.ts, " + ChannelColumns("s.") +
+      ", s.rejected_mask FROM sample_5s s WHERE s.ts >= ? AND s.ts < ? AND NOT EXISTS ("
+      "SELECT 1 FROM measurement_1min m WHERE m.ts = s.ts - ((s.ts % 60) + 60) % 60) "
+      "ORDER BY s.ts";
+  std::vector<Sample> samples;
+  DbStatus s = db.SelectRange(
+      all ? SelectSamplesSql() : pending_sql, from_ts, to_ts,
+      [&samples](sqlite3_stmt* stmt) { ReadSampleRow(stmt, &samples.emplace_back()); },
+      "read samples to aggregate");
+  if (!s.ok()) return s;
+  MinuteRows minutes;
+  std::string error;
+  if (!AggregateSamples(samples, db.options.aggregate, &minutes, &error)) {
+    return {SQLITE_ERROR, "aggregate", error};
+  }
+  s = WriteMinuteRows(minutes, all, false);
+  if (s.ok()) *minutes_written = static_cast<int>(minutes.rows.size());
+  return s;
+}
+
+bool Store::AggregateMinutes(std::int64_t up_to_ts, int* minutes_written, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  const std::int64_t end_ts = MinuteStart(up_to_ts);  // minutes before it are complete
+  int written = 0;
+  const bool ok = db.Run(
+      true, "aggregate minutes",
+      [&] { return db.AggregateRange(db.aggregate_scan_from, end_ts, false, &written); }, error);
+  if (ok) db.aggregate_scan_from = std::max(db.aggregate_scan_from, end_ts);
+  if (minutes_written != nullptr) *minutes_written = ok ? written : 0;
+  return ok;
+}
+
+bool Store::ReaggregateMinutes(std::int64_t from_ts, std::int64_t to_ts, int* minutes_written,
+                               std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  const std::int64_t begin = MinuteStart(from_ts);
+  const std::int64_t end = MinuteStart(to_ts) + (to_ts == MinuteStart(to_ts) ? 0 : kMinuteS);
+  int written = 0;
+  const bool ok = db.Run(
+      true, "re-aggregate minutes", [&] { return db.AggregateRange(begin, end, true, &written); },
+      error);
+  if (minutes_written != nullptr) *minutes_written = ok ? written : 0;
+  return ok;
+}
+
+bool Store::WriteMinutes(const Series& rows_1min, std::string* error) {
+  MinuteRows minutes;
+  minutes.rows = rows_1min;
+  minutes.n_samples.assign(rows_1min.size(), 0);
+  minutes.qc_flags.assign(rows_1min.size(), kQcImported);
+  for (std::size_t i = 0; i < rows_1min.size(); ++i) {
+    if (rows_1min.time_s[i] != MinuteStart(rows_1min.time_s[i])) {
+      *error = impl_->path + ": 1-min row " + std::to_string(i) + " at ts " +
+               std::to_string(rows_1min.time_s[i]) + ": not the start of a minute";
+      return false;
+    }
+    std::uint32_t& f = minutes.qc_flags[i];
+    for (std::size_t c = 0; c < kNumChannels; ++c) {
+      const auto channel = static_cast<Channel>(c);
+      if (channel != Channel::kValid && std::isnan(rows_1min.At(channel, i))) {
+        f |= QcChannelMissingBit(channel);
+      }
+    }
+    if (!RequiredChannelsPresent(f)) f |= kQcRequiredMissing;
+  }
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "write " + std::to_string(rows_1min.size()) + " 1-min rows",
+      [&] { return db.WriteMinuteRows(minutes, true, true); }, error);
+}
+
+bool Store::ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows* out,
+                           std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  static const std::string sql = "SELECT ts, " + ChannelColumns() +
+                                 ", n_samples, qc_flags FROM measurement_1min "
+                                 "WHERE ts >= ? AND ts < ? ORDER BY ts";
+  MinuteRows result;
+  const bool ok = db.Run(
+      false, "read 1-min rows",
+      [&]() -> DbStatus {
+        result = MinuteRows{};
+        Series& rows = result.rows;
+        rows.step_s = static_cast<double>(kMinuteS);
+        auto on_row = [&result, &rows](sqlite3_stmt* stmt) {
+          rows.time_s.push_back(sqlite3_column_int64(stmt, 0));
+          for (std::size_t c = 0; c < kNumChannels; ++c) {
+            rows.columns[c].push_back(
+                FromSql(static_cast<Channel>(c), ColumnReal(stmt, static_cast<int>(c) + 1)));
+          }
+          const int n_index = static_cast<int>(kNumChannels) + 1;
+          result.n_samples.push_back(sqlite3_column_int(stmt, n_index));
+          result.qc_flags.push_back(
+              static_cast<std::uint32_t>(sqlite3_column_int64(stmt, n_index + 1)));
+        };
+        return db.SelectRange(sql, from_ts, to_ts, on_row, "read 1-min rows");
+      },
+      error);
+  if (!ok) return false;
+  DropEmptyColumns(&result.rows);
+  *out = std::move(result);
+  return true;
+}
+
+bool Store::ReadMinutes(std::int64_t from_ts, std::int64_t to_ts, Series* out, std::string* error) {
+  MinuteRows rows;
+  if (!ReadMinuteRows(from_ts, to_ts, &rows, error)) return false;
+  *out = std::move(rows.rows);
+  return true;
+}
+
+bool Store::ApplyRetention(std::int64_t now_ts, int raw_retention_days, std::string* error) {
+  Impl& db = *impl_;
+  if (raw_retention_days < 1) {
+    *error = "raw_retention_days = " + std::to_string(raw_retention_days) + ": must be >= 1";
+    return false;
+  }
+  std::lock_guard lock(db.mutex);
+  const std::int64_t cutoff_ts = MinuteStart(now_ts - raw_retention_days * kSecondsPerDay);
+  return db.Run(
+      true, "apply retention",
+      [&]() -> DbStatus {
+        int written = 0;
+        DbStatus s = db.AggregateRange(kNoLowerBound, cutoff_ts, false, &written);
+        if (!s.ok()) return s;
+        sqlite3_stmt* stmt = nullptr;
+        s = db.Prepare("DELETE FROM sample_5s WHERE ts < ?", &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_int64(stmt, 1, cutoff_ts);
+        return db.StepDone(stmt, "delete samples before " + std::to_string(cutoff_ts));
+      },
+      error);
+}
+
+bool Store::InsertCalibration(CalibrationRow* row, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::int64_t id = 0;
+  const bool ok = db.Run(
+      true, "insert calibration",
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "INSERT INTO calibration(run_at, variant, window_start, window_end, status, "
+            "mae_p_el_w, mae_q_th_w, runtime_s, n_evals, params_json, reason, heldout_mae_w, "
+            "accepted) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_int64(stmt, 1, row->run_at);
+        sqlite3_bind_text(stmt, 2, row->variant.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_int64(stmt, 3, row->window_start);
+        sqlite3_bind_int64(stmt, 4, row->window_end);
+        sqlite3_bind_text(stmt, 5, row->status.c_str(), -1, SQLITE_TRANSIENT);
+        BindReal(stmt, 6, row->mae_p_el_w);
+        BindReal(stmt, 7, row->mae_q_th_w);
+        BindReal(stmt, 8, row->runtime_s);
+        sqlite3_bind_int64(stmt, 9, row->n_evals);
+        sqlite3_bind_text(stmt, 10, row->params_json.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(stmt, 11, row->reason.c_str(), -1, SQLITE_TRANSIENT);
+        BindReal(stmt, 12, row->heldout_mae_w);
+        sqlite3_bind_int(stmt, 13, row->accepted ? 1 : 0);
+        s = db.StepDone(stmt, "insert calibration");
+        if (s.ok()) id = sqlite3_last_insert_rowid(db.db);
+        return s;
+      },
+      error);
+  if (ok) row->id = id;
+  return ok;
+}
+
+bool Store::LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  CalibrationRow result;
+  bool any = false;
+  const bool ok = db.Run(
+      false, "read latest accepted calibration",
+      [&]() -> DbStatus {
+        any = false;
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "SELECT id, run_at, variant, window_start, window_end, status, mae_p_el_w, "
+            "mae_q_th_w, runtime_s, n_evals, params_json, reason, heldout_mae_w, accepted "
+            "FROM calibration WHERE accepted != 0 ORDER BY run_at DESC, id DESC LIMIT 1",
+            &stmt);
+        if (!s.ok()) return s;
+        const int rc = sqlite3_step(stmt);
+        if (rc == SQLITE_DONE) return {};
+        if (rc != SQLITE_ROW) return db.Fail(rc, "read calibration");
+        any = true;
+        result.id = sqlite3_column_int64(stmt, 0);
+        result.run_at = sqlite3_column_int64(stmt, 1);
+        result.variant = ColumnText(stmt, 2);
+        result.window_start = sqlite3_column_int64(stmt, 3);
+        result.window_end = sqlite3_column_int64(stmt, 4);
+        result.status = ColumnText(stmt, 5);
+        result.mae_p_el_w = ColumnReal(stmt, 6);
+        result.mae_q_th_w = ColumnReal(stmt, 7);
+        result.runtime_s = ColumnReal(stmt, 8);
+        result.n_evals = static_cast<long>(sqlite3_column_int64(stmt, 9));
+        result.params_json = ColumnText(stmt, 10);
+        result.reason = ColumnText(stmt, 11);
+        result.heldout_mae_w = ColumnReal(stmt, 12);
+        result.accepted = sqlite3_column_int(stmt, 13) != 0;
+        sqlite3_reset(stmt);
+        return {};
+      },
+      error);
+  if (!ok) return false;
+  *found = any;
+  if (any) *row = std::move(result);
+  return true;
+}
+
+bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
+                           const std::string& inputs, const std::vector<ForecastRow>& rows,
+                           std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "insert forecast issued at " + std::to_string(issued_at),
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "INSERT OR REPLACE INTO forecast(issued_at, ts, calibration_id, p_el_w, q_th_w, "
+            "t_pv_c, t_out_c, inputs) VALUES(?, ?, ?, ?, ?, ?, ?, ?)",
+            &stmt);
+        if (!s.ok()) return s;
+        for (const ForecastRow& row : rows) {
+          sqlite3_reset(stmt);
+          sqlite3_bind_int64(stmt, 1, issued_at);
+          sqlite3_bind_int64(stmt, 2, row.ts);
+          if (calibration_id > 0) {
+            sqlite3_bind_int64(stmt, 3, calibration_id);
+          } else {
+            sqlite3_bind_null(stmt, 3);
+          }
+          BindReal(stmt, 4, row.p_el_w);
+          BindReal(stmt, 5, row.q_th_w);
+          BindReal(stmt, 6, row.t_pv_c);
+          BindReal(stmt, 7, row.t_out_c);
+          sqlite3_bind_text(stmt, 8, inputs.c_str(), -1, SQLITE_TRANSIENT);
+          s = db.StepDone(stmt, "insert forecast row ts " + std::to_string(row.ts));
+          if (!s.ok()) return s;
+        }
+        return {};
+      },
+      error);
+}
+
+bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Channel> channels,
+                                 std::int64_t from, std::int64_t to, Series* out,
+                                 std::string* error) {
+  Impl& db = *this;
+  std::string sql = "SELECT ts";
+  for (const Channel c : channels) sql += ", " + std::string(ChannelName(c));
+  sql += " FROM " + table + " WHERE ts >= ? AND ts < ? ORDER BY ts";
+  Series result;
+  const bool ok = db.Run(
+      false, "read " + table,
+      [&]() -> DbStatus {
+        result = Series{};
+        auto on_row = [&result, channels](sqlite3_stmt* stmt) {
+          result.time_s.push_back(sqlite3_column_int64(stmt, 0));
+          for (std::size_t k = 0; k < channels.size(); ++k) {
+            result[channels[k]].push_back(
+                FromSql(channels[k], ColumnReal(stmt, static_cast<int>(k) + 1)));
+          }
+        };
+        return db.SelectRange(sql, from, to, on_row, "read " + table);
+      },
+      error);
+  if (!ok) return false;
+  DropEmptyColumns(&result);
+  result.step_s = 0.0;
+  for (std::size_t i = 1; i < result.size(); ++i) {
+    const auto dt_s = static_cast<double>(result.time_s[i] - result.time_s[i - 1]);
+    if (result.step_s == 0.0 || dt_s < result.step_s) result.step_s = dt_s;
+  }
+  *out = std::move(result);
+  return true;
+}
+
+bool Store::ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out,
+                                std::string* error) {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->ReadInputTable("weather_forecast", kWeatherChannels, from, to, out, error);
+}
+
+bool Store::ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error) {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->ReadInputTable("operation_plan", kOperationChannels, from, to, out, error);
+}
+
+bool Store::Checkpoint(std::int64_t* db_bytes, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::int64_t bytes = 0;
+  const bool ok = db.Run(
+      false, "checkpoint",
+      [&]() -> DbStatus {
+        int log_frames = 0, checkpointed = 0;
+        const int rc = sqlite3_wal_checkpoint_v2(db.db, nullptr, SQLITE_CHECKPOINT_TRUNCATE,
+                                                 &log_frames, &checkpointed);
+        // BUSY here means a reader holds an old snapshot: the checkpoint did
+        // what it could, which is all a best-effort checkpoint promises.
+        if (rc != SQLITE_OK && rc != SQLITE_BUSY) return db.Fail(rc, "wal_checkpoint");
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "SELECT page_count * page_size FROM pragma_page_count(), pragma_page_size()", &stmt);
+        if (!s.ok()) return s;
+        const int src = sqlite3_step(stmt);
+        if (src != SQLITE_ROW) return db.Fail(src, "page_count * page_size");
+        bytes = sqlite3_column_int64(stmt, 0);
+        sqlite3_reset(stmt);
+        return {};
+      },
+      error);
+  if (ok && db_bytes != nullptr) *db_bytes = bytes;
+  return ok;
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,188 @@
+// The SQLite store of the daemon: raw 5 s samples, 1-min measurements,
+// calibration runs and forecasts. SQL is pvtwin's user interface, so the
+// schema below is a contract (DESIGN.md "SQLite"): extend it, never rename.
+//
+// Schema (version 1, PRAGMA user_version = 1):
+//   sample_5s(ts INTEGER PRIMARY KEY, <channel> REAL ..., rejected_mask INTEGER)
+//       one row per poll period; <channel> is every canonical channel of
+//       core/channels.h kChannels, in that order, named as there. A missing
+//       or rejected reading is NULL; bit c of rejected_mask is set when
+//       channel c was read but failed the poller's checks (core/sample.h).
+//   measurement_1min(ts INTEGER PRIMARY KEY, <channel> REAL ...,
+//                    n_samples INTEGER, qc_flags INTEGER)
+//       one row per minute with samples: means of the valid samples after the
+//       paper's corrections (core/aggregate.h, which also lists the qc_flags
+//       bits). n_samples is NULL for rows imported from a 1-min CSV
+//       (qc_flags has kQcImported).
+//   calibration(id INTEGER PRIMARY KEY, run_at INTEGER, variant TEXT,
+//               window_start INTEGER, window_end INTEGER, status TEXT,
+//               mae_p_el_w REAL, mae_q_th_w REAL, runtime_s REAL,
+//               n_evals INTEGER, params_json TEXT,
+//               reason TEXT, heldout_mae_w REAL, accepted INTEGER)
+//       every calibration attempt; reason says why it was (not) accepted,
+//       heldout_mae_w is MAE(P_el) + MAE(Q_u) on the held-out day(s),
+//       accepted is 0/1.
+//   forecast(issued_at INTEGER, ts INTEGER, calibration_id INTEGER,
+//            p_el_w REAL, q_th_w REAL, t_pv_c REAL, t_out_c REAL,
+//            inputs TEXT, PRIMARY KEY(issued_at, ts))
+//       inputs names what the forecast was driven by (e.g.
+//       "weather=weather_forecast;operation=operation_plan").
+//   view forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c)
+//       for each ts, the row of the newest forecast (largest issued_at).
+//   view forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th)
+//       per UTC day (day = unix seconds of 00:00 UTC), a day-ahead skill:
+//       each minute ts of the day is scored with the newest forecast issued
+//       at or before the start of that day (so only forecasts that were real
+//       forecasts for the whole day count), against the measurement_1min row
+//       at the same ts with valid not 0. MAE = mean |forecast − measured|
+//       over the minutes where both are known; nMAE = MAE / mean |measured|
+//       over the same minutes (paper 3.2.2, as core/identification.h).
+//       Days without such forecasts and measurements have no row.
+//   weather_forecast(ts INTEGER PRIMARY KEY, g_poa_w_m2, ghi_w_m2, dhi_w_m2,
+//                    g_poa_diffuse_w_m2, t_amb_c, wind_m_s, t_sky_c,
+//                    lw_down_w_m2 REAL)
+//   operation_plan(ts INTEGER PRIMARY KEY, t_in_c REAL, flow_kg_s REAL)
+//       forecast inputs that outside programs fill by SQL; pvtwin only reads
+//       them. A NULL is a missing value.
+//
+// Units and time: every time is unix seconds UTC (INTEGER) and marks the
+// start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
+// irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
+// degrees, as its name says (core's Sample and Series hold radians; the store
+// converts).
+//
+// WAL and crash behaviour: the database runs in WAL mode, so readers (a
+// dashboard, the sqlite3 shell holding a read transaction) never block the
+// writer and the writer never blocks them; a reader only keeps the WAL from
+// being checkpointed past its snapshot. synchronous = NORMAL: in WAL mode a
+// commit is not fsync'ed, the WAL is synced at checkpoints. The database
+// stays consistent after a crash of the process or of the machine; a crash
+// of the process loses nothing committed, a power cut may lose the last
+// transactions committed before it (seconds of samples), which a 5 s logger
+// can afford and which spares the flash storage of a plant controller an
+// fsync every 5 s. Writes run in BEGIN IMMEDIATE transactions with prepared
+// statements; SQLITE_BUSY (another writer, e.g. a program filling
+// weather_forecast) is waited for by busy_timeout and the whole transaction
+// is retried StoreOptions::busy_retries times; then the call returns false
+// with the reason and the database is unchanged and readable. No call aborts
+// on a database error.
+//
+// Retention: ApplyRetention deletes sample_5s rows older than
+// raw_retention_days (config [storage]), after aggregating any of their
+// minutes that have no measurement_1min row yet. 1-min rows, calibrations
+// and forecasts are kept.
+//
+// Threads: one Store is one connection, guarded by a mutex; another thread
+// (the calibration worker) may share it or, better for long reads, open its
+// own Store on the same file.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/aggregate.h"
+#include "core/sample.h"
+#include "core/series.h"
+
+namespace pvtwin {
+
+inline constexpr int kStoreSchemaVersion = 1;
+
+struct StoreOptions {
+  int busy_timeout_ms = 2000;  // SQLite waits this long for a lock per attempt
+  int busy_retries = 3;        // whole-transaction retries after SQLITE_BUSY
+  // How AggregateMinutes averages: poll period and fluid c_p (plant config).
+  AggregateOptions aggregate;
+};
+
+class Store {
+ public:
+  struct CalibrationRow {
+    std::int64_t id = 0, run_at = 0;
+    std::string variant;
+    std::int64_t window_start = 0, window_end = 0;
+    std::string status;
+    double mae_p_el_w = 0.0, mae_q_th_w = 0.0, runtime_s = 0.0;  // NaN is stored as NULL
+    long n_evals = 0;
+    std::string params_json;
+    std::string reason;
+    bool accepted = false;
+    double heldout_mae_w = 0.0;
+  };
+
+  struct ForecastRow {
+    std::int64_t ts = 0;
+    double p_el_w = 0.0, q_th_w = 0.0, t_pv_c = 0.0, t_out_c = 0.0;
+  };
+
+  // Opens (creating if needed) and migrates the database at path. Returns
+  // null and sets *error when it cannot be opened, is not a pvtwin database
+  // of a known version, or the migration fails.
+  static std::unique_ptr<Store> Open(const std::string& path, std::string* error);
+  static std::unique_ptr<Store> Open(const std::string& path, const StoreOptions& options,
+                                     std::string* error);
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+
+  const std::string& path() const;
+
+  // Upserts the batch into sample_5s in one transaction (a sample whose ts is
+  // already stored replaces it).
+  bool InsertSamples(const std::vector<Sample>& batch, std::string* error);
+  // Samples with from_ts <= ts < to_ts, in time order.
+  bool ReadSamples(std::int64_t from_ts, std::int64_t to_ts, std::vector<Sample>* out,
+                   std::string* error);
+
+  // Aggregates every complete minute (minute start + 60 <= up_to_ts) that has
+  // samples and no measurement_1min row yet, in one transaction. A minute is
+  // written once: a minute whose samples were partly stored before a crash
+  // is aggregated, completely, on the first call after restart. The caller
+  // passes the end of the newest poll period it has stored (last ts +
+  // period), so a minute still being polled is left for a later call.
+  bool AggregateMinutes(std::int64_t up_to_ts, int* minutes_written, std::string* error);
+  // Re-computes (replaces) the row of every minute in [from_ts, to_ts) that
+  // has samples, e.g. after importing samples into minutes already stored.
+  bool ReaggregateMinutes(std::int64_t from_ts, std::int64_t to_ts, int* minutes_written,
+                          std::string* error);
+  // Upserts 1-min rows (import of a 1-min CSV): channels of the series, NULL
+  // for the absent ones, n_samples NULL, qc_flags kQcImported.
+  bool WriteMinutes(const Series& rows_1min, std::string* error);
+  // Rows with from_ts <= ts < to_ts as a canonical Series (step_s = 60); a
+  // channel that is NULL in every row is left absent.
+  bool ReadMinutes(std::int64_t from_ts, std::int64_t to_ts, Series* out, std::string* error);
+  // As ReadMinutes, plus n_samples (0 where NULL) and qc_flags per row.
+  bool ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows* out,
+                      std::string* error);
+
+  // Deletes sample_5s rows with ts < now_ts − raw_retention_days·86400 (after
+  // aggregating their minutes that have no 1-min row).
+  bool ApplyRetention(std::int64_t now_ts, int raw_retention_days, std::string* error);
+
+  bool InsertCalibration(CalibrationRow* row, std::string* error);  // sets row->id
+  bool LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error);
+
+  // Upserts one forecast issue (all rows in one transaction).
+  bool InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
+                      const std::string& inputs, const std::vector<ForecastRow>& rows,
+                      std::string* error);
+
+  // weather_forecast / operation_plan rows with from <= ts < to as a Series
+  // (step_s = the smallest spacing of the rows, 0 for fewer than 2); a column
+  // that is NULL in every row is absent.
+  bool ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out, std::string* error);
+  bool ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error);
+
+  // Writes the WAL back into the database file and truncates it (best effort
+  // while readers hold old snapshots). *db_bytes gets page_count · page_size.
+  bool Checkpoint(std::int64_t* db_bytes, std::string* error);
+
+ private:
+  struct Impl;
+  explicit Store(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pvtwin

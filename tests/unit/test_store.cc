@@ -1,0 +1,419 @@
+// The SQLite store on a real database file: schema and views with their
+// exact columns, round trips, restart-safe aggregation, retention,
+// calibration rows, forecast_latest and forecast_skill against hand-computed
+// errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/units.h"
+#include "io/store.h"
+#include "tests/support/sqlite_db.h"
+
+namespace pvtwin {
+namespace {
+
+using testing::RawDb;
+
+constexpr std::int64_t kDay0 = 1717200000;            // 2024-06-01T00:00:00Z
+constexpr std::int64_t kMinute0 = kDay0 + 12 * 3600;  // 12:00 UTC
+
+// A sample whose values follow from its time, so reads can be checked.
+Sample MakeSample(std::int64_t ts) {
+  Sample s;
+  s.ts_s = ts;
+  const double k = static_cast<double>(ts - kMinute0) / 5.0;
+  s.Set(Channel::kTInC, 20.0 + 0.01 * k);
+  s.Set(Channel::kTOutC, 30.0 + 0.01 * k);
+  s.Set(Channel::kMdotKgS, 0.03);
+  s.Set(Channel::kGPoaWM2, 600.0 + k);
+  s.Set(Channel::kTAmbC, 15.0);
+  s.Set(Channel::kPElW, 150.0 + k);
+  s.Set(Channel::kAoiRad, DegToRad(30.0));
+  return s;
+}
+
+std::vector<Sample> MakeSamples(std::int64_t t0, int n) {
+  std::vector<Sample> v;
+  for (int i = 0; i < n; ++i) v.push_back(MakeSample(t0 + 5 * i));
+  return v;
+}
+
+class StoreTest : public testing::TempDirTest {
+ protected:
+  std::string DbPath() const { return (dir_ / "pvtwin.db").string(); }
+  std::unique_ptr<Store> OpenStore() {
+    std::string error;
+    std::unique_ptr<Store> store = Store::Open(DbPath(), &error);
+    EXPECT_NE(store, nullptr) << error;
+    return store;
+  }
+};
+
+std::vector<std::string> WithChannels(std::vector<std::string> head,
+                                      const std::vector<std::string>& tail) {
+  for (const ChannelInfo& info : kChannels) head.emplace_back(info.name);
+  head.insert(head.end(), tail.begin(), tail.end());
+  return head;
+}
+
+TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
+  ASSERT_NE(OpenStore(), nullptr);
+  RawDb db(DbPath());
+  EXPECT_EQ(db.Number("PRAGMA user_version"), 1.0);
+  EXPECT_EQ(db.Rows("PRAGMA journal_mode")[0][0], "wal");
+  // sample_5s and measurement_1min: every canonical channel, named as in
+  // core/channels.h (DESIGN.md "SQLite").
+  EXPECT_EQ(db.Columns("sample_5s"), WithChannels({"ts"}, {"rejected_mask"}));
+  EXPECT_EQ(db.Columns("measurement_1min"), WithChannels({"ts"}, {"n_samples", "qc_flags"}));
+  EXPECT_EQ(db.Columns("sample_5s")[8], "aoi_deg");
+  EXPECT_EQ(db.Columns("calibration"),
+            (std::vector<std::string>{"id", "run_at", "variant", "window_start", "window_end",
+                                      "status", "mae_p_el_w", "mae_q_th_w", "runtime_s", "n_evals",
+                                      "params_json", "reason", "heldout_mae_w", "accepted"}));
+  EXPECT_EQ(db.Columns("forecast"),
+            (std::vector<std::string>{"issued_at", "ts", "calibration_id", "p_el_w", "q_th_w",
+                                      "t_pv_c", "t_out_c", "inputs"}));
+  EXPECT_EQ(db.Columns("forecast_latest"),
+            (std::vector<std::string>{"ts", "issued_at", "p_el_w", "q_th_w", "t_pv_c", "t_out_c"}));
+  EXPECT_EQ(
+      db.Columns("forecast_skill"),
+      (std::vector<std::string>{"day", "mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th"}));
+  EXPECT_EQ(
+      db.Columns("weather_forecast"),
+      (std::vector<std::string>{"ts", "g_poa_w_m2", "ghi_w_m2", "dhi_w_m2", "g_poa_diffuse_w_m2",
+                                "t_amb_c", "wind_m_s", "t_sky_c", "lw_down_w_m2"}));
+  EXPECT_EQ(db.Columns("operation_plan"), (std::vector<std::string>{"ts", "t_in_c", "flow_kg_s"}));
+  // Primary key of forecast: (issued_at, ts); views are views.
+  EXPECT_EQ(db.Rows("SELECT name FROM pragma_table_info('forecast') WHERE pk > 0 ORDER BY pk"),
+            (std::vector<std::vector<std::string>>{{"issued_at"}, {"ts"}}));
+  EXPECT_EQ(db.Rows("SELECT name FROM sqlite_master WHERE type = 'view' ORDER BY name"),
+            (std::vector<std::vector<std::string>>{{"forecast_latest"}, {"forecast_skill"}}));
+}
+
+TEST_F(StoreTest, ReopeningKeepsDataAndANewerSchemaOrAForeignFileIsRefused) {
+  {
+    auto store = OpenStore();
+    std::string error;
+    ASSERT_TRUE(store->InsertSamples(MakeSamples(kMinute0, 3), &error)) << error;
+  }
+  {
+    auto store = OpenStore();  // second open: no migration runs again
+    std::vector<Sample> out;
+    std::string error;
+    ASSERT_TRUE(store->ReadSamples(kMinute0, kMinute0 + 60, &out, &error)) << error;
+    EXPECT_EQ(out.size(), 3u);
+  }
+  {
+    RawDb db(DbPath());
+    ASSERT_EQ(db.Exec("PRAGMA user_version = 7"), SQLITE_OK);
+  }
+  std::string error;
+  EXPECT_EQ(Store::Open(DbPath(), &error), nullptr);
+  EXPECT_NE(error.find("schema version 7 is newer"), std::string::npos) << error;
+
+  const std::string text_file = (dir_ / "notes.txt").string();
+  FILE* f = std::fopen(text_file.c_str(), "w");
+  std::fputs("this is not a database, but it is long enough to look like a header.........\n", f);
+  std::fclose(f);
+  error.clear();
+  EXPECT_EQ(Store::Open(text_file, &error), nullptr);
+  EXPECT_NE(error.find(text_file), std::string::npos) << error;
+}
+
+TEST_F(StoreTest, SamplesRoundTripWithMissingAndRejectedValuesAndAoiInDegrees) {
+  auto store = OpenStore();
+  std::vector<Sample> in = MakeSamples(kMinute0, 4);
+  in[1].Set(Channel::kPElW, std::nan(""));  // not read
+  in[2].Reject(Channel::kTAmbC);            // read but rejected
+  std::string error;
+  ASSERT_TRUE(store->InsertSamples(in, &error)) << error;
+  std::vector<Sample> out;
+  ASSERT_TRUE(store->ReadSamples(kMinute0 + 5, kMinute0 + 20, &out, &error)) << error;
+  ASSERT_EQ(out.size(), 3u);  // [from, to): ts 5, 10, 15
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const Sample& expected = in[i + 1];
+    EXPECT_EQ(out[i].ts_s, expected.ts_s);
+    EXPECT_EQ(out[i].rejected_mask, expected.rejected_mask);
+    for (std::size_t c = 0; c < kNumChannels; ++c) {
+      if (std::isnan(expected.value[c])) {
+        EXPECT_TRUE(std::isnan(out[i].value[c])) << kChannels[c].name;
+      } else {
+        EXPECT_DOUBLE_EQ(out[i].value[c], expected.value[c]) << kChannels[c].name;
+      }
+    }
+  }
+  EXPECT_TRUE(out[1].Rejected(Channel::kTAmbC));
+  RawDb db(DbPath());
+  // SQL users see degrees in aoi_deg, NULL for missing values.
+  EXPECT_NEAR(db.Number("SELECT aoi_deg FROM sample_5s LIMIT 1"), 30.0, 1e-12);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s WHERE p_el_w IS NULL"), 1.0);
+  EXPECT_EQ(
+      db.Number("SELECT rejected_mask FROM sample_5s WHERE ts = " + std::to_string(kMinute0 + 10)),
+      static_cast<double>(1u << static_cast<unsigned>(Channel::kTAmbC)));
+}
+
+TEST_F(StoreTest, InsertingTheSameTimeAgainReplacesTheSample) {
+  auto store = OpenStore();
+  std::string error;
+  std::vector<Sample> batch = MakeSamples(kMinute0, 2);
+  ASSERT_TRUE(store->InsertSamples(batch, &error)) << error;
+  batch[1].Set(Channel::kPElW, 999.0);
+  ASSERT_TRUE(store->InsertSamples(batch, &error)) << error;
+  std::vector<Sample> out;
+  ASSERT_TRUE(store->ReadSamples(0, kMinute0 + 3600, &out, &error)) << error;
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[1].Get(Channel::kPElW), 999.0);
+}
+
+TEST_F(StoreTest, AMinuteSplitByARestartIsAggregatedOnceWithAllTwelveSamples) {
+  const std::vector<Sample> minute = MakeSamples(kMinute0, 12);
+  std::string error;
+  int written = -1;
+  {
+    auto store = OpenStore();
+    ASSERT_TRUE(store->InsertSamples({minute.begin(), minute.begin() + 6}, &error)) << error;
+    // The minute is still being polled: nothing to aggregate yet.
+    ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 30, &written, &error)) << error;
+    EXPECT_EQ(written, 0);
+  }  // "crash": the process ends in the middle of the minute
+  auto store = OpenStore();
+  ASSERT_TRUE(store->InsertSamples({minute.begin() + 6, minute.end()}, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  EXPECT_EQ(written, 1);
+  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  EXPECT_EQ(written, 0);
+  {
+    auto again = OpenStore();  // a fresh process scans the whole table: still no duplicate
+    ASSERT_TRUE(again->AggregateMinutes(kMinute0 + 3600, &written, &error)) << error;
+    EXPECT_EQ(written, 0);
+  }
+  MinuteRows rows;
+  ASSERT_TRUE(store->ReadMinuteRows(0, kMinute0 + 3600, &rows, &error)) << error;
+  ASSERT_EQ(rows.rows.size(), 1u);
+  EXPECT_EQ(rows.rows.time_s[0], kMinute0);
+  EXPECT_EQ(rows.n_samples[0], 12);
+  // p_el_w = 150 + k for k = 0..11: mean 155.5; q_th from 0.03 kg/s · 3650 · 10 K.
+  EXPECT_DOUBLE_EQ(rows.rows[Channel::kPElW][0], 155.5);
+  EXPECT_NEAR(rows.rows[Channel::kQThW][0], 1095.0, 1e-9);
+  EXPECT_NEAR(rows.rows[Channel::kAoiRad][0], DegToRad(30.0), 1e-12);
+  EXPECT_TRUE(rows.qc_flags[0] & kQcThermalPowerComputed);
+  EXPECT_FALSE(rows.rows.Has(Channel::kTBackC));  // NULL everywhere: absent
+  RawDb db(DbPath());
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 1.0);
+}
+
+TEST_F(StoreTest, ReaggregationReplacesMinutesAfterLateSamples) {
+  auto store = OpenStore();
+  const std::vector<Sample> minute = MakeSamples(kMinute0, 12);
+  std::string error;
+  int written = 0;
+  ASSERT_TRUE(store->InsertSamples({minute.begin(), minute.begin() + 4}, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  ASSERT_TRUE(store->InsertSamples({minute.begin() + 4, minute.end()}, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  EXPECT_EQ(written, 0);  // AggregateMinutes never writes a minute twice
+  ASSERT_TRUE(store->ReaggregateMinutes(kMinute0, kMinute0 + 1, &written, &error)) << error;
+  EXPECT_EQ(written, 1);
+  MinuteRows rows;
+  ASSERT_TRUE(store->ReadMinuteRows(0, kMinute0 + 60, &rows, &error)) << error;
+  ASSERT_EQ(rows.rows.size(), 1u);
+  EXPECT_EQ(rows.n_samples[0], 12);
+}
+
+TEST_F(StoreTest, ImportedMinutesRoundTripAndAreMarkedImported) {
+  auto store = OpenStore();
+  Series s;
+  s.step_s = 60;
+  s.time_s = {kMinute0, kMinute0 + 60};
+  s[Channel::kPElW] = {100.0, std::nan("")};
+  s[Channel::kAoiRad] = {DegToRad(45.0), DegToRad(50.0)};
+  std::string error;
+  ASSERT_TRUE(store->WriteMinutes(s, &error)) << error;
+  s[Channel::kPElW][0] = 110.0;
+  ASSERT_TRUE(store->WriteMinutes(s, &error)) << error;  // upsert
+  MinuteRows rows;
+  ASSERT_TRUE(store->ReadMinuteRows(0, kMinute0 + 3600, &rows, &error)) << error;
+  ASSERT_EQ(rows.rows.size(), 2u);
+  EXPECT_EQ(rows.rows[Channel::kPElW][0], 110.0);
+  EXPECT_TRUE(std::isnan(rows.rows[Channel::kPElW][1]));
+  EXPECT_NEAR(rows.rows[Channel::kAoiRad][1], DegToRad(50.0), 1e-12);
+  EXPECT_TRUE(rows.qc_flags[0] & kQcImported);
+  EXPECT_TRUE(rows.qc_flags[0] & kQcRequiredMissing);  // no t_in_c etc.
+  RawDb db(DbPath());
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min WHERE n_samples IS NULL"), 2.0);
+  s.time_s[1] = kMinute0 + 61;  // not a minute start
+  EXPECT_FALSE(store->WriteMinutes(s, &error));
+  EXPECT_NE(error.find("not the start of a minute"), std::string::npos) << error;
+}
+
+TEST_F(StoreTest, RetentionDeletesOldSamplesAfterAggregatingThemAndKeepsMinutes) {
+  auto store = OpenStore();
+  std::string error;
+  // One full minute at noon of each of 41 days.
+  for (int day = 0; day <= 40; ++day) {
+    ASSERT_TRUE(store->InsertSamples(MakeSamples(kMinute0 + day * 86400, 12), &error)) << error;
+  }
+  const std::int64_t now = kMinute0 + 40 * 86400 + 3600;  // 13:00 of day 40
+  ASSERT_TRUE(store->ApplyRetention(now, 30, &error)) << error;
+  // Cutoff 13:00 of day 10: noon samples of days 0..10 are gone, 11..40 kept.
+  RawDb db(DbPath());
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 30.0 * 12);
+  EXPECT_EQ(db.Number("SELECT MIN(ts) FROM sample_5s"), static_cast<double>(kMinute0 + 11 * 86400));
+  // The deleted minutes were aggregated first; the kept ones wait for
+  // AggregateMinutes.
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 11.0);
+  EXPECT_EQ(db.Number("SELECT MIN(n_samples) FROM measurement_1min"), 12.0);
+  int written = 0;
+  ASSERT_TRUE(store->AggregateMinutes(now, &written, &error)) << error;
+  EXPECT_EQ(written, 30);
+  EXPECT_FALSE(store->ApplyRetention(now, 0, &error));
+  EXPECT_NE(error.find("raw_retention_days = 0"), std::string::npos) << error;
+}
+
+TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
+  auto store = OpenStore();
+  std::string error;
+  Store::CalibrationRow row;
+  bool found = true;
+  ASSERT_TRUE(store->LatestAcceptedCalibration(&row, &found, &error)) << error;
+  EXPECT_FALSE(found);
+
+  auto make = [](std::int64_t run_at, bool accepted, const std::string& reason) {
+    Store::CalibrationRow r;
+    r.run_at = run_at;
+    r.variant = "2N1Ccolwr";
+    r.window_start = run_at - 14 * 86400;
+    r.window_end = run_at;
+    r.status = accepted ? "accepted" : "rejected";
+    r.mae_p_el_w = 3.5;
+    r.mae_q_th_w = 20.25;
+    r.runtime_s = 12.5;
+    r.n_evals = 4242;
+    r.params_json = "{\"u_front_w_m2k\": 9.5}";
+    r.reason = reason;
+    r.accepted = accepted;
+    r.heldout_mae_w = accepted ? 23.0 : std::nan("");
+    return r;
+  };
+  Store::CalibrationRow first = make(kDay0, true, "first calibration");
+  Store::CalibrationRow worse = make(kDay0 + 2 * 86400, false, "held-out MAE 30 W > 23 W");
+  Store::CalibrationRow second = make(kDay0 + 86400, true, "held-out MAE 22 W <= 23 W");
+  for (Store::CalibrationRow* r : {&first, &worse, &second}) {
+    ASSERT_TRUE(store->InsertCalibration(r, &error)) << error;
+  }
+  EXPECT_GT(first.id, 0);
+  EXPECT_GT(worse.id, first.id);
+  EXPECT_GT(second.id, worse.id);
+  ASSERT_TRUE(store->LatestAcceptedCalibration(&row, &found, &error)) << error;
+  ASSERT_TRUE(found);
+  EXPECT_EQ(row.id, second.id);
+  EXPECT_EQ(row.run_at, kDay0 + 86400);
+  EXPECT_EQ(row.variant, "2N1Ccolwr");
+  EXPECT_EQ(row.window_start, kDay0 + 86400 - 14 * 86400);
+  EXPECT_EQ(row.status, "accepted");
+  EXPECT_EQ(row.mae_q_th_w, 20.25);
+  EXPECT_EQ(row.n_evals, 4242);
+  EXPECT_EQ(row.params_json, "{\"u_front_w_m2k\": 9.5}");
+  EXPECT_EQ(row.reason, "held-out MAE 22 W <= 23 W");
+  EXPECT_TRUE(row.accepted);
+  RawDb db(DbPath());
+  EXPECT_EQ(
+      db.Rows("SELECT heldout_mae_w FROM calibration WHERE id = " + std::to_string(worse.id))[0][0],
+      "NULL");
+}
+
+TEST_F(StoreTest, ForecastLatestPicksTheNewestIssueForEachTime) {
+  auto store = OpenStore();
+  std::string error;
+  const std::int64_t t = kMinute0;
+  // Issue A at 1000 covers t, t+60, t+120; issue B at 2000 covers t+60 … t+180.
+  ASSERT_TRUE(store->InsertForecast(
+      t - 1000, 1, "weather=persistence",
+      {{t, 1, 10, 20, 30}, {t + 60, 2, 11, 21, 31}, {t + 120, 3, 12, 22, 32}}, &error))
+      << error;
+  ASSERT_TRUE(store->InsertForecast(
+      t - 500, 2, "weather=weather_forecast",
+      {{t + 60, 102, 111, 121, 131}, {t + 120, 103, 112, 122, 132}, {t + 180, 104, 113, 123, 133}},
+      &error))
+      << error;
+  RawDb db(DbPath());
+  const std::string ts = std::to_string(t);
+  EXPECT_EQ(
+      db.Rows("SELECT ts - " + ts + ", issued_at - " + ts +
+              ", p_el_w, q_th_w, t_pv_c, t_out_c FROM forecast_latest ORDER BY ts"),
+      (std::vector<std::vector<std::string>>{{"0", "-1000", "1.0", "10.0", "20.0", "30.0"},
+                                             {"60", "-500", "102.0", "111.0", "121.0", "131.0"},
+                                             {"120", "-500", "103.0", "112.0", "122.0", "132.0"},
+                                             {"180", "-500", "104.0", "113.0", "123.0", "133.0"}}));
+  EXPECT_EQ(db.Rows("SELECT DISTINCT inputs FROM forecast WHERE calibration_id = 2")[0][0],
+            "weather=weather_forecast");
+}
+
+TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements) {
+  auto store = OpenStore();
+  std::string error;
+  const std::int64_t m0 = kMinute0, m1 = kMinute0 + 60, m2 = kMinute0 + 120;
+  // Measurements at three minutes of day 0; the third is invalid.
+  Series meas;
+  meas.step_s = 60;
+  meas.time_s = {m0, m1, m2};
+  meas[Channel::kPElW] = {110.0, 180.0, 1000.0};
+  meas[Channel::kQThW] = {400.0, -100.0, 1000.0};
+  meas[Channel::kValid] = {1.0, 1.0, 0.0};
+  ASSERT_TRUE(store->WriteMinutes(meas, &error)) << error;
+  // An old issue (two days before), the day-ahead issue (1 h before the day
+  // starts) and an intraday issue (after the day started, not scored).
+  ASSERT_TRUE(store->InsertForecast(
+      kDay0 - 2 * 86400, 1, "", {{m0, 0, 0, 0, 0}, {m1, 0, 0, 0, 0}, {m2, 0, 0, 0, 0}}, &error));
+  ASSERT_TRUE(store->InsertForecast(
+      kDay0 - 3600, 2, "", {{m0, 100, 500, 0, 0}, {m1, 200, 0, 0, 0}, {m2, 0, 0, 0, 0}}, &error));
+  ASSERT_TRUE(store->InsertForecast(kDay0 + 600, 3, "",
+                                    {{m0, 110, 400, 0, 0}, {m1, 180, -100, 0, 0}}, &error));
+  // Day-ahead errors: P_el |100 − 110| = 10, |200 − 180| = 20 → MAE 15 W,
+  // mean |measured| 145 W → nMAE 15/145. Q_u: |500 − 400| = 100,
+  // |0 − (−100)| = 100 → MAE 100 W, mean |measured| 250 W → nMAE 0.4.
+  RawDb db(DbPath());
+  const auto rows = db.Rows(
+      "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th FROM "
+      "forecast_skill");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0][0], std::to_string(kDay0));
+  EXPECT_DOUBLE_EQ(std::stod(rows[0][1]), 15.0);
+  EXPECT_DOUBLE_EQ(std::stod(rows[0][2]), 100.0);
+  EXPECT_NEAR(std::stod(rows[0][3]), 15.0 / 145.0, 1e-12);
+  EXPECT_NEAR(std::stod(rows[0][4]), 0.4, 1e-12);
+}
+
+TEST_F(StoreTest, ForecastInputsWrittenBySqlAreReadAsSeries) {
+  auto store = OpenStore();
+  {
+    RawDb db(DbPath());
+    const std::string t = std::to_string(kMinute0);
+    ASSERT_EQ(db.Exec("INSERT INTO weather_forecast(ts, g_poa_w_m2, t_amb_c, wind_m_s) VALUES "
+                      "(" +
+                      t + ", 500, 20, 2), (" + t + " + 900, 600, 21, NULL), (" + t +
+                      " + 1800, 700, 22, 3)"),
+              SQLITE_OK);
+    ASSERT_EQ(db.Exec("INSERT INTO operation_plan(ts, t_in_c, flow_kg_s) VALUES (" + t +
+                      ", 25, 0.03), (" + t + " + 60, 26, 0.0)"),
+              SQLITE_OK);
+  }
+  Series weather, plan;
+  std::string error;
+  ASSERT_TRUE(store->ReadWeatherForecast(kMinute0, kMinute0 + 1800, &weather, &error)) << error;
+  ASSERT_EQ(weather.size(), 2u);  // [from, to)
+  EXPECT_EQ(weather.step_s, 900.0);
+  EXPECT_EQ(weather[Channel::kGPoaWM2], (std::vector<double>{500.0, 600.0}));
+  EXPECT_EQ(weather[Channel::kWindMS][0], 2.0);
+  EXPECT_TRUE(std::isnan(weather[Channel::kWindMS][1]));
+  EXPECT_FALSE(weather.Has(Channel::kGhiWM2));  // NULL everywhere: absent
+  ASSERT_TRUE(store->ReadOperationPlan(kMinute0, kMinute0 + 3600, &plan, &error)) << error;
+  EXPECT_EQ(plan[Channel::kTInC], (std::vector<double>{25.0, 26.0}));
+  EXPECT_EQ(plan[Channel::kMdotKgS], (std::vector<double>{0.03, 0.0}));
+}
+
+}  // namespace
+}  // namespace pvtwin

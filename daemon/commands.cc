@@ -15,6 +15,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterSimulate(app);
   RegisterBench(app);
   RegisterBacktest(app);
+  RegisterSim(app);
 }
 
 }  // namespace pvtwin::cli

@@ -9,7 +9,7 @@
 //   [poll]         period_s
 //   [calibration]  variant, window_days, step_s, at, timezone
 //   [forecast]     horizon_h, refresh_min
-//   [[modbus.*]]   register map; accepted here, validated by the Modbus layer.
+//   [[modbus.*]]   the Modbus register map (config/modbus_config.h).
 //
 // Every problem is reported as one Diagnostic "file:line: key = value: rule",
 // all of them in one pass and in file order. Unknown keys and sections are
@@ -19,6 +19,7 @@
 #include <string>
 #include <string_view>
 
+#include "config/modbus_config.h"
 #include "core/diagnostic.h"
 #include "core/plant.h"
 
@@ -54,6 +55,7 @@ struct Config {
   PollConfig poll;
   CalibrationConfig calibration;
   ForecastConfig forecast;
+  ModbusConfig modbus;
   std::string source_path;  // the file it was read from
 };
 

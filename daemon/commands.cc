@@ -17,6 +17,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterBacktest(app);
   RegisterImport(app);
   RegisterExport(app);
+  RegisterSim(app);
 }
 
 }  // namespace pvtwin::cli

@@ -24,5 +24,6 @@ void RegisterBench(CLI::App& app);
 void RegisterBacktest(CLI::App& app);
 void RegisterImport(CLI::App& app);
 void RegisterExport(CLI::App& app);
+void RegisterSim(CLI::App& app);
 
 }  // namespace pvtwin::cli

@@ -1,0 +1,293 @@
+#include "io/modbus_poller.h"
+
+#include <modbus/modbus.h>
+
+#include <algorithm>
+#include <cassert>
+#include <cerrno>
+#include <cmath>
+
+#include "io/register_codec.h"
+
+namespace pvtwin {
+
+namespace {
+
+// Results of a few recent periods are kept, so a late delivery thread still
+// finds period k although the device has already published k + 1.
+constexpr std::size_t kResultSlots = 4;
+
+enum class LinkState { kStarting, kOk, kDown, kExceptions, kFrozen };
+
+bool IsException(int error) { return error > MODBUS_ENOBASE && error <= EMBXGTAR; }
+
+// The only request-sending libmodbus calls of the poller: read-only.
+int ReadRegisters(modbus_t* ctx, RegisterTable table, int address, int count, std::uint16_t* dest) {
+  const int function = table == RegisterTable::kInput ? MODBUS_FC_READ_INPUT_REGISTERS
+                                                      : MODBUS_FC_READ_HOLDING_REGISTERS;
+  assert(function == 3 || function == 4);
+  return function == MODBUS_FC_READ_INPUT_REGISTERS
+             ? modbus_read_input_registers(ctx, address, count, dest)
+             : modbus_read_registers(ctx, address, count, dest);
+}
+
+}  // namespace
+
+struct ModbusPoller::Result {
+  std::int64_t period = -1;
+  std::array<double, kNumChannels> value{};
+  std::uint32_t read_mask = 0;  // channel bits with a value or a reject
+  std::uint32_t rejected_mask = 0;
+};
+
+struct ModbusPoller::Device {
+  std::size_t index = 0;
+  ModbusDevice config;
+  std::vector<const RegisterRead*> reads;
+  modbus_t* ctx = nullptr;
+  bool connected = false;
+  bool ever_connected = false;
+  int failures = 0;  // consecutive polls that lost the connection
+  std::int64_t next_attempt_period = 0;
+  LinkState state = LinkState::kStarting;
+  std::uint64_t failed_polls_in_state = 0;
+  std::vector<std::uint16_t> words;  // this poll's raw registers, reads concatenated
+  std::vector<std::uint16_t> previous_words;
+  int unchanged_polls = 0;
+
+  mutable std::mutex mutex;  // guards stats and slots
+  DeviceStats stats;
+  std::array<Result, kResultSlots> slots;
+
+  std::string Who() const {
+    return "modbus " + config.name + " (" + config.Endpoint() + " unit " +
+           std::to_string(config.unit_id) + ")";
+  }
+
+  void Close() {
+    if (ctx != nullptr) {
+      modbus_flush(ctx);
+      modbus_close(ctx);
+      modbus_free(ctx);
+      ctx = nullptr;
+    }
+    connected = false;
+  }
+};
+
+ModbusPoller::ModbusPoller(const ModbusConfig& map, PollerOptions options, const Clock& clock,
+                           LogFn log)
+    : map_(map), options_(options), clock_(clock), log_(std::move(log)) {
+  assert(options_.period_s > 0 && options_.backoff_max_periods >= 1);
+  plan_ = PlanReads(map_, options_.plan);
+  for (std::size_t d = 0; d < map_.devices.size(); ++d) {
+    auto device = std::make_unique<Device>();
+    device->index = d;
+    device->config = map_.devices[d];
+    device->stats.name = device->config.name;
+    for (const RegisterRead& read : plan_) {
+      if (read.device == d) device->reads.push_back(&read);
+    }
+    devices_.push_back(std::move(device));
+  }
+}
+
+ModbusPoller::~ModbusPoller() { Stop(); }
+
+void ModbusPoller::Start(std::function<void(const Sample&)> on_sample) {
+  assert(threads_.empty());
+  on_sample_ = std::move(on_sample);
+  stop_.store(false);
+  for (auto& device : devices_) threads_.emplace_back([this, d = device.get()] { RunDevice(d); });
+  threads_.emplace_back([this] { RunDelivery(); });
+}
+
+void ModbusPoller::Stop() {
+  stop_.store(true);
+  for (std::thread& t : threads_) t.join();
+  threads_.clear();
+  for (auto& device : devices_) device->Close();
+}
+
+std::vector<DeviceStats> ModbusPoller::Stats() const {
+  std::vector<DeviceStats> stats;
+  for (const auto& device : devices_) {
+    std::lock_guard<std::mutex> lock(device->mutex);
+    stats.push_back(device->stats);
+  }
+  return stats;
+}
+
+void ModbusPoller::RunDevice(Device* device) {
+  const double period_s = options_.period_s;
+  std::int64_t k = static_cast<std::int64_t>(std::floor(clock_.NowS() / period_s)) + 1;
+  while (!stop_.load()) {
+    if (!clock_.SleepUntil(static_cast<double>(k) * period_s, stop_)) break;
+    // After a long timeout the device may be late: poll the current period.
+    k = std::max(k, static_cast<std::int64_t>(std::floor(clock_.NowS() / period_s)));
+    Result result;
+    result.period = k;
+    PollDevice(device, k, &result);
+    {
+      std::lock_guard<std::mutex> lock(device->mutex);
+      device->slots[static_cast<std::size_t>(k) % kResultSlots] = result;
+    }
+    ++k;
+  }
+}
+
+void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* result) {
+  const ModbusDevice& c = device->config;
+  const auto set_state = [&](LinkState state, const std::string& why, int priority) {
+    if (state == device->state) {
+      ++device->failed_polls_in_state;
+      return;
+    }
+    std::string line = device->Who() + ": " + why;
+    if (state == LinkState::kOk && device->state != LinkState::kStarting) {
+      line += " after " + std::to_string(device->failed_polls_in_state + 1) + " failed polls";
+    }
+    log_(priority, line);
+    device->state = state;
+    device->failed_polls_in_state = 0;
+  };
+  const auto record_error = [&](const std::string& message, bool timeout) {
+    std::lock_guard<std::mutex> lock(device->mutex);
+    ++device->stats.errors;
+    if (timeout) ++device->stats.timeouts;
+    device->stats.last_error = message;
+    device->stats.connected = device->connected;
+  };
+  const auto lose_connection = [&](const std::string& message) {
+    device->Close();
+    ++device->failures;
+    const int wait =
+        std::min(1 << std::min(device->failures - 1, 20), options_.backoff_max_periods);
+    device->next_attempt_period = period + wait;
+    set_state(LinkState::kDown,
+              message + "; reconnecting in " + std::to_string(wait) + " period(s), backoff up to " +
+                  std::to_string(options_.backoff_max_periods),
+              kErr);
+  };
+
+  if (!device->connected) {
+    if (period < device->next_attempt_period) return;
+    device->ctx = c.IsRtu()
+                      ? modbus_new_rtu(c.serial.c_str(), c.baud, c.parity, c.data_bits, c.stop_bits)
+                      : modbus_new_tcp_pi(c.host.c_str(), std::to_string(c.port).c_str());
+    std::string error;
+    if (device->ctx == nullptr) {
+      error = std::string("cannot create the libmodbus context: ") + modbus_strerror(errno);
+    } else {
+      modbus_set_response_timeout(device->ctx, static_cast<std::uint32_t>(c.timeout_ms / 1000),
+                                  static_cast<std::uint32_t>(c.timeout_ms % 1000) * 1000u);
+      modbus_set_slave(device->ctx, c.unit_id);
+      if (modbus_connect(device->ctx) != 0) {
+        error = std::string("connect failed: ") + modbus_strerror(errno);
+      }
+    }
+    if (!error.empty()) {
+      record_error(error, false);
+      lose_connection(error);
+      return;
+    }
+    device->connected = true;
+    std::lock_guard<std::mutex> lock(device->mutex);
+    if (device->ever_connected) ++device->stats.reconnects;
+    device->ever_connected = true;
+    device->stats.connected = true;
+  }
+
+  device->words.clear();
+  bool all_answered = true;
+  std::string exception;
+  for (const RegisterRead* read : device->reads) {
+    std::array<std::uint16_t, kMaxReadRegisters> buf{};
+    const int n = ReadRegisters(device->ctx, read->table, read->address, read->count, buf.data());
+    const int error = errno;
+    {
+      std::lock_guard<std::mutex> lock(device->mutex);
+      ++device->stats.requests;
+    }
+    const std::string what = "read " + std::string(TableName(read->table)) + " " +
+                             std::to_string(read->address) + "+" + std::to_string(read->count);
+    if (n != read->count) {
+      all_answered = false;
+      const std::string message = what + ": " + (n < 0 ? modbus_strerror(error) : "short answer");
+      const bool timeout = n < 0 && error == ETIMEDOUT;
+      if (n < 0 && IsException(error)) {
+        // The device answered: the connection is fine, this read's data is not.
+        record_error(message, false);
+        exception = message;
+        continue;
+      }
+      // Timeout, transaction id or unit mismatch, bad CRC, broken connection:
+      // a late or stray answer may still come, so flush and re-open.
+      record_error(message, timeout);
+      lose_connection(message);
+      return;
+    }
+    device->words.insert(device->words.end(), buf.begin(), buf.begin() + n);
+    for (const std::size_t i : read->points) {
+      const ModbusPoint& p = map_.points[i];
+      const auto offset = static_cast<std::size_t>(p.address - read->address);
+      const DecodedValue v = DecodePoint(
+          p,
+          std::span<const std::uint16_t>(buf.data() + offset, static_cast<std::size_t>(p.Count())));
+      const auto c_index = static_cast<std::size_t>(p.channel);
+      result->read_mask |= 1u << c_index;
+      result->value[c_index] = WireToChannelUnit(p.channel, v.value);
+      if (v.rejected) result->rejected_mask |= 1u << c_index;
+    }
+  }
+  device->failures = 0;
+
+  if (all_answered) {
+    device->unchanged_polls =
+        device->words == device->previous_words ? device->unchanged_polls + 1 : 0;
+    device->previous_words.swap(device->words);
+    std::lock_guard<std::mutex> lock(device->mutex);
+    device->stats.last_success_s = clock_.NowS();
+  }
+  const bool frozen =
+      options_.frozen_after_polls > 0 && device->unchanged_polls >= options_.frozen_after_polls;
+  if (frozen) {
+    result->rejected_mask |= result->read_mask;
+    set_state(LinkState::kFrozen,
+              "every register unchanged for " + std::to_string(device->unchanged_polls) +
+                  " polls: values frozen, rejected until they change",
+              kWarning);
+  } else if (!exception.empty()) {
+    set_state(LinkState::kExceptions, "device answers with an exception: " + exception, kWarning);
+  } else {
+    set_state(LinkState::kOk, "polling " + std::to_string(device->reads.size()) + " read(s)",
+              device->ever_connected && device->state == LinkState::kStarting ? kInfo : kNotice);
+  }
+}
+
+void ModbusPoller::RunDelivery() {
+  const double period_s = options_.period_s;
+  std::int64_t k = static_cast<std::int64_t>(std::floor(clock_.NowS() / period_s)) + 1;
+  while (!stop_.load()) {
+    if (!clock_.SleepUntil(static_cast<double>(k + 1) * period_s, stop_)) break;
+    Sample sample;
+    sample.ts_s = std::llround(static_cast<double>(k) * period_s);
+    for (const auto& device : devices_) {
+      std::lock_guard<std::mutex> lock(device->mutex);
+      const Result& r = device->slots[static_cast<std::size_t>(k) % kResultSlots];
+      if (r.period != k) continue;
+      for (std::size_t c = 0; c < kNumChannels; ++c) {
+        if (!((r.read_mask >> c) & 1u)) continue;
+        if ((r.rejected_mask >> c) & 1u) {
+          sample.Reject(static_cast<Channel>(c));
+        } else {
+          sample.value[c] = r.value[c];
+        }
+      }
+    }
+    on_sample_(sample);
+    ++k;
+  }
+}
+
+}  // namespace pvtwin

@@ -12,7 +12,8 @@ enum LogPriority { kErr = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug = 7 };
 
 using LogFn = std::function<void(int priority, const std::string& line)>;
 
-// "<N>line\n" on stderr, one write per line (safe from several threads).
+// One line on stderr, one write per line (safe from several threads): "<N>line"
+// under systemd (journald reads the priority), "HH:MM:SSZ level: line" otherwise.
 void LogToStderr(int priority, const std::string& line);
 
 }  // namespace pvtwin

@@ -18,6 +18,8 @@ void RegisterCommands(CLI::App& app) {
   RegisterImport(app);
   RegisterExport(app);
   RegisterSim(app);
+  RegisterRun(app);
+  RegisterDemo(app);
 }
 
 }  // namespace pvtwin::cli

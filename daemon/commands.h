@@ -25,5 +25,7 @@ void RegisterBacktest(CLI::App& app);
 void RegisterImport(CLI::App& app);
 void RegisterExport(CLI::App& app);
 void RegisterSim(CLI::App& app);
+void RegisterRun(CLI::App& app);
+void RegisterDemo(CLI::App& app);
 
 }  // namespace pvtwin::cli

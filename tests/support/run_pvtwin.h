@@ -22,14 +22,14 @@ struct ProcessResult {
   std::string err;
 };
 
-// `pvtwin <args>` run through the shell in directory `dir`.
-inline ProcessResult RunPvtwin(const std::filesystem::path& dir, const std::string& args) {
+// A shell command line run in directory `dir`.
+inline ProcessResult RunCommand(const std::filesystem::path& dir, const std::string& command_line) {
   namespace fs = std::filesystem;
   static int counter = 0;
   const fs::path err_path = fs::temp_directory_path() / ("pvtwin_test_" + std::to_string(getpid()) +
                                                          "_" + std::to_string(counter++) + ".err");
-  const std::string command = "cd '" + dir.string() + "' && '" + PVTWIN_BINARY + "' " + args +
-                              " 2>'" + err_path.string() + "'";
+  const std::string command =
+      "cd '" + dir.string() + "' && " + command_line + " 2>'" + err_path.string() + "'";
   ProcessResult run;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
@@ -41,6 +41,11 @@ inline ProcessResult RunPvtwin(const std::filesystem::path& dir, const std::stri
   run.err = ReadFile(err_path);
   fs::remove(err_path);
   return run;
+}
+
+// `pvtwin <args>` run through the shell in directory `dir`.
+inline ProcessResult RunPvtwin(const std::filesystem::path& dir, const std::string& args) {
+  return RunCommand(dir, "'" + std::string(PVTWIN_BINARY) + "' " + args);
 }
 
 }  // namespace pvtwin::testing

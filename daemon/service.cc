@@ -1,0 +1,597 @@
+#include "daemon/service.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <vector>
+
+#include "config/plant_config.h"
+#include "core/clock.h"
+#include "core/forecast.h"
+#include "core/identification.h"
+#include "core/sample.h"
+#include "core/thermal_model.h"
+#include "core/variant.h"
+#include "daemon/notify.h"
+#include "io/child_process.h"
+#include "io/csv.h"
+#include "io/local_time.h"
+#include "io/log.h"
+#include "io/modbus_poller.h"
+#include "io/params_json.h"
+#include "io/store.h"
+#include "io/time_format.h"
+
+namespace pvtwin {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::int64_t kDayS = 86400;
+// Samples kept in memory while the database refuses writes: one day at 5 s.
+constexpr std::size_t kMaxPendingSamples = 17280;
+// A daemon without parameters retries a calibration it lacked data for.
+constexpr double kUncalibratedRetryS = 3600.0;
+constexpr double kRetentionPeriodS = 3600.0;
+
+std::string Format(const char* fmt, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), fmt, a);
+  return buf;
+}
+
+// Samples handed over by the poller's threads.
+class SampleQueue {
+ public:
+  void Push(const Sample& s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(s);
+  }
+  std::vector<Sample> Take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<Sample> out;
+    out.swap(queue_);
+    return out;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<Sample> queue_;
+};
+
+// Held-out objective (W/m², paper 3.2.2) of params on a series.
+std::optional<ErrorMetrics> HeldOutErrors(const Series& test, const Plant& plant,
+                                          const ModelSpec& spec, const ParamVector& params) {
+  Drivers drivers;
+  std::string error;
+  if (!PrepareDrivers(test, plant, spec, &drivers, &error)) return std::nullopt;
+  SimOutputs sim;
+  Simulate(drivers, params, &sim);
+  const Measurements meas = MakeMeasurements(test, drivers);
+  if (meas.rows.empty()) return std::nullopt;
+  ErrorMetrics e = ComputeErrors(meas, sim, plant.area_m2);
+  if (!std::isfinite(e.objective_w_m2())) return std::nullopt;
+  return e;
+}
+
+Series RowsBetween(const Series& s, std::int64_t from, std::int64_t to) {
+  std::size_t b = 0;
+  while (b < s.size() && s.time_s[b] < from) ++b;
+  std::size_t e = b;
+  while (e < s.size() && s.time_s[e] < to) ++e;
+  return s.Slice(b, e);
+}
+
+class Service {
+ public:
+  explicit Service(const ServiceOptions& options) : options_(options) {}
+
+  int Run();
+
+ private:
+  bool LoadAndApplyConfig(bool initial);
+  void StoreSamples();
+  void Aggregate();
+  void MaybeStartCalibration();
+  void CheckCalibration();
+  void FinishCalibration(int exit_code);
+  // Inserts the row and returns its id (0 when it could not be stored).
+  std::int64_t RecordCalibration(Store::CalibrationRow row);
+  bool LoadCurrentParameters();
+  void IssueForecast();
+  void Shutdown();
+  void UpdateDeviceStatus();
+  double Now() const { return clock_->NowS(); }
+
+  ServiceOptions options_;
+  Config config_;
+  ModelSpec spec_;
+  int at_hour_ = 2, at_minute_ = 0;
+  std::unique_ptr<ScaledClock> clock_;
+  std::unique_ptr<Store> store_;
+  std::unique_ptr<ModbusPoller> poller_;
+  SampleQueue queue_;
+  std::vector<Sample> pending_;
+  bool store_failing_ = false;
+  ServiceStatus status_;
+
+  // Calibration.
+  fs::path work_dir_;
+  ChildProcess child_;
+  double child_started_wall_s_ = 0.0;
+  Store::CalibrationRow job_;
+  Series job_test_;
+  double next_calibration_s_ = 0.0;
+  // Current parameters.
+  bool have_params_ = false;
+  std::int64_t params_id_ = 0;
+  ParamVector params_{};
+  std::string params_json_;
+  // Forecast and housekeeping.
+  double next_forecast_s_ = 0.0;
+  double next_retention_s_ = 0.0;
+  double next_watchdog_wall_s_ = 0.0;
+};
+
+bool Service::LoadAndApplyConfig(bool initial) {
+  Config config;
+  Diagnostics errors;
+  if (!LoadConfig(options_.config_path, &config, &errors)) {
+    for (const Diagnostic& d : errors) LogToStderr(kErr, d.ToString());
+    return false;
+  }
+  ModelSpec spec;
+  std::string error;
+  if (!ParseVariant(config.calibration.variant, &spec, &error)) {
+    LogToStderr(kErr, options_.config_path + ": [calibration] variant = \"" +
+                          config.calibration.variant + "\": " + error);
+    return false;
+  }
+  if (!UseTimeZone(config.calibration.timezone, &error)) {
+    LogToStderr(kErr, options_.config_path + ": [calibration] " + error);
+    return false;
+  }
+  ParseClockTime(config.calibration.at, &at_hour_, &at_minute_);
+  if (!options_.db_path.empty()) config.storage.path = options_.db_path;
+  if (!initial) {
+    // The store and the poller own a file and connections; they keep the
+    // settings they were started with.
+    if (config.storage.path != config_.storage.path ||
+        config.poll.period_s != config_.poll.period_s)
+      LogToStderr(kWarning, "reload: [storage] and [poll] changes take effect after a restart");
+    if (config.modbus.devices.size() != config_.modbus.devices.size() ||
+        config.modbus.points.size() != config_.modbus.points.size())
+      LogToStderr(kWarning, "reload: [[modbus.*]] changes take effect after a restart");
+    config.storage = config_.storage;
+    config.poll = config_.poll;
+    config.modbus = config_.modbus;
+  }
+  const bool spec_changed = !initial && spec.Name() != spec_.Name();
+  config_ = config;
+  spec_ = spec;
+  if (spec_changed) {
+    LogToStderr(kNotice, "reload: variant is now " + spec_.Name() +
+                             "; forecasts use it after the next accepted calibration");
+  }
+  return true;
+}
+
+void Service::StoreSamples() {
+  std::vector<Sample> fresh = queue_.Take();
+  pending_.insert(pending_.end(), fresh.begin(), fresh.end());
+  if (pending_.empty()) return;
+  if (pending_.size() > kMaxPendingSamples) {
+    const std::size_t drop = pending_.size() - kMaxPendingSamples;
+    LogToStderr(kErr, "database unwritable for a day: dropping the " + std::to_string(drop) +
+                          " oldest samples");
+    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(drop));
+  }
+  std::string error;
+  if (!store_->InsertSamples(pending_, &error)) {
+    if (!store_failing_) {
+      LogToStderr(kErr, "storing samples failed (kept in memory, retried): " + error);
+      store_failing_ = true;
+    }
+    return;
+  }
+  if (store_failing_) LogToStderr(kNotice, "storing samples works again");
+  store_failing_ = false;
+  status_.samples_stored += pending_.size();
+  pending_.clear();
+}
+
+void Service::Aggregate() {
+  // The sample of the period starting at t arrives at t + period; a minute
+  // is complete once its last period has been delivered.
+  const double settled_s = Now() - config_.poll.period_s - 1.0;
+  const std::int64_t up_to = static_cast<std::int64_t>(std::floor(settled_s / 60.0)) * 60;
+  int written = 0;
+  std::string error;
+  if (!store_->AggregateMinutes(up_to, &written, &error)) {
+    LogToStderr(kWarning, "aggregation to 1-min rows failed (retried): " + error);
+    return;
+  }
+  status_.minutes_aggregated += static_cast<std::uint64_t>(written);
+}
+
+bool Service::LoadCurrentParameters() {
+  Store::CalibrationRow row;
+  bool found = false;
+  std::string error;
+  if (!store_->LatestAcceptedCalibration(&row, &found, &error)) {
+    LogToStderr(kErr, "reading the accepted calibration failed: " + error);
+    return false;
+  }
+  if (!found) return false;
+  ParamsFile file;
+  Diagnostics errors;
+  if (!ParseParamsJson(row.params_json, "calibration " + std::to_string(row.id), config_.plant,
+                       &file, &errors)) {
+    for (const Diagnostic& d : errors) LogToStderr(kErr, d.ToString());
+    return false;
+  }
+  ModelSpec spec;
+  if (!file.variant.empty() && ParseVariant(file.variant, &spec, &error)) spec_ = spec;
+  have_params_ = true;
+  params_id_ = row.id;
+  params_ = file.values;
+  params_json_ = row.params_json;
+  status_.calibration_id = row.id;
+  return true;
+}
+
+void Service::MaybeStartCalibration() {
+  if (child_.running() || Now() < next_calibration_s_) return;
+  const double now = Now();
+  next_calibration_s_ =
+      static_cast<double>(NextLocalTime(static_cast<std::int64_t>(now), at_hour_, at_minute_));
+  const std::int64_t end = static_cast<std::int64_t>(std::floor(now / 60.0)) * 60;
+  const std::int64_t begin = end - config_.calibration.window_days * kDayS;
+
+  Store::CalibrationRow row;
+  row.run_at = static_cast<std::int64_t>(now);
+  row.variant = spec_.Name();
+  row.window_start = begin;
+  row.window_end = end;
+  Series window;
+  std::string error;
+  if (!store_->ReadMinutes(begin, end, &window, &error)) {
+    row.status = "failed";
+    row.reason = "reading the window failed: " + error;
+    RecordCalibration(row);
+    return;
+  }
+  const std::int64_t span = window.size() ? window.time_s.back() - window.time_s.front() : 0;
+  if (span < 2 * kDayS - 120) {
+    row.status = "skipped";
+    row.reason = "window holds " + Format("%.1f", span / 86400.0) +
+                 " days of 1-min data; two are needed (training days and a held-out day)";
+    RecordCalibration(row);
+    if (!have_params_)
+      next_calibration_s_ = std::min(next_calibration_s_, now + kUncalibratedRetryS);
+    return;
+  }
+  const Series train = RowsBetween(window, begin, end - kDayS);
+  job_test_ = RowsBetween(window, end - kDayS, end);
+
+  std::error_code ec;
+  fs::create_directories(work_dir_, ec);
+  const fs::path train_csv = work_dir_ / "train.csv";
+  const fs::path new_json = work_dir_ / "new-params.json";
+  const fs::path log_path = work_dir_ / "calibrate.log";
+  std::vector<Channel> channels;
+  for (const ChannelInfo& info : kChannels) {
+    if (train.Has(info.channel)) channels.push_back(info.channel);
+  }
+  fs::remove(new_json, ec);
+  fs::remove(log_path, ec);
+  if (!WriteCsv(train_csv.string(), train, channels, &error)) {
+    row.status = "failed";
+    row.reason = error;
+    RecordCalibration(row);
+    return;
+  }
+  std::vector<std::string> argv = {options_.exe_path.empty() ? SelfExecutable() : options_.exe_path,
+                                   "calibrate",
+                                   "--config",
+                                   options_.config_path,
+                                   "--csv",
+                                   train_csv.string(),
+                                   "--variant",
+                                   spec_.Name(),
+                                   "--step",
+                                   Format("%.0f", config_.calibration.step_s),
+                                   "--ftol",
+                                   Format("%g", options_.calibration_ftol),
+                                   "--out",
+                                   new_json.string()};
+  if (have_params_) {
+    const fs::path current = work_dir_ / "current-params.json";
+    if (WriteTextFileAtomically(current.string(), params_json_, &error)) {
+      argv.push_back("--start");
+      argv.push_back(current.string());
+    }
+  }
+  if (!child_.Start(argv, log_path.string(), &error)) {
+    row.status = "failed";
+    row.reason = error;
+    RecordCalibration(row);
+    return;
+  }
+  child_started_wall_s_ = WallNowS();
+  job_ = row;
+  status_.calibrating = true;
+  LogToStderr(kInfo, "calibration of " + spec_.Name() + " started on " + FormatIsoUtc(begin) +
+                         " .. " + FormatIsoUtc(end) + " (last day held out)");
+}
+
+void Service::CheckCalibration() {
+  if (!child_.running()) return;
+  int exit_code = 0;
+  if (child_.Finished(&exit_code)) {
+    FinishCalibration(exit_code);
+    return;
+  }
+  const double ran_s = WallNowS() - child_started_wall_s_;
+  if (ran_s > options_.calibration_timeout_s) {
+    child_.Kill();
+    Store::CalibrationRow row = job_;
+    row.status = "timeout";
+    row.runtime_s = ran_s;
+    row.reason = "abandoned after " + Format("%.0f", ran_s) + " s (limit " +
+                 Format("%.0f", options_.calibration_timeout_s) + " s); parameters kept";
+    RecordCalibration(row);
+  }
+}
+
+// The last line of the child's output: why it failed, in its own words.
+std::string LastLine(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
+void Service::FinishCalibration(int exit_code) {
+  Store::CalibrationRow row = job_;
+  row.runtime_s = WallNowS() - child_started_wall_s_;
+  const fs::path new_json = work_dir_ / "new-params.json";
+  if (exit_code != 0) {
+    row.status = exit_code < 0 ? "crashed" : "failed";
+    row.reason = (exit_code < 0 ? "calibrate ended by signal " + std::to_string(-exit_code)
+                                : "calibrate exited with " + std::to_string(exit_code)) +
+                 ": " + LastLine(work_dir_ / "calibrate.log");
+    RecordCalibration(row);
+    return;
+  }
+  std::ifstream in(new_json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ParamsFile file;
+  Diagnostics errors;
+  if (!ParseParamsJson(text, new_json.string(), config_.plant, &file, &errors)) {
+    row.status = "failed";
+    row.reason = errors.empty() ? "unreadable parameters" : errors.front().ToString();
+    RecordCalibration(row);
+    return;
+  }
+  const nlohmann::json fit =
+      nlohmann::json::parse(text, nullptr, false).value("fit", nlohmann::json::object());
+  row.n_evals = fit.value("simulations", 0L);
+  row.params_json = text;
+  const std::optional<ErrorMetrics> fresh =
+      HeldOutErrors(job_test_, config_.plant, spec_, file.values);
+  if (!fresh) {
+    row.status = "rejected";
+    row.reason = "the held-out day has no usable rows to judge the new parameters";
+    RecordCalibration(row);
+    return;
+  }
+  row.mae_p_el_w = fresh->mae_p_el_w;
+  row.mae_q_th_w = fresh->mae_q_th_w;
+  row.heldout_mae_w = fresh->mae_p_el_w + fresh->mae_q_th_w;
+  std::optional<ErrorMetrics> current;
+  if (have_params_) current = HeldOutErrors(job_test_, config_.plant, spec_, params_);
+  if (current && fresh->objective_w_m2() > current->objective_w_m2()) {
+    row.status = "rejected";
+    row.reason = "held-out MAE " + Format("%.2f", row.heldout_mae_w) + " W exceeds the current " +
+                 Format("%.2f", current->mae_p_el_w + current->mae_q_th_w) + " W (calibration " +
+                 std::to_string(params_id_) + "); parameters kept";
+    RecordCalibration(row);
+    return;
+  }
+  row.status = "accepted";
+  row.accepted = true;
+  row.reason = current ? "held-out MAE " + Format("%.2f", row.heldout_mae_w) + " W ≤ current " +
+                             Format("%.2f", current->mae_p_el_w + current->mae_q_th_w) + " W"
+                       : "first parameters of this database";
+  row.id = RecordCalibration(row);
+  if (row.id > 0) {
+    have_params_ = true;
+    params_id_ = row.id;
+    params_ = file.values;
+    params_json_ = text;
+    status_.calibration_id = row.id;
+    IssueForecast();
+  }
+}
+
+std::int64_t Service::RecordCalibration(Store::CalibrationRow row) {
+  std::string error;
+  if (!store_->InsertCalibration(&row, &error)) {
+    LogToStderr(kErr, "recording the calibration failed: " + error);
+    row.id = 0;
+  }
+  status_.calibrating = false;
+  ++status_.calibrations;
+  status_.last_calibration = row.status + ": " + row.reason;
+  LogToStderr(row.status == "accepted" ? kNotice : kWarning,
+              "calibration " + std::to_string(row.id) + " " + row.status + ": " + row.reason);
+  return row.id;
+}
+
+void Service::IssueForecast() {
+  if (!have_params_) return;
+  const double now = Now();
+  next_forecast_s_ = now + config_.forecast.refresh_min * 60.0;
+  ForecastRequest request;
+  request.issued_at_s = static_cast<std::int64_t>(std::floor(now / 60.0)) * 60;
+  request.horizon_s = config_.forecast.horizon_h * 3600.0;
+  const std::int64_t horizon_end =
+      request.issued_at_s + static_cast<std::int64_t>(request.horizon_s);
+  Series history, weather, plan;
+  std::string error;
+  const std::int64_t history_from = request.issued_at_s - config_.calibration.window_days * kDayS;
+  if (!store_->ReadMinutes(history_from, request.issued_at_s, &history, &error) ||
+      !store_->ReadWeatherForecast(request.issued_at_s, horizon_end, &weather, &error) ||
+      !store_->ReadOperationPlan(request.issued_at_s, horizon_end, &plan, &error)) {
+    LogToStderr(kErr, "forecast inputs could not be read: " + error);
+    return;
+  }
+  Forecast forecast;
+  if (!MakeForecast(config_.plant, spec_, params_, history, weather, plan, request, &forecast,
+                    &error)) {
+    LogToStderr(kWarning, "no forecast issued: " + error);
+    return;
+  }
+  std::vector<Store::ForecastRow> rows(forecast.rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    rows[i] = {forecast.rows.time_s[i], forecast.rows[Channel::kPElW][i],
+               forecast.rows[Channel::kQThW][i], forecast.rows[Channel::kTPvC][i],
+               forecast.rows[Channel::kTOutC][i]};
+  }
+  const std::string inputs = forecast.inputs.Describe();
+  if (!store_->InsertForecast(request.issued_at_s, params_id_, inputs, rows, &error)) {
+    LogToStderr(kErr, "writing the forecast failed: " + error);
+    return;
+  }
+  ++status_.forecasts;
+  status_.last_forecast_rows = rows.size();
+  LogToStderr(kInfo, "forecast issued at " + FormatIsoUtc(request.issued_at_s) + ": " +
+                         std::to_string(rows.size()) + " rows, calibration " +
+                         std::to_string(params_id_) + "; " + inputs);
+}
+
+void Service::UpdateDeviceStatus() {
+  if (!poller_) return;
+  int up = 0;
+  const std::vector<DeviceStats> stats = poller_->Stats();
+  for (const DeviceStats& d : stats) up += d.connected ? 1 : 0;
+  status_.devices = static_cast<int>(stats.size());
+  status_.devices_up = up;
+}
+
+void Service::Shutdown() {
+  NotifyStopping();
+  LogToStderr(kInfo, "stopping");
+  if (poller_) poller_->Stop();
+  StoreSamples();
+  if (store_) Aggregate();
+  if (child_.running()) {
+    child_.Kill();
+    Store::CalibrationRow row = job_;
+    row.status = "abandoned";
+    row.runtime_s = WallNowS() - child_started_wall_s_;
+    row.reason = "the daemon stopped during the fit";
+    RecordCalibration(row);
+  }
+  if (!pending_.empty()) {
+    LogToStderr(kErr, std::to_string(pending_.size()) + " samples could not be stored");
+  }
+}
+
+int Service::Run() {
+  if (!LoadAndApplyConfig(true)) return 2;
+  clock_ = options_.sim_start_s > 0
+               ? std::make_unique<ScaledClock>(options_.sim_start_s, options_.wall_anchor_s,
+                                               options_.speed)
+               : std::make_unique<ScaledClock>();
+  std::string error;
+  store_ = Store::Open(config_.storage.path, &error);
+  if (!store_) {
+    LogToStderr(kErr, config_.storage.path + ": " + error);
+    return 1;
+  }
+  work_dir_ = fs::path(config_.storage.path).parent_path() / "calibration";
+  LoadCurrentParameters();
+  if (!config_.modbus.devices.empty()) {
+    PollerOptions poller_options;
+    poller_options.period_s = config_.poll.period_s;
+    poller_ = std::make_unique<ModbusPoller>(
+        config_.modbus, poller_options, *clock_,
+        [](int priority, const std::string& line) { LogToStderr(priority, line); });
+    poller_->Start([this](const Sample& s) { queue_.Push(s); });
+  } else {
+    LogToStderr(kNotice,
+                "no [[modbus.device]] in the config: polling is off; calibrations and "
+                "forecasts use the data imported into the database");
+  }
+  const double now = Now();
+  next_calibration_s_ = !have_params_ && options_.calibrate_when_uncalibrated
+                            ? now
+                            : static_cast<double>(NextLocalTime(static_cast<std::int64_t>(now),
+                                                                at_hour_, at_minute_));
+  next_forecast_s_ = have_params_ ? now : INFINITY;
+  next_retention_s_ = now;
+  const double watchdog_s = WatchdogIntervalS();
+  NotifyReady("polling " + std::to_string(config_.modbus.devices.size()) + " devices into " +
+              config_.storage.path);
+  LogToStderr(kInfo, "ready: " + config_.storage.path + ", variant " + spec_.Name() +
+                         ", next calibration " +
+                         FormatIsoUtc(static_cast<std::int64_t>(next_calibration_s_)));
+
+  const std::atomic<bool> never(false);
+  const std::atomic<bool>& stop = options_.stop ? *options_.stop : never;
+  // One pass per poll period (simulated time), at least every second of wall
+  // time so that signals, the watchdog and the calibration child are served.
+  const double pass_s = std::min(config_.poll.period_s, clock_->speed());
+  while (!stop.load()) {
+    clock_->SleepUntil(Now() + pass_s, stop);
+    if (options_.reload && options_.reload->exchange(false)) {
+      NotifyReloading();
+      LogToStderr(kInfo, "SIGHUP: reloading " + options_.config_path);
+      if (!LoadAndApplyConfig(false)) LogToStderr(kErr, "reload failed; the old config stays");
+      NotifyReady("reloaded");
+    }
+    StoreSamples();
+    Aggregate();
+    CheckCalibration();
+    MaybeStartCalibration();
+    if (Now() >= next_forecast_s_) IssueForecast();
+    if (Now() >= next_retention_s_) {
+      next_retention_s_ = Now() + kRetentionPeriodS;
+      if (!store_->ApplyRetention(static_cast<std::int64_t>(Now()),
+                                  config_.storage.raw_retention_days, &error))
+        LogToStderr(kWarning, "retention failed (retried in an hour): " + error);
+    }
+    if (watchdog_s > 0 && WallNowS() >= next_watchdog_wall_s_) {
+      NotifyWatchdog();
+      next_watchdog_wall_s_ = WallNowS() + watchdog_s;
+    }
+    UpdateDeviceStatus();
+    status_.now_s = Now();
+    if (options_.on_tick && !options_.on_tick(status_)) break;
+  }
+  Shutdown();
+  return 0;
+}
+
+}  // namespace
+
+int RunService(const ServiceOptions& options) {
+  Service service(options);
+  return service.Run();
+}
+
+}  // namespace pvtwin

@@ -13,5 +13,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start);
 void BenchIdentification(int repeats, std::uint64_t seed);
 void BenchTable6(std::uint64_t seed);
 void BenchStore(int repeats, std::uint64_t seed);
+// Real processes, real time: CPU and memory of `pvtwin run` over `seconds`.
+void BenchDaemon(double seconds);
 
 }  // namespace pvtwin::cli

@@ -30,6 +30,7 @@ struct BenchArgs {
   std::vector<std::string> what = {"sim"};
   int repeats = 21;
   std::uint64_t seed = 1;
+  double daemon_seconds = 60.0;
 };
 
 // One 14-day, 1-min simulation (20 160 rows) of each variant.
@@ -80,18 +81,22 @@ void RegisterBench(CLI::App& app) {
       "  ident  identification of 2N1Ccolwr: 14 days at 1 min and at 5 s, and the\n"
       "         algorithm comparison behind the default\n"
       "  table6 the paper's Table 6 protocol (9 variants x 29 test days) on both cores\n"
-      "  store  the SQLite store: 14 days of 5 s samples ingested, aggregated, read back");
-  cmd->add_option("what", args->what, "what to benchmark: sim, ident, table6, store")
-      ->check(CLI::IsMember({"sim", "ident", "table6", "store"}));
+      "  store  the SQLite store: 14 days of 5 s samples ingested, aggregated, read back\n"
+      "  daemon CPU and memory of `pvtwin run` polling `pvtwin sim` at 5 s (real time)");
+  cmd->add_option("what", args->what, "what to benchmark: sim, ident, table6, store, daemon")
+      ->check(CLI::IsMember({"sim", "ident", "table6", "store", "daemon"}));
   cmd->add_option("--repeats", args->repeats, "runs per figure (median)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
+  cmd->add_option("--daemon-seconds", args->daemon_seconds, "measuring time of `bench daemon`")
+      ->check(CLI::PositiveNumber);
   cmd->callback([args] {
     for (const std::string& w : args->what) {
       if (w == "sim") BenchSimulation(*args);
       if (w == "ident") BenchIdentification(args->repeats, args->seed);
       if (w == "table6") BenchTable6(args->seed);
       if (w == "store") BenchStore(args->repeats, args->seed);
+      if (w == "daemon") BenchDaemon(args->daemon_seconds);
     }
     SetExitCode(kExitOk);
   });

@@ -1,0 +1,216 @@
+// End to end through real processes: `pvtwin sim` serving the example plant
+// over Modbus TCP on loopback, `pvtwin run` polling it into a real SQLite
+// file, both on one accelerated clock (120 simulated seconds per second).
+// The history comes from `pvtwin sim --export` through `pvtwin import`.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+
+#include <chrono>
+#include <fstream>
+#include <functional>
+#include <thread>
+
+#include "config/config_edit.h"
+#include "core/clock.h"
+#include "io/child_process.h"
+#include "tests/support/files.h"
+#include "tests/support/run_pvtwin.h"
+
+namespace pvtwin {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadFile;
+using testing::RunPvtwin;
+using testing::ScratchDir;
+
+const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
+constexpr double kSpeed = 120.0;
+// 2024-06-01 08:00 UTC: a June morning at the example plant (47° N, 16° E).
+constexpr std::int64_t kMorning = 1717228800;
+// 2024-06-01 23:40 UTC: forecast_skill scores a day with the newest forecast
+// issued before it began, so the run crosses midnight.
+constexpr std::int64_t kBeforeMidnight = 1717285200;
+
+// One connection to the daemon's database, as a dashboard would hold it.
+class Db {
+ public:
+  explicit Db(const fs::path& path) {
+    sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr);
+    sqlite3_busy_timeout(db_, 5000);
+  }
+  ~Db() { sqlite3_close(db_); }
+  // First column of the first row as text ("" when there is none).
+  std::string Text(const std::string& sql) const {
+    sqlite3_stmt* st = nullptr;
+    std::string result;
+    if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &st, nullptr) == SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0) != nullptr) {
+      result = reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
+    }
+    sqlite3_finalize(st);
+    return result;
+  }
+  long long Count(const std::string& sql) const {
+    const std::string t = Text(sql);
+    return t.empty() ? -1 : std::stoll(t);
+  }
+  void Exec(const std::string& sql) const {
+    sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr);
+  }
+
+ private:
+  sqlite3* db_ = nullptr;
+};
+
+class DaemonE2E : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(fs::exists(kExampleMap)) << kExampleMap;
+    fs::copy_file(kExampleMap, dir_ / "sim.toml");
+    const auto exported = RunPvtwin(
+        dir_.path(), "sim --config sim.toml --export history.csv --days 14 --step 60 --start " +
+                         std::to_string(t0_ - 14 * 86400));
+    ASSERT_EQ(exported.exit_code, 0) << exported.err;
+    const auto imported =
+        RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + Db());
+    ASSERT_EQ(imported.exit_code, 0) << imported.err;
+    anchor_ = WallNowS();
+    std::string error;
+    ASSERT_TRUE(sim_.StartPiped({PVTWIN_BINARY, "sim", "--config", (dir_ / "sim.toml").string(),
+                                 "--ephemeral-ports", "--speed", std::to_string(kSpeed), "--start",
+                                 std::to_string(t0_), "--wall-anchor", std::to_string(anchor_)},
+                                (dir_ / "sim.log").string(), &error))
+        << error;
+    std::vector<std::string> lines;
+    ASSERT_TRUE(sim_.ReadUntil("ready", 20.0, &lines)) << ReadFile(dir_ / "sim.log");
+    DaemonSettings settings;
+    settings.db_path = Db();
+    std::string text;
+    ASSERT_TRUE(
+        EditConfig(ReadFile(kExampleMap), ParseListeningLines(lines), settings, &text, &error))
+        << error;
+    std::ofstream(dir_ / "pvtwin.toml") << text;
+  }
+  void TearDown() override {
+    daemon_.Stop(SIGTERM, 10.0);
+    sim_.SendLine("quit");
+    sim_.Stop(0, 5.0);
+  }
+
+  std::string Db() const { return (dir_ / "pvtwin.db").string(); }
+
+  void StartDaemon() {
+    std::string error;
+    ASSERT_TRUE(daemon_.Start({PVTWIN_BINARY, "run", "--config", (dir_ / "pvtwin.toml").string(),
+                               "--speed", std::to_string(kSpeed), "--sim-start",
+                               std::to_string(t0_), "--wall-anchor", std::to_string(anchor_)},
+                              (dir_ / "daemon.log").string(), &error))
+        << error;
+  }
+
+  // Polls `done` every 100 ms for at most timeout_s of wall time.
+  bool WaitFor(double timeout_s, const std::function<bool()>& done) const {
+    const double deadline = WallNowS() + timeout_s;
+    while (WallNowS() < deadline) {
+      if (done()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return done();
+  }
+  std::string DaemonLog() const { return ReadFile(dir_ / "daemon.log"); }
+
+  ScratchDir dir_{"e2e"};
+  std::int64_t t0_ = kMorning;  // simulated time at which live polling starts
+  double anchor_ = 0.0;
+  ChildProcess sim_;
+  ChildProcess daemon_;
+};
+
+class DaemonE2EOverMidnight : public DaemonE2E {
+ protected:
+  DaemonE2EOverMidnight() { t0_ = kBeforeMidnight; }
+};
+
+TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
+  StartDaemon();
+  const class Db db(Db());
+  const std::string live = " WHERE ts >= " + std::to_string(t0_);
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Count("SELECT count(*) FROM calibration WHERE status = 'accepted'") >= 1;
+  })) << DaemonLog();
+  ASSERT_TRUE(WaitFor(30, [&] { return db.Count("SELECT count(*) FROM forecast_latest") == 1440; }))
+      << DaemonLog();
+  ASSERT_TRUE(WaitFor(30, [&] {
+    return db.Count("SELECT count(*) FROM measurement_1min" + live) >= 5;
+  })) << DaemonLog();
+  EXPECT_GT(db.Count("SELECT count(*) FROM sample_5s" + live), 50);
+  // One row per minute, every minute averaged from the samples of that minute.
+  EXPECT_EQ(db.Count("SELECT count(*) FROM measurement_1min" + live + " AND ts % 60 != 0"), 0);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM (SELECT issued_at FROM forecast GROUP BY issued_at "
+                     "HAVING count(*) != 1440)"),
+            0);
+  // The forecast issued before midnight is scored once the new day's
+  // measurements exist (20 simulated minutes after the start: 10 s here).
+  ASSERT_TRUE(WaitFor(60, [&] { return db.Count("SELECT count(*) FROM forecast_skill") >= 1; }))
+      << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_NE(DaemonLog().find("stopping"), std::string::npos);
+}
+
+TEST_F(DaemonE2E, KillNineLosesNoCommittedRowAndCorruptsNothing) {
+  StartDaemon();
+  const std::string live = " WHERE ts >= " + std::to_string(t0_);
+  long long samples = 0, minutes = 0;
+  {
+    const class Db db(Db());
+    ASSERT_TRUE(WaitFor(30, [&] {
+      return db.Count("SELECT count(*) FROM measurement_1min" + live) >= 3;
+    })) << DaemonLog();
+    samples = db.Count("SELECT count(*) FROM sample_5s");
+    minutes = db.Count("SELECT count(*) FROM measurement_1min");
+  }
+  ::kill(daemon_.pid(), SIGKILL);
+  EXPECT_EQ(daemon_.Stop(0, 5.0), -SIGKILL);
+  {
+    const class Db db(Db());
+    EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
+    EXPECT_GE(db.Count("SELECT count(*) FROM sample_5s"), samples);
+    EXPECT_GE(db.Count("SELECT count(*) FROM measurement_1min"), minutes);
+  }
+  StartDaemon();
+  const class Db db(Db());
+  ASSERT_TRUE(WaitFor(30, [&] {
+    return db.Count("SELECT count(*) FROM sample_5s") > samples + 24;
+  })) << DaemonLog();
+  // No minute is counted twice after the restart.
+  EXPECT_EQ(db.Count("SELECT count(*) FROM (SELECT ts FROM measurement_1min GROUP BY ts HAVING "
+                     "count(*) > 1)"),
+            0);
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
+}
+
+TEST_F(DaemonE2E, AReaderHoldingATransactionDoesNotStopIngestion) {
+  StartDaemon();
+  const class Db reader(Db());
+  const class Db observer(Db());
+  ASSERT_TRUE(WaitFor(30, [&] { return observer.Count("SELECT count(*) FROM sample_5s") > 0; }))
+      << DaemonLog();
+  reader.Exec("BEGIN");
+  const long long seen = reader.Count("SELECT count(*) FROM sample_5s");
+  // 3 s of wall time are 360 simulated seconds: 72 poll periods.
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  EXPECT_EQ(reader.Count("SELECT count(*) FROM sample_5s"), seen);  // its snapshot
+  EXPECT_GT(observer.Count("SELECT count(*) FROM sample_5s"), seen + 36);
+  // Live samples carry the simulator's values: irradiance on a June morning.
+  EXPECT_GT(observer.Count("SELECT count(*) FROM sample_5s WHERE g_poa_w_m2 > 100 AND ts >= " +
+                           std::to_string(t0_)),
+            0);
+  reader.Exec("COMMIT");
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+}
+
+}  // namespace
+}  // namespace pvtwin

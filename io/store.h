@@ -96,8 +96,12 @@ namespace pvtwin {
 inline constexpr int kStoreSchemaVersion = 1;
 
 struct StoreOptions {
-  int busy_timeout_ms = 2000;  // SQLite waits this long for a lock per attempt
-  int busy_retries = 3;        // whole-transaction retries after SQLITE_BUSY
+  // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
+  // transaction is retried busy_retries times. The defaults give up after
+  // about 3 s, within a 5 s poll period: the daemon keeps the batch and
+  // tries again with the next one.
+  int busy_timeout_ms = 1000;
+  int busy_retries = 2;
   // How AggregateMinutes averages: poll period and fluid c_p (plant config).
   AggregateOptions aggregate;
 };

@@ -236,6 +236,11 @@ struct Store::Impl {
   // Reads the samples of [from, to) whose minute has no 1-min row yet (all of
   // them if `all`), aggregates and writes them (inside a transaction).
   DbStatus AggregateRange(std::int64_t from_ts, std::int64_t to_ts, bool all, int* minutes_written);
+  // Rows of (INTEGER time, 4 REAL) from a query over a time range, as Row
+  // (ForecastRow or SkillRow, which have that layout).
+  template <typename Row>
+  bool ReadTimeAndFourReals(const std::string& sql, const std::string& what, std::int64_t from,
+                            std::int64_t to, std::vector<Row>* out, std::string* error);
   // Deletes the forecast rows in [from_ts, to_ts) that neither view uses.
   DbStatus PruneForecasts(std::int64_t from_ts, std::int64_t to_ts);
   bool ReadInputTable(const std::string& table, std::span<const Channel> channels,
@@ -743,50 +748,42 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
       error);
 }
 
-bool Store::ReadLatestForecast(std::int64_t from_ts, std::int64_t to_ts,
-                               std::vector<ForecastRow>* out, std::string* error) {
-  Impl& db = *impl_;
+template <typename Row>
+bool Store::Impl::ReadTimeAndFourReals(const std::string& sql, const std::string& what,
+                                       std::int64_t from, std::int64_t to, std::vector<Row>* out,
+                                       std::string* error) {
+  Impl& db = *this;
   std::lock_guard lock(db.mutex);
-  std::vector<ForecastRow> rows;
+  std::vector<Row> rows;
   const bool ok = db.Run(
-      false, "read forecast_latest",
+      false, what,
       [&]() -> DbStatus {
         rows.clear();
         auto on_row = [&rows](sqlite3_stmt* stmt) {
           rows.push_back({sqlite3_column_int64(stmt, 0), ColumnReal(stmt, 1), ColumnReal(stmt, 2),
                           ColumnReal(stmt, 3), ColumnReal(stmt, 4)});
         };
-        return db.SelectRange(
-            "SELECT ts, p_el_w, q_th_w, t_pv_c, t_out_c FROM forecast_latest "
-            "WHERE ts >= ? AND ts < ? ORDER BY ts",
-            from_ts, to_ts, on_row, "read forecast_latest");
+        return db.SelectRange(sql, from, to, on_row, what);
       },
       error);
   if (ok) *out = std::move(rows);
   return ok;
 }
 
+bool Store::ReadLatestForecast(std::int64_t from_ts, std::int64_t to_ts,
+                               std::vector<ForecastRow>* out, std::string* error) {
+  return impl_->ReadTimeAndFourReals(
+      "SELECT ts, p_el_w, q_th_w, t_pv_c, t_out_c FROM forecast_latest "
+      "WHERE ts >= ? AND ts < ? ORDER BY ts",
+      "read forecast_latest", from_ts, to_ts, out, error);
+}
+
 bool Store::ReadForecastSkill(std::int64_t from_day, std::int64_t to_day,
                               std::vector<SkillRow>* out, std::string* error) {
-  Impl& db = *impl_;
-  std::lock_guard lock(db.mutex);
-  std::vector<SkillRow> rows;
-  const bool ok = db.Run(
-      false, "read forecast_skill",
-      [&]() -> DbStatus {
-        rows.clear();
-        auto on_row = [&rows](sqlite3_stmt* stmt) {
-          rows.push_back({sqlite3_column_int64(stmt, 0), ColumnReal(stmt, 1), ColumnReal(stmt, 2),
-                          ColumnReal(stmt, 3), ColumnReal(stmt, 4)});
-        };
-        return db.SelectRange(
-            "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th FROM forecast_skill "
-            "WHERE day >= ? AND day < ? ORDER BY day",
-            from_day, to_day, on_row, "read forecast_skill");
-      },
-      error);
-  if (ok) *out = std::move(rows);
-  return ok;
+  return impl_->ReadTimeAndFourReals(
+      "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th FROM "
+      "forecast_skill WHERE day >= ? AND day < ? ORDER BY day",
+      "read forecast_skill", from_day, to_day, out, error);
 }
 
 bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Channel> channels,

@@ -9,8 +9,12 @@
 //   2. aggregation of the 13 bulk days in one call;
 //   3. reading the 14-day window of 1-min rows into a Series (target
 //      <= 0.5 s), and reading 14 days of 5 s samples and aggregating them;
-//   4. database growth per day, from page_count · page_size after a
-//      checkpoint, for the 5 s samples and for the 1-min rows.
+//   4. forecasts as the daemon writes them: a 24 h forecast at 1 min issued
+//      every hour for the 14 days; the time to write one issue, to read the
+//      next 24 h of forecast_latest and to compute forecast_skill of 14 days;
+//   5. database growth per day, from the pages in use after a checkpoint,
+//      for the 5 s samples, the 1-min rows and the forecasts (before and
+//      after PruneForecasts, which ApplyRetention runs).
 #include <unistd.h>
 
 #include <chrono>
@@ -69,7 +73,7 @@ void BenchStore(int repeats, std::uint64_t seed) {
   options.aggregate.sample_period_s = kPollS;
   options.aggregate.fluid_cp_j_kgk = plant.fluid_cp_j_kgk;
   std::unique_ptr<Store> store = Store::Open(path, options, &error);
-  std::int64_t empty_bytes = 0, samples_bytes = 0, all_bytes = 0;
+  std::int64_t empty_bytes = 0, samples_bytes = 0, all_bytes = 0, forecast_bytes = 0;
   if (!Check(store != nullptr, error) || !Check(store->Checkpoint(&empty_bytes, &error), error)) {
     fs::remove_all(dir);
     return;
@@ -128,7 +132,7 @@ void BenchStore(int repeats, std::uint64_t seed) {
   Check(store->Checkpoint(&all_bytes, &error), error);
 
   // 3. Reads of the 14-day window (the calibration's input).
-  std::vector<double> read_minutes_s, read_aggregate_s;
+  std::vector<double> read_minutes_s, read_raw_s, read_aggregate_s;
   std::size_t rows = 0;
   for (int r = 0; r < repeats; ++r) {
     start = std::chrono::steady_clock::now();
@@ -146,27 +150,82 @@ void BenchStore(int repeats, std::uint64_t seed) {
     start = std::chrono::steady_clock::now();
     std::vector<Sample> raw;
     MinuteRows aggregated;
-    if (!Check(store->ReadSamples(begin_ts, end_ts, &raw, &error), error) ||
-        !Check(AggregateSamples(raw, options.aggregate, &aggregated, &error), error)) {
-      break;
-    }
+    if (!Check(store->ReadSamples(begin_ts, end_ts, &raw, &error), error)) break;
+    read_raw_s.push_back(SecondsSince(start));
+    if (!Check(AggregateSamples(raw, options.aggregate, &aggregated, &error), error)) break;
     read_aggregate_s.push_back(SecondsSince(start));
     rows = aggregated.rows.size();
   }
   std::printf(
-      "  read 14 days of 5 s samples and aggregate them (%zu minutes): median %.1f ms of"
-      " %d runs\n",
-      rows, Median(read_aggregate_s) * 1e3, heavy_repeats);
+      "  read 14 days of 5 s samples and aggregate them (%zu minutes): median %.1f ms"
+      " (read %.1f ms) of %d runs\n",
+      rows, Median(read_aggregate_s) * 1e3, Median(read_raw_s) * 1e3, heavy_repeats);
 
-  // 4. Growth per day.
+  // 4. Hourly 24 h forecasts (the model's values do not matter here: the
+  //    measured outputs, scaled, stand in for them).
+  std::vector<double> issue_s;
+  const std::int64_t horizon_s = 86400;
+  for (std::int64_t issued = begin_ts; issued + horizon_s <= end_ts; issued += 3600) {
+    std::vector<Store::ForecastRow> rows_24h;
+    for (std::int64_t t = issued; t < issued + horizon_s; t += 60) {
+      const auto i = static_cast<std::size_t>((t - begin_ts) / static_cast<std::int64_t>(kPollS));
+      rows_24h.push_back({t, data[Channel::kPElW][i] * 1.05, data[Channel::kQThW][i] * 0.95,
+                          data[Channel::kTPvC][i], data[Channel::kTOutC][i]});
+    }
+    start = std::chrono::steady_clock::now();
+    if (!Check(store->InsertForecast(issued, 1, "weather=weather_forecast", rows_24h, &error),
+               error)) {
+      break;
+    }
+    issue_s.push_back(SecondsSince(start));
+  }
+  Check(store->Checkpoint(&forecast_bytes, &error), error);
+  std::vector<double> latest_s, skill_s;
+  std::size_t skill_days = 0;
+  for (int r = 0; r < repeats; ++r) {
+    std::vector<Store::ForecastRow> latest;
+    start = std::chrono::steady_clock::now();
+    if (!Check(store->ReadLatestForecast(end_ts - horizon_s, end_ts, &latest, &error), error)) {
+      break;
+    }
+    latest_s.push_back(SecondsSince(start));
+  }
+  for (int r = 0; r < heavy_repeats; ++r) {
+    std::vector<Store::SkillRow> skill;
+    start = std::chrono::steady_clock::now();
+    if (!Check(store->ReadForecastSkill(begin_ts, end_ts, &skill, &error), error)) break;
+    skill_s.push_back(SecondsSince(start));
+    skill_days = skill.size();
+  }
+  std::printf(
+      "  forecasts: %zu hourly issues of 1440 rows; write one issue %.1f ms, read 24 h of"
+      " forecast_latest %.1f ms, forecast_skill of %zu days %.1f ms (medians)\n",
+      issue_s.size(), Median(issue_s) * 1e3, Median(latest_s) * 1e3, skill_days,
+      Median(skill_s) * 1e3);
+
+  // Pruning as ApplyRetention does it, for all 14 days.
+  std::int64_t pruned_bytes = 0;
+  start = std::chrono::steady_clock::now();
+  Check(store->PruneForecasts(begin_ts, end_ts, &error), error);
+  const double prune_s = SecondsSince(start);
+  Check(store->Checkpoint(&pruned_bytes, &error), error);
+
+  // 5. Growth per day.
   const double mb = 1024.0 * 1024.0;
+  const double issues_per_day =
+      static_cast<double>(std::max<std::size_t>(1, issue_s.size())) / 24.0;
   const double raw_per_day = static_cast<double>(samples_bytes - empty_bytes) / kDays;
   const double minute_per_day = static_cast<double>(all_bytes - samples_bytes) / kDays;
+  const double forecast_per_day = static_cast<double>(forecast_bytes - all_bytes) / issues_per_day;
+  const double pruned_per_day = static_cast<double>(pruned_bytes - all_bytes) / issues_per_day;
   std::printf(
-      "  database growth per day: 5 s samples %.2f MiB, 1-min rows %.2f MiB, total %.2f MiB"
-      " (%.1f MiB for 30 days of samples + a year of 1-min rows)\n",
-      raw_per_day / mb, minute_per_day / mb, (raw_per_day + minute_per_day) / mb,
-      (30 * raw_per_day + 365 * minute_per_day) / mb);
+      "  database growth per day: 5 s samples %.2f MiB, 1-min rows %.2f MiB, hourly"
+      " forecasts %.2f MiB (%.2f MiB once pruned; pruning 14 days took %.2f s)\n",
+      raw_per_day / mb, minute_per_day / mb, forecast_per_day / mb, pruned_per_day / mb, prune_s);
+  std::printf(
+      "    steady state: %.0f MiB for 30 days of samples + %.0f MiB per year of 1-min rows"
+      " and pruned forecasts\n",
+      30 * (raw_per_day + forecast_per_day) / mb, 365 * (minute_per_day + pruned_per_day) / mb);
   store.reset();
   fs::remove_all(dir);
 }

@@ -89,17 +89,19 @@ std::vector<std::string> SchemaV1() {
       "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c) AS "
       "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c FROM forecast f "
       "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)",
-      // Day-ahead pairs: per ts, the newest forecast issued at or before
-      // 00:00 UTC of ts's day, joined with the valid measurement at ts.
+      // Day-ahead pairs: for each valid measurement, the forecast row at its
+      // ts from the newest issue at or before 00:00 UTC of its day. The
+      // measurements drive the join (CROSS JOIN fixes SQLite's loop order),
+      // each looking up its forecast through forecast_by_ts.
       "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th) AS "
       "WITH pairs AS ("
-      " SELECT f.ts - ((f.ts % 86400) + 86400) % 86400 AS day,"
+      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
       "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
       "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q"
-      " FROM forecast f JOIN measurement_1min m ON m.ts = f.ts"
-      " WHERE (m.valid IS NULL OR m.valid != 0)"
-      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts"
-      "   AND g.issued_at <= f.ts - ((f.ts % 86400) + 86400) % 86400))"
+      " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
+      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+      "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+      " WHERE m.valid IS NULL OR m.valid != 0)"
       " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
       "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
       "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END))"
@@ -234,6 +236,13 @@ struct Store::Impl {
   // Reads the samples of [from, to) whose minute has no 1-min row yet (all of
   // them if `all`), aggregates and writes them (inside a transaction).
   DbStatus AggregateRange(std::int64_t from_ts, std::int64_t to_ts, bool all, int* minutes_written);
+  // Rows of (INTEGER time, 4 REAL) from a query over a time range, as Row
+  // (ForecastRow or SkillRow, which have that layout).
+  template <typename Row>
+  bool ReadTimeAndFourReals(const std::string& sql, const std::string& what, std::int64_t from,
+                            std::int64_t to, std::vector<Row>* out, std::string* error);
+  // Deletes the forecast rows in [from_ts, to_ts) that neither view uses.
+  DbStatus PruneForecasts(std::int64_t from_ts, std::int64_t to_ts);
   bool ReadInputTable(const std::string& table, std::span<const Channel> channels,
                       std::int64_t from, std::int64_t to, Series* out, std::string* error);
 };
@@ -592,9 +601,35 @@ bool Store::ApplyRetention(std::int64_t now_ts, int raw_retention_days, std::str
         s = db.Prepare("DELETE FROM sample_5s WHERE ts < ?", &stmt);
         if (!s.ok()) return s;
         sqlite3_bind_int64(stmt, 1, cutoff_ts);
-        return db.StepDone(stmt, "delete samples before " + std::to_string(cutoff_ts));
+        s = db.StepDone(stmt, "delete samples before " + std::to_string(cutoff_ts));
+        if (!s.ok()) return s;
+        // A week back: rows before that were pruned by earlier daily calls,
+        // and the DELETE stays short while it holds the write lock.
+        return db.PruneForecasts(cutoff_ts - 7 * kSecondsPerDay, cutoff_ts);
       },
       error);
+}
+
+bool Store::PruneForecasts(std::int64_t from_ts, std::int64_t to_ts, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "prune forecasts", [&] { return db.PruneForecasts(from_ts, to_ts); }, error);
+}
+
+DbStatus Store::Impl::PruneForecasts(std::int64_t from_ts, std::int64_t to_ts) {
+  // A row survives if forecast_latest shows it or forecast_skill scores it.
+  sqlite3_stmt* stmt = nullptr;
+  DbStatus s = Prepare(
+      "DELETE FROM forecast WHERE ts >= ? AND ts < ?"
+      " AND issued_at != (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = forecast.ts)"
+      " AND issued_at IS NOT (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = forecast.ts"
+      "  AND g.issued_at <= forecast.ts - ((forecast.ts % 86400) + 86400) % 86400)",
+      &stmt);
+  if (!s.ok()) return s;
+  sqlite3_bind_int64(stmt, 1, from_ts);
+  sqlite3_bind_int64(stmt, 2, to_ts);
+  return StepDone(stmt, "delete superseded forecasts before " + std::to_string(to_ts));
 }
 
 bool Store::InsertCalibration(CalibrationRow* row, std::string* error) {
@@ -713,6 +748,44 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
       error);
 }
 
+template <typename Row>
+bool Store::Impl::ReadTimeAndFourReals(const std::string& sql, const std::string& what,
+                                       std::int64_t from, std::int64_t to, std::vector<Row>* out,
+                                       std::string* error) {
+  Impl& db = *this;
+  std::lock_guard lock(db.mutex);
+  std::vector<Row> rows;
+  const bool ok = db.Run(
+      false, what,
+      [&]() -> DbStatus {
+        rows.clear();
+        auto on_row = [&rows](sqlite3_stmt* stmt) {
+          rows.push_back({sqlite3_column_int64(stmt, 0), ColumnReal(stmt, 1), ColumnReal(stmt, 2),
+                          ColumnReal(stmt, 3), ColumnReal(stmt, 4)});
+        };
+        return db.SelectRange(sql, from, to, on_row, what);
+      },
+      error);
+  if (ok) *out = std::move(rows);
+  return ok;
+}
+
+bool Store::ReadLatestForecast(std::int64_t from_ts, std::int64_t to_ts,
+                               std::vector<ForecastRow>* out, std::string* error) {
+  return impl_->ReadTimeAndFourReals(
+      "SELECT ts, p_el_w, q_th_w, t_pv_c, t_out_c FROM forecast_latest "
+      "WHERE ts >= ? AND ts < ? ORDER BY ts",
+      "read forecast_latest", from_ts, to_ts, out, error);
+}
+
+bool Store::ReadForecastSkill(std::int64_t from_day, std::int64_t to_day,
+                              std::vector<SkillRow>* out, std::string* error) {
+  return impl_->ReadTimeAndFourReals(
+      "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th FROM "
+      "forecast_skill WHERE day >= ? AND day < ? ORDER BY day",
+      "read forecast_skill", from_day, to_day, out, error);
+}
+
 bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Channel> channels,
                                  std::int64_t from, std::int64_t to, Series* out,
                                  std::string* error) {
@@ -772,10 +845,12 @@ bool Store::Checkpoint(std::int64_t* db_bytes, std::string* error) {
         if (rc != SQLITE_OK && rc != SQLITE_BUSY) return db.Fail(rc, "wal_checkpoint");
         sqlite3_stmt* stmt = nullptr;
         DbStatus s = db.Prepare(
-            "SELECT page_count * page_size FROM pragma_page_count(), pragma_page_size()", &stmt);
+            "SELECT (page_count - freelist_count) * page_size "
+            "FROM pragma_page_count(), pragma_freelist_count(), pragma_page_size()",
+            &stmt);
         if (!s.ok()) return s;
         const int src = sqlite3_step(stmt);
-        if (src != SQLITE_ROW) return db.Fail(src, "page_count * page_size");
+        if (src != SQLITE_ROW) return db.Fail(src, "page_count");
         bytes = sqlite3_column_int64(stmt, 0);
         sqlite3_reset(stmt);
         return {};

@@ -69,8 +69,13 @@
 //
 // Retention: ApplyRetention deletes sample_5s rows older than
 // raw_retention_days (config [storage]), after aggregating any of their
-// minutes that have no measurement_1min row yet. 1-min rows, calibrations
-// and forecasts are kept.
+// minutes that have no measurement_1min row yet. 1-min rows and calibrations
+// are kept. Of the forecast rows older than that, only the two that the
+// views use are kept for each ts (the newest issue, shown by
+// forecast_latest, and the newest issue before the day began, scored by
+// forecast_skill): hourly 24 h forecasts would otherwise add 1440 rows per
+// hour (about 3 MiB a day, pvtwin bench store), and both views return the
+// same rows before and after pruning.
 //
 // Threads: one Store is one connection, guarded by a mutex; another thread
 // (the calibration worker) may share it or, better for long reads, open its
@@ -91,8 +96,12 @@ namespace pvtwin {
 inline constexpr int kStoreSchemaVersion = 1;
 
 struct StoreOptions {
-  int busy_timeout_ms = 2000;  // SQLite waits this long for a lock per attempt
-  int busy_retries = 3;        // whole-transaction retries after SQLITE_BUSY
+  // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
+  // transaction is retried busy_retries times. The defaults give up after
+  // about 3 s, within a 5 s poll period: the daemon keeps the batch and
+  // tries again with the next one.
+  int busy_timeout_ms = 1000;
+  int busy_retries = 2;
   // How AggregateMinutes averages: poll period and fluid c_p (plant config).
   AggregateOptions aggregate;
 };
@@ -115,6 +124,12 @@ class Store {
   struct ForecastRow {
     std::int64_t ts = 0;
     double p_el_w = 0.0, q_th_w = 0.0, t_pv_c = 0.0, t_out_c = 0.0;
+  };
+
+  // One row of the forecast_skill view.
+  struct SkillRow {
+    std::int64_t day = 0;  // unix s of 00:00 UTC
+    double mae_p_el_w = 0.0, mae_q_th_w = 0.0, nmae_p_el = 0.0, nmae_q_th = 0.0;
   };
 
   // Opens (creating if needed) and migrates the database at path. Returns
@@ -157,9 +172,13 @@ class Store {
   bool ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows* out,
                       std::string* error);
 
-  // Deletes sample_5s rows with ts < now_ts − raw_retention_days·86400 (after
-  // aggregating their minutes that have no 1-min row).
+  // Deletes sample_5s rows with ts < cut = now_ts − raw_retention_days·86400
+  // (after aggregating their minutes that have no 1-min row), and prunes the
+  // forecasts of [cut − 7 days, cut) (meant to run daily).
   bool ApplyRetention(std::int64_t now_ts, int raw_retention_days, std::string* error);
+  // Deletes the forecast rows with from_ts <= ts < to_ts that neither
+  // forecast_latest nor forecast_skill uses.
+  bool PruneForecasts(std::int64_t from_ts, std::int64_t to_ts, std::string* error);
 
   bool InsertCalibration(CalibrationRow* row, std::string* error);  // sets row->id
   bool LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error);
@@ -169,6 +188,13 @@ class Store {
                       const std::string& inputs, const std::vector<ForecastRow>& rows,
                       std::string* error);
 
+  // forecast_latest rows with from_ts <= ts < to_ts, in time order.
+  bool ReadLatestForecast(std::int64_t from_ts, std::int64_t to_ts, std::vector<ForecastRow>* out,
+                          std::string* error);
+  // forecast_skill rows with from_day <= day < to_day (unix s of 00:00 UTC).
+  bool ReadForecastSkill(std::int64_t from_day, std::int64_t to_day, std::vector<SkillRow>* out,
+                         std::string* error);
+
   // weather_forecast / operation_plan rows with from <= ts < to as a Series
   // (step_s = the smallest spacing of the rows, 0 for fewer than 2); a column
   // that is NULL in every row is absent.
@@ -176,7 +202,8 @@ class Store {
   bool ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error);
 
   // Writes the WAL back into the database file and truncates it (best effort
-  // while readers hold old snapshots). *db_bytes gets page_count · page_size.
+  // while readers hold old snapshots). *db_bytes (may be null) gets the bytes
+  // in use: (page_count − freelist_count) · page_size.
   bool Checkpoint(std::int64_t* db_bytes, std::string* error);
 
  private:

@@ -249,12 +249,18 @@ TEST_F(StoreTest, ImportedMinutesRoundTripAndAreMarkedImported) {
   EXPECT_NE(error.find("not the start of a minute"), std::string::npos) << error;
 }
 
-TEST_F(StoreTest, RetentionDeletesOldSamplesAfterAggregatingThemAndKeepsMinutes) {
+TEST_F(StoreTest, RetentionDeletesOldSamplesAfterAggregatingThemKeepsMinutesPrunesForecasts) {
   auto store = OpenStore();
   std::string error;
   // One full minute at noon of each of 41 days.
   for (int day = 0; day <= 40; ++day) {
     ASSERT_TRUE(store->InsertSamples(MakeSamples(kMinute0 + day * 86400, 12), &error)) << error;
+  }
+  // Three issues for noon of day 5: the day-ahead one (23:00 the day
+  // before), a superseded one (10:00) and the newest (11:00).
+  const std::int64_t noon5 = kMinute0 + 5 * 86400;
+  for (const std::int64_t issued : {noon5 - 13 * 3600, noon5 - 7200, noon5 - 3600}) {
+    ASSERT_TRUE(store->InsertForecast(issued, 0, "", {{noon5, 1, 2, 3, 4}}, &error)) << error;
   }
   const std::int64_t now = kMinute0 + 40 * 86400 + 3600;  // 13:00 of day 40
   ASSERT_TRUE(store->ApplyRetention(now, 30, &error)) << error;
@@ -266,6 +272,9 @@ TEST_F(StoreTest, RetentionDeletesOldSamplesAfterAggregatingThemAndKeepsMinutes)
   // AggregateMinutes.
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 11.0);
   EXPECT_EQ(db.Number("SELECT MIN(n_samples) FROM measurement_1min"), 12.0);
+  EXPECT_EQ(
+      db.Rows("SELECT issued_at - " + std::to_string(noon5) + " FROM forecast ORDER BY issued_at"),
+      (std::vector<std::vector<std::string>>{{"-46800"}, {"-3600"}}));
   int written = 0;
   ASSERT_TRUE(store->AggregateMinutes(now, &written, &error)) << error;
   EXPECT_EQ(written, 30);
@@ -350,6 +359,12 @@ TEST_F(StoreTest, ForecastLatestPicksTheNewestIssueForEachTime) {
                                              {"180", "-500", "104.0", "113.0", "123.0", "133.0"}}));
   EXPECT_EQ(db.Rows("SELECT DISTINCT inputs FROM forecast WHERE calibration_id = 2")[0][0],
             "weather=weather_forecast");
+  std::vector<Store::ForecastRow> latest;
+  ASSERT_TRUE(store->ReadLatestForecast(t + 60, t + 180, &latest, &error)) << error;
+  ASSERT_EQ(latest.size(), 2u);
+  EXPECT_EQ(latest[0].ts, t + 60);
+  EXPECT_EQ(latest[0].p_el_w, 102.0);
+  EXPECT_EQ(latest[1].t_out_c, 132.0);
 }
 
 TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements) {
@@ -385,6 +400,55 @@ TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements
   EXPECT_DOUBLE_EQ(std::stod(rows[0][2]), 100.0);
   EXPECT_NEAR(std::stod(rows[0][3]), 15.0 / 145.0, 1e-12);
   EXPECT_NEAR(std::stod(rows[0][4]), 0.4, 1e-12);
+  std::vector<Store::SkillRow> skill;
+  ASSERT_TRUE(store->ReadForecastSkill(kDay0, kDay0 + 86400, &skill, &error)) << error;
+  ASSERT_EQ(skill.size(), 1u);
+  EXPECT_EQ(skill[0].day, kDay0);
+  EXPECT_DOUBLE_EQ(skill[0].mae_p_el_w, 15.0);
+  EXPECT_NEAR(skill[0].nmae_q_th, 0.4, 1e-12);
+  ASSERT_TRUE(store->ReadForecastSkill(kDay0 + 86400, kDay0 + 2 * 86400, &skill, &error));
+  EXPECT_TRUE(skill.empty());
+}
+
+TEST_F(StoreTest, PruningOldForecastsLeavesBothViewsAsTheyWere) {
+  auto store = OpenStore();
+  std::string error;
+  // Hourly issues from 6 h before day 1 to 5 h into it, each 6 h ahead at
+  // 1 min, and measurements for every minute they cover.
+  const std::int64_t day1 = kDay0 + 86400;
+  Series meas;
+  meas.step_s = 60;
+  for (std::int64_t t = day1 - 6 * 3600; t < day1 + 11 * 3600; t += 60) {
+    meas.time_s.push_back(t);
+    meas.Ensure(Channel::kPElW).push_back(100.0 + static_cast<double>(t % 7));
+    meas.Ensure(Channel::kQThW).push_back(500.0 - static_cast<double>(t % 5));
+  }
+  ASSERT_TRUE(store->WriteMinutes(meas, &error)) << error;
+  for (int h = -6; h < 6; ++h) {
+    const std::int64_t issued = day1 + h * 3600;
+    std::vector<Store::ForecastRow> rows;
+    for (std::int64_t t = issued; t < issued + 6 * 3600; t += 60) {
+      rows.push_back({t, 100.0 + h, 500.0 + 2 * h, 0.0, 0.0});
+    }
+    ASSERT_TRUE(store->InsertForecast(issued, 0, "", rows, &error)) << error;
+  }
+  RawDb db(DbPath());
+  const std::string latest = "SELECT * FROM forecast_latest ORDER BY ts";
+  const std::string skill = "SELECT * FROM forecast_skill ORDER BY day";
+  const auto latest_before = db.Rows(latest);
+  const auto skill_before = db.Rows(skill);
+  // Day 0's minutes have no issue from before day 0 began: day 1 only.
+  ASSERT_EQ(skill_before.size(), 1u);
+  const double rows_before = db.Number("SELECT COUNT(*) FROM forecast");
+  EXPECT_EQ(rows_before, 12.0 * 360);
+  ASSERT_TRUE(store->PruneForecasts(kDay0, day1 + 86400, &error)) << error;
+  EXPECT_EQ(db.Rows(latest), latest_before);
+  EXPECT_EQ(db.Rows(skill), skill_before);
+  // Left: the newest issue of each ts, plus the day-ahead issue of day 1
+  // (issued at 00:00, the newest at or before the day began) where a newer
+  // one exists: 01:00 … 06:00, 300 minutes.
+  const double distinct_ts = db.Number("SELECT COUNT(DISTINCT ts) FROM forecast");
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast"), distinct_ts + 5 * 60);
 }
 
 TEST_F(StoreTest, ForecastInputsWrittenBySqlAreReadAsSeries) {

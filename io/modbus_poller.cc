@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 
 #include "io/register_codec.h"
@@ -127,10 +128,14 @@ void ModbusPoller::RunDevice(Device* device) {
     k = std::max(k, static_cast<std::int64_t>(std::floor(clock_.NowS() / period_s)));
     Result result;
     result.period = k;
+    const auto begin = std::chrono::steady_clock::now();
     PollDevice(device, k, &result);
+    const double wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     {
       std::lock_guard<std::mutex> lock(device->mutex);
       device->slots[static_cast<std::size_t>(k) % kResultSlots] = result;
+      device->stats.last_poll_wall_s = wall_s;
     }
     ++k;
   }

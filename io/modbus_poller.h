@@ -59,6 +59,7 @@ struct DeviceStats {
   std::uint64_t reconnects = 0;  // connections opened after the first
   double last_success_s = 0;     // clock time of the last poll with every read answered; 0 = never
   std::string last_error;        // libmodbus message of the last failure
+  double last_poll_wall_s = 0;   // wall-clock duration of the last poll (connect and reads)
 };
 
 struct PollerOptions {

@@ -112,11 +112,7 @@ int RunSim(const SimArgs& a) {
   source_options.plant = config.plant;
   source_options.truth_variant = a.truth_variant;
   source_options.seed = a.seed;
-  for (const std::string& sky : a.sky) {
-    source_options.day_types.push_back(sky == "clear"    ? DayType::kClear
-                                       : sky == "broken" ? DayType::kBrokenClouds
-                                                         : DayType::kOvercast);
-  }
+  for (const std::string& sky : a.sky) source_options.day_types.push_back(*DayTypeFromName(sky));
   if (a.weather == "replay") {
     if (a.csv.empty()) {
       std::cerr << "--weather replay needs --csv FILE\n";
@@ -257,9 +253,11 @@ void RegisterSim(CLI::App& app) {
       std::string("model variant of the simulated plant (default ") + kDefaultTruthVariant + ")");
   cmd->add_option("--weather", args->weather, "generate (default) or replay --csv")
       ->check(CLI::IsMember({"generate", "replay"}));
-  cmd->add_option("--sky", args->sky,
-                  "sky of each day, cycled: clear, broken, overcast (default: drawn from the seed)")
-      ->check(CLI::IsMember({"clear", "broken", "overcast"}));
+  cmd->add_option(
+         "--sky", args->sky,
+         "sky of each day, cycled: clear, broken_clouds, overcast (default: drawn from the "
+         "seed)")
+      ->check(CLI::IsMember({"clear", "broken_clouds", "overcast"}));
   cmd->add_option("--csv", args->csv, "canonical CSV to replay (--weather replay)");
   cmd->add_option("--fault", args->faults, "DEVICE:KIND:from=S:for=S[:ms=N] (repeatable)");
   cmd->add_option("--export", args->export_path, "write the plant's history as CSV and exit");

@@ -81,7 +81,9 @@ class ModbusPoller {
   // Starts polling; on_sample is called once per period (from a poller
   // thread), with Sample::ts_s = period start, every mapped channel's value
   // or NaN (rejected_mask for QC rejects). The first sample is of the first
-  // period that starts after Start().
+  // period that starts after Start(). on_sample should return quickly (hand
+  // the sample to a queue): a slow callback delays later deliveries, though
+  // never the devices' reads.
   void Start(std::function<void(const Sample&)> on_sample);
   // Stops the threads; bounded by the longest device timeout. Idempotent.
   void Stop();

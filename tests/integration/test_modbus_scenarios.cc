@@ -266,9 +266,9 @@ TEST_P(ModbusScenarioTest, Run) {
   source_options.plant = config.plant;
   source_options.seed = sc.seed;
   for (const std::string& sky : sc.sky) {
-    source_options.day_types.push_back(sky == "clear"    ? DayType::kClear
-                                       : sky == "broken" ? DayType::kBrokenClouds
-                                                         : DayType::kOvercast);
+    const std::optional<DayType> type = DayTypeFromName(sky);
+    ASSERT_TRUE(type.has_value()) << "sky = " << sky;
+    source_options.day_types.push_back(*type);
   }
   std::unique_ptr<PlantSource> truth = PlantSource::Create(source_options, &errors);
   ASSERT_NE(truth, nullptr);

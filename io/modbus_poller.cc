@@ -150,7 +150,7 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
     }
     std::string line = device->Who() + ": " + why;
     if (state == LinkState::kOk && device->state != LinkState::kStarting) {
-      line += " after " + std::to_string(device->failed_polls_in_state + 1) + " failed polls";
+      line += " after " + std::to_string(device->failed_polls_in_state + 1) + " failed attempts";
     }
     log_(priority, line);
     device->state = state;

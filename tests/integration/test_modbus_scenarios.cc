@@ -27,8 +27,10 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <mutex>
 #include <regex>
 #include <string>
@@ -356,6 +358,7 @@ TEST_P(ModbusScenarioTest, Run) {
 
   std::string log_text;
   for (const std::string& l : log) log_text += l + "\n";
+  if (std::getenv("PVTWIN_SHOW_LOG") != nullptr) std::cerr << log_text;
   SCOPED_TRACE("poller log:\n" + log_text + "simulator stderr:\n" + ReadFile(work / "sim.err"));
   ASSERT_GE(samples.size(), static_cast<std::size_t>(sc.periods));
 

@@ -82,6 +82,30 @@ TEST(PlantSource, IsReproducibleAndAtAgreesWithHistory) {
   EXPECT_GT(differs_from_other_seed, 10);
 }
 
+TEST(PlantSource, ReplaysACanonicalCsv) {
+  const fs::path path =
+      fs::temp_directory_path() / ("pvtwin_replay_" + std::to_string(getpid()) + ".csv");
+  std::ofstream(path) << "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n"
+                         "2024-06-21T10:00:00Z,30,35,0.03,800,22,120\n"
+                         "2024-06-21T10:01:00Z,31,36.5,0.03,810,22.5,121\n"
+                         "2024-06-21T10:02:00Z,32,38,0.03,820,23,122\n";
+  PlantSourceOptions options;
+  options.plant = DesignExamplePlant();
+  options.replay_csv = path.string();
+  Diagnostics errors;
+  auto source = PlantSource::Create(options, &errors);
+  ASSERT_NE(source, nullptr) << (errors.empty() ? "" : errors[0].ToString());
+  const double t0 = static_cast<double>(kJune21 + 36000);
+  EXPECT_FALSE(source->At(t0 - 1).Has(Channel::kTOutC));  // before the file
+  EXPECT_EQ(source->At(t0).Get(Channel::kTOutC), 35);
+  EXPECT_EQ(source->At(t0 + 59.9).Get(Channel::kTOutC), 35);  // a row lasts one step
+  EXPECT_EQ(source->At(t0 + 60).Get(Channel::kTOutC), 36.5);
+  EXPECT_EQ(source->At(t0 + 179).Get(Channel::kPElW), 122);
+  EXPECT_FALSE(source->At(t0 + 180).Has(Channel::kTOutC));  // after the file
+  EXPECT_EQ(source->History(kJune21, 1).size(), 3u);
+  fs::remove(path);
+}
+
 TEST(PlantSource, RejectsAnUnknownTruthVariant) {
   PlantSourceOptions options;
   options.plant = DesignExamplePlant();

@@ -53,6 +53,7 @@ namespace pvtwin {
 struct DeviceStats {
   std::string name;
   bool connected = false;
+  std::uint64_t polls = 0;       // periods polled (results handed to the delivery)
   std::uint64_t requests = 0;    // read requests sent
   std::uint64_t errors = 0;      // failed requests and connection attempts (timeouts included)
   std::uint64_t timeouts = 0;    // requests without an answer in time
@@ -106,6 +107,7 @@ class ModbusPoller {
   std::vector<RegisterRead> plan_;
   std::vector<std::unique_ptr<Device>> devices_;
   std::function<void(const Sample&)> on_sample_;
+  std::int64_t first_period_ = 0;  // index of the first period polled
   std::vector<std::thread> threads_;
   std::atomic<bool> stop_{false};
 };

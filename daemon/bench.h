@@ -15,5 +15,6 @@ void BenchTable6(std::uint64_t seed);
 void BenchStore(int repeats, std::uint64_t seed);
 // Real processes, real time: CPU and memory of `pvtwin run` over `seconds`.
 void BenchDaemon(double seconds);
+void BenchPoll(int cycles, std::uint64_t seed);
 
 }  // namespace pvtwin::cli

@@ -112,11 +112,7 @@ int RunSim(const SimArgs& a) {
   source_options.plant = config.plant;
   source_options.truth_variant = a.truth_variant;
   source_options.seed = a.seed;
-  for (const std::string& sky : a.sky) {
-    source_options.day_types.push_back(sky == "clear"    ? DayType::kClear
-                                       : sky == "broken" ? DayType::kBrokenClouds
-                                                         : DayType::kOvercast);
-  }
+  for (const std::string& sky : a.sky) source_options.day_types.push_back(*DayTypeFromName(sky));
   if (a.weather == "replay") {
     if (a.csv.empty()) {
       std::cerr << "--weather replay needs --csv FILE\n";
@@ -234,7 +230,8 @@ void RegisterSim(CLI::App& app) {
       "Prints 'listening DEVICE tcp HOST:PORT' per device, then 'ready', on stdout.\n"
       "Control lines on stdin: 'advance S' (with --stepped), 'fault SPEC', 'time', 'quit'.\n"
       "Faults: DEVICE:KIND:from=S:for=S[:ms=N], KIND drop | exception | delay | nan | range |\n"
-      "freeze, S simulated seconds after --start (delay: ms of wall time, default 2000).\n"
+      "freeze | stray (replies with a wrong transaction or unit id), S simulated seconds\n"
+      "after --start (delay: ms of wall time, default 2000).\n"
       "With --export FILE it writes the same plant's history as canonical CSV and exits.");
   cmd->add_option("--config", args->config, "TOML config with [plant] and the register map")
       ->required();
@@ -257,9 +254,11 @@ void RegisterSim(CLI::App& app) {
       std::string("model variant of the simulated plant (default ") + kDefaultTruthVariant + ")");
   cmd->add_option("--weather", args->weather, "generate (default) or replay --csv")
       ->check(CLI::IsMember({"generate", "replay"}));
-  cmd->add_option("--sky", args->sky,
-                  "sky of each day, cycled: clear, broken, overcast (default: drawn from the seed)")
-      ->check(CLI::IsMember({"clear", "broken", "overcast"}));
+  cmd->add_option(
+         "--sky", args->sky,
+         "sky of each day, cycled: clear, broken_clouds, overcast (default: drawn from the "
+         "seed)")
+      ->check(CLI::IsMember({"clear", "broken_clouds", "overcast"}));
   cmd->add_option("--csv", args->csv, "canonical CSV to replay (--weather replay)");
   cmd->add_option("--fault", args->faults, "DEVICE:KIND:from=S:for=S[:ms=N] (repeatable)");
   cmd->add_option("--export", args->export_path, "write the plant's history as CSV and exit");

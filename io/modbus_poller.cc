@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 
 #include "io/register_codec.h"
@@ -98,6 +99,9 @@ void ModbusPoller::Start(std::function<void(const Sample&)> on_sample) {
   assert(threads_.empty());
   on_sample_ = std::move(on_sample);
   stop_.store(false);
+  // Computed here, not in the threads: a thread that starts late must not
+  // skip a period that began after Start().
+  first_period_ = static_cast<std::int64_t>(std::floor(clock_.NowS() / options_.period_s)) + 1;
   for (auto& device : devices_) threads_.emplace_back([this, d = device.get()] { RunDevice(d); });
   threads_.emplace_back([this] { RunDelivery(); });
 }
@@ -120,17 +124,22 @@ std::vector<DeviceStats> ModbusPoller::Stats() const {
 
 void ModbusPoller::RunDevice(Device* device) {
   const double period_s = options_.period_s;
-  std::int64_t k = static_cast<std::int64_t>(std::floor(clock_.NowS() / period_s)) + 1;
+  std::int64_t k = first_period_;
   while (!stop_.load()) {
     if (!clock_.SleepUntil(static_cast<double>(k) * period_s, stop_)) break;
     // After a long timeout the device may be late: poll the current period.
     k = std::max(k, static_cast<std::int64_t>(std::floor(clock_.NowS() / period_s)));
     Result result;
     result.period = k;
+    const auto begin = std::chrono::steady_clock::now();
     PollDevice(device, k, &result);
+    const double wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     {
       std::lock_guard<std::mutex> lock(device->mutex);
       device->slots[static_cast<std::size_t>(k) % kResultSlots] = result;
+      device->stats.last_poll_wall_s = wall_s;
+      ++device->stats.polls;
     }
     ++k;
   }
@@ -145,7 +154,7 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
     }
     std::string line = device->Who() + ": " + why;
     if (state == LinkState::kOk && device->state != LinkState::kStarting) {
-      line += " after " + std::to_string(device->failed_polls_in_state + 1) + " failed polls";
+      line += " after " + std::to_string(device->failed_polls_in_state + 1) + " failed attempts";
     }
     log_(priority, line);
     device->state = state;
@@ -267,7 +276,7 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
 
 void ModbusPoller::RunDelivery() {
   const double period_s = options_.period_s;
-  std::int64_t k = static_cast<std::int64_t>(std::floor(clock_.NowS() / period_s)) + 1;
+  std::int64_t k = first_period_;
   while (!stop_.load()) {
     if (!clock_.SleepUntil(static_cast<double>(k + 1) * period_s, stop_)) break;
     Sample sample;

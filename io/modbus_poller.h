@@ -53,12 +53,14 @@ namespace pvtwin {
 struct DeviceStats {
   std::string name;
   bool connected = false;
+  std::uint64_t polls = 0;       // periods polled (results handed to the delivery)
   std::uint64_t requests = 0;    // read requests sent
   std::uint64_t errors = 0;      // failed requests and connection attempts (timeouts included)
   std::uint64_t timeouts = 0;    // requests without an answer in time
   std::uint64_t reconnects = 0;  // connections opened after the first
   double last_success_s = 0;     // clock time of the last poll with every read answered; 0 = never
   std::string last_error;        // libmodbus message of the last failure
+  double last_poll_wall_s = 0;   // wall-clock duration of the last poll (connect and reads)
 };
 
 struct PollerOptions {
@@ -80,7 +82,9 @@ class ModbusPoller {
   // Starts polling; on_sample is called once per period (from a poller
   // thread), with Sample::ts_s = period start, every mapped channel's value
   // or NaN (rejected_mask for QC rejects). The first sample is of the first
-  // period that starts after Start().
+  // period that starts after Start(). on_sample should return quickly (hand
+  // the sample to a queue): a slow callback delays later deliveries, though
+  // never the devices' reads.
   void Start(std::function<void(const Sample&)> on_sample);
   // Stops the threads; bounded by the longest device timeout. Idempotent.
   void Stop();
@@ -103,6 +107,7 @@ class ModbusPoller {
   std::vector<RegisterRead> plan_;
   std::vector<std::unique_ptr<Device>> devices_;
   std::function<void(const Sample&)> on_sample_;
+  std::int64_t first_period_ = 0;  // index of the first period polled
   std::vector<std::thread> threads_;
   std::atomic<bool> stop_{false};
 };

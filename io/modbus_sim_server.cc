@@ -22,13 +22,14 @@ namespace pvtwin {
 
 namespace {
 
-constexpr std::array<std::pair<std::string_view, FaultKind>, 6> kFaultNames = {{
+constexpr std::array<std::pair<std::string_view, FaultKind>, 7> kFaultNames = {{
     {"drop", FaultKind::kDrop},
     {"exception", FaultKind::kException},
     {"delay", FaultKind::kDelay},
     {"nan", FaultKind::kNan},
     {"range", FaultKind::kRange},
     {"freeze", FaultKind::kFreeze},
+    {"stray", FaultKind::kStray},
 }};
 
 bool ParseNumber(std::string_view text, double* out) {
@@ -319,6 +320,11 @@ void ModbusSimServer::Serve(Device* device) {
       } else {
         EncodePoint(p, ChannelToWireUnit(p.channel, sample.Get(p.channel)), words);
       }
+    }
+    if (has(faults, FaultKind::kStray)) {
+      // The reply copies these bytes from the request: the TCP transaction
+      // id (bytes 0-1) or the RTU unit id (byte 0).
+      query[0] = static_cast<std::uint8_t>(query[0] ^ 0x5A);
     }
     modbus_reply(device->ctx, query.data(), n, device->mapping);
     return true;

@@ -16,6 +16,8 @@
 //              largest raw value (integer types)
 //   range      serve valid_max plus the valid span (or 1e9 without a range)
 //   freeze     keep serving the values of the fault's first request
+//   stray      answer with a reply that belongs to another request (TCP: a
+//              wrong transaction id; RTU: a wrong unit id)
 // Text form (command line, control protocol):
 //   DEVICE:KIND:from=S:for=S[:ms=N]   S simulated seconds after the start
 #pragma once
@@ -35,7 +37,7 @@
 
 namespace pvtwin {
 
-enum class FaultKind { kDrop, kException, kDelay, kNan, kRange, kFreeze };
+enum class FaultKind { kDrop, kException, kDelay, kNan, kRange, kFreeze, kStray };
 
 struct Fault {
   std::string device;

@@ -36,6 +36,13 @@ Sample RowOf(const Series& s, std::size_t i) {
 
 }  // namespace
 
+std::optional<DayType> DayTypeFromName(std::string_view name) {
+  for (const DayType type : {DayType::kClear, DayType::kBrokenClouds, DayType::kOvercast}) {
+    if (DayTypeName(type) == name) return type;
+  }
+  return std::nullopt;
+}
+
 std::unique_ptr<PlantSource> PlantSource::Create(const PlantSourceOptions& options,
                                                  Diagnostics* errors) {
   std::unique_ptr<PlantSource> source(new PlantSource(options));

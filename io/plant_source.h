@@ -18,7 +18,9 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/diagnostic.h"
@@ -44,6 +46,10 @@ struct PlantSourceOptions {
   std::string replay_csv;                            // non-empty: replay this canonical CSV
   std::vector<DayType> day_types;  // sky of every day, cycled; empty: drawn (weather_generator.h)
 };
+
+// The day type spelled as DayTypeName spells it ("clear", "broken_clouds",
+// "overcast"); nullopt for any other text.
+std::optional<DayType> DayTypeFromName(std::string_view name);
 
 class PlantSource {
  public:

@@ -27,11 +27,15 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iostream>
 #include <mutex>
 #include <regex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "config/plant_config.h"
@@ -266,9 +270,9 @@ TEST_P(ModbusScenarioTest, Run) {
   source_options.plant = config.plant;
   source_options.seed = sc.seed;
   for (const std::string& sky : sc.sky) {
-    source_options.day_types.push_back(sky == "clear"    ? DayType::kClear
-                                       : sky == "broken" ? DayType::kBrokenClouds
-                                                         : DayType::kOvercast);
+    const std::optional<DayType> type = DayTypeFromName(sky);
+    ASSERT_TRUE(type.has_value()) << "sky = " << sky;
+    source_options.day_types.push_back(*type);
   }
   std::unique_ptr<PlantSource> truth = PlantSource::Create(source_options, &errors);
   ASSERT_NE(truth, nullptr);
@@ -356,6 +360,7 @@ TEST_P(ModbusScenarioTest, Run) {
 
   std::string log_text;
   for (const std::string& l : log) log_text += l + "\n";
+  if (std::getenv("PVTWIN_SHOW_LOG") != nullptr) std::cerr << log_text;
   SCOPED_TRACE("poller log:\n" + log_text + "simulator stderr:\n" + ReadFile(work / "sim.err"));
   ASSERT_GE(samples.size(), static_cast<std::size_t>(sc.periods));
 
@@ -482,6 +487,93 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, ModbusScenarioTest, ::testing::ValuesIn(Scen
                            std::replace(name.begin(), name.end(), '-', '_');
                            return "s" + name;
                          });
+
+// Time stepped by the test: the simulator (--stepped, "advance 5" on stdin)
+// and the poller (a SteppedClock here) move together one period at a time,
+// and the test waits for each period's reads before the next step. Every
+// value must then be exactly the one of its own period's row.
+TEST(ModbusStepped, EveryPeriodHoldsExactlyItsOwnRow) {
+  const fs::path work = fs::temp_directory_path() / ("pvtwin_stepped_" + std::to_string(getpid()));
+  fs::create_directories(work);
+  const fs::path config_path = kScenarioDir / "../../../config/examples/sim-plant.toml";
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseConfig(ReadFile(config_path), config_path.string(), &config, &errors));
+  const std::int64_t start_s = 1718964000;  // 2024-06-21T10:00:00Z
+  ChildProcess sim;
+  ASSERT_TRUE(
+      sim.Start({PVTWIN_BINARY, "sim", "--config", config_path.string(), "--ephemeral-ports",
+                 "--stepped", "--start", std::to_string(start_s), "--seed", "5"},
+                (work / "sim.err").string()));
+  std::string line;
+  const std::regex listening(R"(listening (\S+) tcp [0-9.]+:([0-9]+))");
+  while (sim.ReadLine(&line, 30.0) && !line.starts_with("ready")) {
+    std::smatch m;
+    if (!std::regex_match(line, m, listening)) continue;
+    for (ModbusDevice& d : config.modbus.devices) {
+      if (d.name == m[1]) d.port = std::stoi(m[2]);
+    }
+  }
+  ASSERT_TRUE(line.starts_with("ready")) << ReadFile(work / "sim.err");
+
+  PlantSourceOptions source_options;
+  source_options.plant = config.plant;
+  source_options.seed = 5;
+  std::unique_ptr<PlantSource> truth = PlantSource::Create(source_options, &errors);
+  ASSERT_NE(truth, nullptr);
+
+  SteppedClock clock(static_cast<double>(start_s));
+  PollerOptions options;
+  options.period_s = kPeriodS;
+  std::mutex mutex;
+  std::vector<Sample> samples;
+  ModbusPoller poller(config.modbus, options, clock, [](int, const std::string&) {});
+  const auto polls = [&] {
+    std::uint64_t n = 0;
+    for (const DeviceStats& st : poller.Stats()) n += st.polls;
+    return n;
+  };
+  poller.Start([&](const Sample& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    samples.push_back(s);
+  });
+  const auto wait_for = [](const std::function<bool()>& done) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!done() && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return done();
+  };
+  constexpr int kSteps = 12;
+  for (int step = 1; step <= kSteps; ++step) {
+    const std::uint64_t before = polls();
+    ASSERT_TRUE(sim.WriteLine("advance 5"));
+    ASSERT_TRUE(sim.ReadLine(&line, 10.0));
+    ASSERT_EQ(line, "ok " + std::to_string(start_s + 5 * step));
+    clock.Advance(kPeriodS);
+    ASSERT_TRUE(wait_for([&] { return polls() >= before + config.modbus.devices.size(); }))
+        << "step " << step << ": the reads of the period did not happen";
+  }
+  ASSERT_TRUE(wait_for([&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return samples.size() >= kSteps - 1;
+  }));
+  poller.Stop();
+  EXPECT_TRUE(sim.WriteLine("quit"));
+  EXPECT_EQ(sim.Wait(10.0), 0);
+
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const Sample& s : samples) {
+    EXPECT_EQ(s.rejected_mask, 0u);
+    const Sample row = truth->At(static_cast<double>(s.ts_s));
+    for (const ModbusPoint& p : config.modbus.points) {
+      EXPECT_EQ(s.Get(p.channel), ThroughRegisters(p, row.Get(p.channel)))
+          << ChannelName(p.channel) << " at " << s.ts_s;
+    }
+  }
+  EXPECT_EQ(samples.front().ts_s, start_s + 5);
+  fs::remove_all(work);
+}
 
 TEST(ModbusScenarios, HasTheNumberedCatalogue) {
   const std::vector<std::string> names = ScenarioNames();

@@ -15,6 +15,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterSimulate(app);
   RegisterBench(app);
   RegisterBacktest(app);
+  RegisterDiagnose(app);
 }
 
 }  // namespace pvtwin::cli

@@ -22,5 +22,6 @@ void RegisterSimulate(CLI::App& app);
 void RegisterCalibrate(CLI::App& app);
 void RegisterBench(CLI::App& app);
 void RegisterBacktest(CLI::App& app);
+void RegisterDiagnose(CLI::App& app);
 
 }  // namespace pvtwin::cli

@@ -42,16 +42,7 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
     }
     d->t_sky_c[i] = t_sky_c;
   }
-  std::vector<double> mid_s(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    mid_s[i] = static_cast<double>(s.time_s[i]) + 0.5 * s.step_s;
-  }
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  std::vector<SolarPosition> sun;
-  ComputeSolarPositions(mid_s, site, &sun);
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   d->sun_azimuth_rad.resize(n);
   d->sun_elevation_rad.resize(n);
   d->aoi_rad.resize(n);

@@ -42,16 +42,7 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
     }
     d->t_sky_c[i] = t_sky_c;
   }
-  std::vector<double> mid_s(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    mid_s[i] = static_cast<double>(s.time_s[i]) + 0.5 * s.step_s;
-  }
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  std::vector<SolarPosition> sun;
-  ComputeSolarPositions(mid_s, site, &sun);
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   d->sun_azimuth_rad.resize(n);
   d->sun_elevation_rad.resize(n);
   d->aoi_rad.resize(n);
@@ -90,6 +81,27 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
 }
 
 }  // namespace
+
+void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t end,
+                               Drivers* coarse) {
+  double dt_s = 0.0;
+  for (std::size_t k = begin; k < end; ++k) dt_s += d.dt_s[k];
+  auto mean = [&](const std::vector<double>& v) {
+    double acc = 0.0;
+    for (std::size_t k = begin; k < end; ++k) acc += v[k] * d.dt_s[k];
+    return acc / dt_s;
+  };
+  const std::size_t mid = begin + (end - begin) / 2;
+  coarse->wind_m_s.push_back(mean(d.wind_m_s));
+  coarse->t_sky_c.push_back(mean(d.t_sky_c));
+  coarse->sun_azimuth_rad.push_back(d.sun_azimuth_rad[mid]);
+  coarse->sun_elevation_rad.push_back(d.sun_elevation_rad[mid]);
+  coarse->aoi_rad.push_back(d.aoi_rad[mid]);
+  coarse->g_beam_w_m2.push_back(mean(d.g_beam_w_m2));
+  coarse->g_ref_w_m2.push_back(mean(d.g_ref_w_m2));
+  coarse->days_since_clean.push_back(mean(d.days_since_clean));
+  coarse->irradiance_bias = d.irradiance_bias;
+}
 
 void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers* d) {
   std::vector<std::int64_t> cleanings = cleaning_times_s;

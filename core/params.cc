@@ -41,12 +41,15 @@ const std::array<ParamInfo, kNumParams> kParamTable = {{
     // 0 = laminar (Nusselt number independent of flow), 0.8 = turbulent
     // Dittus–Boelter (h ∝ Re^0.8).
     {Param::kNFlow, "n_flow", "-", "n_flow", 0.4, 0.0, 1.2, kLin, false},
-    {Param::kPLimitWM2, "p_limit_w_m2", "W/m²", "P_limit", 150.0, 30.0, 300.0, kLin, false},
+    {Param::kPLimitWM2, "p_limit_w_m2", "W/m²", "P_limit", 100.0, 30.0, 300.0, kLin, false},
     {Param::kShadeAzimuthRad, "shade_azimuth_rad", "rad", "γ_shade", 3.14159265358979323846,
      1.5707963267948966, 4.71238898038469, kLin, false},
-    {Param::kShadeWidthRad, "shade_width_rad", "rad", "Δγ_shade", 1.0471975511965976,
-     0.08726646259971647, 2.0943951023931953, kLin, false},
-    {Param::kShadeElevationRad, "shade_elevation_rad", "rad", "α_shade", 0.2617993877991494, 0.0,
+    // The start window (240° wide, up to 20° elevation) shades the low sun
+    // of mornings and evenings in every season, so the fit starts with a
+    // gradient in every shading parameter.
+    {Param::kShadeWidthRad, "shade_width_rad", "rad", "Δγ_shade", 4.1887902047863905,
+     0.08726646259971647, 5.235987755982989, kLin, false},
+    {Param::kShadeElevationRad, "shade_elevation_rad", "rad", "α_shade", 0.3490658503988659, 0.0,
      1.0471975511965976, kLin, false},
     {Param::kShadeMismatch, "shade_mismatch", "-", "f_mismatch", 0.5, 0.0, 1.0, kLin, false},
     {Param::kSoilingPerDay, "soiling_per_day", "1/d", "r_soil", 0.002, 0.0, 0.02, kLin, false},

@@ -58,10 +58,7 @@ ParamVector ReferenceTruthParams(const Plant& plant) {
 ParamVector TruthParamsFor(const Plant& plant, const ModelSpec& spec) {
   ParamVector p = ReferenceTruthParams(plant);
   for (const EffectInfo& info : EffectTable()) {
-    const bool letter = info.effect == Effect::kCapacitance || info.effect == Effect::kSecondNode ||
-                        info.effect == Effect::kWind || info.effect == Effect::kSkyRadiation ||
-                        info.effect == Effect::kIam;
-    if (letter || !HasEffect(spec, info.effect)) continue;
+    if (!HasEffect(spec, info.effect)) continue;
     for (const auto& [param, value] : info.typical_truth) {
       p[static_cast<std::size_t>(param)] = value;
     }

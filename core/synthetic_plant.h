@@ -49,9 +49,8 @@ Series MakeSyntheticPlantData(const Plant& plant, const WeatherOptions& weather,
 // ("1N1Cwr+pv_clipping+shading") at a chosen magnitude, realistic operation,
 // noise, the paper's data defects and uncatalogued disturbances.
 
-// ReferenceTruthParams with EffectInfo::typical_truth of every effect of
-// DESIGN.md's vocabulary that spec has beyond the paper's letters (the
-// letters' parameters are already in ReferenceTruthParams).
+// ReferenceTruthParams with EffectInfo::typical_truth of every effect that
+// spec has (HasEffect), letters included.
 ParamVector TruthParamsFor(const Plant& plant, const ModelSpec& spec);
 
 // Plant faults that no catalogued effect explains (the diagnosis's

@@ -98,6 +98,12 @@ bool PrepareDrivers(const Series& series, const Plant& plant, const ModelSpec& s
 // loss; recomputes drivers->days_since_clean. Times need not be sorted.
 void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers* drivers);
 
+// Appends to *coarse the effect library's drivers of rows [begin, end) of d
+// averaged to one row (time-weighted means; sun angles of the middle row),
+// for a coarsened copy of d such as identification's coarse stage builds.
+void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t end,
+                               Drivers* coarse);
+
 // flow_dependent_u: the specific capacity flow at which the fluid-side
 // resistance equals r0_fluid, w_ref = 0.02 kg/(s·m²) · c_p (the nominal
 // specific flow of the paper's plant and of the weather generator).

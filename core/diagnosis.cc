@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "core/backtest.h"
+#include "core/effects.h"
 #include "core/resample.h"
 #include "core/solar_position.h"
 #include "core/thermal_model.h"
@@ -43,9 +44,19 @@ struct Part {
   Measurements meas;
 };
 
-bool PreparePart(const Series& s, const Plant& plant, const ModelSpec& spec, Part* part,
-                 std::string* error) {
+// data_start_s: the first row of the whole data set. Soiling counts the days
+// since the last cleaning; with no cleaning known, from the start of the data,
+// not from the start of each part (SetCleaningTimes ignores cleanings before a
+// part's first row, so the count is set here).
+bool PreparePart(const Series& s, const Plant& plant, const ModelSpec& spec,
+                 std::int64_t data_start_s, Part* part, std::string* error) {
   if (!PrepareDrivers(s, plant, spec, &part->drivers, error)) return false;
+  Drivers& d = part->drivers;
+  if (d.days_since_clean.size() == d.size()) {
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      d.days_since_clean[i] = static_cast<double>(d.time_s[i] - data_start_s) / 86400.0;
+    }
+  }
   part->meas = MakeMeasurements(s, part->drivers);
   return true;
 }
@@ -128,6 +139,80 @@ std::vector<double> Residual(const Measurements& m, const std::vector<double>& p
   std::vector<double> r(m.size(), kNaN);
   for (std::uint32_t i : m.rows) r[i] = pred[i] - meas[i];
   return r;
+}
+
+// A start for the shading parameters from where the base model over-predicts
+// P_el under beam light: cells of sun azimuth (10°) × elevation (5°) whose
+// mean relative P_el residual (predicted − measured)/predicted exceeds 15 %
+// on rows with at least 200 W/m² in the plane. The obstacle's azimuth window
+// spans those cells, its edge is the highest of them. A local fit started at
+// the default (a shade due south) does not find an obstacle elsewhere.
+// Returns false when no cell qualifies.
+bool ShadingStartFromResiduals(const Series& s, const Drivers& d, const SimOutputs& sim,
+                               const Measurements& m, const Plant& plant, ParamVector* start) {
+  std::vector<double> mid_s(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    mid_s[i] = static_cast<double>(d.time_s[i]) + 0.5 * d.dt_s[i];
+  }
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  site.elevation_m = plant.elevation_m;
+  std::vector<SolarPosition> sun;
+  ComputeSolarPositions(mid_s, site, &sun);
+  constexpr int kAz = 36, kEl = 18;
+  std::vector<double> sum(kAz * kEl, 0.0), count(kAz * kEl, 0.0);
+  for (std::uint32_t i : m.rows) {
+    if (sun[i].elevation_rad <= 0.0 || d.g_poa_w_m2[i] < 200.0 || !(sim.p_el_w[i] > 0.0)) continue;
+    const int a = std::clamp(static_cast<int>(RadToDeg(sun[i].azimuth_rad) / 10.0), 0, kAz - 1);
+    const int e = std::clamp(static_cast<int>(RadToDeg(sun[i].elevation_rad) / 5.0), 0, kEl - 1);
+    sum[a * kEl + e] += (sim.p_el_w[i] - m.p_el_w[i]) / sim.p_el_w[i];
+    count[a * kEl + e] += 1.0;
+  }
+  (void)s;
+  int az_lo = kAz, az_hi = -1, el_hi = -1;
+  for (int a = 0; a < kAz; ++a) {
+    for (int e = 0; e < kEl; ++e) {
+      const int k = a * kEl + e;
+      if (count[k] < 5 || sum[k] / count[k] < 0.15) continue;
+      az_lo = std::min(az_lo, a);
+      az_hi = std::max(az_hi, a);
+      el_hi = std::max(el_hi, e);
+    }
+  }
+  if (az_hi < 0) return false;
+  auto set = [start](Param p, double v) { (*start)[static_cast<std::size_t>(p)] = v; };
+  set(Param::kShadeAzimuthRad, DegToRad(5.0 * (az_lo + az_hi + 1)));
+  set(Param::kShadeWidthRad, DegToRad(10.0 * (az_hi - az_lo + 1)));
+  set(Param::kShadeElevationRad, DegToRad(5.0 * (el_hi + 1)));
+  return true;
+}
+
+// The sensor test of irradiance_bias (see EffectTrial): k per day of data.
+void IrradianceBiasTest(const Series& data, const std::vector<std::int64_t>& day_starts,
+                        const Plant& plant, const ModelSpec& spec, EffectTrial* t) {
+  std::vector<double> k;
+  for (std::int64_t day : day_starts) {
+    const auto lo = static_cast<std::size_t>(
+        std::lower_bound(data.time_s.begin(), data.time_s.end(), day) - data.time_s.begin());
+    const auto hi = static_cast<std::size_t>(
+        std::lower_bound(data.time_s.begin(), data.time_s.end(), day + kSecondsPerDay) -
+        data.time_s.begin());
+    Drivers d;
+    std::string why;
+    if (hi <= lo || !PrepareDrivers(data.Slice(lo, hi), plant, spec, &d, &why)) continue;
+    const double kd = EstimateIrradianceBias(d);
+    if (std::isfinite(kd)) k.push_back(kd);
+  }
+  if (k.size() < 3) return;
+  std::vector<double> sorted = k;
+  std::sort(sorted.begin(), sorted.end());
+  t->irradiance_bias = sorted[sorted.size() / 2];
+  const std::vector<double> zeros(k.size(), 0.0);
+  const PairedTest up = OneSidedPairedTest(k, zeros);
+  const PairedTest down = OneSidedPairedTest(zeros, k);
+  t->irradiance_bias_p = std::min(1.0, 2.0 * std::min(up.wilcoxon_p, down.wilcoxon_p));
+  t->irradiance_bias_days = static_cast<int>(k.size());
 }
 
 }  // namespace
@@ -228,13 +313,14 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
     return static_cast<std::size_t>(std::lower_bound(data.time_s.begin(), data.time_s.end(), t) -
                                     data.time_s.begin());
   };
+  const std::int64_t data_start_s = data.time_s.front();
   const Series train_series = data.Slice(0, lower_row(train_end_s));
   const Series heldout_series = data.Slice(lower_row(train_end_s), lower_row(heldout_end_s));
 
   // 2. Base fit.
   Part base_train, base_heldout;
-  if (!PreparePart(train_series, plant, base, &base_train, error) ||
-      !PreparePart(heldout_series, plant, base, &base_heldout, error)) {
+  if (!PreparePart(train_series, plant, base, data_start_s, &base_train, error) ||
+      !PreparePart(heldout_series, plant, base, data_start_s, &base_heldout, error)) {
     return false;
   }
   const std::size_t min_rows = static_cast<std::size_t>(std::max(options.ident.min_rows, 1));
@@ -281,6 +367,8 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
     return false;
   }
   const double area_m2 = plant.area_m2;
+  SimOutputs base_train_sim;
+  Simulate(base_train.drivers, base_fit.params, &base_train_sim);
   Score base_score = ScoreHeldout(base_heldout, base_fit.params, units, area_m2);
   r.gap = base_score.errors;
   progress("base " + r.base_variant + ": held-out MAE P_el " + Fixed(r.gap.mae_p_el_w, 2) +
@@ -347,8 +435,8 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
         t.heldout_mae_before_w = MaeSumW(current_score.errors);
         Part tr, ho;
         std::string why;
-        if (!PreparePart(train_series, plant, c.spec, &tr, &why) ||
-            !PreparePart(heldout_series, plant, c.spec, &ho, &why)) {
+        if (!PreparePart(train_series, plant, c.spec, data_start_s, &tr, &why) ||
+            !PreparePart(heldout_series, plant, c.spec, data_start_s, &ho, &why)) {
           t.failure = why;
         } else {
           // Evidence on the base model's residuals (the gap being explained).
@@ -365,8 +453,12 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
             t.evidence_corr = use_q ? cq : cp;
             t.evidence_output = use_q ? "q_th" : "p_el";
           }
-          const IdentSummary fit = Identify(
-              tr.drivers, tr.meas, MergedStart(plant, current_spec, current_params), options.ident);
+          ParamVector start = MergedStart(plant, current_spec, current_params);
+          if (c.name == "shading") {
+            ShadingStartFromResiduals(train_series, base_train.drivers, base_train_sim,
+                                      base_train.meas, plant, &start);
+          }
+          const IdentSummary fit = Identify(tr.drivers, tr.meas, start, options.ident);
           t.fit_runtime_s = fit.runtime_s;
           t.params = fit.params;
           if (!fit.ok) {
@@ -383,6 +475,11 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
               t.test = CompareUnits(current_score, scores[k]);
               t.significant =
                   t.test.wilcoxon_p <= options.alpha && t.shrink_pct >= options.min_shrink_pct;
+              if (c.name == "irradiance_bias") {
+                IrradianceBiasTest(data, day_starts, plant, c.spec, &t);
+                t.significant = t.irradiance_bias_p <= options.alpha &&
+                                std::fabs(t.irradiance_bias) >= options.min_irradiance_bias;
+              }
             }
           }
         }
@@ -413,6 +510,14 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
            << " residual with " << t.signature << " r = " << Fixed(t.evidence_corr.r, 2)
            << " (z = " << Fixed(t.evidence_corr.z, 1)
            << ", n_eff = " << Fixed(t.evidence_corr.n_eff, 0) << "); ";
+      }
+      if (std::isfinite(t.irradiance_bias)) {
+        ev << "against GHI/DHI transposed to the plane, the plane-of-array pyranometer reads "
+           << Fixed(100.0 * std::fabs(t.irradiance_bias), 1) << " % "
+           << (t.irradiance_bias > 0 ? "low" : "high") << " (median over " << t.irradiance_bias_days
+           << " days, two-sided Wilcoxon p = " << PValue(t.irradiance_bias_p)
+           << "); η_PV and F_th absorb such a scale error, so "
+           << "the held-out error barely moves; ";
       }
       if (t.fit_ok) {
         ev << "re-identified " << t.variant << " lowers the held-out MAE on " << t.test.positives
@@ -486,7 +591,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   {
     Part final_heldout;
     std::string why;
-    if (!PreparePart(heldout_series, plant, current_spec, &final_heldout, &why)) {
+    if (!PreparePart(heldout_series, plant, current_spec, data_start_s, &final_heldout, &why)) {
       *error = "internal: final model " + r.final_variant + ": " + why;
       return false;
     }

@@ -3,13 +3,13 @@
 // null cases (the base is the truth); and uncatalogued disturbances (a
 // failing pump, snow cover) that no effect of the catalogue explains.
 //
-// Each case and seed: generate train_days + heldout_days of weather and
-// operation (core/weather_generator.h, drawn day types, the pump's
-// hysteresis), run the truth model, add realistic sensor noise
-// (RealisticSensorNoise) and the paper's data defects (night irradiance
-// glitches > 5000 W/m², small negative flows at standstill, both undone by
-// ApplyPaperCorrections as the CSV reader does, and a few rows with missing
-// outputs or valid = 0), inject the case's disturbance, then Diagnose.
+// Each case and seed: train_days + heldout_days of data from the truth model
+// as a real plant delivers it (core/synthetic_plant.h, DefaultSyntheticOptions:
+// drawn clear/broken/overcast days, variable flow with pump starts and stops,
+// realistic sensor noise, the paper's data defects, truth parameters
+// TruthParamsFor with each effect's typical magnitude), the case's
+// disturbance on two held-out days, ApplyPaperCorrections as the CSV reader
+// does, then Diagnose.
 // A case is correct when
 //   * withheld effect e: verdict == e, the ladder's first step is e, and the
 //     held-out objective after adding it is within after_tolerance of the
@@ -22,17 +22,17 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/diagnosis.h"
 #include "core/params.h"
 #include "core/plant.h"
+#include "core/synthetic_plant.h"
 #include "core/variant.h"
 
 namespace pvtwin {
-
-enum class Disturbance { kNone, kFailingPump, kSnowCover };
 
 struct SelftestCase {
   std::string name;      // "wind", "null", "failing_pump", …
@@ -40,7 +40,9 @@ struct SelftestCase {
   ModelSpec base;        // diagnosed model
   ModelSpec truth;       // data-generating model
   ParamVector truth_params{};
-  Disturbance disturbance = Disturbance::kNone;
+  // Uncatalogued disturbance on two held-out days (the "unknown" cases).
+  std::optional<DisturbanceKind> disturbance;
+  double severity = 0.0;  // Disturbance::severity
 };
 
 struct SelftestOptions {

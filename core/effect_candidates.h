@@ -1,8 +1,9 @@
 // The candidate effects of the gap diagnosis: which catalogued effects
 // (DESIGN.md's vocabulary) can be added to a model, the model with the effect
 // added, and the per-row signature its residual evidence is correlated with.
-// A thin layer over the effect library (core/effects.h), so that the
-// diagnosis only sees names, specs and signatures.
+// A thin layer over the effect library (core/effects.h: EffectTable,
+// CanAddEffect with the data's channels, WithEffect, EffectSignature), so that
+// the diagnosis handles effects by their vocabulary names.
 #pragma once
 
 #include <string>

@@ -200,6 +200,37 @@ Localisation LocaliseGap(std::span<const std::int64_t> time_s, std::span<const d
         if (g.rows > 0) result.bins.push_back(g);
       }
     }
+    if (d.name == "day") {
+      // Days are the blocks themselves: a day's excess is judged against the
+      // other days, by the robust z of its MAE (median, 1.4826·MAD).
+      std::vector<double> maes;
+      for (const GapRegion& g : evaluated) {
+        if (g.rows > 0) maes.push_back(g.mae_w);
+      }
+      if (maes.size() >= 3) {
+        std::vector<double> sorted = maes;
+        std::sort(sorted.begin(), sorted.end());
+        const double median = sorted[sorted.size() / 2];
+        for (double& v : sorted) v = std::fabs(v - median);
+        std::sort(sorted.begin(), sorted.end());
+        const double mad = 1.4826 * sorted[sorted.size() / 2];
+        for (GapRegion& g : evaluated) {
+          if (g.rows == 0) continue;
+          const double excess = g.mae_w - median;
+          g.z = mad > 0.0 ? excess / mad : (excess > 0.0 ? kInf : 0.0);
+          g.flagged = g.z >= options.min_z && g.share_of_rows > 0.0 &&
+                      g.share_of_abs_error / g.share_of_rows >= options.min_ratio &&
+                      g.rows >= options.min_rows;
+          if (g.flagged) candidates.push_back(g);
+        }
+        for (GapRegion& b : result.bins) {
+          for (const GapRegion& g : evaluated) {
+            if (b.driver == g.driver && b.lower == g.lower && b.output == g.output) b = g;
+          }
+        }
+      }
+      continue;
+    }
     if (two_d) {
       for (const GapRegion& g : evaluated) {
         if (g.flagged) candidates.push_back(g);
@@ -236,8 +267,14 @@ Localisation LocaliseGap(std::span<const std::int64_t> time_s, std::span<const d
       candidates.begin(), candidates.end(), [](const GapRegion& a, const GapRegion& b) {
         return a.share_of_abs_error - a.share_of_rows > b.share_of_abs_error - b.share_of_rows;
       });
-  if (candidates.size() > options.max_regions) candidates.resize(options.max_regions);
-  result.regions = std::move(candidates);
+  // At most two regions per driver, so that one strong regime (e.g. all of
+  // the pump-on rows) does not crowd out the others (e.g. the days).
+  std::map<std::string, int> per_driver;
+  for (const GapRegion& g : candidates) {
+    if (result.regions.size() >= options.max_regions) break;
+    if (++per_driver[g.driver] > 2) continue;
+    result.regions.push_back(g);
+  }
   return result;
 }
 

@@ -16,7 +16,10 @@
 // z ≥ min_z, share_of_abs_error / share_of_rows ≥ min_ratio and it holds at
 // least min_rows rows; adjacent flagged bins of a 1-D driver are merged into
 // one range (and re-tested). Two-dimensional cells (sun azimuth × elevation)
-// work the same with a second driver.
+// work the same with a second driver. The driver named "day" is the
+// exception: days are the blocks themselves, so a day's z is the robust
+// z-score of its MAE among the days, (MAE_d − median)/(1.4826·MAD), and days
+// are not merged.
 #pragma once
 
 #include <cstdint>
@@ -65,7 +68,7 @@ struct LocaliseOptions {
   double min_z = 3.0;            // flag threshold on z, > 0
   double min_ratio = 1.3;        // flag threshold on share_of_abs_error / share_of_rows, ≥ 1
   std::size_t min_rows = 10;     // fewer rows: never flagged
-  std::size_t max_regions = 12;  // regions kept per output (most excess first)
+  std::size_t max_regions = 12;  // regions kept per output: most excess first, ≤ 2 per driver
   std::uint64_t seed = 1;        // of the bootstrap draws
   bool IsValid(std::string* why) const;
 };

@@ -79,9 +79,10 @@ void RegisterBench(CLI::App& app) {
       "  sim    one 14-day 1-min simulation of each variant\n"
       "  ident  identification of 2N1Ccolwr: 14 days at 1 min and at 5 s, and the\n"
       "         algorithm comparison behind the default\n"
-      "  table6 the paper's Table 6 protocol (9 variants x 29 test days) on both cores");
-  cmd->add_option("what", args->what, "what to benchmark: sim, ident, table6")
-      ->check(CLI::IsMember({"sim", "ident", "table6"}));
+      "  table6 the paper's Table 6 protocol (9 variants x 29 test days) on both cores\n"
+      "  diagnose one gap diagnosis, 14 + 7 days at 1 min, every effect, both cores");
+  cmd->add_option("what", args->what, "what to benchmark: sim, ident, table6, diagnose")
+      ->check(CLI::IsMember({"sim", "ident", "table6", "diagnose"}));
   cmd->add_option("--repeats", args->repeats, "runs per figure (median)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
@@ -90,6 +91,7 @@ void RegisterBench(CLI::App& app) {
       if (w == "sim") BenchSimulation(*args);
       if (w == "ident") BenchIdentification(args->repeats, args->seed);
       if (w == "table6") BenchTable6(args->seed);
+      if (w == "diagnose") BenchDiagnosis(args->seed);
     }
     SetExitCode(kExitOk);
   });

@@ -32,7 +32,7 @@ struct DiagnoseArgs {
   std::string report;
   std::vector<std::string> effects;
   double alpha = 0.05;
-  double min_shrink_pct = 3.0;
+  double min_shrink_pct = 1.0;
   int threads = 0;
 };
 
@@ -260,7 +260,7 @@ void RegisterDiagnose(CLI::App& app) {
   cmd->add_option("--alpha", args->alpha,
                   "one-sided Wilcoxon p at or below which an improvement is consistent (0.05)");
   cmd->add_option("--min-shrink", args->min_shrink_pct,
-                  "smallest held-out error reduction in % that counts (3)");
+                  "smallest held-out error reduction in % that counts (1)");
   cmd->add_option("--threads", args->threads, "worker threads, 0 = all cores (default 0)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--report", args->report, "directory for report.json and report.html");

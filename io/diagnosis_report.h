@@ -18,7 +18,8 @@
 //                  "variant", "tested_against", "accepted_at_step",
 //                  "p_value" (one-sided Wilcoxon), "sign_test_p", "t_stat",
 //                  "units_better", "units", "evidence_r", "evidence_z",
-//                  "evidence_output", "explanation", "fit_ok", "failure"}],   ranked
+//                  "evidence_output", "explanation", "fit_ok", "failure",
+//                  "irradiance_bias_k", "irradiance_bias_p" (irradiance_bias only)}],   ranked
 //     "verdict": "wind",                       an effect, "none" or "unknown"
 //     "verdict_sentence": "...",
 //     "final_variant", "ladder": [{"variant", "added", "heldout_mae_w",

@@ -23,6 +23,9 @@ namespace {
 
 const double kNaN = std::nan("");
 
+// Fewest training days on which soiling (a loss growing over days) is tried.
+constexpr int kMinSoilingTrainDays = 3;
+
 std::string Fixed(double x, int digits) {
   std::ostringstream s;
   s.setf(std::ios::fixed);
@@ -415,6 +418,15 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
       std::erase_if(candidates, [&options](const EffectCandidate& c) {
         return std::find(options.effects.begin(), options.effects.end(), c.name) ==
                options.effects.end();
+      });
+    }
+    // A drift over days is not seen within fewer than three training days.
+    if (train_days < kMinSoilingTrainDays) {
+      std::erase_if(candidates, [&skipped](const EffectCandidate& c) {
+        if (c.name != "soiling") return false;
+        skipped.push_back({c.name, "needs at least " + std::to_string(kMinSoilingTrainDays) +
+                                       " training days to see a drift over days"});
+        return true;
       });
     }
     if (step == 1) r.skipped = skipped;

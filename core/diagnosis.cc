@@ -12,6 +12,7 @@
 
 #include "core/backtest.h"
 #include "core/effects.h"
+#include "core/irradiance_drivers.h"
 #include "core/resample.h"
 #include "core/solar_position.h"
 #include "core/thermal_model.h"
@@ -25,14 +26,6 @@ const double kNaN = std::nan("");
 
 // Fewest training days on which soiling (a loss growing over days) is tried.
 constexpr int kMinSoilingTrainDays = 3;
-
-std::string Fixed(double x, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << x;
-  return s.str();
-}
 
 std::string PValue(double p) {
   std::ostringstream s;
@@ -153,16 +146,7 @@ std::vector<double> Residual(const Measurements& m, const std::vector<double>& p
 // Returns false when no cell qualifies.
 bool ShadingStartFromResiduals(const Series& s, const Drivers& d, const SimOutputs& sim,
                                const Measurements& m, const Plant& plant, ParamVector* start) {
-  std::vector<double> mid_s(d.size());
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    mid_s[i] = static_cast<double>(d.time_s[i]) + 0.5 * d.dt_s[i];
-  }
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  std::vector<SolarPosition> sun;
-  ComputeSolarPositions(mid_s, site, &sun);
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   constexpr int kAz = 36, kEl = 18;
   std::vector<double> sum(kAz * kEl, 0.0), count(kAz * kEl, 0.0);
   for (std::uint32_t i : m.rows) {
@@ -172,7 +156,6 @@ bool ShadingStartFromResiduals(const Series& s, const Drivers& d, const SimOutpu
     sum[a * kEl + e] += (sim.p_el_w[i] - m.p_el_w[i]) / sim.p_el_w[i];
     count[a * kEl + e] += 1.0;
   }
-  (void)s;
   int az_lo = kAz, az_hi = -1, el_hi = -1;
   for (int a = 0; a < kAz; ++a) {
     for (int e = 0; e < kEl; ++e) {
@@ -219,6 +202,14 @@ void IrradianceBiasTest(const Series& data, const std::vector<std::int64_t>& day
 }
 
 }  // namespace
+
+std::string FixedDecimals(double x, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << x;
+  return s.str();
+}
 
 IdentOptions DiagnosisIdentOptions() {
   IdentOptions o;
@@ -359,7 +350,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
                       std::to_string(options.min_test_units) + "+ days");
   }
   progress("diagnosis: " + std::to_string(train_days) + " training days, " +
-           std::to_string(heldout_days) + " held-out days, step " + Fixed(data.step_s, 0) +
+           std::to_string(heldout_days) + " held-out days, step " + FixedDecimals(data.step_s, 0) +
            " s; fitting the base model " + r.base_variant);
   const IdentSummary base_fit =
       Identify(base_train.drivers, base_train.meas, StartParams(plant), options.ident);
@@ -374,8 +365,9 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   Simulate(base_train.drivers, base_fit.params, &base_train_sim);
   Score base_score = ScoreHeldout(base_heldout, base_fit.params, units, area_m2);
   r.gap = base_score.errors;
-  progress("base " + r.base_variant + ": held-out MAE P_el " + Fixed(r.gap.mae_p_el_w, 2) +
-           " W, Q_u " + Fixed(r.gap.mae_q_th_w, 2) + " W (" + Fixed(base_fit.runtime_s, 2) + " s)");
+  progress("base " + r.base_variant + ": held-out MAE P_el " + FixedDecimals(r.gap.mae_p_el_w, 2) +
+           " W, Q_u " + FixedDecimals(r.gap.mae_q_th_w, 2) + " W (" +
+           FixedDecimals(base_fit.runtime_s, 2) + " s)");
   {
     LadderStep step;
     step.variant = r.base_variant;
@@ -498,12 +490,12 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
         const int finished = ++done;
         progress("[step " + std::to_string(step) + ", " + std::to_string(finished) + "/" +
                  std::to_string(candidates.size()) + "] +" + t.name + ": " +
-                 (t.fit_ok ? "shrink " + Fixed(t.shrink_pct, 1) + " %, better on " +
+                 (t.fit_ok ? "shrink " + FixedDecimals(t.shrink_pct, 1) + " %, better on " +
                                  std::to_string(t.test.positives) + " of " +
                                  std::to_string(t.test.pairs) + " " + r.test_unit + "s, p = " +
                                  PValue(t.test.wilcoxon_p) + (t.significant ? " (significant)" : "")
                            : "FAILED: " + t.failure) +
-                 " (" + Fixed(t.fit_runtime_s, 2) + " s)");
+                 " (" + FixedDecimals(t.fit_runtime_s, 2) + " s)");
       }
     };
     {
@@ -519,13 +511,13 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
       std::ostringstream ev;
       if (step == 1 && t.evidence_corr.rows > 0) {
         ev << "partial correlation of the " << (t.evidence_output == "q_th" ? "Q_u" : "P_el")
-           << " residual with " << t.signature << " r = " << Fixed(t.evidence_corr.r, 2)
-           << " (z = " << Fixed(t.evidence_corr.z, 1)
-           << ", n_eff = " << Fixed(t.evidence_corr.n_eff, 0) << "); ";
+           << " residual with " << t.signature << " r = " << FixedDecimals(t.evidence_corr.r, 2)
+           << " (z = " << FixedDecimals(t.evidence_corr.z, 1)
+           << ", n_eff = " << FixedDecimals(t.evidence_corr.n_eff, 0) << "); ";
       }
       if (std::isfinite(t.irradiance_bias)) {
         ev << "against GHI/DHI transposed to the plane, the plane-of-array pyranometer reads "
-           << Fixed(100.0 * std::fabs(t.irradiance_bias), 1) << " % "
+           << FixedDecimals(100.0 * std::fabs(t.irradiance_bias), 1) << " % "
            << (t.irradiance_bias > 0 ? "low" : "high") << " (median over " << t.irradiance_bias_days
            << " days, two-sided Wilcoxon p = " << PValue(t.irradiance_bias_p)
            << "); η_PV and F_th absorb such a scale error, so "
@@ -690,9 +682,9 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
     std::ostringstream s;
     s << "The model " << r.base_variant << " misses " << r.verdict
       << ": adding it and re-identifying "
-      << "cuts the held-out error (MAE P_el + Q_u) by " << Fixed(r.ladder[1].shrink_pct, 1)
-      << " %, from " << Fixed(first.heldout_mae_w, 1) << " W to "
-      << Fixed(r.ladder[1].heldout_mae_w, 1) << " W";
+      << "cuts the held-out error (MAE P_el + Q_u) by " << FixedDecimals(r.ladder[1].shrink_pct, 1)
+      << " %, from " << FixedDecimals(first.heldout_mae_w, 1) << " W to "
+      << FixedDecimals(r.ladder[1].heldout_mae_w, 1) << " W";
     if (top != nullptr) {
       s << ", lower on " << top->test.positives << " of " << top->test.pairs << " held-out "
         << r.test_unit << "s (Wilcoxon p = " << PValue(top->test.wilcoxon_p) << ")";
@@ -702,39 +694,40 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
       s << " Then";
       for (std::size_t k = 2; k < r.ladder.size(); ++k) {
         s << (k > 2 ? "," : "") << " +" << r.ladder[k].added << " (−"
-          << Fixed(r.ladder[k].shrink_pct, 1) << " %)";
+          << FixedDecimals(r.ladder[k].shrink_pct, 1) << " %)";
       }
-      s << ", ending at " << Fixed(last.heldout_mae_w, 1) << " W with " << r.final_variant << ".";
+      s << ", ending at " << FixedDecimals(last.heldout_mae_w, 1) << " W with " << r.final_variant
+        << ".";
     }
     if (r.low_confidence) s << " Low confidence: too few held-out days.";
     r.verdict_sentence = s.str();
   } else if (r.noise.ratio > options.unknown_noise_ratio) {
     r.verdict = "unknown";
     std::ostringstream s;
-    s << "The held-out error of " << r.base_variant << " (" << Fixed(first.heldout_mae_w, 1)
-      << " W, MAE P_el + Q_u) is " << Fixed(r.noise.ratio, 1)
+    s << "The held-out error of " << r.base_variant << " (" << FixedDecimals(first.heldout_mae_w, 1)
+      << " W, MAE P_el + Q_u) is " << FixedDecimals(r.noise.ratio, 1)
       << "× what sensor noise explains, but no catalogued effect removes it consistently";
     if (!r.where.empty()) {
       const GapRegion& w = r.where.front();
-      s << "; it concentrates where " << w.driver << " is in [" << Fixed(w.lower, 1) << ", "
-        << Fixed(w.upper, 1) << ")";
+      s << "; it concentrates where " << w.driver << " is in [" << FixedDecimals(w.lower, 1) << ", "
+        << FixedDecimals(w.upper, 1) << ")";
       if (!w.label.empty()) s << " (" << w.label << ")";
       if (!w.driver2.empty()) {
-        s << " and " << w.driver2 << " in [" << Fixed(w.lower2, 1) << ", " << Fixed(w.upper2, 1)
-          << ")";
+        s << " and " << w.driver2 << " in [" << FixedDecimals(w.lower2, 1) << ", "
+          << FixedDecimals(w.upper2, 1) << ")";
       }
-      s << ": " << Fixed(100.0 * w.share_of_abs_error, 0) << " % of the "
+      s << ": " << FixedDecimals(100.0 * w.share_of_abs_error, 0) << " % of the "
         << (w.output == "q_th" ? "Q_u" : "P_el") << " error in "
-        << Fixed(100.0 * w.share_of_rows, 0) << " % of the rows";
+        << FixedDecimals(100.0 * w.share_of_rows, 0) << " % of the rows";
     }
     s << ".";
     r.verdict_sentence = s.str();
   } else {
     r.verdict = "none";
     r.verdict_sentence = "No catalogued effect lowers the held-out error of " + r.base_variant +
-                         " consistently; its held-out error (" + Fixed(first.heldout_mae_w, 1) +
-                         " W, MAE P_el + Q_u) is " + Fixed(r.noise.ratio, 1) +
-                         "× the sensor-noise floor.";
+                         " consistently; its held-out error (" +
+                         FixedDecimals(first.heldout_mae_w, 1) + " W, MAE P_el + Q_u) is " +
+                         FixedDecimals(r.noise.ratio, 1) + "× the sensor-noise floor.";
   }
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   *result = std::move(r);

@@ -185,6 +185,9 @@ struct DiagnosisResult {
   double wall_time_s = 0.0;
 };
 
+// x with `digits` decimals ("12.35"), as the verdict sentence prints numbers.
+std::string FixedDecimals(double x, int digits);
+
 // Runs the diagnosis of `base` on `data`. Returns false with *error when it
 // cannot run: invalid options, a step the data cannot be averaged to, missing
 // columns for the base variant, too few days or rows, or a failed base fit.

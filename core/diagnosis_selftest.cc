@@ -33,14 +33,6 @@ ModelSpec Parse(const std::string& name) {
   return spec;
 }
 
-std::string Fixed(double x, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << x;
-  return s.str();
-}
-
 // Held-out objective of the truth model with its true parameters, simulated
 // over the whole data (soiling counts from the first row) and scored on the
 // held-out days.
@@ -168,8 +160,9 @@ SelftestOutcome RunSelftestCase(const Plant& plant, const SelftestCase& c, std::
     if (o.first_step != c.expected) why << "first ladder step '" << o.first_step << "'; ";
     // After the ladder, the held-out error is near the truth model's.
     if (!(o.heldout_after_w_m2 <= (1.0 + options.after_tolerance) * o.heldout_truth_w_m2)) {
-      why << "held-out after " << Fixed(o.heldout_after_w_m2, 3) << " W/m² > (1 + "
-          << options.after_tolerance << ") × truth " << Fixed(o.heldout_truth_w_m2, 3) << "; ";
+      why << "held-out after " << FixedDecimals(o.heldout_after_w_m2, 3) << " W/m² > (1 + "
+          << options.after_tolerance << ") × truth " << FixedDecimals(o.heldout_truth_w_m2, 3)
+          << "; ";
     }
   }
   if (c.expected == "unknown") {
@@ -248,7 +241,8 @@ std::string FormatSelftestReport(const std::vector<SelftestOutcome>& outcomes) {
     null_cases += o.expected == "none";
   }
   out << "\nhit rate: " << correct << " / " << outcomes.size() << " = "
-      << Fixed(outcomes.empty() ? 0.0 : 100.0 * correct / static_cast<double>(outcomes.size()), 1)
+      << FixedDecimals(
+             outcomes.empty() ? 0.0 : 100.0 * correct / static_cast<double>(outcomes.size()), 1)
       << " %; false significant effects on null cases: " << false_significant << " of "
       << null_cases << "\n";
   return out.str();

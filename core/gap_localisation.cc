@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/backtest.h"
+#include "core/irradiance_drivers.h"
 #include "core/sky_radiation.h"
 #include "core/solar_position.h"
 #include "core/units.h"
@@ -311,16 +312,7 @@ std::vector<RegimeDriver> StandardRegimeDrivers(const Series& s, const Drivers& 
   }
 
   // Sun position at the middle of each row.
-  std::vector<double> mid_s(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    mid_s[i] = static_cast<double>(s.time_s[i]) + 0.5 * (i < d.dt_s.size() ? d.dt_s[i] : s.step_s);
-  }
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  std::vector<SolarPosition> sun;
-  ComputeSolarPositions(mid_s, site, &sun);
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
 
   {  // angle of incidence, measured when logged
     RegimeDriver aoi{

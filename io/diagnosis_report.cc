@@ -49,8 +49,10 @@ std::string Fixed(double x, int digits) {
 
 std::string RangeText(double lo, double hi) {
   auto b = [](double v) {
-    return std::isinf(v) ? (v < 0 ? std::string("−∞") : std::string("∞"))
-                         : Fixed(v, v == std::round(v) ? 0 : 2);
+    if (std::isinf(v)) return std::string(v < 0 ? "−∞" : "∞");
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::string(buf);
   };
   return "[" + b(lo) + ", " + b(hi) + ")";
 }

@@ -33,7 +33,7 @@ double TickStep(double span, int target) {
 std::string TickLabel(double v, double step) {
   char buf[32];
   if (step >= 1.0 || v == 0.0) {
-    std::snprintf(buf, sizeof buf, "%g", std::round(v / step) * step);
+    std::snprintf(buf, sizeof buf, "%g", std::round(v / step) * step + 0.0);  // no "-0"
   } else {
     std::snprintf(buf, sizeof buf, "%.*f", static_cast<int>(std::ceil(-std::log10(step))), v);
   }

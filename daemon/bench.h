@@ -12,5 +12,6 @@ double SecondsSince(std::chrono::steady_clock::time_point start);
 
 void BenchIdentification(int repeats, std::uint64_t seed);
 void BenchTable6(std::uint64_t seed);
+void BenchEffects(int repeats, std::uint64_t seed);
 
 }  // namespace pvtwin::cli

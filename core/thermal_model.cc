@@ -428,7 +428,10 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
       continue;
     }
     const RowTerms r = MakeRowTerms(k, d, w, i);
-    if (!std::isfinite(r.q_sun_w) || !std::isfinite(r.t_amb_c)) {  // shifted weather missing
+    // clock_offset: a shifted weather value may come from a row with a gap.
+    if (!std::isfinite(r.q_sun_w) || !std::isfinite(r.t_amb_c) || !std::isfinite(r.t_back_c) ||
+        !std::isfinite(r.t_sky_k4) || !std::isfinite(r.eta.eta_at_ref_temp) ||
+        std::isnan(r.g_front_w_k)) {
       SetRowNaN(out, i, energy);
       need_restart = true;
       continue;

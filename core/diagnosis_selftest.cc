@@ -67,15 +67,7 @@ std::vector<SelftestCase> SelftestCases(const Plant& plant) {
       const ModelSpec base = Parse(base_name);
       if (!CanAddEffect(base, info.effect, probe, nullptr)) continue;
       const ModelSpec truth = WithEffect(base, info.effect);
-      ParamVector params = TruthParamsFor(plant, truth);
-      if (info.effect == Effect::kSecondNode) {
-        // At the reference U_coll = 45 W/m²K the PV runs within about 1 K of
-        // the absorber and a one-node model's held-out error is only 0.3 %
-        // higher: no test can (or should) call that. 15 W/m²K is a PVT
-        // module with poor laminate-to-absorber bonding, where the second
-        // node matters.
-        params[static_cast<std::size_t>(Param::kUCollWM2K)] = 15.0;
-      }
+      const ParamVector params = TruthParamsFor(plant, truth);
       cases.push_back(
           {std::string(info.name), std::string(info.name), base, truth, params, std::nullopt, 0.0});
       break;

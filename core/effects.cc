@@ -34,7 +34,8 @@ std::vector<EffectInfo> BuildTable() {
                "channel: the cells run warmer than the fluid-side node by Q/U_coll, which lowers "
                "P_el at high heat flux (paper 2.10, two-node network).",
                {P::kUCollWM2K},
-               {{P::kUCollWM2K, 20.0}},
+               // A PVT module without lamination of the cells onto the absorber.
+               {{P::kUCollWM2K, 12.0}},
                "inlet minus ambient temperature, K",
                {}});
   t.push_back({Effect::kWind,
@@ -75,7 +76,9 @@ std::vector<EffectInfo> BuildTable() {
                "form. Visible when the flow varies: Q_u falls faster than the base model "
                "predicts at low flow.",
                {P::kNFlow},
-               {{P::kNFlow, 0.8}, {P::kR0FluidM2KW, 0.05}},
+               // Turbulent flow in a sheet-and-tube absorber with a poor bond,
+               // where the convective resistance matters.
+               {{P::kNFlow, 0.8}, {P::kR0FluidM2KW, 0.08}},
                "mass flow relative to the nominal 0.02 kg/(s·m²)",
                {}});
   t.push_back({Effect::kTransportDelay,

@@ -95,8 +95,8 @@ struct WeatherView {
   const double* t_back_c;
   const double* ln_wind;
   const double* t_sky_k4;
-  const double* pv_factor;  // shading: P_el factor 1 − f_mismatch·s; null = 1
-  std::vector<double> store[7];
+  const double* pv_factor;     // shading: P_el factor 1 − f_mismatch·s; null = 1
+  std::vector<double>* store;  // SimOutputs::effect_work
 };
 
 // Effect shading: fraction of the beam blocked by the obstacle,
@@ -134,8 +134,9 @@ void ShiftInTime(const Drivers& d, const std::vector<double>& v, double offset_s
   }
 }
 
-void MakeWeatherView(const Drivers& d, const ParamVector& p, WeatherView* w) {
+void MakeWeatherView(const Drivers& d, const ParamVector& p, SimOutputs* out, WeatherView* w) {
   const ModelSpec& spec = d.spec;
+  w->store = out->effect_work.data();
   w->g_poa_w_m2 = d.g_poa_w_m2.data();
   w->g_abs_w_m2 = d.g_abs_w_m2.data();
   w->t_amb_c = d.t_amb_c.data();
@@ -154,7 +155,7 @@ void MakeWeatherView(const Drivers& d, const ParamVector& p, WeatherView* w) {
   g_beam = d.g_beam_w_m2;
   if (clock) {
     const double offset_s = P(p, Param::kClockOffsetS);
-    std::vector<double> shifted;
+    std::vector<double>& shifted = w->store[7];
     ShiftInTime(d, d.g_abs_w_m2, offset_s, &g_abs);
     ShiftInTime(d, d.g_beam_w_m2, offset_s, &g_beam);
     ShiftInTime(d, d.g_poa_w_m2, offset_s, &w->store[2]);
@@ -162,7 +163,8 @@ void MakeWeatherView(const Drivers& d, const ParamVector& p, WeatherView* w) {
     ShiftInTime(d, d.t_back_c, offset_s, &w->store[4]);
     ShiftInTime(d, d.t_sky_k4, offset_s, &w->store[5]);
     // ln v is −inf in calm: interpolate v itself.
-    std::vector<double> v(n);
+    std::vector<double>& v = w->store[6];
+    v.resize(n);
     for (std::size_t i = 0; i < n; ++i) v[i] = std::exp(d.ln_wind[i]);
     ShiftInTime(d, v, offset_s, &shifted);
     for (std::size_t i = 0; i < n; ++i) {
@@ -171,7 +173,6 @@ void MakeWeatherView(const Drivers& d, const ParamVector& p, WeatherView* w) {
                  : (shifted[i] > 0.0 ? std::log(shifted[i])
                                      : -std::numeric_limits<double>::infinity());
     }
-    w->store[6] = std::move(v);
     w->g_poa_w_m2 = w->store[2].data();
     w->t_amb_c = w->store[3].data();
     w->t_back_c = w->store[4].data();
@@ -375,7 +376,8 @@ void ApplyTransportDelay(const Drivers& d, const WeatherView& w, double delay_s,
                          double cp, SimOutputs* out) {
   const std::size_t n = d.size();
   if (n == 0 || !(delay_s > 0.0 || pipe_w_k > 0.0)) return;
-  std::vector<double> t_out = out->t_out_c;  // undelayed copy
+  std::vector<double>& t_out = out->effect_work[8];
+  t_out = out->t_out_c;  // undelayed copy
   for (std::size_t i = 0; i < n; ++i) {
     if (!d.usable[i]) continue;
     const double t_seen = static_cast<double>(d.time_s[i]) - delay_s;
@@ -413,7 +415,7 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
   }
   const RunConstants k = MakeConstants(d, params);
   WeatherView w;
-  MakeWeatherView(d, params, &w);
+  MakeWeatherView(d, params, out, &w);
   double state[2] = {0.0, 0.0};  // node temperatures at the start of the row
   // Step-mean PV temperatures of the last two rows: their linear
   // extrapolation is the first linearisation point, which usually meets the
@@ -428,7 +430,10 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
       continue;
     }
     const RowTerms r = MakeRowTerms(k, d, w, i);
-    if (!std::isfinite(r.q_sun_w) || !std::isfinite(r.t_amb_c)) {  // shifted weather missing
+    // clock_offset: a shifted weather value may come from a row with a gap.
+    if (!std::isfinite(r.q_sun_w) || !std::isfinite(r.t_amb_c) || !std::isfinite(r.t_back_c) ||
+        !std::isfinite(r.t_sky_k4) || !std::isfinite(r.eta.eta_at_ref_temp) ||
+        std::isnan(r.g_front_w_k)) {
       SetRowNaN(out, i, energy);
       need_restart = true;
       continue;

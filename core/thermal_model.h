@@ -28,6 +28,7 @@
 // parameter within Table 3's bounds and any step from 5 s to 15 min.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -118,6 +119,10 @@ struct SimOutputs {
   // Energy terms (interval means, W), filled when SimOptions::energy_terms:
   // q_abs = q_th + q_front + q_back + q_rad + q_store.
   std::vector<double> q_abs_w, q_front_w, q_back_w, q_rad_w, q_store_w;
+  // Work space of the effects shading, soiling, clock_offset and
+  // transport_delay (modified weather drivers, the undelayed outlet), kept
+  // here so that repeated runs do not allocate.
+  std::array<std::vector<double>, 9> effect_work;
 };
 
 struct SimOptions {

@@ -12,6 +12,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start);
 
 void BenchIdentification(int repeats, std::uint64_t seed);
 void BenchTable6(std::uint64_t seed);
+void BenchEffects(int repeats, std::uint64_t seed);
 void BenchDiagnosis(std::uint64_t seed);
 
 }  // namespace pvtwin::cli

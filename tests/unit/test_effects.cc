@@ -2,9 +2,11 @@
 // CanAddEffect (core/effects.h).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "core/effects.h"
+#include "core/synthetic_plant.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
@@ -98,6 +100,46 @@ TEST(EffectVariants, CannotAddWhatIsThereOrWhatTheDataCannotIdentify) {
   both.Ensure(Channel::kGhiWM2);
   both.Ensure(Channel::kDhiWM2);
   EXPECT_TRUE(CanAddEffect(testing::SpecOf("1N1Cwr"), Effect::kIrradianceBias, both, &why));
+}
+
+}  // namespace
+}  // namespace pvtwin
+
+namespace pvtwin {
+namespace {
+
+// Every signature is defined on the drivers of a base model without the
+// effect (what the diagnosis has), with the sign its explanation implies.
+TEST(EffectSignature, DefinedOnBaseDriversWithTheExpectedSign) {
+  const Plant plant = DesignExamplePlant();
+  SyntheticOptions o;
+  std::string error;
+  ASSERT_TRUE(DefaultSyntheticOptions(plant, "1N1Cwr", 2, 31, &o, &error)) << error;
+  o.defects = DataDefects{};
+  const Series s = MakeSyntheticPlantData(plant, o);
+  Drivers d;
+  ASSERT_TRUE(PrepareDrivers(s, plant, testing::SpecOf("1N"), &d, &error)) << error;
+  SimOutputs base;
+  Simulate(d, o.truth, &base);
+  for (const EffectInfo& info : EffectTable()) {
+    const std::vector<double> sig = EffectSignature(info.effect, d, base);
+    ASSERT_EQ(sig.size(), d.size()) << info.name;
+    std::size_t finite = 0;
+    for (double v : sig) finite += std::isfinite(v);
+    EXPECT_GT(finite, d.size() / 10) << info.name;
+  }
+  const auto at = [&](Effect e, std::size_t i) { return EffectSignature(e, d, base)[i]; };
+  for (std::size_t i = 1; i + 1 < d.size(); ++i) {
+    EXPECT_DOUBLE_EQ(at(Effect::kPvClipping, i), base.p_el_w[i] / plant.area_m2);
+    EXPECT_DOUBLE_EQ(at(Effect::kSoiling, i), static_cast<double>(i) * 60.0 / 86400.0);
+    if (i > 100) break;
+  }
+  // The sky is colder than the air on average; the generated data's two
+  // irradiance sources agree (no bias).
+  double deficit = 0.0;
+  for (double v : EffectSignature(Effect::kSkyRadiation, d, base)) deficit += v;
+  EXPECT_GT(deficit, 0.0);
+  EXPECT_NEAR(EstimateIrradianceBias(d), 0.0, 0.01);
 }
 
 }  // namespace

@@ -113,6 +113,10 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
                 at(truth_p, Param::kShadeAzimuthRad) + 0.5 * at(truth_p, Param::kShadeWidthRad),
                 0.03);
   }
+  if (c.effect == Effect::kTransportDelay) {
+    const std::size_t pipe = static_cast<std::size_t>(Param::kUPipeWM2K);
+    EXPECT_NEAR(fit_with.summary.params[pipe], options.truth[pipe], 0.3);
+  }
   if (c.effect == Effect::kIrradianceBias) {
     // Without the second source the fit absorbs the pyranometer's 6 % low
     // reading into η_PV; with it, η_PV comes back unbiased.

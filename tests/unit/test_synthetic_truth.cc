@@ -138,7 +138,7 @@ TEST(SyntheticTruth, DisturbancesActOnTheirDaysOnly) {
         break;
       case DisturbanceKind::kStuckFlowReading:
         EXPECT_LT(p_ratio, 1.0) << name;  // stagnation: hot cells
-        EXPECT_GT(q_ratio, 2.0) << name;   // reading × stagnation temperature rise
+        EXPECT_GT(q_ratio, 2.0) << name;  // reading × stagnation temperature rise
         break;
       case DisturbanceKind::kSnowCover:
         EXPECT_LT(p_ratio, 0.01) << name;

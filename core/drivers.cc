@@ -3,8 +3,12 @@
 #include <cmath>
 #include <limits>
 
+#include "core/effects.h"
+#include "core/iam.h"
+#include "core/irradiance.h"
 #include "core/irradiance_drivers.h"
 #include "core/sky_radiation.h"
+#include "core/solar_position.h"
 #include "core/thermal_model.h"
 #include "core/units.h"
 
@@ -22,7 +26,99 @@ std::string ChannelList(const std::vector<Channel>& channels) {
   return out;
 }
 
+// The raw drivers of the effect library (thermal_model.h, Drivers): sun
+// geometry at the row middles, measured wind and sky temperature, the beam
+// part of the absorbed irradiance, the transposed GHI/DHI and the soiling
+// clock.
+void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d) {
+  const std::size_t n = s.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  d->wind_m_s = s.Has(Channel::kWindMS) ? s[Channel::kWindMS] : std::vector<double>(n, nan);
+  d->t_sky_c.assign(n, nan);
+  for (std::size_t i = 0; i < n; ++i) {
+    double t_sky_c = s.At(Channel::kTSkyC, i);
+    if (std::isnan(t_sky_c) && s.Has(Channel::kLwDownWM2)) {
+      t_sky_c = KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
+    }
+    d->t_sky_c[i] = t_sky_c;
+  }
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
+  d->sun_azimuth_rad.resize(n);
+  d->sun_elevation_rad.resize(n);
+  d->aoi_rad.resize(n);
+  d->g_beam_w_m2.assign(n, nan);
+  d->g_ref_w_m2.assign(n, nan);
+  const bool have_horizontal = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
+  for (std::size_t i = 0; i < n; ++i) {
+    d->sun_azimuth_rad[i] = sun[i].azimuth_rad;
+    d->sun_elevation_rad[i] = sun[i].elevation_rad;
+    double aoi_rad = s.At(Channel::kAoiRad, i);
+    if (std::isnan(aoi_rad)) {
+      aoi_rad = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
+                                    plant.azimuth_rad);
+    }
+    d->aoi_rad[i] = aoi_rad;
+    double beam_w_m2 = nan;
+    if (have_horizontal) {
+      IsotropicSkyInput h;
+      h.ghi_w_m2 = s[Channel::kGhiWM2][i];
+      h.dhi_w_m2 = s[Channel::kDhiWM2][i];
+      h.zenith_rad = sun[i].zenith_rad;
+      h.aoi_rad = aoi_rad;
+      h.tilt_rad = plant.tilt_rad;
+      h.ground_albedo = plant.ground_albedo;
+      const PoaComponents poa = TransposeIsotropicSky(h);
+      d->g_ref_w_m2[i] = poa.global_w_m2();
+      beam_w_m2 = poa.beam_w_m2;
+    }
+    const double g_poa = s.At(Channel::kGPoaWM2, i);
+    const double diffuse = s.At(Channel::kGPoaDiffuseWM2, i);
+    if (!std::isnan(g_poa) && !std::isnan(diffuse)) beam_w_m2 = std::max(0.0, g_poa - diffuse);
+    if (spec.iam) beam_w_m2 *= IamSoukaSafwat(aoi_rad, plant.iam_b0);
+    d->g_beam_w_m2[i] = beam_w_m2;
+  }
+  SetCleaningTimes({}, d);
+}
+
 }  // namespace
+
+void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t end,
+                               Drivers* coarse) {
+  double dt_s = 0.0;
+  for (std::size_t k = begin; k < end; ++k) dt_s += d.dt_s[k];
+  auto mean = [&](const std::vector<double>& v) {
+    double acc = 0.0;
+    for (std::size_t k = begin; k < end; ++k) acc += v[k] * d.dt_s[k];
+    return acc / dt_s;
+  };
+  const std::size_t mid = begin + (end - begin) / 2;
+  coarse->wind_m_s.push_back(mean(d.wind_m_s));
+  coarse->t_sky_c.push_back(mean(d.t_sky_c));
+  coarse->sun_azimuth_rad.push_back(d.sun_azimuth_rad[mid]);
+  coarse->sun_elevation_rad.push_back(d.sun_elevation_rad[mid]);
+  coarse->aoi_rad.push_back(d.aoi_rad[mid]);
+  coarse->g_beam_w_m2.push_back(mean(d.g_beam_w_m2));
+  coarse->g_ref_w_m2.push_back(mean(d.g_ref_w_m2));
+  coarse->days_since_clean.push_back(mean(d.days_since_clean));
+  coarse->irradiance_bias = d.irradiance_bias;
+}
+
+void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers* d) {
+  std::vector<std::int64_t> cleanings = cleaning_times_s;
+  std::sort(cleanings.begin(), cleanings.end());
+  const std::size_t n = d->size();
+  d->days_since_clean.resize(n);
+  if (n == 0) return;
+  std::int64_t last_clean_s = d->time_s[0];
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (next < cleanings.size() && cleanings[next] <= d->time_s[i]) {
+      last_clean_s = std::max(last_clean_s, cleanings[next]);
+      ++next;
+    }
+    d->days_since_clean[i] = static_cast<double>(d->time_s[i] - last_clean_s) / 86400.0;
+  }
+}
 
 bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d,
                     std::string* error) {
@@ -84,6 +180,23 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
   }
 
   ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2);
+  FillEffectDrivers(s, plant, spec, &out);
+  if (spec.Has(Extension::kIrradianceBias)) {
+    const double k = EstimateIrradianceBias(out);
+    if (std::isnan(k)) {
+      *error = "variant " + spec.Name() +
+               ": irradiance_bias needs at least 30 rows where g_poa_w_m2 and the transposed "
+               "ghi_w_m2 + dhi_w_m2 both exceed 300 W/m² at an angle of incidence below 60°";
+      return false;
+    }
+    out.irradiance_bias = k;
+    const bool beam_from_poa = s.Has(Channel::kGPoaDiffuseWM2);
+    for (std::size_t i = 0; i < n; ++i) {
+      out.g_poa_w_m2[i] *= 1.0 + k;
+      out.g_abs_w_m2[i] *= 1.0 + k;
+      if (beam_from_poa) out.g_beam_w_m2[i] *= 1.0 + k;
+    }
+  }
 
   out.ln_wind.assign(n, 0.0);
   if (spec.wind_paper || spec.Has(Extension::kWind)) {

@@ -438,6 +438,7 @@ void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, M
     cd->t_back_c.push_back(mean(d.t_back_c));
     cd->ln_wind.push_back(std::log(wind / dt));
     cd->t_sky_k4.push_back(mean(d.t_sky_k4));
+    AppendCoarseEffectDrivers(d, i, end, cd);
     if (all_obj) cm->rows.push_back(static_cast<std::uint32_t>(cm->p_el_w.size()));
     cm->p_el_w.push_back(all_obj ? mean(m.p_el_w) : kNaN);
     cm->q_th_w.push_back(all_obj ? mean(m.q_th_w) : kNaN);

@@ -8,10 +8,6 @@
 
 namespace pvtwin {
 
-namespace {
-
-// Sun position at the middle of each row: a row is the mean over
-// [t_k, t_k + step).
 std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) {
   std::vector<double> mid_s(s.size());
   for (std::size_t i = 0; i < s.size(); ++i) {
@@ -25,8 +21,6 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) 
   ComputeSolarPositions(mid_s, site, &sun);
   return sun;
 }
-
-}  // namespace
 
 void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
                               std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2) {
@@ -70,9 +64,8 @@ void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSp
     } else {
       continue;  // no irradiance for this row
     }
-    (*g_abs_w_m2)[i] = spec.iam
-                           ? AbsorbedIrradianceWM2(poa, aoi_rad, diffuse_angles, plant.iam_b0)
-                           : (*g_poa_w_m2)[i];
+    (*g_abs_w_m2)[i] = spec.iam ? AbsorbedIrradianceWM2(poa, aoi_rad, diffuse_angles, plant.iam_b0)
+                                : (*g_poa_w_m2)[i];
   }
 }
 

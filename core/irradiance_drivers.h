@@ -7,9 +7,14 @@
 
 #include "core/plant.h"
 #include "core/series.h"
+#include "core/solar_position.h"
 #include "core/variant.h"
 
 namespace pvtwin {
+
+// Sun position at the middle of each row (a row is the mean over
+// [t_k, t_k + step)), at the plant's site.
+std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant);
 
 // Sources, in order of preference:
 //  * I_gt: measured g_poa_w_m2; else transposed from ghi_w_m2 + dhi_w_m2

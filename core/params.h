@@ -49,6 +49,18 @@ enum class Param : std::size_t {
   kPvTempCoeffPerK,  // f_corr_T (fixed by default, from the plant config)
   kPvIrrCoeffM2W,    // f_corr_I (fixed by default, from the plant config)
   kTransportDelayS,  // effect transport_delay: inlet-to-outlet dead time
+  // Parameters of the effect library (core/effects.h); appended so that the
+  // indices above keep their meaning.
+  kUPipeWM2K,          // transport_delay: pipe loss to ambient, W/(m²K) of collector
+  kNFlow,              // flow_dependent_u: exponent of the fluid-side resistance on flow
+  kPLimitWM2,          // pv_clipping: inverter AC limit per m² of collector, W/m²
+  kShadeAzimuthRad,    // shading: centre of the obstacle's azimuth window
+  kShadeWidthRad,      // shading: full width of the azimuth window
+  kShadeElevationRad,  // shading: elevation of the obstacle's upper edge
+  kShadeMismatch,      // shading: extra P_el loss per shaded fraction (bypass diodes)
+  kSoilingPerDay,      // soiling: transmittance loss per day since cleaning
+  kClockOffsetS,       // clock_offset: weather clock behind the collector clock
+  kIrradianceBias,     // irradiance_bias: pyranometer scale error k
   kCount
 };
 
@@ -66,7 +78,7 @@ struct ParamInfo {
   double start;             // reference start value (Table 3)
   double lower;             // identification bounds (Table 3)
   double upper;
-  ParamScale scale;  // how identification scales the search variable
+  ParamScale scale;        // how identification scales the search variable
   bool relative_to_plant;  // start/bounds are factors of the plant config value
 };
 

@@ -1,10 +1,12 @@
 #include "core/synthetic_plant.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <random>
 
+#include "core/effects.h"
 #include "core/thermal_model.h"
 #include "core/units.h"
 
@@ -53,24 +55,133 @@ ParamVector ReferenceTruthParams(const Plant& plant) {
   return p;
 }
 
-Series MakeSyntheticPlantData(const Plant& plant, const WeatherOptions& weather,
-                              const ModelSpec& truth_spec, const ParamVector& truth,
-                              const SensorNoise& noise) {
-  Series s = GenerateWeather(plant, weather);
+ParamVector TruthParamsFor(const Plant& plant, const ModelSpec& spec) {
+  ParamVector p = ReferenceTruthParams(plant);
+  for (const EffectInfo& info : EffectTable()) {
+    if (!HasEffect(spec, info.effect)) continue;
+    for (const auto& [param, value] : info.typical_truth) {
+      p[static_cast<std::size_t>(param)] = value;
+    }
+  }
+  return p;
+}
+
+std::string_view DisturbanceName(DisturbanceKind kind) {
+  switch (kind) {
+    case DisturbanceKind::kFailingPump:
+      return "failing_pump";
+    case DisturbanceKind::kStuckFlowReading:
+      return "stuck_flow_reading";
+    case DisturbanceKind::kSnowCover:
+      return "snow_cover";
+  }
+  return "?";
+}
+
+bool DefaultSyntheticOptions(const Plant& plant, std::string_view truth_variant, int days,
+                             std::uint64_t seed, SyntheticOptions* options, std::string* error) {
+  SyntheticOptions o;
+  if (!ParseVariant(truth_variant, &o.truth_spec, error)) return false;
+  o.weather.num_days = days;
+  o.weather.step_s = 60.0;
+  o.weather.seed = seed;
+  o.weather.flow_mode = FlowMode::kVariable;
+  o.truth = TruthParamsFor(plant, o.truth_spec);
+  o.noise = RealisticSensorNoise(seed + 1000);
+  o.defects = PaperDataDefects(seed + 2000);
+  *options = o;
+  return true;
+}
+
+namespace {
+
+bool InWindow(const Disturbance& d, std::int64_t t_s) { return t_s >= d.start_s && t_s < d.end_s; }
+
+// Applies the data defects in place (own random stream: the outputs' noise
+// does not depend on them).
+void InjectDefects(const DataDefects& defects, Series* s) {
+  std::mt19937_64 rng(defects.seed);
+  const std::size_t n = s->size();
+  if (n == 0) return;
+  auto uniform = [&rng](double a, double b) {
+    return a + (b - a) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
+  };
+  auto row = [&rng, n]() { return static_cast<std::size_t>(rng() % n); };
+  auto& g_poa = (*s)[Channel::kGPoaWM2];
+  for (int k = 0, tries = 0; k < defects.irradiance_glitches && tries < 10000; ++tries) {
+    const std::size_t i = row();
+    if (g_poa[i] != 0.0) continue;  // only at night, as in the paper
+    g_poa[i] = uniform(5001.0, 9999.0);
+    ++k;
+  }
+  if (defects.negative_flow_at_rest) {
+    auto& flow = (*s)[Channel::kMdotKgS];
+    for (double& f : flow) {
+      if (f == 0.0) f = -uniform(0.0, 0.8e-3);
+    }
+  }
+  auto block = [&](std::size_t len, auto&& apply) {
+    const std::size_t i0 = row();
+    for (std::size_t i = i0; i < std::min(n, i0 + len); ++i) apply(i);
+  };
+  auto& valid = s->Ensure(Channel::kValid);
+  for (int k = 0; k < defects.invalid_blocks; ++k) {
+    block(30, [&valid](std::size_t i) { valid[i] = 0.0; });
+  }
+  const double nan = std::nan("");
+  for (int k = 0; k < defects.dropout_blocks; ++k) {
+    block(10, [s, nan](std::size_t i) {
+      (*s)[Channel::kTOutC][i] = nan;
+      (*s)[Channel::kQThW][i] = nan;
+    });
+  }
+}
+
+}  // namespace
+
+Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options) {
+  Series s = GenerateWeather(plant, options.weather);
+  const std::size_t n = s.size();
+  // The plant's physics: the real flow and irradiance under disturbances, the
+  // true irradiance (irradiance_bias is a sensor error, applied below).
+  Series physics = s;
+  for (const Disturbance& d : options.disturbances) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!InWindow(d, s.time_s[i])) continue;
+      switch (d.kind) {
+        case DisturbanceKind::kFailingPump:
+          physics[Channel::kMdotKgS][i] *= d.severity;
+          break;
+        case DisturbanceKind::kStuckFlowReading:
+          physics[Channel::kMdotKgS][i] = 0.0;
+          break;
+        case DisturbanceKind::kSnowCover:
+          for (Channel c :
+               {Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2, Channel::kGhiWM2, Channel::kDhiWM2}) {
+            if (physics.Has(c)) physics[c][i] *= d.severity;
+          }
+          break;
+      }
+    }
+  }
+  ModelSpec physics_spec = options.truth_spec;
+  physics_spec.extensions.reset(static_cast<std::size_t>(Extension::kIrradianceBias));
   Drivers drivers;
   std::string error;
-  if (!PrepareDrivers(s, plant, truth_spec, &drivers, &error)) {
+  if (!PrepareDrivers(physics, plant, physics_spec, &drivers, &error)) {
     std::cerr << "MakeSyntheticPlantData: " << error << "\n";
     std::abort();  // the generator provides every channel: a bug
   }
+  if (!options.cleaning_times_s.empty()) SetCleaningTimes(options.cleaning_times_s, &drivers);
   SimOutputs out;
-  Simulate(drivers, truth, &out);
+  Simulate(drivers, options.truth, &out);
+  const SensorNoise& noise = options.noise;
   std::mt19937_64 rng(noise.seed);
-  const std::size_t n = s.size();
   auto& p_el = s.Ensure(Channel::kPElW);
   auto& q_th = s.Ensure(Channel::kQThW);
   auto& t_out = s.Ensure(Channel::kTOutC);
   auto& t_pv = s.Ensure(Channel::kTPvC);
+  const auto& flow_read = s[Channel::kMdotKgS];
   for (std::size_t i = 0; i < n; ++i) {
     p_el[i] = out.p_el_w[i] * (1.0 + noise.p_el_rel * Normal(rng));
     // A heat meter reads zero without flow.
@@ -78,8 +189,34 @@ Series MakeSyntheticPlantData(const Plant& plant, const WeatherOptions& weather,
     q_th[i] = out.q_th_w[i] + (drivers.mdot_kg_s[i] > 0.0 ? q_noise : 0.0);
     t_out[i] = out.t_out_c[i] + noise.t_out_c * Normal(rng);
     t_pv[i] = out.t_pv_c[i];
+    if (flow_read[i] != drivers.mdot_kg_s[i]) {
+      // Disturbed flow: the heat meter multiplies its flow reading by the
+      // real temperature rise.
+      q_th[i] = flow_read[i] > 0.0
+                    ? flow_read[i] * plant.fluid_cp_j_kgk * (t_out[i] - s[Channel::kTInC][i])
+                    : 0.0;
+    }
   }
+  if (options.truth_spec.Has(Extension::kIrradianceBias)) {
+    const double k = options.truth[static_cast<std::size_t>(Param::kIrradianceBias)];
+    for (Channel c : {Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2}) {
+      if (!s.Has(c)) continue;
+      for (double& g : s[c]) g /= 1.0 + k;
+    }
+  }
+  InjectDefects(options.defects, &s);
   return s;
+}
+
+Series MakeSyntheticPlantData(const Plant& plant, const WeatherOptions& weather,
+                              const ModelSpec& truth_spec, const ParamVector& truth,
+                              const SensorNoise& noise) {
+  SyntheticOptions options;
+  options.weather = weather;
+  options.truth_spec = truth_spec;
+  options.truth = truth;
+  options.noise = noise;
+  return MakeSyntheticPlantData(plant, options);
 }
 
 }  // namespace pvtwin

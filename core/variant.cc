@@ -15,12 +15,13 @@ struct ExtensionName {
 constexpr std::array<ExtensionName, kNumExtensions> kExtensionNames = {{
     {Extension::kWind, "wind"},
     {Extension::kTransportDelay, "transport_delay"},
+    {Extension::kFlowDependentU, "flow_dependent_u"},
+    {Extension::kPvClipping, "pv_clipping"},
+    {Extension::kShading, "shading"},
+    {Extension::kSoiling, "soiling"},
+    {Extension::kClockOffset, "clock_offset"},
+    {Extension::kIrradianceBias, "irradiance_bias"},
 }};
-
-// Effects of DESIGN.md's vocabulary that are not model extensions (yet).
-constexpr std::array<std::string_view, 8> kUnimplementedEffects = {
-    "capacitance", "second_node",   "flow_dependent_u", "pv_clipping",
-    "shading",     "soiling",       "clock_offset",     "irradiance_bias"};
 
 bool ConsumePrefix(std::string_view* s, std::string_view prefix) {
   if (s->substr(0, prefix.size()) != prefix) return false;
@@ -70,22 +71,30 @@ bool ParseEffect(std::string_view effect, ModelSpec* spec, std::string* error) {
     spec->iam = true;
     return true;
   }
+  if (effect == "capacitance") {
+    if (spec->nodes == 1) {
+      spec->c_pv = true;
+    } else if (!spec->c_coll) {
+      spec->c_coll = true;
+    } else {
+      spec->c_pv = true;
+    }
+    return true;
+  }
+  if (effect == "second_node") {
+    spec->nodes = 2;
+    return true;
+  }
   for (const ExtensionName& e : kExtensionNames) {
     if (e.name == effect) {
       spec->extensions.set(static_cast<std::size_t>(e.extension));
       return true;
     }
   }
-  for (std::string_view name : kUnimplementedEffects) {
-    if (name == effect) {
-      *error = "effect '" + std::string(effect) + "' is not available as a model extension";
-      return false;
-    }
-  }
   std::string known;
   for (const ExtensionName& e : kExtensionNames) known += std::string(e.name) + ", ";
   *error = "unknown effect '" + std::string(effect) + "' (known: " + known +
-           "sky_radiation, iam)";
+           "capacitance, second_node, sky_radiation, iam)";
   return false;
 }
 
@@ -145,9 +154,9 @@ const std::vector<std::string>& PaperVariants() {
 std::bitset<kNumParams> UsedParams(const ModelSpec& spec) {
   std::bitset<kNumParams> used;
   auto use = [&used](Param p) { used.set(static_cast<std::size_t>(p)); };
-  for (Param p : {Param::kAreaM2, Param::kEtaPvRef, Param::kFTh, Param::kUFrontWM2K,
-                  Param::kUBackWM2K, Param::kR0FluidM2KW, Param::kR1Fluid,
-                  Param::kPvTempCoeffPerK, Param::kPvIrrCoeffM2W}) {
+  for (Param p :
+       {Param::kAreaM2, Param::kEtaPvRef, Param::kFTh, Param::kUFrontWM2K, Param::kUBackWM2K,
+        Param::kR0FluidM2KW, Param::kR1Fluid, Param::kPvTempCoeffPerK, Param::kPvIrrCoeffM2W}) {
     use(p);
   }
   if (spec.nodes == 2) use(Param::kUCollWM2K);
@@ -162,7 +171,23 @@ std::bitset<kNumParams> UsedParams(const ModelSpec& spec) {
     use(Param::kUWindWM2K);
     use(Param::kNWind);
   }
-  if (spec.Has(Extension::kTransportDelay)) use(Param::kTransportDelayS);
+  if (spec.Has(Extension::kTransportDelay)) {
+    use(Param::kTransportDelayS);
+    use(Param::kUPipeWM2K);
+  }
+  if (spec.Has(Extension::kFlowDependentU)) use(Param::kNFlow);
+  if (spec.Has(Extension::kPvClipping)) use(Param::kPLimitWM2);
+  if (spec.Has(Extension::kShading)) {
+    for (Param p : {Param::kShadeAzimuthRad, Param::kShadeWidthRad, Param::kShadeElevationRad,
+                    Param::kShadeMismatch}) {
+      use(p);
+    }
+  }
+  if (spec.Has(Extension::kSoiling)) use(Param::kSoilingPerDay);
+  if (spec.Has(Extension::kClockOffset)) use(Param::kClockOffsetS);
+  // irradiance_bias: k is calibrated from the two irradiance sources when the
+  // drivers are prepared (Drivers::irradiance_bias), not by the fit: P_el and
+  // Q_u alone cannot separate it from η_PV·F_th (see effects.cc).
   return used;
 }
 
@@ -185,13 +210,20 @@ std::vector<InputRequirement> RequiredInputs(const ModelSpec& spec) {
     req.push_back({"beam/diffuse irradiance (I)",
                    {{C::kGPoaWM2, C::kGPoaDiffuseWM2}, {C::kGhiWM2, C::kDhiWM2}}});
   } else {
-    req.push_back({"irradiance in the collector plane",
-                   {{C::kGPoaWM2}, {C::kGhiWM2, C::kDhiWM2}}});
+    req.push_back({"irradiance in the collector plane", {{C::kGPoaWM2}, {C::kGhiWM2, C::kDhiWM2}}});
   }
   if (spec.wind_paper || spec.Has(Extension::kWind)) {
     req.push_back({"wind speed (w)", {{C::kWindMS}}});
   }
   if (spec.sky) req.push_back({"sky temperature (r)", {{C::kTSkyC}, {C::kLwDownWM2}}});
+  if (spec.Has(Extension::kShading)) {
+    req.push_back({"beam/diffuse irradiance (shading)",
+                   {{C::kGPoaWM2, C::kGPoaDiffuseWM2}, {C::kGhiWM2, C::kDhiWM2}}});
+  }
+  if (spec.Has(Extension::kIrradianceBias)) {
+    req.push_back({"plane-of-array and a second irradiance source (irradiance_bias)",
+                   {{C::kGPoaWM2, C::kGhiWM2, C::kDhiWM2}}});
+  }
   return req;
 }
 

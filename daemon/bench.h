@@ -16,5 +16,7 @@ void BenchStore(int repeats, std::uint64_t seed);
 // Real processes, real time: CPU and memory of `pvtwin run` over `seconds`.
 void BenchDaemon(double seconds);
 void BenchPoll(int cycles, std::uint64_t seed);
+void BenchEffects(int repeats, std::uint64_t seed);
+void BenchDiagnosis(std::uint64_t seed);
 
 }  // namespace pvtwin::cli

@@ -46,6 +46,7 @@ void BenchSimulation(const BenchArgs& a) {
   std::printf("  %-24s %12s %14s\n", "variant", "median (ms)", "per row (ns)");
   std::vector<std::string> variants = PaperVariants();
   variants.push_back("1N1Cwr+transport_delay");
+  variants.push_back("1N1Cwr+pv_clipping+shading+soiling+clock_offset");
   for (const std::string& name : variants) {
     ModelSpec spec;
     std::string error;
@@ -84,9 +85,14 @@ void RegisterBench(CLI::App& app) {
       "  store  the SQLite store: 14 days of 5 s samples ingested, aggregated, read back\n"
       "  daemon CPU and memory of `pvtwin run` polling `pvtwin sim` at 5 s (real time)\n"
       "  poll   the Modbus poller, 2 devices x 40 points, against a simulator on loopback\n"
-      "         (CPU at real time; latency over max(400, --repeats) accelerated cycles)");
-  cmd->add_option("what", args->what, "what to benchmark: sim, ident, table6, store, daemon, poll")
-      ->check(CLI::IsMember({"sim", "ident", "table6", "store", "daemon", "poll"}));
+      "         (CPU at real time; latency over max(400, --repeats) accelerated cycles)\n"
+      "  effects each effect of the library: fit time and held-out MAE of base + effect\n"
+      "         on 14 + 7 days of synthetic truth data with that effect\n"
+      "  diagnose one gap diagnosis, 14 + 7 days at 1 min, every effect, both cores");
+  cmd->add_option("what", args->what,
+                  "what to benchmark: sim, ident, table6, store, daemon, poll, effects, diagnose")
+      ->check(CLI::IsMember(
+          {"sim", "ident", "table6", "store", "daemon", "poll", "effects", "diagnose"}));
   cmd->add_option("--repeats", args->repeats, "runs per figure (median)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
@@ -100,6 +106,8 @@ void RegisterBench(CLI::App& app) {
       if (w == "store") BenchStore(args->repeats, args->seed);
       if (w == "daemon") BenchDaemon(args->daemon_seconds);
       if (w == "poll") BenchPoll(std::max(args->repeats, 400), args->seed);
+      if (w == "effects") BenchEffects(std::min(args->repeats, 3), args->seed);
+      if (w == "diagnose") BenchDiagnosis(args->seed);
     }
     SetExitCode(kExitOk);
   });

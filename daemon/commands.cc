@@ -20,6 +20,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterSim(app);
   RegisterRun(app);
   RegisterDemo(app);
+  RegisterDiagnose(app);
 }
 
 }  // namespace pvtwin::cli

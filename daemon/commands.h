@@ -27,5 +27,6 @@ void RegisterExport(CLI::App& app);
 void RegisterSim(CLI::App& app);
 void RegisterRun(CLI::App& app);
 void RegisterDemo(CLI::App& app);
+void RegisterDiagnose(CLI::App& app);
 
 }  // namespace pvtwin::cli

@@ -46,6 +46,7 @@ std::vector<std::string> AllTestedVariants() {
   v.push_back("2N1Ccolr");
   v.push_back("1N1Cr+wind");
   v.push_back("2N2C+wind+transport_delay");
+  v.push_back("1N1Cwr+flow_dependent_u+pv_clipping+soiling");
   return v;
 }
 

@@ -52,8 +52,7 @@ TEST(Variant, BadNamesSayWhy) {
   };
   for (const Case& c : {Case{"3N", "starts with 1N or 2N"}, Case{"2N1Cwr", "1Cpv or 1Ccol"},
                         Case{"1N2C", "unexpected '2C'"}, Case{"1Nwr+foo", "unknown effect 'foo'"},
-                        Case{"1Nwr+wind", "exclude each other"},
-                        Case{"1N+shading", "not available"}, Case{"1N+", "empty effect"},
+                        Case{"1Nwr+wind", "exclude each other"}, Case{"1N+", "empty effect"},
                         Case{"2N1Ccolrw", "unexpected 'w'"}}) {
     ModelSpec s;
     std::string error;

@@ -1,0 +1,327 @@
+// Gap diagnosis: its statistics against hand-computed and closed-form cases,
+// localisation on residuals whose answer is known analytically, the
+// report.json keys of DESIGN.md, and `pvtwin diagnose` end to end on
+// synthetic data with one withheld effect.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "core/diagnosis.h"
+#include "core/diagnosis_stats.h"
+#include "core/gap_localisation.h"
+#include "core/qc.h"
+#include "core/synthetic_plant.h"
+#include "core/units.h"
+#include "io/csv.h"
+#include "io/diagnosis_report.h"
+#include "tests/support/run_pvtwin.h"
+
+namespace pvtwin {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------
+// Statistics.
+
+TEST(DiagnosisStats, StudentTMatchesClosedForms) {
+  // ν = 1 is the Cauchy distribution: F(t) = 1/2 + atan(t)/π.
+  for (double t : {-3.0, -0.5, 0.0, 0.7, 2.0, 10.0}) {
+    EXPECT_NEAR(StudentTCdf(t, 1.0), 0.5 + std::atan(t) / kPi, 1e-12) << t;
+  }
+  // ν = 2: F(t) = 1/2 + t / (2·√(2 + t²)).
+  for (double t : {-4.0, -1.0, 0.3, 1.5, 6.0}) {
+    EXPECT_NEAR(StudentTCdf(t, 2.0), 0.5 + t / (2.0 * std::sqrt(2.0 + t * t)), 1e-12) << t;
+  }
+}
+
+TEST(DiagnosisStats, PairedTestMatchesAHandComputedCase) {
+  // d = before − after = {1, 2, −0.5, 3, 1}. Ranks of |d|: 0.5 → 1, the two
+  // 1s → 2.5 each, 2 → 4, 3 → 5; W+ = 2.5 + 2.5 + 4 + 5 = 14 of 15.
+  // Exact one-sided p: sign patterns with W+ ≥ 14 are those whose negative
+  // ranks sum to ≤ 1: none negative, or only the rank-1 one → 2/32.
+  // Sign test: 4 of 5 positive → P(Bin(5, ½) ≥ 4) = 6/32.
+  // Paired t: mean 1.3, sd √1.7, t = 1.3/(√1.7/√5) = 2.229493.
+  const std::vector<double> before = {10, 12, 9, 11, 14};
+  const std::vector<double> after = {9, 10, 9.5, 8, 13};
+  const PairedTest t = OneSidedPairedTest(before, after);
+  EXPECT_EQ(t.pairs, 5u);
+  EXPECT_EQ(t.nonzero, 5u);
+  EXPECT_EQ(t.positives, 4u);
+  EXPECT_DOUBLE_EQ(t.w_plus, 14.0);
+  EXPECT_NEAR(t.wilcoxon_p, 2.0 / 32.0, 1e-12);
+  EXPECT_NEAR(t.sign_p, 6.0 / 32.0, 1e-12);
+  EXPECT_NEAR(t.mean_difference, 1.3, 1e-12);
+  EXPECT_NEAR(t.t_stat, 1.3 / (std::sqrt(1.7) / std::sqrt(5.0)), 1e-9);
+  EXPECT_NEAR(t.t_p, 1.0 - StudentTCdf(t.t_stat, 4.0), 1e-12);
+}
+
+TEST(DiagnosisStats, WilcoxonExtremesAndZeros) {
+  // Seven improvements: the smallest possible p, 2^-7.
+  const std::vector<double> b7 = {5, 6, 7, 8, 9, 10, 11};
+  const std::vector<double> a7 = {4, 5, 6, 7, 8, 9, 10};
+  EXPECT_NEAR(OneSidedPairedTest(b7, a7).wilcoxon_p, 1.0 / 128.0, 1e-12);
+  // Seven deteriorations: p = 1.
+  EXPECT_NEAR(OneSidedPairedTest(a7, b7).wilcoxon_p, 1.0, 1e-12);
+  // Ties (d = 0) are dropped: two improvements and a zero → n = 2, p = 1/4.
+  const PairedTest z =
+      OneSidedPairedTest(std::vector<double>{3, 4, 5}, std::vector<double>{2, 4, 4});
+  EXPECT_EQ(z.nonzero, 2u);
+  EXPECT_NEAR(z.wilcoxon_p, 0.25, 1e-12);
+}
+
+TEST(DiagnosisStats, NoiseFloorOfWhiteNoiseOnALinearTrend) {
+  // σ = 2 white noise on a ramp: the second differences remove the ramp, and
+  // the expected MAE of the noise is σ·√(2/π) = 1.5958.
+  std::mt19937_64 rng(42);
+  std::normal_distribution<double> normal(0.0, 2.0);
+  std::vector<double> r(20000);
+  std::vector<std::int64_t> segment(r.size(), 0);
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] = 0.3 * static_cast<double>(i) + normal(rng);
+  const double mae = NoiseMaeFromSecondDifferences(r, segment);
+  EXPECT_NEAR(mae, 2.0 * std::sqrt(2.0 / kPi), 0.03 * 2.0 * std::sqrt(2.0 / kPi));
+  // A jump between segments is not a second difference.
+  for (std::size_t i = 10000; i < r.size(); ++i) {
+    r[i] += 1000.0;
+    segment[i] = 1;
+  }
+  EXPECT_NEAR(NoiseMaeFromSecondDifferences(r, segment), mae, 0.01 * mae);
+}
+
+TEST(DiagnosisStats, PartialCorrelationRemovesTheControls) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const std::size_t n = 2000;
+  std::vector<double> c(n), x(n), y_dep(n), y_conf(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    c[i] = normal(rng);
+    x[i] = normal(rng);
+    y_dep[i] = 2.0 * c[i] + 0.5 * x[i] + 0.5 * normal(rng);
+  }
+  // y depends on x beyond c: partial r = 0.5/√(0.5² + 0.5²) = 0.707.
+  const PartialCorrelation dep = PartialCorrelate(y_dep, x, {c});
+  EXPECT_NEAR(dep.r, std::sqrt(0.5), 0.05);
+  EXPECT_GT(dep.z, 10.0);
+  // x confounded with c only: the raw correlation is large, the partial one is not.
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = c[i] + 0.3 * normal(rng);
+    y_conf[i] = 2.0 * c[i] + 0.5 * normal(rng);
+  }
+  const PartialCorrelation conf = PartialCorrelate(y_conf, x, {c});
+  EXPECT_LT(std::fabs(conf.r), 0.08);
+  EXPECT_LT(std::fabs(conf.z), 3.5);
+}
+
+// ---------------------------------------------------------------------------
+// Localisation.
+
+// 6000 rows at 60 s; driver x = i mod 100 in [0, 100), five bins of 20.
+// |r| = 1 outside the bad range, 4 inside, so with a bad range of width w the
+// share of rows is w/100 and the share of |error| is 4w / (4w + (100 − w)).
+struct Constructed {
+  std::vector<std::int64_t> time_s;
+  std::vector<double> residual;
+  std::vector<RegimeDriver> drivers;
+};
+
+Constructed MakeConstructed(double bad_lo, double bad_hi) {
+  Constructed c;
+  RegimeDriver x{"x", {}, {0, 20, 40, 60, 80, 100}, {}, {}, {}, {}};
+  for (int i = 0; i < 6000; ++i) {
+    const double v = i % 100;
+    c.time_s.push_back(1'700'000'000 + 60 * i);
+    x.values.push_back(v);
+    const double mag = v >= bad_lo && v < bad_hi ? 4.0 : 1.0;
+    c.residual.push_back(i % 2 ? mag : -mag);
+  }
+  c.drivers.push_back(x);
+  return c;
+}
+
+TEST(GapLocalisation, FindsTheOneBinWithTheExcessError) {
+  const Constructed c = MakeConstructed(60, 80);
+  const Localisation loc = LocaliseGap(c.time_s, c.residual, "q_th", c.drivers, {});
+  ASSERT_EQ(loc.regions.size(), 1u);
+  const GapRegion& g = loc.regions[0];
+  EXPECT_EQ(g.driver, "x");
+  EXPECT_EQ(g.output, "q_th");
+  EXPECT_DOUBLE_EQ(g.lower, 60.0);
+  EXPECT_DOUBLE_EQ(g.upper, 80.0);
+  EXPECT_EQ(g.rows, 1200u);
+  EXPECT_NEAR(g.share_of_rows, 0.2, 1e-12);
+  EXPECT_NEAR(g.share_of_abs_error, 80.0 / 160.0, 1e-12);
+  EXPECT_NEAR(g.mae_w, 4.0, 1e-12);
+  EXPECT_NEAR(g.bias_w, 0.0, 1e-12);  // alternating signs
+  EXPECT_GT(g.z, 3.0);
+  EXPECT_EQ(loc.bins.size(), 5u);
+  EXPECT_NEAR(loc.total_abs_error_w, 160.0 / 100.0, 1e-12);
+}
+
+TEST(GapLocalisation, MergesAdjacentFlaggedBins) {
+  const Constructed c = MakeConstructed(40, 80);
+  const Localisation loc = LocaliseGap(c.time_s, c.residual, "p_el", c.drivers, {});
+  ASSERT_EQ(loc.regions.size(), 1u);
+  EXPECT_DOUBLE_EQ(loc.regions[0].lower, 40.0);
+  EXPECT_DOUBLE_EQ(loc.regions[0].upper, 80.0);
+  EXPECT_NEAR(loc.regions[0].share_of_rows, 0.4, 1e-12);
+  EXPECT_NEAR(loc.regions[0].share_of_abs_error, 160.0 / 220.0, 1e-12);
+}
+
+TEST(GapLocalisation, UniformErrorFlagsNothing) {
+  const Constructed c = MakeConstructed(0, 0);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<double> noise(c.residual.size());
+  for (double& v : noise) v = normal(rng);
+  const Localisation loc = LocaliseGap(c.time_s, noise, "p_el", c.drivers, {});
+  EXPECT_TRUE(loc.regions.empty());
+  ASSERT_EQ(loc.bins.size(), 5u);
+  for (const GapRegion& b : loc.bins) EXPECT_NEAR(b.share_of_rows, 0.2, 1e-12);
+}
+
+// ---------------------------------------------------------------------------
+// report.json keys (DESIGN.md, "Diagnosis report").
+
+TEST(DiagnosisReport, JsonHasTheDesignKeys) {
+  DiagnosisResult r;
+  r.base_variant = "1N1Cwr";
+  r.final_variant = "1N1Cwr+pv_clipping";
+  r.gap.mae_p_el_w = 12.5;
+  r.gap.mae_q_th_w = 40.0;
+  r.gap.nmae_p_el = 0.05;
+  r.gap.nmae_q_th = 0.1;
+  GapRegion g;
+  g.driver = "aoi_deg";
+  g.lower = 60;
+  g.upper = 90;
+  g.share_of_abs_error = 0.4;
+  g.output = "q_th";
+  r.where.push_back(g);
+  EffectTrial e;
+  e.name = "pv_clipping";
+  e.significant = true;
+  e.fit_ok = true;
+  e.shrink_pct = 35.0;
+  e.heldout_mae_before_w = 52.5;
+  e.heldout_mae_after_w = 34.1;
+  e.evidence = "because";
+  r.effects.push_back(e);
+  r.ladder.push_back({});
+  r.verdict = "pv_clipping";
+  const nlohmann::json j = nlohmann::json::parse(DiagnosisReportJson(r));
+  EXPECT_EQ(j.at("base_variant"), "1N1Cwr");
+  for (const char* key : {"mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th"}) {
+    EXPECT_TRUE(j.at("gap").at(key).is_number()) << key;
+  }
+  EXPECT_DOUBLE_EQ(j["gap"]["mae_p_el_w"].get<double>(), 12.5);
+  const nlohmann::json& w = j.at("where").at(0);
+  EXPECT_EQ(w.at("driver"), "aoi_deg");
+  ASSERT_EQ(w.at("range").size(), 2u);
+  EXPECT_DOUBLE_EQ(w["range"][0].get<double>(), 60.0);
+  EXPECT_DOUBLE_EQ(w["range"][1].get<double>(), 90.0);
+  EXPECT_DOUBLE_EQ(w.at("share_of_abs_error").get<double>(), 0.4);
+  EXPECT_EQ(w.at("output"), "q_th");
+  const nlohmann::json& ej = j.at("effects").at(0);
+  EXPECT_EQ(ej.at("name"), "pv_clipping");
+  EXPECT_EQ(ej.at("significant"), true);
+  EXPECT_DOUBLE_EQ(ej.at("shrink_pct").get<double>(), 35.0);
+  EXPECT_DOUBLE_EQ(ej.at("heldout_mae_before_w").get<double>(), 52.5);
+  EXPECT_DOUBLE_EQ(ej.at("heldout_mae_after_w").get<double>(), 34.1);
+  EXPECT_EQ(ej.at("evidence"), "because");
+  EXPECT_EQ(j.at("verdict"), "pv_clipping");
+
+  const std::string html = DiagnosisReportHtml(r);
+  EXPECT_NE(html.find("<svg"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("src="), std::string::npos);  // self-contained
+}
+
+// ---------------------------------------------------------------------------
+// pvtwin diagnose end to end: 15 days of synthetic 1-min data from a truth
+// model with wind ("w"), diagnosed with 1N1Cr, which lacks it.
+
+class DiagnoseCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("pvtwin_diagnose_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+std::string PlantConfig() {
+  return "'" +
+         (fs::path(PVTWIN_GOLDEN_DIR) / ".." / ".." / "config" / "examples" / "plant.toml")
+             .string() +
+         "'";
+}
+
+TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesTheReports) {
+  const Plant plant = DesignExamplePlant();
+  SyntheticOptions synth;
+  std::string error;
+  ASSERT_TRUE(DefaultSyntheticOptions(plant, "1N1Cwr", 15, 5, &synth, &error)) << error;
+  Series s = MakeSyntheticPlantData(plant, synth);
+  ApplyPaperCorrections(&s);
+  const std::vector<Channel> channels = {Channel::kTInC,    Channel::kTOutC,  Channel::kMdotKgS,
+                                         Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2,
+                                         Channel::kTAmbC,   Channel::kWindMS, Channel::kLwDownWM2,
+                                         Channel::kPElW,    Channel::kQThW,   Channel::kValid};
+  ASSERT_TRUE(WriteCsv((dir_ / "data.csv").string(), s, channels, &error)) << error;
+
+  const testing::ProcessResult run = testing::RunPvtwin(
+      dir_, "diagnose --config " + PlantConfig() +
+                " --csv data.csv --variant 1N1Cr --train-days 7 --heldout-days 7 --step 300"
+                " --report out");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("verdict: wind"), std::string::npos) << run.out;
+  const nlohmann::json j = nlohmann::json::parse(testing::ReadFile(dir_ / "out" / "report.json"));
+  EXPECT_EQ(j.at("verdict"), "wind");
+  EXPECT_EQ(j.at("base_variant"), "1N1Cr");
+  EXPECT_EQ(j.at("effects").at(0).at("name"), "wind");
+  EXPECT_EQ(j["effects"][0].at("significant"), true);
+  EXPECT_GT(j["effects"][0].at("shrink_pct").get<double>(), 10.0);
+  EXPECT_EQ(j.at("ladder").at(1).at("added"), "wind");
+  // No other effect is significant at the first step.
+  for (std::size_t k = 1; k < j["effects"].size(); ++k) {
+    if (j["effects"][k].at("accepted_at_step").get<int>() == 0) {
+      EXPECT_FALSE(j["effects"][k].at("significant").get<bool>()) << j["effects"][k].dump();
+    }
+  }
+  const std::string html = testing::ReadFile(dir_ / "out" / "report.html");
+  EXPECT_NE(html.find("Verdict: wind"), std::string::npos);
+  EXPECT_NE(html.find("<svg"), std::string::npos);
+}
+
+TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
+  const Plant plant = DesignExamplePlant();
+  SyntheticOptions synth;
+  std::string error;
+  ASSERT_TRUE(DefaultSyntheticOptions(plant, "1N1Cwr", 2, 5, &synth, &error)) << error;
+  const Series s = MakeSyntheticPlantData(plant, synth);
+  const std::vector<Channel> no_wind = {Channel::kTInC,    Channel::kTOutC, Channel::kMdotKgS,
+                                        Channel::kGPoaWM2, Channel::kTAmbC, Channel::kPElW};
+  ASSERT_TRUE(WriteCsv((dir_ / "no_wind.csv").string(), s, no_wind, &error)) << error;
+  testing::ProcessResult run = testing::RunPvtwin(
+      dir_, "diagnose --config " + PlantConfig() + " --csv no_wind.csv --variant 1N1Cw");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("no_wind.csv"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("wind"), std::string::npos) << run.err;
+  run = testing::RunPvtwin(
+      dir_, "diagnose --config " + PlantConfig() + " --csv no_wind.csv --variant 1N9C");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--variant = 1N9C"), std::string::npos) << run.err;
+  run = testing::RunPvtwin(dir_, "diagnose --config " + PlantConfig() +
+                                     " --csv no_wind.csv --variant 1N --train-days 5");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("train_days = 5"), std::string::npos) << run.err;
+}
+
+}  // namespace
+}  // namespace pvtwin

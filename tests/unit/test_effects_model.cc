@@ -1,0 +1,309 @@
+// Each effect of the library on an analytic case: the effect moves the
+// outputs in the predicted direction by the predicted amount
+// (core/effects.h, thermal_model.cc, drivers.cc).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/effects.h"
+#include "core/synthetic_plant.h"
+#include "core/thermal_model.h"
+#include "core/units.h"
+#include "core/weather_generator.h"
+#include "tests/support/synthetic_series.h"
+
+namespace pvtwin {
+namespace {
+
+double& At(ParamVector& p, Param name) { return p[static_cast<std::size_t>(name)]; }
+
+Drivers DriversOf(const Series& s, const Plant& plant, const std::string& variant) {
+  Drivers d;
+  std::string error;
+  EXPECT_TRUE(PrepareDrivers(s, plant, testing::SpecOf(variant), &d, &error)) << error;
+  return d;
+}
+
+SimOutputs SimulateWith(const Drivers& d, const ParamVector& p, bool energy = false) {
+  SimOutputs out;
+  SimOptions options;
+  options.energy_terms = energy;
+  Simulate(d, p, &out, options);
+  return out;
+}
+
+// Parameters with a constant PV efficiency (no temperature or irradiance
+// correction), so that P_el = η_ref·A·I exactly.
+ParamVector ConstantEta(const Plant& plant) {
+  ParamVector p = ReferenceTruthParams(plant);
+  At(p, Param::kPvTempCoeffPerK) = 0.0;
+  At(p, Param::kPvIrrCoeffM2W) = 0.0;
+  return p;
+}
+
+// One summer day of generated weather at the DESIGN.md plant (sun geometry,
+// beam and diffuse), sampled every 10 min.
+Series SummerDay() {
+  WeatherOptions w;
+  w.num_days = 1;
+  w.step_s = 600.0;
+  w.seed = 3;
+  w.day_types = {DayType::kClear};
+  return GenerateWeather(DesignExamplePlant(), w);
+}
+
+// pv_clipping caps P_el exactly at P_limit·A; the clipped power stays in the
+// laminate: Q_abs = F_th·(A·I − P_el), so Q_u and T_PV rise.
+TEST(EffectModel, ClippingCapsPelAtTheLimitAndKeepsTheRestAsHeat) {
+  const Plant plant;
+  testing::ConstantInputs in;
+  in.g_poa_w_m2 = 1000.0;
+  const Series s = testing::MakeConstantSeries(30, 60.0, in);
+  ParamVector p = ConstantEta(plant);
+  At(p, Param::kPLimitWM2) = 100.0;  // below η·I = 170 W/m²
+  const SimOutputs base = SimulateWith(DriversOf(s, plant, "1N1C"), p, true);
+  const SimOutputs clip = SimulateWith(DriversOf(s, plant, "1N1C+pv_clipping"), p, true);
+  const double area = At(p, Param::kAreaM2);
+  const double f_th = At(p, Param::kFTh);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_NEAR(base.p_el_w[i], 0.17 * area * 1000.0, 1e-9);
+    EXPECT_DOUBLE_EQ(clip.p_el_w[i], 100.0 * area);
+    EXPECT_NEAR(clip.q_abs_w[i], f_th * (area * 1000.0 - 100.0 * area), 1e-9);
+    EXPECT_GT(clip.q_th_w[i], base.q_th_w[i]);
+    EXPECT_GT(clip.t_pv_c[i], base.t_pv_c[i]);
+  }
+  // A limit above the DC power changes nothing.
+  At(p, Param::kPLimitWM2) = 250.0;
+  const SimOutputs high = SimulateWith(DriversOf(s, plant, "1N1C+pv_clipping"), p);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    EXPECT_NEAR(high.p_el_w[i], base.p_el_w[i], 1e-9);
+    EXPECT_NEAR(high.q_th_w[i], base.q_th_w[i], 1e-9);
+  }
+}
+
+// shading removes the beam only while the sun is inside the window: with
+// the window around the sun the absorbed irradiance is the diffuse part and
+// P_el additionally loses f_mismatch; with the window on the opposite side
+// nothing changes.
+TEST(EffectModel, ShadingRemovesBeamOnlyInsideTheWindowAndHitsPelHarder) {
+  const Plant plant = DesignExamplePlant();
+  const Series s = SummerDay();
+  const Drivers base_d = DriversOf(s, plant, "1N");
+  const Drivers shade_d = DriversOf(s, plant, "1N+shading");
+  ParamVector p = ConstantEta(plant);
+  const SimOutputs base = SimulateWith(base_d, p, true);
+  const double area = At(p, Param::kAreaM2);
+  const double mismatch = 0.5;
+  At(p, Param::kShadeMismatch) = mismatch;
+  At(p, Param::kShadeWidthRad) = kPi;            // ±90° around the centre
+  At(p, Param::kShadeElevationRad) = kPi / 2.0;  // every elevation
+  int inside = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[Channel::kGPoaWM2][i] < 200.0) continue;
+    const double beam = s[Channel::kGPoaWM2][i] - s[Channel::kGPoaDiffuseWM2][i];
+    ASSERT_GT(beam, 50.0);
+    // Window centred on the sun of this row.
+    At(p, Param::kShadeAzimuthRad) = shade_d.sun_azimuth_rad[i];
+    const SimOutputs in = SimulateWith(shade_d, p, true);
+    const double diffuse = s[Channel::kGPoaDiffuseWM2][i];
+    EXPECT_NEAR(in.p_el_w[i], 0.17 * area * diffuse * (1.0 - mismatch), 1e-3 * base.p_el_w[i]);
+    // P_el loses the beam share and the mismatch; the absorbed heat loses
+    // less than the beam share (the mismatch power stays as heat).
+    const double beam_share = beam / s[Channel::kGPoaWM2][i];
+    const double p_drop = 1.0 - in.p_el_w[i] / base.p_el_w[i];
+    const double q_abs_drop = 1.0 - in.q_abs_w[i] / base.q_abs_w[i];
+    EXPECT_NEAR(p_drop, beam_share + mismatch * (1.0 - beam_share), 1e-3) << "row " << i;
+    EXPECT_LT(q_abs_drop, beam_share) << "row " << i;
+    EXPECT_GT(q_abs_drop, 0.0) << "row " << i;
+    if (s[Channel::kMdotKgS][i] > 0.0) {
+      EXPECT_LT(in.q_th_w[i], base.q_th_w[i]) << "row " << i;
+    }
+    // Window on the opposite side of the sky.
+    At(p, Param::kShadeAzimuthRad) = shade_d.sun_azimuth_rad[i] + kPi;
+    const SimOutputs out = SimulateWith(shade_d, p);
+    EXPECT_NEAR(out.p_el_w[i], base.p_el_w[i], 1e-9 * base.p_el_w[i]);
+    EXPECT_NEAR(out.q_th_w[i], base.q_th_w[i], 1e-6 * std::fabs(base.q_th_w[i]) + 1e-9);
+    ++inside;
+  }
+  EXPECT_GE(inside, 30);
+  // An obstacle below the sun shades nothing.
+  At(p, Param::kShadeAzimuthRad) = kPi;
+  At(p, Param::kShadeElevationRad) = 0.0;
+  const SimOutputs low = SimulateWith(shade_d, p);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (shade_d.sun_elevation_rad[i] > DegToRad(20.0)) {
+      EXPECT_NEAR(low.p_el_w[i], base.p_el_w[i], 1e-6 * base.p_el_w[i] + 1e-9);
+    }
+  }
+}
+
+// soiling: P_el = η·A·I·(1 − r·d), d the days since the last cleaning; a
+// cleaning resets d.
+TEST(EffectModel, SoilingGrowsLinearlyAndCleaningResetsIt) {
+  const Plant plant;
+  testing::ConstantInputs in;
+  in.g_poa_w_m2 = 800.0;
+  const std::size_t rows = 10 * 24;  // ten days, hourly
+  const Series s = testing::MakeConstantSeries(rows, 3600.0, in);
+  ParamVector p = ConstantEta(plant);
+  const double rate = 0.01;
+  At(p, Param::kSoilingPerDay) = rate;
+  Drivers d = DriversOf(s, plant, "1N+soiling");
+  const double area = At(p, Param::kAreaM2);
+  SimOutputs out = SimulateWith(d, p);
+  for (std::size_t i = 0; i < rows; ++i) {
+    const double days = static_cast<double>(i) / 24.0;
+    EXPECT_NEAR(out.p_el_w[i], 0.17 * area * 800.0 * (1.0 - rate * days), 1e-9) << i;
+  }
+  const std::int64_t rain_s = s.time_s[0] + 4 * 86400 + 1800;  // mid-row on day 4
+  SetCleaningTimes({rain_s}, &d);
+  out = SimulateWith(d, p);
+  for (std::size_t i = 0; i < rows; ++i) {
+    const double t = static_cast<double>(s.time_s[i]);
+    const double days = t < static_cast<double>(rain_s)
+                            ? (t - static_cast<double>(s.time_s[0])) / 86400.0
+                            : (t - static_cast<double>(rain_s)) / 86400.0;
+    EXPECT_NEAR(out.p_el_w[i], 0.17 * area * 800.0 * (1.0 - rate * days), 1e-9) << i;
+  }
+}
+
+// clock_offset by a whole number of rows equals the base model on inputs
+// whose weather columns are shifted by those rows (a model without
+// capacitance: each row depends on its own inputs only).
+TEST(EffectModel, ClockOffsetEqualsTheBaseModelOnShiftedWeather) {
+  const Plant plant = DesignExamplePlant();
+  const Series s = SummerDay();
+  const auto n = static_cast<long>(s.size());
+  for (const long shift_rows : {2L, -1L}) {  // weather clock behind / ahead
+    ParamVector p = ReferenceTruthParams(plant);
+    At(p, Param::kClockOffsetS) = static_cast<double>(shift_rows) * s.step_s;
+    const SimOutputs shifted_model = SimulateWith(DriversOf(s, plant, "1Nwr+clock_offset"), p);
+    Series moved = s;
+    for (Channel c : {Channel::kGPoaWM2, Channel::kTAmbC, Channel::kWindMS, Channel::kLwDownWM2,
+                      Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2}) {
+      for (long i = 0; i < n; ++i) {
+        const long j = i + shift_rows;
+        if (j >= 0 && j < n)
+          moved[c][static_cast<std::size_t>(i)] = s[c][static_cast<std::size_t>(j)];
+      }
+    }
+    const SimOutputs base_on_moved = SimulateWith(DriversOf(moved, plant, "1Nwr"), p);
+    int compared = 0;
+    for (long i = std::max(0L, -shift_rows); i < std::min(n, n - shift_rows); ++i) {
+      const auto r = static_cast<std::size_t>(i);
+      EXPECT_NEAR(shifted_model.p_el_w[r], base_on_moved.p_el_w[r], 1e-9) << shift_rows << " " << i;
+      EXPECT_NEAR(shifted_model.q_th_w[r], base_on_moved.q_th_w[r], 1e-7) << shift_rows << " " << i;
+      compared += s[Channel::kGPoaWM2][r] > 100.0;
+    }
+    EXPECT_GT(compared, 40);
+  }
+}
+
+// flow_dependent_u: 1/U_fluid = r1/(2w) + r0·(w_ref/w)^n. Without sun the
+// one-node balance is G_f·(T_in − T) + G_loss·(T_amb − T) = 0, so
+// Q_u = G_f·G_loss/(G_f + G_loss)·(T_amb − T_in) with G_f = U_fluid·A.
+TEST(EffectModel, FlowDependentUFollowsTheFlowPowerLaw) {
+  const Plant plant;
+  ParamVector p = ReferenceTruthParams(plant);
+  const double area = At(p, Param::kAreaM2);
+  const double r0 = 0.05, r1 = At(p, Param::kR1Fluid), n_flow = 0.8;
+  At(p, Param::kR0FluidM2KW) = r0;
+  At(p, Param::kNFlow) = n_flow;
+  const double g_loss_w_k = (At(p, Param::kUFrontWM2K) + At(p, Param::kUBackWM2K)) * area;
+  for (double flow_factor : {0.25, 0.5, 1.0, 2.0}) {
+    testing::ConstantInputs in;
+    in.t_in_c = 40.0;
+    in.t_amb_c = 10.0;
+    in.t_back_c = 10.0;
+    in.mdot_kg_s = kFlowReferenceKgSM2 * area * flow_factor;
+    const Series s = testing::MakeConstantSeries(5, 60.0, in);
+    const SimOutputs out = SimulateWith(DriversOf(s, plant, "1N+flow_dependent_u"), p);
+    const double w = in.mdot_kg_s * plant.fluid_cp_j_kgk / area;
+    const double u_fluid = 1.0 / (r1 / (2.0 * w) + r0 * std::pow(1.0 / flow_factor, n_flow));
+    const double g_f = u_fluid * area;
+    const double expected = g_f * g_loss_w_k / (g_f + g_loss_w_k) * (in.t_amb_c - in.t_in_c);
+    EXPECT_NEAR(out.q_th_w[4], expected, 1e-9 * std::fabs(expected)) << flow_factor;
+    const SimOutputs base = SimulateWith(DriversOf(s, plant, "1N"), p);
+    if (flow_factor == 1.0) {
+      EXPECT_NEAR(out.q_th_w[4], base.q_th_w[4], 1e-9);
+    }
+    // Below the reference flow the convective resistance grows: less heat
+    // exchanged than the laminar form predicts, above it more.
+    if (flow_factor < 1.0) {
+      EXPECT_LT(std::fabs(out.q_th_w[4]), std::fabs(base.q_th_w[4]));
+    }
+    if (flow_factor > 1.0) {
+      EXPECT_GT(std::fabs(out.q_th_w[4]), std::fabs(base.q_th_w[4]));
+    }
+  }
+}
+
+// transport_delay's pipe loss: at steady state the sensor sees
+// T_amb + (T_out − T_amb)·exp(−U_pipe·A/(ṁ·c_p)); the dead time delays a step.
+TEST(EffectModel, TransportDelayCoolsTheOutletInThePipeAndDelaysSteps) {
+  const Plant plant;
+  testing::ConstantInputs in;
+  in.g_poa_w_m2 = 700.0;
+  in.mdot_kg_s = 0.02;
+  Series s = testing::MakeConstantSeries(60, 60.0, in);
+  for (std::size_t i = 30; i < 60; ++i) s[Channel::kTInC][i] = 35.0;  // inlet step at row 30
+  ParamVector p = ReferenceTruthParams(plant);
+  const double area = At(p, Param::kAreaM2);
+  At(p, Param::kUPipeWM2K) = 2.0;
+  At(p, Param::kTransportDelayS) = 180.0;  // three rows
+  const SimOutputs base = SimulateWith(DriversOf(s, plant, "1N"), p);
+  const SimOutputs pipe = SimulateWith(DriversOf(s, plant, "1N+transport_delay"), p);
+  const double decay = std::exp(-2.0 * area / (in.mdot_kg_s * plant.fluid_cp_j_kgk));
+  for (std::size_t i : {std::size_t{20}, std::size_t{29}, std::size_t{50}}) {
+    const double t_sensor = in.t_amb_c + (base.t_out_c[i] - in.t_amb_c) * decay;
+    EXPECT_NEAR(pipe.t_out_c[i], t_sensor, 1e-9) << i;
+    EXPECT_NEAR(pipe.q_th_w[i],
+                in.mdot_kg_s * plant.fluid_cp_j_kgk * (t_sensor - s[Channel::kTInC][i]), 1e-6);
+    EXPECT_LT(pipe.q_th_w[i], base.q_th_w[i]);
+  }
+  // Rows 30–32 still see the outlet of the old inlet temperature.
+  for (std::size_t i = 30; i < 33; ++i) {
+    EXPECT_NEAR(pipe.t_out_c[i], in.t_amb_c + (base.t_out_c[29] - in.t_amb_c) * decay, 1e-9);
+  }
+}
+
+// irradiance_bias: the scale error of a plane-of-array sensor that reads 6 %
+// low is found from the transposed GHI/DHI, and the model with the effect
+// sees the true irradiance again.
+TEST(EffectModel, IrradianceBiasIsCalibratedAgainstTheSecondSource) {
+  const Plant plant = DesignExamplePlant();
+  WeatherOptions w;
+  w.num_days = 2;
+  w.step_s = 300.0;
+  w.seed = 5;
+  const Series truth = GenerateWeather(plant, w);
+  Series biased = truth;
+  for (double& g : biased[Channel::kGPoaWM2]) g /= 1.06;
+  for (double& g : biased[Channel::kGPoaDiffuseWM2]) g /= 1.06;
+  const Drivers d = DriversOf(biased, plant, "1N+irradiance_bias");
+  EXPECT_NEAR(d.irradiance_bias, 0.06, 0.01);
+  const Drivers unbiased = DriversOf(truth, plant, "1N");
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    EXPECT_NEAR(d.g_poa_w_m2[i], unbiased.g_poa_w_m2[i], 0.01 * unbiased.g_poa_w_m2[i] + 1e-9);
+  }
+  // The base model's drivers keep the signature: reference − measured > 0.
+  const Drivers base = DriversOf(biased, plant, "1N");
+  const std::vector<double> sig = EffectSignature(Effect::kIrradianceBias, base, SimOutputs{});
+  double sum = 0.0;
+  for (std::size_t i = 0; i < sig.size(); ++i) {
+    if (base.g_poa_w_m2[i] > 300.0) sum += sig[i] / base.g_poa_w_m2[i];
+  }
+  EXPECT_GT(sum, 0.0);
+  // Without a second source the variant cannot be prepared.
+  Series poa_only = biased;
+  poa_only[Channel::kGhiWM2].clear();
+  poa_only[Channel::kDhiWM2].clear();
+  Drivers none;
+  std::string error;
+  EXPECT_FALSE(
+      PrepareDrivers(poa_only, plant, testing::SpecOf("1N+irradiance_bias"), &none, &error));
+  EXPECT_NE(error.find("ghi_w_m2 + dhi_w_m2"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -61,12 +61,6 @@ bool IsDivisorOfDay(double step_s) {
          std::fmod(86400.0, step_s) == 0.0;
 }
 
-// First row with time ≥ t.
-std::size_t LowerRow(const Series& s, std::int64_t t) {
-  return static_cast<std::size_t>(std::lower_bound(s.time_s.begin(), s.time_s.end(), t) -
-                                  s.time_s.begin());
-}
-
 struct Slice {
   Drivers drivers;
   Measurements meas;
@@ -103,7 +97,7 @@ void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
   std::string error;
 
   Slice test;
-  if (!PrepareSlice(s, LowerRow(s, day_start_s), LowerRow(s, day_end_s), plant, spec, &test,
+  if (!PrepareSlice(s, s.RowAtOrAfter(day_start_s), s.RowAtOrAfter(day_end_s), plant, spec, &test,
                     &error)) {
     out->failure = BacktestFailure::kTooLittleData;
     out->failure_reason = "test day " + SolarDate(day_start_s, solar_offset_s) + ": " + error;
@@ -121,8 +115,8 @@ void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
   const std::string window = "training window " + SolarDate(train_start_s, solar_offset_s) + " … " +
                              SolarDate(day_start_s - 1, solar_offset_s) + " (" +
                              std::to_string(out->train_days) + " days)";
-  if (!PrepareSlice(s, LowerRow(s, train_start_s), LowerRow(s, day_start_s), plant, spec, &train,
-                    &error)) {
+  if (!PrepareSlice(s, s.RowAtOrAfter(train_start_s), s.RowAtOrAfter(day_start_s), plant, spec,
+                    &train, &error)) {
     out->failure = BacktestFailure::kTooLittleData;
     out->failure_reason = window + ": " + error;
     return;

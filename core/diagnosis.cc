@@ -179,11 +179,8 @@ void IrradianceBiasTest(const Series& data, const std::vector<std::int64_t>& day
                         const Plant& plant, const ModelSpec& spec, EffectTrial* t) {
   std::vector<double> k;
   for (std::int64_t day : day_starts) {
-    const auto lo = static_cast<std::size_t>(
-        std::lower_bound(data.time_s.begin(), data.time_s.end(), day) - data.time_s.begin());
-    const auto hi = static_cast<std::size_t>(
-        std::lower_bound(data.time_s.begin(), data.time_s.end(), day + kSecondsPerDay) -
-        data.time_s.begin());
+    const std::size_t lo = data.RowAtOrAfter(day);
+    const std::size_t hi = data.RowAtOrAfter(day + kSecondsPerDay);
     Drivers d;
     std::string why;
     if (hi <= lo || !PrepareDrivers(data.Slice(lo, hi), plant, spec, &d, &why)) continue;
@@ -303,13 +300,9 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   const std::int64_t train_end_s = day_starts[static_cast<std::size_t>(train_days)];
   const std::int64_t heldout_end_s =
       day_starts[static_cast<std::size_t>(train_days + heldout_days - 1)] + kSecondsPerDay;
-  auto lower_row = [&data](std::int64_t t) {
-    return static_cast<std::size_t>(std::lower_bound(data.time_s.begin(), data.time_s.end(), t) -
-                                    data.time_s.begin());
-  };
   const std::int64_t data_start_s = data.time_s.front();
-  const Series train_series = data.Slice(0, lower_row(train_end_s));
-  const Series heldout_series = data.Slice(lower_row(train_end_s), lower_row(heldout_end_s));
+  const Series train_series = data.Slice(0, data.RowAtOrAfter(train_end_s));
+  const Series heldout_series = data.Between(train_end_s, heldout_end_s);
 
   // 2. Base fit.
   Part base_train, base_heldout;

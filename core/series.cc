@@ -14,4 +14,9 @@ Series Series::Slice(std::size_t begin, std::size_t end) const {
   return out;
 }
 
+std::size_t Series::RowAtOrAfter(std::int64_t t) const {
+  return static_cast<std::size_t>(std::lower_bound(time_s.begin(), time_s.end(), t) -
+                                  time_s.begin());
+}
+
 }  // namespace pvtwin

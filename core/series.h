@@ -6,6 +6,7 @@
 // column is NaN.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -39,6 +40,13 @@ struct Series {
   }
   // Rows [begin, end) as a new series.
   Series Slice(std::size_t begin, std::size_t end) const;
+  // Index of the first row with time_s ≥ t (size() if none); rows are in
+  // time order.
+  std::size_t RowAtOrAfter(std::int64_t t) const;
+  // Rows with from ≤ time_s < to.
+  Series Between(std::int64_t from, std::int64_t to) const {
+    return Slice(RowAtOrAfter(from), std::max(RowAtOrAfter(from), RowAtOrAfter(to)));
+  }
 };
 
 }  // namespace pvtwin

@@ -33,15 +33,6 @@ struct CalibrateArgs {
   bool use_t_pv = false;
 };
 
-// Rows of `s` with start ≤ time < end.
-Series Window(const Series& s, std::int64_t start, std::int64_t end) {
-  std::size_t b = 0;
-  while (b < s.size() && s.time_s[b] < start) ++b;
-  std::size_t e = b;
-  while (e < s.size() && s.time_s[e] < end) ++e;
-  return s.Slice(b, e);
-}
-
 bool ResampleOrReport(const std::string& path, double step_s, Series* s) {
   if (step_s <= 0.0 || step_s == s->step_s) return true;
   Series out;
@@ -165,7 +156,7 @@ int RunCalibrate(const CalibrateArgs& a) {
   if (!a.train_end.empty() && !ParseTimeOrReport("--train-end", a.train_end, &t_end)) {
     return kExitBadInput;
   }
-  Series train = Window(series, t_begin, t_end);
+  Series train = series.Between(t_begin, t_end);
   if (!ResampleOrReport(a.csv, a.step_s, &train)) return kExitBadInput;
   Drivers drivers;
   if (!PrepareDriversOrReport(train, a.csv, config, spec, &drivers)) return kExitBadInput;

@@ -60,13 +60,7 @@ int RunExport(const ExportArgs& a) {
   for (const ChannelInfo& info : kChannels) {
     if (series.Has(info.channel)) channels.push_back(info.channel);
   }
-  if (a.out.empty() || a.out == "-") {
-    WriteCsv(std::cout, series, channels);
-    if (!std::cout) return kExitRuntime;
-  } else if (!WriteCsv(a.out, series, channels, &error)) {
-    std::cerr << error << "\n";
-    return kExitRuntime;
-  }
+  if (!WriteCsvOrReport(a.out, series, channels)) return kExitRuntime;
   std::cerr << "exported " << series.size() << " rows of "
             << (a.table == "5s" ? "sample_5s" : "measurement_1min") << " from " << path << "\n";
   return kExitOk;

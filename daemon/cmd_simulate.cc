@@ -51,16 +51,10 @@ int RunSimulate(const SimulateArgs& a) {
   pred[Channel::kTPvC] = sim.t_pv_c;
   pred[Channel::kTOutC] = sim.t_out_c;
   const Channel columns[] = {Channel::kPElW, Channel::kQThW, Channel::kTPvC, Channel::kTOutC};
-  if (a.out.empty() || a.out == "-") {
-    WriteCsv(std::cout, pred, columns);
-    return std::cout ? kExitOk : kExitRuntime;
+  if (!WriteCsvOrReport(a.out, pred, columns)) return kExitRuntime;
+  if (!a.out.empty() && a.out != "-") {
+    std::cerr << "wrote " << pred.size() << " rows to " << a.out << "\n";
   }
-  std::string error;
-  if (!WriteCsv(a.out, pred, columns, &error)) {
-    std::cerr << error << "\n";
-    return kExitRuntime;
-  }
-  std::cerr << "wrote " << pred.size() << " rows to " << a.out << "\n";
   return kExitOk;
 }
 

@@ -52,4 +52,19 @@ bool ParseTimeOrReport(const std::string& option, const std::string& text, std::
   return false;
 }
 
+bool WriteCsvOrReport(const std::string& out, const Series& series,
+                      std::span<const Channel> channels) {
+  if (out.empty() || out == "-") {
+    WriteCsv(std::cout, series, channels);
+    if (!std::cout) std::cerr << "writing CSV to standard output failed\n";
+    return static_cast<bool>(std::cout);
+  }
+  std::string error;
+  if (!WriteCsv(out, series, channels, &error)) {
+    std::cerr << error << "\n";
+    return false;
+  }
+  return true;
+}
+
 }  // namespace pvtwin::cli

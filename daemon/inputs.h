@@ -4,6 +4,7 @@
 // caller exits with code 2.
 #pragma once
 
+#include <span>
 #include <string>
 
 #include "config/plant_config.h"
@@ -22,5 +23,10 @@ bool PrepareDriversOrReport(const Series& series, const std::string& csv_path, c
 
 // Parses a time given on the command line (ISO 8601 or unix seconds).
 bool ParseTimeOrReport(const std::string& option, const std::string& text, std::int64_t* unix_s);
+
+// Writes time and `channels` of `series` as canonical CSV to `out`, or to
+// standard output when `out` is empty or "-". Reports a failure on stderr.
+bool WriteCsvOrReport(const std::string& out, const Series& series,
+                      std::span<const Channel> channels);
 
 }  // namespace pvtwin::cli

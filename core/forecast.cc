@@ -88,6 +88,19 @@ std::vector<double> TypicalDay(const Track& track, double step_s) {
   return median;
 }
 
+// Column c of `in`: the warm-up rows (the first n_warm) from the measured
+// track, holding the last value across short gaps; horizon row h (at time t)
+// from horizon_value(h, t).
+template <class HorizonValue>
+void FillColumn(const Track& measured, std::size_t n_warm, Series* in, Channel c,
+                HorizonValue horizon_value) {
+  std::vector<double>& col = in->Ensure(c);
+  for (std::size_t k = 0; k < col.size(); ++k) {
+    const std::int64_t t = in->time_s[k];
+    col[k] = k < n_warm ? measured.Held(t, kWarmupHoldS) : horizon_value(k - n_warm, t);
+  }
+}
+
 }  // namespace
 
 std::string ForecastInputUse::Describe() const {
@@ -142,14 +155,7 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
     const Track measured(history, c);
     if (measured.time_s.empty()) continue;
     const Track predicted(weather_forecast, c);
-    std::vector<double>& col = in.Ensure(c);
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::int64_t t = in.time_s[k];
-      if (k < n_warm) {
-        col[k] = measured.Held(t, kWarmupHoldS);
-        continue;
-      }
-      const std::size_t h = k - n_warm;
+    FillColumn(measured, n_warm, &in, c, [&](std::size_t h, std::int64_t t) {
       double v = predicted.Interpolated(t, request.max_interp_gap_s);
       if (std::isnan(v)) {
         row_from_forecast[h] = 0;
@@ -157,13 +163,10 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
              back += 86400) {
           v = measured.Exact(t - back);
         }
-        if (std::isnan(v))
-          row_missing[h] = 1;
-        else
-          row_persisted[h] = 1;
+        (std::isnan(v) ? row_missing : row_persisted)[h] = 1;
       }
-      col[k] = v;
-    }
+      return v;
+    });
   }
   for (std::size_t h = 0; h < n_horizon; ++h) {
     use.weather_forecast += row_from_forecast[h] && !row_missing[h];
@@ -176,14 +179,7 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
     const Track measured(history, c);
     const Track planned(operation_plan, c);
     const std::vector<double> typical = TypicalDay(measured, request.step_s);
-    std::vector<double>& col = in.Ensure(c);
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::int64_t t = in.time_s[k];
-      if (k < n_warm) {
-        col[k] = measured.Held(t, kWarmupHoldS);
-        continue;
-      }
-      const std::size_t h = k - n_warm;
+    FillColumn(measured, n_warm, &in, c, [&](std::size_t h, std::int64_t t) {
       double v = planned.Held(t, request.max_interp_gap_s);
       if (std::isnan(v)) {
         row_planned[h] = 0;
@@ -192,8 +188,8 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
         v = slot < typical.size() ? typical[slot] : kNaN;
         if (!std::isnan(v)) row_typical[h] = 1;
       }
-      col[k] = v;
-    }
+      return v;
+    });
   }
   for (std::size_t h = 0; h < n_horizon; ++h) {
     use.operation_plan += row_planned[h];

@@ -84,14 +84,6 @@ std::optional<ErrorMetrics> HeldOutErrors(const Series& test, const Plant& plant
   return e;
 }
 
-Series RowsBetween(const Series& s, std::int64_t from, std::int64_t to) {
-  std::size_t b = 0;
-  while (b < s.size() && s.time_s[b] < from) ++b;
-  std::size_t e = b;
-  while (e < s.size() && s.time_s[e] < to) ++e;
-  return s.Slice(b, e);
-}
-
 class Service {
  public:
   explicit Service(const ServiceOptions& options) : options_(options) {}
@@ -246,7 +238,6 @@ bool Service::LoadCurrentParameters() {
   params_id_ = row.id;
   params_ = file.values;
   params_json_ = row.params_json;
-  status_.calibration_id = row.id;
   return true;
 }
 
@@ -281,8 +272,8 @@ void Service::MaybeStartCalibration() {
       next_calibration_s_ = std::min(next_calibration_s_, now + kUncalibratedRetryS);
     return;
   }
-  const Series train = RowsBetween(window, begin, end - kDayS);
-  job_test_ = RowsBetween(window, end - kDayS, end);
+  const Series train = window.Between(begin, end - kDayS);
+  job_test_ = window.Between(end - kDayS, end);
 
   std::error_code ec;
   fs::create_directories(work_dir_, ec);
@@ -422,7 +413,6 @@ void Service::FinishCalibration(int exit_code) {
     params_id_ = row.id;
     params_ = file.values;
     params_json_ = text;
-    status_.calibration_id = row.id;
     IssueForecast();
   }
 }
@@ -581,6 +571,7 @@ int Service::Run() {
     }
     UpdateDeviceStatus();
     status_.now_s = Now();
+    status_.calibration_id = params_id_;
     if (options_.on_tick && !options_.on_tick(status_)) break;
   }
   Shutdown();

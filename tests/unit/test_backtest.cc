@@ -363,10 +363,6 @@ using testing::RunPvtwin;
 class BacktestCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pvtwin_backtest_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
     std::ofstream(dir_ / "config.toml") << "[plant]\n"
                                            "latitude_deg = 47.358\n"
                                            "longitude_deg = 16.128\n"
@@ -381,8 +377,8 @@ class BacktestCli : public ::testing::Test {
     std::string error;
     ASSERT_TRUE(WriteCsv((dir_ / "data.csv").string(), data, channels, &error)) << error;
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  testing::ScratchDir scratch_{"backtest"};
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(BacktestCli, RunsOnACsvAndPrintsOneRowPerVariant) {

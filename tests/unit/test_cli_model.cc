@@ -21,15 +21,9 @@ const fs::path kData = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
 
 class CliModel : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pvtwin_cli_model_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Data(const char* name) const { return "'" + (kData / name).string() + "'"; }
-  fs::path dir_;
+  testing::ScratchDir scratch_{"cli_model"};
+  const fs::path dir_ = scratch_.path();
 };
 
 std::vector<std::string> Lines(const std::string& text) {

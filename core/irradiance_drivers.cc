@@ -28,7 +28,9 @@ void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSp
   const bool measured_poa = s.Has(Channel::kGPoaWM2);
   const bool measured_aoi = s.Has(Channel::kAoiRad);
   const bool have_horizontal = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
-  const bool need_sun = (have_horizontal && !measured_poa) || (spec.iam && !measured_aoi);
+  // A row whose measured g_poa is missing falls back to the transposition, so
+  // the sun is needed wherever GHI and DHI are, measured POA or not.
+  const bool need_sun = have_horizontal || (spec.iam && !measured_aoi);
   const std::vector<SolarPosition> sun =
       need_sun ? SunAtRowMiddles(s, plant) : std::vector<SolarPosition>{};
   const EffectiveDiffuseAngles diffuse_angles = BrandemuehlBeckmanAngles(plant.tilt_rad);

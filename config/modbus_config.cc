@@ -198,12 +198,16 @@ bool ReadPoint(SectionReader& r, const std::vector<ModbusDevice>& devices, Modbu
   if (r.Choice("word_order", kOptional, Choices(kOrderNames), &text)) {
     p->word_order = FromName<WordOrder>(kOrderNames, text);
   }
-  if (r.Number("scale", kOptional, Interval{}, &p->scale) && p->scale == 0.0) {
+  // Wide enough for any meter's scaling (a u32 counter in Wh to W needs
+  // 3600), narrow enough that a typo like 1e308 cannot turn a register into
+  // infinity.
+  constexpr Interval kScaling = Closed(-1e9, 1e9);
+  if (r.Number("scale", kOptional, kScaling, &p->scale) && p->scale == 0.0) {
     r.Reject("scale", "must not be 0");
   }
-  r.Number("offset", kOptional, Interval{}, &p->offset);
-  r.Number("valid_min", kOptional, Interval{}, &p->valid_min);
-  if (r.Number("valid_max", kOptional, Interval{}, &p->valid_max) &&
+  r.Number("offset", kOptional, kScaling, &p->offset);
+  r.Number("valid_min", kOptional, kScaling, &p->valid_min);
+  if (r.Number("valid_max", kOptional, kScaling, &p->valid_max) &&
       !(p->valid_max > p->valid_min)) {
     r.Reject("valid_max", "must be > valid_min");
   }

@@ -17,6 +17,7 @@
 
 #include "config/toml_reader.h"
 #include "core/units.h"
+#include "core/variant.h"
 
 namespace pvtwin {
 namespace {
@@ -38,13 +39,13 @@ constexpr PlantKey kPlantKeys[] = {
     {"elevation_m", kOptional, Closed(-500, 9000), &Plant::elevation_m, false},
     {"tilt_deg", kRequired, Closed(0, 90), &Plant::tilt_rad, true},
     {"azimuth_deg", kRequired, HalfOpen(0, 360), &Plant::azimuth_rad, true},
-    {"area_m2", kRequired, Above(0), &Plant::area_m2, false},
-    {"fluid_cp_j_kgk", kOptional, Above(0), &Plant::fluid_cp_j_kgk, false},
-    {"fluid_density_kg_m3", kOptional, Above(0), &Plant::fluid_density_kg_m3, false},
+    {"area_m2", kRequired, LeftOpen(0, 1e6), &Plant::area_m2, false},
+    {"fluid_cp_j_kgk", kOptional, Closed(1000, 5000), &Plant::fluid_cp_j_kgk, false},
+    {"fluid_density_kg_m3", kOptional, Closed(500, 2000), &Plant::fluid_density_kg_m3, false},
     {"ground_albedo", kOptional, Closed(0, 1), &Plant::ground_albedo, false},
     {"iam_b0", kOptional, HalfOpen(0, 1), &Plant::iam_b0, false},
     {"pv_t_ref_c", kOptional, Closed(-50, 100), &Plant::pv_t_ref_c, false},
-    {"pv_g_ref_w_m2", kOptional, Above(0), &Plant::pv_g_ref_w_m2, false},
+    {"pv_g_ref_w_m2", kOptional, Closed(100, 1500), &Plant::pv_g_ref_w_m2, false},
     {"pv_temp_coeff_per_k", kOptional, Closed(-0.02, 0.01), &Plant::pv_temp_coeff_per_k, false},
     {"pv_irr_coeff_m2_w", kOptional, Closed(-1e-3, 1e-3), &Plant::pv_irr_coeff_m2_w, false},
 };
@@ -60,17 +61,35 @@ void ReadPlant(SectionReader& r, Plant* plant) {
 
 void ReadStorage(SectionReader& r, StorageConfig* storage) {
   r.String("path", kOptional, &storage->path);
-  r.Integer("raw_retention_days", kOptional, AtLeast(1), &storage->raw_retention_days);
+  r.Integer("raw_retention_days", kOptional, Closed(1, 3650), &storage->raw_retention_days);
 }
 
 void ReadPoll(SectionReader& r, PollConfig* poll) {
-  r.Number("period_s", kOptional, Above(0), &poll->period_s);
+  // The 1-min aggregation counts whole periods per minute (core/aggregate.h).
+  double period_s = poll->period_s;
+  if (r.Number("period_s", kOptional, Closed(1, 60), &period_s)) {
+    if (period_s != std::floor(period_s) || std::fmod(60.0, period_s) != 0.0) {
+      r.Reject("period_s", "must be a whole number of seconds that divides 60");
+    } else {
+      poll->period_s = period_s;
+    }
+  }
 }
 
 void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
   // The variant grammar (paper Table 6 names plus "+effect") belongs to the
-  // model layer; here it only has to be a non-empty string.
-  r.String("variant", kOptional, &calibration->variant);
+  // model layer; it is checked here so that every command reports it at its
+  // line.
+  std::string variant;
+  if (r.String("variant", kOptional, &variant)) {
+    ModelSpec spec;
+    std::string why;
+    if (ParseVariant(variant, &spec, &why)) {
+      calibration->variant = variant;
+    } else {
+      r.Reject("variant", why);
+    }
+  }
   r.Integer("window_days", kOptional, Closed(1, 60), &calibration->window_days);
   double step_s = calibration->step_s;
   if (r.Number("step_s", kOptional, Closed(5, 900), &step_s)) {
@@ -102,7 +121,7 @@ void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
 
 void ReadForecast(SectionReader& r, ForecastConfig* forecast) {
   r.Number("horizon_h", kOptional, LeftOpen(0, 168), &forecast->horizon_h);
-  r.Number("refresh_min", kOptional, Above(0), &forecast->refresh_min);
+  r.Number("refresh_min", kOptional, Closed(1, 1440), &forecast->refresh_min);
 }
 
 void ReadDocument(const toml::table& root, const SourceText& source, const std::string& file,

@@ -27,11 +27,11 @@ namespace pvtwin {
 
 struct StorageConfig {
   std::string path = "/var/lib/pvtwin/pvtwin.db";  // SQLite file
-  int raw_retention_days = 30;                     // days of sample_5s kept, >= 1
+  int raw_retention_days = 30;                     // days of sample_5s kept, [1, 3650]
 };
 
 struct PollConfig {
-  double period_s = 5;  // Modbus poll period, > 0
+  double period_s = 5;  // Modbus poll period: whole seconds in [1, 60] dividing 60
 };
 
 struct CalibrationConfig {
@@ -44,7 +44,7 @@ struct CalibrationConfig {
 
 struct ForecastConfig {
   double horizon_h = 24;    // forecast length, (0, 168]
-  double refresh_min = 60;  // re-issue period, > 0
+  double refresh_min = 60;  // re-issue period, [1, 1440]
 };
 
 // The whole configuration. Plain values only: a loaded Config does not refer

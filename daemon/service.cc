@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <deque>
@@ -22,6 +23,7 @@
 #include "core/thermal_model.h"
 #include "core/variant.h"
 #include "daemon/notify.h"
+#include "daemon/store_cli.h"
 #include "io/child_process.h"
 #include "io/csv.h"
 #include "io/local_time.h"
@@ -144,11 +146,8 @@ bool Service::LoadAndApplyConfig(bool initial) {
   }
   ModelSpec spec;
   std::string error;
-  if (!ParseVariant(config.calibration.variant, &spec, &error)) {
-    LogToStderr(kErr, options_.config_path + ": [calibration] variant = \"" +
-                          config.calibration.variant + "\": " + error);
-    return false;
-  }
+  [[maybe_unused]] const bool parsed = ParseVariant(config.calibration.variant, &spec, &error);
+  assert(parsed && "LoadConfig checks the variant");
   if (!UseTimeZone(config.calibration.timezone, &error)) {
     LogToStderr(kErr, options_.config_path + ": [calibration] " + error);
     return false;
@@ -161,6 +160,11 @@ bool Service::LoadAndApplyConfig(bool initial) {
     if (config.storage.path != config_.storage.path ||
         config.poll.period_s != config_.poll.period_s)
       LogToStderr(kWarning, "reload: [storage] and [poll] changes take effect after a restart");
+    if (config.plant.fluid_cp_j_kgk != config_.plant.fluid_cp_j_kgk) {
+      LogToStderr(kWarning,
+                  "reload: the 1-min aggregation uses the new [plant] fluid_cp_j_kgk after a "
+                  "restart");
+    }
     if (config.modbus.devices.size() != config_.modbus.devices.size() ||
         config.modbus.points.size() != config_.modbus.points.size())
       LogToStderr(kWarning, "reload: [[modbus.*]] changes take effect after a restart");
@@ -508,7 +512,8 @@ int Service::Run() {
                                                options_.speed)
                : std::make_unique<ScaledClock>();
   std::string error;
-  store_ = Store::Open(config_.storage.path, &error);
+  // The 1-min aggregation needs the poll period and the fluid's c_p.
+  store_ = Store::Open(config_.storage.path, cli::StoreOptionsFor(config_), &error);
   if (!store_) {
     LogToStderr(kErr, config_.storage.path + ": " + error);
     return 1;

@@ -39,7 +39,7 @@ TEST(ConfigLoad, FullConfigValuesAreReadAndAnglesConvertedToRadians) {
   EXPECT_DOUBLE_EQ(p.pv_irr_coeff_m2_w, 3.6e-5);
   EXPECT_EQ(config.storage.path, "/srv/pvtwin/field.db");
   EXPECT_EQ(config.storage.raw_retention_days, 7);
-  EXPECT_DOUBLE_EQ(config.poll.period_s, 2.5);
+  EXPECT_DOUBLE_EQ(config.poll.period_s, 2);
   EXPECT_EQ(config.calibration.variant, "1N1Cwr+transport_delay");
   EXPECT_EQ(config.calibration.window_days, 21);
   EXPECT_DOUBLE_EQ(config.calibration.step_s, 120);
@@ -110,7 +110,7 @@ TEST(ConfigLoad, FailedParseLeavesOutputAndEarlierErrorsAlone) {
                            &config, &errors));
   ASSERT_EQ(errors.size(), 2u);
   EXPECT_EQ(errors[0].rule, "earlier problem");
-  EXPECT_EQ(errors[1].ToString(), "config.toml:8: period_s = -1: must be > 0");
+  EXPECT_EQ(errors[1].ToString(), "config.toml:8: period_s = -1: must be within [1, 60]");
   EXPECT_EQ(config.calibration.variant, "kept");
 }
 

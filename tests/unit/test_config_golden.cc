@@ -1,48 +1,33 @@
 // Config error cases as folders (STYLE.md, tests): tests/golden/config/<case>/
 // holds config.toml and expected.txt, the exact lines `pvtwin check-config
 // config.toml` prints to stderr (empty for a valid config). Cases named ok_*
-// must load; all others must fail.
-//
-// To re-record after an intended change of the messages, run the tests with
-// PVTWIN_UPDATE_GOLDEN=1 and review the diff.
+// must load; all others must fail. After an intended change of the messages,
+// re-record with the separate program pvtwin_golden_record and review the
+// diff.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "config/plant_config.h"
-#include "tests/support/files.h"
+#include "tests/support/golden_reports.h"
 
 namespace pvtwin {
 namespace {
 
 namespace fs = std::filesystem;
-
-const fs::path kCasesDir = fs::path(PVTWIN_GOLDEN_DIR) / "config";
-
+using pvtwin::testing::kGoldenConfigDir;
 using pvtwin::testing::ReadFile;
 
-std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kCasesDir); }
+std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kGoldenConfigDir); }
 
 class ConfigGoldenTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ConfigGoldenTest, MessagesMatchExpected) {
-  const fs::path dir = kCasesDir / GetParam();
-  Config config;
-  Diagnostics errors;
-  const bool ok = ParseConfig(ReadFile(dir / "config.toml"), "config.toml", &config, &errors);
-  std::string actual;
-  for (const Diagnostic& d : errors) actual += d.ToString() + "\n";
-
-  if (std::getenv("PVTWIN_UPDATE_GOLDEN") != nullptr) {
-    std::ofstream(dir / "expected.txt", std::ios::binary) << actual;
-  }
-  EXPECT_EQ(ok, errors.empty());
+  const fs::path dir = kGoldenConfigDir / GetParam();
+  bool ok = false;
+  const std::string actual = pvtwin::testing::ConfigCaseReport(dir, &ok);
+  EXPECT_EQ(ok, actual.empty());
   EXPECT_EQ(ok, GetParam().starts_with("ok_")) << actual;
   EXPECT_EQ(actual, ReadFile(dir / "expected.txt"));
 }
@@ -65,7 +50,7 @@ TEST(ConfigGolden, HasTheCatalogueOfCases) {
 TEST(ConfigGolden, SeveralErrorsAreReportedTogether) {
   Config config;
   Diagnostics errors;
-  EXPECT_FALSE(ParseConfig(ReadFile(kCasesDir / "several_errors_at_once" / "config.toml"),
+  EXPECT_FALSE(ParseConfig(ReadFile(kGoldenConfigDir / "several_errors_at_once" / "config.toml"),
                            "config.toml", &config, &errors));
   EXPECT_GE(errors.size(), 3u);
 }

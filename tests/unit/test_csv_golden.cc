@@ -1,68 +1,30 @@
 // Canonical CSV cases as folders: tests/golden/csv/<case>/ holds input.csv and
-// expected.txt with
-//   error: <diagnostic>      every error, in order
-//   warning: <diagnostic>    every warning, in order
-// and, if the file was read, "step_s = <median step>" followed by the series
-// as WriteCsv writes it (time and every channel present, in channel order),
-// which shows unit conversions and corrections. Cases named ok_* must read
-// without errors. Read with CsvReadOptions{} (fluid density 1040 kg/m³).
-//
-// To re-record after an intended change, run the tests with
-// PVTWIN_UPDATE_GOLDEN=1 and review the diff.
+// expected.txt, the report of tests/support/golden_reports.h. Cases named
+// ok_* must read without errors. After an intended change, re-record with
+// the separate program pvtwin_golden_record and review the diff.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "io/csv.h"
-#include "tests/support/files.h"
+#include "tests/support/golden_reports.h"
 
 namespace pvtwin {
 namespace {
 
 namespace fs = std::filesystem;
-
-const fs::path kCasesDir = fs::path(PVTWIN_GOLDEN_DIR) / "csv";
-
+using pvtwin::testing::kGoldenCsvDir;
 using pvtwin::testing::ReadFile;
 
-std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kCasesDir); }
-
-// The report described at the top of this file.
-std::string Report(const fs::path& input, bool* ok) {
-  std::ifstream in(input, std::ios::binary);
-  Series series;
-  Diagnostics errors;
-  Diagnostics warnings;
-  *ok = ParseCanonicalCsv(in, "input.csv", CsvReadOptions{}, &series, &errors, &warnings);
-  std::ostringstream out;
-  for (const Diagnostic& d : errors) out << "error: " << d.ToString() << "\n";
-  for (const Diagnostic& d : warnings) out << "warning: " << d.ToString() << "\n";
-  if (*ok) {
-    std::vector<Channel> present;
-    for (const ChannelInfo& info : kChannels) {
-      if (series.Has(info.channel)) present.push_back(info.channel);
-    }
-    out << "step_s = " << series.step_s << "\n";
-    WriteCsv(out, series, present);
-  }
-  return out.str();
-}
+std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kGoldenCsvDir); }
 
 class CsvGoldenTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(CsvGoldenTest, ReportMatchesExpected) {
-  const fs::path dir = kCasesDir / GetParam();
+  const fs::path dir = kGoldenCsvDir / GetParam();
   bool ok = false;
-  const std::string actual = Report(dir / "input.csv", &ok);
-  if (std::getenv("PVTWIN_UPDATE_GOLDEN") != nullptr) {
-    std::ofstream(dir / "expected.txt", std::ios::binary) << actual;
-  }
+  const std::string actual = pvtwin::testing::CsvCaseReport(dir, &ok);
   EXPECT_EQ(ok, GetParam().starts_with("ok_")) << actual;
   EXPECT_EQ(actual, ReadFile(dir / "expected.txt"));
 }

@@ -1,0 +1,59 @@
+// What the golden folders under tests/golden record: for a config case the
+// lines `pvtwin check-config` prints, for a CSV case the reader's errors,
+// warnings and the series read. The tests compare these with expected.txt;
+// the separate program pvtwin_golden_record (tests/golden_record.cc) writes
+// them after an intended change, never the test run itself.
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "config/plant_config.h"
+#include "io/csv.h"
+#include "tests/support/files.h"
+
+namespace pvtwin::testing {
+
+inline const std::filesystem::path kGoldenConfigDir =
+    std::filesystem::path(PVTWIN_GOLDEN_DIR) / "config";
+inline const std::filesystem::path kGoldenCsvDir = std::filesystem::path(PVTWIN_GOLDEN_DIR) / "csv";
+
+// Every diagnostic of <case>/config.toml, one per line; *ok: it loaded.
+inline std::string ConfigCaseReport(const std::filesystem::path& case_dir, bool* ok) {
+  Config config;
+  Diagnostics errors;
+  *ok = ParseConfig(ReadFile(case_dir / "config.toml"), "config.toml", &config, &errors);
+  std::string report;
+  for (const Diagnostic& d : errors) report += d.ToString() + "\n";
+  return report;
+}
+
+// <case>/input.csv read with CsvReadOptions{} (fluid density 1040 kg/m³):
+//   error: <diagnostic>      every error, in order
+//   warning: <diagnostic>    every warning, in order
+// and, if the file was read, "step_s = <median step>" followed by the series
+// as WriteCsv writes it (time and every channel present, in channel order).
+inline std::string CsvCaseReport(const std::filesystem::path& case_dir, bool* ok) {
+  std::ifstream in(case_dir / "input.csv", std::ios::binary);
+  Series series;
+  Diagnostics errors;
+  Diagnostics warnings;
+  *ok = ParseCanonicalCsv(in, "input.csv", CsvReadOptions{}, &series, &errors, &warnings);
+  std::ostringstream out;
+  for (const Diagnostic& d : errors) out << "error: " << d.ToString() << "\n";
+  for (const Diagnostic& d : warnings) out << "warning: " << d.ToString() << "\n";
+  if (*ok) {
+    std::vector<Channel> present;
+    for (const ChannelInfo& info : kChannels) {
+      if (series.Has(info.channel)) present.push_back(info.channel);
+    }
+    out << "step_s = " << series.step_s << "\n";
+    WriteCsv(out, series, present);
+  }
+  return out.str();
+}
+
+}  // namespace pvtwin::testing

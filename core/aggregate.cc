@@ -3,6 +3,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "core/physical_limits.h"
 #include "core/qc.h"
 #include "core/resample.h"
 
@@ -86,6 +87,7 @@ bool AggregateSamples(std::span<const Sample> samples, const AggregateOptions& o
   Series raw = SeriesFromSamples(samples, period_s);
   Series corrected = raw;
   ApplyPaperCorrections(&corrected);
+  ApplyPhysicalLimits(&corrected, options.area_m2);
 
   // Minute groups [group_begin[k], group_begin[k + 1]) of sample indices.
   std::vector<std::size_t> group_begin;
@@ -121,6 +123,17 @@ bool AggregateSamples(std::span<const Sample> samples, const AggregateOptions& o
       if (raw.Has(Channel::kMdotKgS) &&
           Changed(raw[Channel::kMdotKgS][i], corrected[Channel::kMdotKgS][i])) {
         f |= kQcFlowCorrected;
+      }
+      for (std::size_t c = 0; c < kNumChannels; ++c) {
+        // A value outside its physical limits is a rejected reading too.
+        const std::vector<double>& before = raw.columns[c];
+        if (before.empty() || std::isnan(before[i]) || !std::isnan(corrected.columns[c][i])) {
+          continue;
+        }
+        // A negative flow made missing is the paper's correction, above.
+        if (static_cast<Channel>(c) != Channel::kMdotKgS || before[i] >= 0.0) {
+          f |= kQcRejectedValues;
+        }
       }
     }
     bool q_measured = false;

@@ -61,6 +61,9 @@ bool RequiredChannelsPresent(std::uint32_t qc_flags);
 struct AggregateOptions {
   double sample_period_s = 5.0;    // poll period: whole seconds dividing 60
   double fluid_cp_j_kgk = 3650.0;  // fluid heat capacity (plant config)
+  // Collector area for the area-scaled physical limits (core/physical_limits.h);
+  // 0: unknown, the widest limits.
+  double area_m2 = 0.0;
 };
 
 // The 1-min rows of a run of samples.

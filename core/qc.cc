@@ -11,7 +11,7 @@ QcCorrections ApplyPaperCorrections(Series* series) {
   for (const Channel c :
        {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2}) {
     for (double& g_w_m2 : (*series)[c]) {
-      if (g_w_m2 > kIrradianceGlitchWM2) {
+      if (IsIrradianceGlitch(g_w_m2)) {
         g_w_m2 = 0.0;
         ++counts.irradiance_zeroed;
       }

@@ -24,6 +24,7 @@ bool LoadCsvOrReport(const std::string& path, const Config& config, Series* seri
   Diagnostics errors, warnings;
   CsvReadOptions options;
   options.fluid_density_kg_m3 = config.plant.fluid_density_kg_m3;
+  options.area_m2 = config.plant.area_m2;
   const bool ok = ReadCanonicalCsv(path, options, series, &errors, &warnings);
   for (const Diagnostic& w : warnings) std::cerr << "warning: " << w.ToString() << "\n";
   Report(errors);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <istream>
 #include <optional>
@@ -15,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/physical_limits.h"
 #include "core/qc.h"
 #include "core/units.h"
 #include "io/time_format.h"
@@ -39,18 +41,71 @@ std::string_view Trim(std::string_view s) {
   return s;
 }
 
-void SplitFields(std::string_view line, std::vector<std::string_view>* fields) {
+// Splits a line at its commas. A field may be quoted as RFC 4180 writes it
+// ("a,b", with "" for a quote inside); an unescaped quoted field is a view
+// into the line, one with "" is unescaped into *storage. Returns false (with
+// *why) for a quote that is not closed on the line.
+bool SplitFields(std::string_view line, std::vector<std::string_view>* fields,
+                 std::deque<std::string>* storage, std::string* why) {
   fields->clear();
-  std::size_t start = 0;
+  storage->clear();
+  std::size_t pos = 0;
   while (true) {
-    const std::size_t comma = line.find(',', start);
-    if (comma == std::string_view::npos) {
-      fields->push_back(Trim(line.substr(start)));
-      return;
+    while (pos < line.size() && (line[pos] == ' ' || line[pos] == '\t')) ++pos;
+    if (pos < line.size() && line[pos] == '"') {
+      std::string unescaped;
+      std::size_t i = pos + 1;
+      bool closed = false;
+      for (; i < line.size(); ++i) {
+        if (line[i] != '"') {
+          unescaped += line[i];
+        } else if (i + 1 < line.size() && line[i + 1] == '"') {
+          unescaped += '"';
+          ++i;
+        } else {
+          closed = true;
+          break;
+        }
+      }
+      if (!closed) {
+        *why = "quoted field not closed on this line (fields spanning lines are not supported)";
+        return false;
+      }
+      if (unescaped.size() == i - pos - 1) {
+        fields->push_back(line.substr(pos + 1, i - pos - 1));
+      } else {
+        storage->push_back(std::move(unescaped));
+        fields->push_back(storage->back());
+      }
+      pos = line.find(',', i + 1);
+      if (!Trim(line.substr(i + 1, pos == std::string_view::npos ? std::string_view::npos
+                                                                 : pos - i - 1))
+               .empty()) {
+        *why = "text after a closing quote";
+        return false;
+      }
+    } else {
+      const std::size_t comma = line.find(',', pos);
+      fields->push_back(Trim(line.substr(pos, comma == std::string_view::npos
+                                                  ? std::string_view::npos
+                                                  : comma - pos)));
+      pos = comma;
     }
-    fields->push_back(Trim(line.substr(start, comma - start)));
-    start = comma + 1;
+    if (pos == std::string_view::npos) return true;
+    ++pos;
   }
+}
+
+// A hint for a file written with another separator or decimal mark.
+std::string SeparatorHint(std::string_view header) {
+  if (header.find(';') != std::string_view::npos) {
+    return "; the header looks separated by ';': pvtwin reads comma-separated files with '.' as "
+           "the decimal mark";
+  }
+  if (header.find('\t') != std::string_view::npos) {
+    return "; the header looks separated by tabs: pvtwin reads comma-separated files";
+  }
+  return "";
 }
 
 // How a column's cells become a channel's values.
@@ -79,9 +134,9 @@ class CsvParser {
       std::string_view header = line;
       if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // UTF-8 BOM
       if (header.ends_with('\r')) header.remove_suffix(1);
-      ReadHeader(header);
+      const bool rows_readable = ReadHeader(header);
       int line_no = 1;
-      while (errors_.size() < kMaxCsvErrors && std::getline(in, line)) {
+      while (rows_readable && errors_.size() < kMaxCsvErrors && std::getline(in, line)) {
         ++line_no;
         std::string_view row = line;
         if (row.ends_with('\r')) row.remove_suffix(1);
@@ -93,6 +148,7 @@ class CsvParser {
       }
     }
     if (in.bad()) Error(0, "", "", "read error");
+    SummariseOutOfLimits();
     if (warnings != nullptr) warnings->insert(warnings->end(), warnings_.begin(), warnings_.end());
     if (!errors_.empty()) {
       errors->insert(errors->end(), errors_.begin(), errors_.end());
@@ -121,9 +177,19 @@ class CsvParser {
     errors_.push_back({path_, line, std::string(field), std::string(value), std::move(rule)});
   }
 
-  void ReadHeader(std::string_view header) {
+  // False when the rows cannot be read at all (the header is no canonical
+  // CSV header); other problems are errors and the rows are still checked.
+  bool ReadHeader(std::string_view header) {
     std::vector<std::string_view> names;
-    SplitFields(header, &names);
+    std::string why;
+    if (!SplitFields(header, &names, &unescaped_, &why)) {
+      Error(1, "", "", "header: " + why);
+      return false;
+    }
+    if (names.size() == 1 && !SeparatorHint(header).empty()) {
+      Error(1, "", "", "the header has a single column" + SeparatorHint(header));
+      return false;
+    }
     std::array<std::string_view, kNumChannels> seen_as{};  // header name that gave a channel
     for (std::size_t i = 0; i < names.size(); ++i) {
       Column column;
@@ -191,14 +257,23 @@ class CsvParser {
     for (const Column& column : columns_) {
       if (column.channel) series_[*column.channel].clear();
     }
+    return true;
   }
 
   void ReadRow(int line_no, std::string_view row) {
-    SplitFields(row, &fields_);
+    std::string why;
+    if (!SplitFields(row, &fields_, &unescaped_, &why)) {
+      Error(line_no, "", "", why);
+      return;
+    }
     if (fields_.size() != columns_.size()) {
+      const bool decimal_comma = fields_.size() > columns_.size() &&
+                                 row.find(';') == std::string_view::npos &&
+                                 row.find('.') == std::string_view::npos;
       Error(line_no, "", "",
             "expected " + std::to_string(columns_.size()) + " fields, found " +
-                std::to_string(fields_.size()));
+                std::to_string(fields_.size()) +
+                (decimal_comma ? " (decimal commas? pvtwin reads '.' as the decimal mark)" : ""));
       return;
     }
     if (time_index_) {
@@ -271,7 +346,41 @@ class CsvParser {
                 "; only small negative readings of a stopped pump are set to 0");
       return kMissing;
     }
+    if (!(column.channel == Channel::kGPoaWM2 || column.channel == Channel::kGhiWM2 ||
+          column.channel == Channel::kDhiWM2 || column.channel == Channel::kGPoaDiffuseWM2) ||
+        !IsIrradianceGlitch(value)) {
+      if (!PhysicalLimitOf(*column.channel, options_.area_m2).Contains(value)) {
+        NoteOutOfLimits(line_no, column, cell);
+        return kMissing;
+      }
+    }
     return value;
+  }
+
+  // Values outside the physical limits become missing: the first few are
+  // named one by one, the rest of the column is counted.
+  void NoteOutOfLimits(int line_no, const Column& column, std::string_view cell) {
+    constexpr int kNamed = 3;
+    const auto c = static_cast<std::size_t>(*column.channel);
+    if (out_of_limits_[c]++ < kNamed) {
+      warnings_.push_back({path_, line_no, column.name, std::string(cell),
+                           "outside the physical limits " +
+                               DescribeLimit(*column.channel, options_.area_m2) +
+                               ": read as missing"});
+    }
+  }
+
+  void SummariseOutOfLimits() {
+    constexpr std::size_t kNamed = 3;
+    for (const Column& column : columns_) {
+      if (!column.channel) continue;
+      const std::size_t n = out_of_limits_[static_cast<std::size_t>(*column.channel)];
+      if (n <= kNamed) continue;
+      warnings_.push_back({path_, 0, column.name, "",
+                           std::to_string(n - kNamed) + " more values outside " +
+                               DescribeLimit(*column.channel, options_.area_m2) +
+                               " read as missing (" + std::to_string(n) + " in all)"});
+    }
   }
 
   static double MedianStep(const std::vector<std::int64_t>& time_s) {
@@ -288,6 +397,8 @@ class CsvParser {
   std::vector<Column> columns_;
   std::optional<std::size_t> time_index_;
   std::vector<std::string_view> fields_;  // the current row, split
+  std::deque<std::string> unescaped_;     // its quoted fields that held ""
+  std::array<std::size_t, kNumChannels> out_of_limits_{};
   int previous_line_ = 0;                 // line of the last row read
   Series series_;
   Diagnostics errors_;
@@ -337,15 +448,26 @@ void WriteCsv(std::ostream& out, const Series& series, std::span<const Channel> 
 
 bool WriteCsv(const std::string& path, const Series& series, std::span<const Channel> channels,
               std::string* error) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) {
-    *error = "cannot open " + path + " for writing: " + std::strerror(errno);
-    return false;
+  // Written beside the target and renamed over it once complete: a full
+  // disk or a crash leaves the old file (or none), never a truncated one.
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      *error = "cannot open " + partial + " for writing: " + std::strerror(errno);
+      return false;
+    }
+    WriteCsv(out, series, channels);
+    out.close();
+    if (!out) {
+      *error = "cannot write " + path + ": " + std::strerror(errno);
+      std::remove(partial.c_str());
+      return false;
+    }
   }
-  WriteCsv(out, series, channels);
-  out.flush();
-  if (!out) {
-    *error = "cannot write " + path + ": " + std::strerror(errno);
+  if (std::rename(partial.c_str(), path.c_str()) != 0) {
+    *error = "cannot rename " + partial + " to " + path + ": " + std::strerror(errno);
+    std::remove(partial.c_str());
     return false;
   }
   return true;

@@ -40,6 +40,9 @@ inline constexpr std::size_t kMaxCsvErrors = 100;
 
 struct CsvReadOptions {
   double fluid_density_kg_m3 = 1040;  // converts flow_l_h to kg/s (plant config)
+  // Collector area for the area-scaled physical limits (flow, P_el, Q_u);
+  // 0: unknown, the widest limits (core/physical_limits.h).
+  double area_m2 = 0.0;
 };
 
 // Reads the file at path. Returns true if it was read without errors; then

@@ -55,6 +55,7 @@ std::unique_ptr<PlantSource> PlantSource::Create(const PlantSourceOptions& optio
   if (!options.replay_csv.empty()) {
     CsvReadOptions csv;
     csv.fluid_density_kg_m3 = options.plant.fluid_density_kg_m3;
+    csv.area_m2 = options.plant.area_m2;
     if (!ReadCanonicalCsv(options.replay_csv, csv, &source->replay_, errors, nullptr)) {
       return nullptr;
     }

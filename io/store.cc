@@ -14,6 +14,7 @@
 #include <thread>
 #include <unordered_map>
 
+#include "core/physical_limits.h"
 #include "core/units.h"
 
 namespace pvtwin {
@@ -571,6 +572,8 @@ bool Store::ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows*
       },
       error);
   if (!ok) return false;
+  // Rows written by other programs (SQL) pass the physical limits too.
+  ApplyPhysicalLimits(&result.rows, db.options.aggregate.area_m2);
   DropEmptyColumns(&result.rows);
   *out = std::move(result);
   return true;
@@ -809,6 +812,7 @@ bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Chann
       },
       error);
   if (!ok) return false;
+  ApplyPhysicalLimits(&result, options.aggregate.area_m2);
   DropEmptyColumns(&result);
   result.step_s = 0.0;
   for (std::size_t i = 1; i < result.size(); ++i) {

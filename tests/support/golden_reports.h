@@ -31,7 +31,8 @@ inline std::string ConfigCaseReport(const std::filesystem::path& case_dir, bool*
   return report;
 }
 
-// <case>/input.csv read with CsvReadOptions{} (fluid density 1040 kg/m³):
+// <case>/input.csv read with fluid density 1040 kg/m³ and the example
+// plant's area of 1.8 m² (for the area-scaled physical limits):
 //   error: <diagnostic>      every error, in order
 //   warning: <diagnostic>    every warning, in order
 // and, if the file was read, "step_s = <median step>" followed by the series
@@ -41,7 +42,9 @@ inline std::string CsvCaseReport(const std::filesystem::path& case_dir, bool* ok
   Series series;
   Diagnostics errors;
   Diagnostics warnings;
-  *ok = ParseCanonicalCsv(in, "input.csv", CsvReadOptions{}, &series, &errors, &warnings);
+  CsvReadOptions options;
+  options.area_m2 = 1.8;
+  *ok = ParseCanonicalCsv(in, "input.csv", options, &series, &errors, &warnings);
   std::ostringstream out;
   for (const Diagnostic& d : errors) out << "error: " << d.ToString() << "\n";
   for (const Diagnostic& d : warnings) out << "warning: " << d.ToString() << "\n";

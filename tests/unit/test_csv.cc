@@ -94,6 +94,7 @@ Series MakeSeries() {
       col[i] = 0.1 * static_cast<double>(i + 1) + 1.0 / 3.0 + static_cast<double>(info.channel);
     }
   }
+  for (double& lw_w_m2 : s[Channel::kLwDownWM2]) lw_w_m2 += 300.0;  // within its physical limits
   s[Channel::kValid] = {1, 0, 1, 1, 0};
   s[Channel::kAoiRad] = {0.1, 0.2, 1.0 / 3.0, kPi / 4, 1.5};
   s[Channel::kMdotKgS][3] = 0.0;

@@ -124,6 +124,21 @@ TEST_F(StoreCli, OneMinuteImportExportsBackToTheSameCsvValues) {
   }
 }
 
+// A disk that fills up during the export (a file size limit, with SIGXFSZ
+// ignored so that the write fails with EFBIG as on a full disk): exit 1, and
+// neither a truncated e.csv nor the partial file is left behind.
+TEST_F(StoreCli, ExportToAFullDiskLeavesNoPartialFile) {
+  WriteRows("m.csv", Rows(kMinute0, 5000, 60.0));  // about 400 kB as CSV
+  ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
+  const ProcessResult run = testing::RunCommand(
+      dir_, "trap '' XFSZ; ulimit -f 128; '" + std::string(PVTWIN_BINARY) +
+                "' export --db t.db --out e.csv --from 2024-01-01T00:00:00Z --to 2025-01-01T00:00:00Z --config pvtwin.toml");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("cannot write"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "e.csv"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "e.csv.partial"));
+}
+
 TEST_F(StoreCli, FiveSecondTableExportsTheRawSamples) {
   WriteRows("a.csv", Rows(kMinute0, 24, 5.0));
   ASSERT_EQ(Pvtwin("import --csv a.csv --db t.db").exit_code, 0);

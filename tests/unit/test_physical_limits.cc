@@ -1,0 +1,118 @@
+// The physical limits of the canonical channels (core/physical_limits.h) and
+// the paths that apply them: the CSV reader, the 1-min aggregation, the
+// store's reads; and messages that never echo binary bytes or a 1 MB cell.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "core/aggregate.h"
+#include "core/diagnostic.h"
+#include "core/physical_limits.h"
+#include "core/units.h"
+#include "io/csv.h"
+#include "io/store.h"
+#include "tests/support/files.h"
+#include "tests/support/sqlite_db.h"
+
+namespace pvtwin {
+namespace {
+
+TEST(PhysicalLimits, TheTableHoldsThePublishedLimitsAndScalesWithTheArea) {
+  // BSRN physically possible long-wave limits (Long & Dutton).
+  EXPECT_EQ(PhysicalLimitOf(Channel::kLwDownWM2, 2.0).lo, 40.0);
+  EXPECT_EQ(PhysicalLimitOf(Channel::kLwDownWM2, 2.0).hi, 700.0);
+  // Recorded air temperature extremes −89.2 °C and 56.7 °C lie inside.
+  EXPECT_TRUE(PhysicalLimitOf(Channel::kTAmbC, 2.0).Contains(-89.2));
+  EXPECT_TRUE(PhysicalLimitOf(Channel::kTAmbC, 2.0).Contains(56.7));
+  EXPECT_FALSE(PhysicalLimitOf(Channel::kTAmbC, 2.0).Contains(-300.0));
+  // Per m² limits: P_el ≤ 600 W/m², flow ≤ 1 kg/(s·m²).
+  EXPECT_EQ(PhysicalLimitOf(Channel::kPElW, 2.0).hi, 1200.0);
+  EXPECT_EQ(PhysicalLimitOf(Channel::kMdotKgS, 2.0).hi, 2.0);
+  EXPECT_EQ(PhysicalLimitOf(Channel::kPElW, 0.0).hi, 600.0 * kMaxAreaM2);  // area unknown
+  EXPECT_FALSE(PhysicalLimitOf(Channel::kAoiRad, 2.0).Contains(DegToRad(500.0)));
+  EXPECT_EQ(DescribeLimit(Channel::kAoiRad, 2.0), "[0, 180] °");
+  for (const ChannelInfo& info : kChannels) {
+    const PhysicalLimit limit = PhysicalLimitOf(info.channel, 1.8);
+    EXPECT_LT(limit.lo, limit.hi) << info.name;
+    EXPECT_FALSE(limit.Contains(std::numeric_limits<double>::infinity())) << info.name;
+    EXPECT_FALSE(limit.Contains(-1e308)) << info.name;
+  }
+}
+
+TEST(PhysicalLimits, ApplyMakesOutOfLimitCellsMissingAndCountsThem) {
+  Series s;
+  s.time_s = {0, 60, 120};
+  s[Channel::kTInC] = {20.0, -300.0, 1e308};
+  s[Channel::kWindMS] = {-2.0, 3.0, std::nan("")};
+  const LimitViolations v = ApplyPhysicalLimits(&s, 1.8);
+  EXPECT_EQ(v.Total(), 3u);
+  EXPECT_EQ(v.count[static_cast<std::size_t>(Channel::kTInC)], 2u);
+  EXPECT_EQ(v.first_row[static_cast<std::size_t>(Channel::kTInC)], 1u);
+  EXPECT_EQ(v.first_value[static_cast<std::size_t>(Channel::kTInC)], -300.0);
+  EXPECT_EQ(s[Channel::kTInC][0], 20.0);
+  EXPECT_TRUE(std::isnan(s[Channel::kTInC][1]) && std::isnan(s[Channel::kTInC][2]));
+  EXPECT_TRUE(std::isnan(s[Channel::kWindMS][0]));
+  EXPECT_EQ(s[Channel::kWindMS][1], 3.0);
+}
+
+TEST(PhysicalLimits, AggregationRejectsOutOfLimitSamples) {
+  std::vector<Sample> samples(12);
+  for (int i = 0; i < 12; ++i) {
+    Sample& s = samples[static_cast<std::size_t>(i)];
+    s.ts_s = 1717236000 + 5 * i;
+    s.Set(Channel::kTInC, 20.0);
+    s.Set(Channel::kTOutC, 30.0);
+    s.Set(Channel::kMdotKgS, 0.03);
+    s.Set(Channel::kGPoaWM2, 600.0);
+    s.Set(Channel::kTAmbC, i == 4 ? -300.0 : 10.0);
+    s.Set(Channel::kPElW, i == 7 ? 1e308 : 150.0);
+  }
+  AggregateOptions options;
+  options.area_m2 = 1.8;
+  MinuteRows m;
+  std::string error;
+  ASSERT_TRUE(AggregateSamples(samples, options, &m, &error)) << error;
+  ASSERT_EQ(m.rows.size(), 1u);
+  EXPECT_EQ(m.rows[Channel::kTAmbC][0], 10.0);  // the −300 °C sample is left out
+  EXPECT_EQ(m.rows[Channel::kPElW][0], 150.0);
+  EXPECT_TRUE(m.qc_flags[0] & kQcRejectedValues);
+}
+
+TEST(PhysicalLimits, StoreReadsLeaveOutRowsOtherProgramsWroteOutOfLimits) {
+  testing::ScratchDir dir("limits_store");
+  const std::string path = (dir / "pvtwin.db").string();
+  StoreOptions options;
+  options.aggregate.area_m2 = 1.8;
+  std::string error;
+  std::unique_ptr<Store> store = Store::Open(path, options, &error);
+  ASSERT_TRUE(store) << error;
+  testing::RawDb db(path);
+  db.Exec("INSERT INTO weather_forecast(ts, g_poa_w_m2, t_amb_c, wind_m_s) VALUES "
+          "(1717236000, 500, 20, 2), (1717236060, 510, 1e30, -4)");
+  Series weather;
+  ASSERT_TRUE(store->ReadWeatherForecast(1717236000, 1717236120, &weather, &error)) << error;
+  ASSERT_EQ(weather.size(), 2u);
+  EXPECT_EQ(weather[Channel::kTAmbC][0], 20.0);
+  EXPECT_TRUE(std::isnan(weather[Channel::kTAmbC][1]));
+  EXPECT_TRUE(std::isnan(weather[Channel::kWindMS][1]));
+  EXPECT_EQ(weather[Channel::kGPoaWM2][1], 510.0);
+}
+
+TEST(Messages, AHugeOrBinaryCellIsCutAndEscaped) {
+  const std::string huge(1 << 20, '9');
+  std::istringstream in("time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n"
+                        "2024-06-01T10:00:00Z,27.87,30.76,0.0332,750.08," +
+                        huge + ",177.78\n");
+  Series s;
+  Diagnostics errors;
+  EXPECT_FALSE(ParseCanonicalCsv(in, "big.csv", CsvReadOptions{}, &s, &errors, nullptr));
+  ASSERT_EQ(errors.size(), 1u);
+  const std::string message = errors[0].ToString();
+  EXPECT_LT(message.size(), 200u) << message.substr(0, 300);
+  EXPECT_NE(message.find("... (1048576 bytes)"), std::string::npos) << message;
+  EXPECT_EQ(PrintableExcerpt(std::string("a\x01\xff\xc3\xa9\x1b[31m")), "a\\x01\\xFFé\\x1B[31m");
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -1,5 +1,9 @@
 // pvtwin calibrate: identify a variant's parameters from operation data.
+#include <sys/prctl.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -31,6 +35,7 @@ struct CalibrateArgs {
   int max_evaluations = 0;
   double ftol_rel = 0.0;
   bool use_t_pv = false;
+  int parent_pid = 0;
 };
 
 bool ResampleOrReport(const std::string& path, double step_s, Series* s) {
@@ -112,7 +117,21 @@ bool ParamSetOrReport(const std::string& option, const std::vector<std::string>&
   return ok;
 }
 
+// The daemon's calibration child dies with the daemon: a kill -9 of the
+// daemon must not leave a fit running that writes where the next one reads.
+bool DieWithParent(int parent_pid) {
+  if (parent_pid <= 0) return true;
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  // The parent may have died before prctl took effect.
+  if (::getppid() != parent_pid) {
+    std::cerr << "--parent-pid " << parent_pid << ": the parent is gone\n";
+    return false;
+  }
+  return true;
+}
+
 int RunCalibrate(const CalibrateArgs& a) {
+  if (!DieWithParent(a.parent_pid)) return kExitRuntime;
   Config config;
   if (!LoadConfigOrReport(a.config, &config)) return kExitBadInput;
   ModelSpec spec;
@@ -263,6 +282,9 @@ void RegisterCalibrate(CLI::App& app) {
                   "stop when an iteration lowers the MAE by less than this fraction (default "
                   "1e-3; 1e-4 reaches the noise floor on synthetic data at about twice the time)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--parent-pid", args->parent_pid,
+                  "exit when the process with this pid ends (used by pvtwin run for its "
+                  "calibration child)");
   cmd->add_flag("--use-t-pv", args->use_t_pv,
                 "add the measured PV temperature (t_pv_c) to the objective");
   cmd->callback([args] { SetExitCode(RunCalibrate(*args)); });

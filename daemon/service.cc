@@ -1,6 +1,7 @@
 #include "daemon/service.h"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cassert>
@@ -31,6 +32,7 @@
 #include "io/modbus_poller.h"
 #include "io/params_json.h"
 #include "io/store.h"
+#include "io/store_lock.h"
 #include "io/time_format.h"
 
 namespace pvtwin {
@@ -45,6 +47,27 @@ constexpr std::size_t kMaxPendingSamples = 17280;
 // A daemon without parameters retries a calibration it lacked data for.
 constexpr double kUncalibratedRetryS = 3600.0;
 constexpr double kRetentionPeriodS = 3600.0;
+// Calibration run directories kept (calibration/run-<run_at>), the running one included.
+constexpr std::size_t kKeptCalibrationRuns = 5;
+
+// Removes all but the newest `keep` - 1 run-* directories of dir (a new one
+// is about to be made).
+void RemoveOldRunDirectories(const fs::path& dir, std::size_t keep) {
+  std::error_code ec;
+  std::vector<fs::path> runs;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    if (e.is_directory(ec) && e.path().filename().string().starts_with("run-")) {
+      runs.push_back(e.path());
+    }
+  }
+  // run-<unix seconds>: the same number of digits for centuries, so names
+  // sort by time.
+  std::sort(runs.begin(), runs.end());
+  while (runs.size() >= keep && !runs.empty()) {
+    fs::remove_all(runs.front(), ec);
+    runs.erase(runs.begin());
+  }
+}
 
 std::string Format(const char* fmt, double a) {
   char buf[64];
@@ -104,6 +127,9 @@ class Service {
   bool LoadCurrentParameters();
   void IssueForecast();
   void Shutdown();
+  // False (after logging, stopping and saving the open store beside it)
+  // when the database file was deleted or replaced under the daemon.
+  bool StoreStillAtPath();
   void UpdateDeviceStatus();
   double Now() const { return clock_->NowS(); }
 
@@ -112,6 +138,7 @@ class Service {
   ModelSpec spec_;
   int at_hour_ = 2, at_minute_ = 0;
   std::unique_ptr<ScaledClock> clock_;
+  StoreLock store_lock_;  // declared before store_: released after it is closed
   std::unique_ptr<Store> store_;
   std::unique_ptr<ModbusPoller> poller_;
   SampleQueue queue_;
@@ -120,7 +147,8 @@ class Service {
   ServiceStatus status_;
 
   // Calibration.
-  fs::path work_dir_;
+  fs::path work_dir_;  // <store dir>/calibration
+  fs::path job_dir_;   // work_dir_/run-<run_at>: the running calibration's files
   ChildProcess child_;
   double child_started_wall_s_ = 0.0;
   Store::CalibrationRow job_;
@@ -279,11 +307,16 @@ void Service::MaybeStartCalibration() {
   const Series train = window.Between(begin, end - kDayS);
   job_test_ = window.Between(end - kDayS, end);
 
+  // Each run has its own directory, so a child left over from a killed
+  // daemon can never write where the next run reads; the newest few are kept
+  // for the operator.
+  job_dir_ = work_dir_ / ("run-" + std::to_string(row.run_at));
+  RemoveOldRunDirectories(work_dir_, kKeptCalibrationRuns);
   std::error_code ec;
-  fs::create_directories(work_dir_, ec);
-  const fs::path train_csv = work_dir_ / "train.csv";
-  const fs::path new_json = work_dir_ / "new-params.json";
-  const fs::path log_path = work_dir_ / "calibrate.log";
+  fs::create_directories(job_dir_, ec);
+  const fs::path train_csv = job_dir_ / "train.csv";
+  const fs::path new_json = job_dir_ / "new-params.json";
+  const fs::path log_path = job_dir_ / "calibrate.log";
   std::vector<Channel> channels;
   for (const ChannelInfo& info : kChannels) {
     if (train.Has(info.channel)) channels.push_back(info.channel);
@@ -309,9 +342,11 @@ void Service::MaybeStartCalibration() {
                                    "--ftol",
                                    Format("%g", options_.calibration_ftol),
                                    "--out",
-                                   new_json.string()};
+                                   new_json.string(),
+                                   "--parent-pid",
+                                   std::to_string(::getpid())};
   if (have_params_) {
-    const fs::path current = work_dir_ / "current-params.json";
+    const fs::path current = job_dir_ / "current-params.json";
     if (WriteTextFileAtomically(current.string(), params_json_, &error)) {
       argv.push_back("--start");
       argv.push_back(current.string());
@@ -362,12 +397,12 @@ std::string LastLine(const fs::path& path) {
 void Service::FinishCalibration(int exit_code) {
   Store::CalibrationRow row = job_;
   row.runtime_s = WallNowS() - child_started_wall_s_;
-  const fs::path new_json = work_dir_ / "new-params.json";
+  const fs::path new_json = job_dir_ / "new-params.json";
   if (exit_code != 0) {
     row.status = exit_code < 0 ? "crashed" : "failed";
     row.reason = (exit_code < 0 ? "calibrate ended by signal " + std::to_string(-exit_code)
                                 : "calibrate exited with " + std::to_string(exit_code)) +
-                 ": " + LastLine(work_dir_ / "calibrate.log");
+                 ": " + LastLine(job_dir_ / "calibrate.log");
     RecordCalibration(row);
     return;
   }
@@ -486,6 +521,25 @@ void Service::UpdateDeviceStatus() {
   status_.devices_up = up;
 }
 
+bool Service::StoreStillAtPath() {
+  std::string what;
+  if (store_lock_.StillAtPath(&what)) return true;
+  const std::string& path = config_.storage.path;
+  LogToStderr(kErr, path + " was " + what +
+                        " while the daemon ran: later samples would go to a file nobody can "
+                        "read. Stopping with exit 1; a restart creates a new store.");
+  Shutdown();  // stores the samples held in memory, into the open file
+  const std::string rescue =
+      path + ".rescued-" + std::to_string(static_cast<std::int64_t>(WallNowS()));
+  std::string error;
+  if (store_->BackupTo(rescue, &error)) {
+    LogToStderr(kErr, "the open store's content, up to the last sample, is saved in " + rescue);
+  } else {
+    LogToStderr(kErr, "could not save the open store's content: " + error);
+  }
+  return false;
+}
+
 void Service::Shutdown() {
   NotifyStopping();
   LogToStderr(kInfo, "stopping");
@@ -515,7 +569,11 @@ int Service::Run() {
   // The 1-min aggregation needs the poll period and the fluid's c_p.
   store_ = Store::Open(config_.storage.path, cli::StoreOptionsFor(config_), &error);
   if (!store_) {
-    LogToStderr(kErr, config_.storage.path + ": " + error);
+    LogToStderr(kErr, error);
+    return 1;
+  }
+  if (!store_lock_.Acquire(config_.storage.path, &error)) {
+    LogToStderr(kErr, error);
     return 1;
   }
   work_dir_ = fs::path(config_.storage.path).parent_path() / "calibration";
@@ -559,6 +617,7 @@ int Service::Run() {
       if (!LoadAndApplyConfig(false)) LogToStderr(kErr, "reload failed; the old config stays");
       NotifyReady("reloaded");
     }
+    if (!StoreStillAtPath()) return 1;
     StoreSamples();
     Aggregate();
     CheckCalibration();

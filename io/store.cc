@@ -3,11 +3,15 @@
 #include "io/store.h"
 
 #include <sqlite3.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <mutex>
@@ -18,6 +22,8 @@
 #include "core/units.h"
 
 namespace pvtwin {
+
+namespace fs = std::filesystem;
 namespace {
 
 constexpr std::int64_t kSecondsPerDay = 86400;
@@ -155,6 +161,89 @@ struct Store::Impl {
     std::string text = path + ": " + s.what;
     if (!s.message.empty()) text += ": " + s.message;
     return text + " (SQLite code " + std::to_string(s.rc) + ")";
+  }
+
+  // A store that cannot be written is refused at open with the reason an
+  // operator can act on, not at the first failing write.
+  bool CheckWritable(std::string* error) const {
+    const fs::path file(path);
+    const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const auto who = [] { return "uid " + std::to_string(::geteuid()); };
+    if (::access(path.c_str(), F_OK) == 0 && ::access(path.c_str(), W_OK) != 0) {
+      *error = path + ": permission denied: the database file is read-only for " + who() +
+               " (" + std::strerror(errno) + ")";
+      return false;
+    }
+    // WAL needs the -wal and -shm files beside the database.
+    if (::access(dir.c_str(), W_OK) != 0) {
+      *error = path + ": permission denied: " + who() + " cannot create files in " +
+               dir.string() + " (" + std::strerror(errno) + "); the store needs its -wal and -shm files there";
+      return false;
+    }
+    if (sqlite3_db_readonly(db, "main") == 1) {
+      *error = path + ": read-only: SQLite opened the database read-only (a read-only file system?)";
+      return false;
+    }
+    return true;
+  }
+
+  // PRAGMA quick_check (pages, records, indexes: corruption shows here, not
+  // after an import "worked"), then that a non-empty file is a pvtwin store.
+  bool CheckIntegrityAndOwner(std::string* error) {
+    std::vector<std::string> problems;
+    int rc = sqlite3_exec(
+        db, "PRAGMA quick_check(5)",
+        [](void* out, int, char** values, char**) {
+          auto* list = static_cast<std::vector<std::string>*>(out);
+          list->push_back(values[0] ? values[0] : "");
+          return 0;
+        },
+        &problems, nullptr);
+    if (rc == SQLITE_NOTADB) {
+      *error = path + ": not an SQLite database (file is not a database); pvtwin leaves it alone";
+      return false;
+    }
+    if (rc != SQLITE_OK) {
+      *error = Describe(Fail(rc, "integrity check (PRAGMA quick_check)"));
+      return false;
+    }
+    if (problems.size() != 1 || problems[0] != "ok") {
+      std::string list;
+      for (const std::string& p : problems) list += (list.empty() ? "" : "; ") + p;
+      *error = path + ": the database is damaged (PRAGMA quick_check: " + list +
+               "); pvtwin does not write to it. Keep a copy, then recover it with the sqlite3 "
+               "shell's .recover, or move it away to start a new store";
+      return false;
+    }
+    int version = 0;
+    std::string tables;
+    sqlite3_exec(
+        db, "PRAGMA user_version",
+        [](void* out, int, char** values, char**) {
+          *static_cast<int*>(out) = values[0] ? std::atoi(values[0]) : 0;
+          return 0;
+        },
+        &version, nullptr);
+    sqlite3_exec(
+        db, "SELECT name FROM sqlite_schema WHERE name NOT LIKE 'sqlite_%' ORDER BY name LIMIT 4",
+        [](void* out, int, char** values, char**) {
+          auto* list = static_cast<std::string*>(out);
+          *list += (list->empty() ? "" : ", ") + std::string(values[0] ? values[0] : "");
+          return 0;
+        },
+        &tables, nullptr);
+    if (version > kStoreSchemaVersion) {
+      *error = path + ": schema version " + std::to_string(version) +
+               " is newer than this pvtwin knows (" + std::to_string(kStoreSchemaVersion) +
+               "); use a newer pvtwin";
+      return false;
+    }
+    if (version == 0 && !tables.empty()) {
+      *error = path + ": not a pvtwin store (it holds " + tables +
+               " and no pvtwin schema version); pvtwin leaves it unchanged";
+      return false;
+    }
+    return true;
   }
 
   DbStatus Exec(const std::string& sql) {
@@ -298,6 +387,28 @@ Store::~Store() = default;
 
 const std::string& Store::path() const { return impl_->path; }
 
+bool Store::BackupTo(const std::string& target_path, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  sqlite3* target = nullptr;
+  int rc = sqlite3_open_v2(target_path.c_str(), &target,
+                           SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  if (rc == SQLITE_OK) {
+    sqlite3_backup* backup = sqlite3_backup_init(target, "main", db.db, "main");
+    if (backup == nullptr) {
+      rc = sqlite3_errcode(target);
+    } else {
+      sqlite3_backup_step(backup, -1);
+      rc = sqlite3_backup_finish(backup);
+    }
+  }
+  if (rc != SQLITE_OK) {
+    *error = target_path + ": backup failed: " + (target ? sqlite3_errmsg(target) : "out of memory");
+  }
+  sqlite3_close(target);
+  return rc == SQLITE_OK;
+}
+
 std::unique_ptr<Store> Store::Open(const std::string& path, std::string* error) {
   return Open(path, StoreOptions{}, error);
 }
@@ -317,6 +428,9 @@ std::unique_ptr<Store> Store::Open(const std::string& path, const StoreOptions& 
   }
   sqlite3_extended_result_codes(impl->db, 0);
   sqlite3_busy_timeout(impl->db, options.busy_timeout_ms);
+  // Everything the store refuses is refused before it writes anything (the
+  // switch to WAL below is a write).
+  if (!impl->CheckWritable(error) || !impl->CheckIntegrityAndOwner(error)) return nullptr;
 
   // WAL is persistent in the file; switching needs a moment without other
   // writers, so it is retried like a transaction.

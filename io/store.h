@@ -144,6 +144,11 @@ class Store {
 
   const std::string& path() const;
 
+  // Copies the database, as this connection sees it, into a new file at
+  // target_path with SQLite's online backup (the rescue of a store whose
+  // file was deleted while it was open).
+  bool BackupTo(const std::string& target_path, std::string* error);
+
   // Upserts the batch into sample_5s in one transaction (a sample whose ts is
   // already stored replaces it).
   bool InsertSamples(const std::vector<Sample>& batch, std::string* error);

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "io/modbus_tcp_read.h"
 #include "io/register_codec.h"
 
 namespace pvtwin {
@@ -22,14 +23,43 @@ enum class LinkState { kStarting, kOk, kDown, kExceptions, kFrozen };
 
 bool IsException(int error) { return error > MODBUS_ENOBASE && error <= EMBXGTAR; }
 
-// The only request-sending libmodbus calls of the poller: read-only.
-int ReadRegisters(modbus_t* ctx, RegisterTable table, int address, int count, std::uint16_t* dest) {
-  const int function = table == RegisterTable::kInput ? MODBUS_FC_READ_INPUT_REGISTERS
-                                                      : MODBUS_FC_READ_HOLDING_REGISTERS;
-  assert(function == 3 || function == 4);
-  return function == MODBUS_FC_READ_INPUT_REGISTERS
-             ? modbus_read_input_registers(ctx, address, count, dest)
-             : modbus_read_registers(ctx, address, count, dest);
+// libmodbus's errors for a reply that is not the answer to the request.
+bool IsBadReply(int error) {
+  return error == EMBBADCRC || error == EMBBADDATA || error == EMBBADEXC || error == EMBUNKEXC ||
+         error == EMBBADSLAVE;
+}
+
+int FunctionOf(RegisterTable table) {
+  return table == RegisterTable::kInput ? MODBUS_FC_READ_INPUT_REGISTERS
+                                        : MODBUS_FC_READ_HOLDING_REGISTERS;
+}
+
+// RTU reads stay with libmodbus: for RTU it compares the slave id and checks
+// the CRC (modbus-rtu.c), then the function and byte count (modbus.c
+// check_confirmation). One of the poller's two request-sending paths, both
+// read-only.
+ReadOutcome ReadRegistersRtu(modbus_t* ctx, const RegisterRead& read,
+                             std::span<std::uint16_t> words) {
+  const int function = FunctionOf(read.table);
+  const int n = function == MODBUS_FC_READ_INPUT_REGISTERS
+                    ? modbus_read_input_registers(ctx, read.address, read.count, words.data())
+                    : modbus_read_registers(ctx, read.address, read.count, words.data());
+  const int error = errno;
+  ReadOutcome outcome;
+  if (n == read.count) {
+    outcome.status = ReadStatus::kOk;
+    return outcome;
+  }
+  outcome.message = n < 0 ? modbus_strerror(error) : "short answer";
+  if (n >= 0 || IsBadReply(error)) {
+    outcome.status = ReadStatus::kBadReply;
+  } else if (IsException(error)) {
+    outcome.status = ReadStatus::kException;
+    outcome.exception_code = static_cast<std::uint8_t>(error - MODBUS_ENOBASE);
+  } else {
+    outcome.status = error == ETIMEDOUT ? ReadStatus::kTimeout : ReadStatus::kBroken;
+  }
+  return outcome;
 }
 
 }  // namespace
@@ -48,7 +78,8 @@ struct ModbusPoller::Device {
   modbus_t* ctx = nullptr;
   bool connected = false;
   bool ever_connected = false;
-  int failures = 0;  // consecutive polls that lost the connection
+  int failures = 0;                       // consecutive polls that lost the connection
+  std::uint16_t next_transaction_id = 1;  // TCP: our own counter, wrapping at 65535
   std::int64_t next_attempt_period = 0;
   LinkState state = LinkState::kStarting;
   std::uint64_t failed_polls_in_state = 0;
@@ -63,6 +94,19 @@ struct ModbusPoller::Device {
   std::string Who() const {
     return "modbus " + config.name + " (" + config.Endpoint() + " unit " +
            std::to_string(config.unit_id) + ")";
+  }
+
+  // One read on the open connection; TCP through our own frame checks (the
+  // other request-sending path: EncodeReadRequest sends only 3 and 4).
+  ReadOutcome Read(const RegisterRead& read, std::span<std::uint16_t> words) {
+    if (config.IsRtu()) return ReadRegistersRtu(ctx, read, words);
+    ReadRequest request;
+    request.transaction_id = next_transaction_id++;
+    request.unit_id = static_cast<std::uint8_t>(config.unit_id);
+    request.function = static_cast<std::uint8_t>(FunctionOf(read.table));
+    request.address = static_cast<std::uint16_t>(read.address);
+    request.count = static_cast<std::uint16_t>(read.count);
+    return ReadRegistersTcp(modbus_get_socket(ctx), request, config.timeout_ms, words);
   }
 
   void Close() {
@@ -160,10 +204,11 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
     device->state = state;
     device->failed_polls_in_state = 0;
   };
-  const auto record_error = [&](const std::string& message, bool timeout) {
+  const auto record_error = [&](const std::string& message, ReadStatus status) {
     std::lock_guard<std::mutex> lock(device->mutex);
     ++device->stats.errors;
-    if (timeout) ++device->stats.timeouts;
+    if (status == ReadStatus::kTimeout) ++device->stats.timeouts;
+    if (status == ReadStatus::kBadReply) ++device->stats.bad_replies;
     device->stats.last_error = message;
     device->stats.connected = device->connected;
   };
@@ -196,7 +241,7 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
       }
     }
     if (!error.empty()) {
-      record_error(error, false);
+      record_error(error, ReadStatus::kBroken);
       lose_connection(error);
       return;
     }
@@ -212,31 +257,29 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
   std::string exception;
   for (const RegisterRead* read : device->reads) {
     std::array<std::uint16_t, kMaxReadRegisters> buf{};
-    const int n = ReadRegisters(device->ctx, read->table, read->address, read->count, buf.data());
-    const int error = errno;
+    const ReadOutcome outcome = device->Read(*read, buf);
     {
       std::lock_guard<std::mutex> lock(device->mutex);
       ++device->stats.requests;
     }
-    const std::string what = "read " + std::string(TableName(read->table)) + " " +
-                             std::to_string(read->address) + "+" + std::to_string(read->count);
-    if (n != read->count) {
+    if (outcome.status != ReadStatus::kOk) {
       all_answered = false;
-      const std::string message = what + ": " + (n < 0 ? modbus_strerror(error) : "short answer");
-      const bool timeout = n < 0 && error == ETIMEDOUT;
-      if (n < 0 && IsException(error)) {
+      const std::string message = "read " + std::string(TableName(read->table)) + " " +
+                                  std::to_string(read->address) + "+" +
+                                  std::to_string(read->count) + ": " + outcome.message;
+      record_error(message, outcome.status);
+      if (outcome.status == ReadStatus::kException) {
         // The device answered: the connection is fine, this read's data is not.
-        record_error(message, false);
         exception = message;
         continue;
       }
-      // Timeout, transaction id or unit mismatch, bad CRC, broken connection:
-      // a late or stray answer may still come, so flush and re-open.
-      record_error(message, timeout);
+      // Timeout, a reply that is not this read's (ids, length, function, byte
+      // count, CRC), broken connection: none of the reply is used, and a late
+      // or stray answer may still come, so flush and re-open.
       lose_connection(message);
       return;
     }
-    device->words.insert(device->words.end(), buf.begin(), buf.begin() + n);
+    device->words.insert(device->words.end(), buf.begin(), buf.begin() + read->count);
     for (const std::size_t i : read->points) {
       const ModbusPoint& p = map_.points[i];
       const auto offset = static_cast<std::size_t>(p.address - read->address);

@@ -13,19 +13,25 @@
 // the Sample's QC bit set.
 //
 // Failures: a response timeout, a reply that does not match the request
-// (transaction id or unit id mismatch, bad CRC) or a broken connection flush
-// and close the connection; it is re-opened on a later period with capped
-// exponential backoff (1, 2, 4 … backoff_max_periods periods after
-// consecutive failures). A Modbus exception reply leaves the connection open
-// (the device answered) and the read's channels missing. A device whose raw
-// registers all stay bit-identical for frozen_after_polls polls is "frozen":
-// its channels are rejected until a register changes. Each change of a
-// device's state (connected, down, answering with exceptions, frozen) is
-// logged once, with host, unit id, the read and the libmodbus error; failed
-// polls in the same state are counted, not logged.
+// (TCP: transaction id, protocol id, MBAP length, unit id, function or byte
+// count, checked by io/modbus_frame.h; RTU: slave id, CRC, function or byte
+// count, checked by libmodbus) or a broken connection: nothing of that read's
+// reply is used, and the connection is flushed and closed; it is re-opened on
+// a later period with capped exponential backoff (1, 2, 4 …
+// backoff_max_periods periods after consecutive failures). A Modbus
+// exception reply leaves the connection open (the device answered) and the
+// read's channels missing. A device whose raw registers all stay
+// bit-identical for frozen_after_polls polls is "frozen": its channels are
+// rejected until a register changes. Each change of a device's state
+// (connected, down, answering with exceptions, frozen) is logged once, with
+// host, unit id, the read and the reason (the reply check's message or the
+// libmodbus error); failed polls in the same state are counted, not logged.
 //
-// Read-only by construction: the only libmodbus calls that send a request
-// are function codes 3 (holding) and 4 (input registers).
+// Read-only by construction: requests are function codes 3 (holding) and 4
+// (input registers) only, sent by io/modbus_tcp_read.h on the socket that
+// libmodbus connected (TCP: libmodbus 3.1.6 would accept a reply from another
+// unit, with a non-zero protocol id or a wrong MBAP length) or by libmodbus's
+// read calls (RTU). libmodbus opens, flushes and closes every connection.
 //
 // Timeouts (ModbusDevice::timeout_ms) are wall-clock times of one request;
 // periods and backoff are in clock (possibly simulated) seconds. Stop()
@@ -53,14 +59,16 @@ namespace pvtwin {
 struct DeviceStats {
   std::string name;
   bool connected = false;
-  std::uint64_t polls = 0;       // periods polled (results handed to the delivery)
-  std::uint64_t requests = 0;    // read requests sent
-  std::uint64_t errors = 0;      // failed requests and connection attempts (timeouts included)
-  std::uint64_t timeouts = 0;    // requests without an answer in time
-  std::uint64_t reconnects = 0;  // connections opened after the first
-  double last_success_s = 0;     // clock time of the last poll with every read answered; 0 = never
-  std::string last_error;        // libmodbus message of the last failure
-  double last_poll_wall_s = 0;   // wall-clock duration of the last poll (connect and reads)
+  std::uint64_t polls = 0;        // periods polled (results handed to the delivery)
+  std::uint64_t requests = 0;     // read requests sent
+  std::uint64_t errors = 0;       // failed requests and connection attempts (timeouts included)
+  std::uint64_t timeouts = 0;     // requests without an answer in time
+  std::uint64_t bad_replies = 0;  // replies not belonging to their request (transaction or unit
+                                  // id, protocol id, MBAP length, function, byte count, CRC)
+  std::uint64_t reconnects = 0;   // connections opened after the first
+  double last_success_s = 0;      // clock time of the last poll with every read answered; 0 = never
+  std::string last_error;         // the read and the reason of the last failure
+  double last_poll_wall_s = 0;    // wall-clock duration of the last poll (connect and reads)
 };
 
 struct PollerOptions {

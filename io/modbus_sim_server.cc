@@ -22,7 +22,7 @@ namespace pvtwin {
 
 namespace {
 
-constexpr std::array<std::pair<std::string_view, FaultKind>, 7> kFaultNames = {{
+constexpr std::array<std::pair<std::string_view, FaultKind>, 8> kFaultNames = {{
     {"drop", FaultKind::kDrop},
     {"exception", FaultKind::kException},
     {"delay", FaultKind::kDelay},
@@ -30,6 +30,7 @@ constexpr std::array<std::pair<std::string_view, FaultKind>, 7> kFaultNames = {{
     {"range", FaultKind::kRange},
     {"freeze", FaultKind::kFreeze},
     {"stray", FaultKind::kStray},
+    {"wrong_unit", FaultKind::kWrongUnit},
 }};
 
 bool ParseNumber(std::string_view text, double* out) {
@@ -71,7 +72,7 @@ double OutOfRangeValue(const ModbusPoint& p) {
 bool ParseFault(std::string_view text, Fault* fault, std::string* error) {
   const std::string rule =
       "expected DEVICE:KIND:from=S:for=S[:ms=N] with KIND one of drop, "
-      "exception, delay, nan, range, freeze";
+      "exception, delay, nan, range, freeze, stray, wrong_unit";
   const std::vector<std::string_view> parts = Split(text, ':');
   if (parts.size() < 4 || parts[0].empty()) {
     *error = "fault '" + std::string(text) + "': " + rule;
@@ -325,6 +326,12 @@ void ModbusSimServer::Serve(Device* device) {
       // The reply copies these bytes from the request: the TCP transaction
       // id (bytes 0-1) or the RTU unit id (byte 0).
       query[0] = static_cast<std::uint8_t>(query[0] ^ 0x5A);
+    }
+    if (has(faults, FaultKind::kWrongUnit)) {
+      // The reply copies the unit id from the request's byte before the
+      // function code (TCP: the MBAP unit id; RTU: the slave address).
+      const auto at = static_cast<std::size_t>(header - 1);
+      query[at] = static_cast<std::uint8_t>(query[at] + 6);
     }
     modbus_reply(device->ctx, query.data(), n, device->mapping);
     return true;

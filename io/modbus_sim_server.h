@@ -18,6 +18,8 @@
 //   freeze     keep serving the values of the fault's first request
 //   stray      answer with a reply that belongs to another request (TCP: a
 //              wrong transaction id; RTU: a wrong unit id)
+//   wrong_unit answer as another unit (unit id + 6): a gateway that mixes up
+//              its slaves (TCP: the MBAP unit id; RTU: the slave address)
 // Text form (command line, control protocol):
 //   DEVICE:KIND:from=S:for=S[:ms=N]   S simulated seconds after the start
 #pragma once
@@ -37,7 +39,7 @@
 
 namespace pvtwin {
 
-enum class FaultKind { kDrop, kException, kDelay, kNan, kRange, kFreeze, kStray };
+enum class FaultKind { kDrop, kException, kDelay, kNan, kRange, kFreeze, kStray, kWrongUnit };
 
 struct Fault {
   std::string device;

@@ -7,12 +7,18 @@
 // simulator, and what to check. The checks follow from the faults:
 //   * a device without an active fault delivers every channel in every
 //     period (values, not NaN, not rejected);
-//   * inside a fault window, drop / exception / delay leave the device's
-//     channels missing (NaN, QC bit clear), nan / range / freeze (after
-//     frozen_after_polls identical polls) leave them rejected (QC bit set);
+//   * inside a fault window, drop / exception / delay / stray / wrong_unit
+//     leave the device's channels missing (NaN, QC bit clear), nan / range /
+//     freeze (after frozen_after_polls identical polls) leave them rejected
+//     (QC bit set);
 //   * from two periods after the window's end the device is back;
 //   * the period in which a window begins or ends may go either way (the
-//     request is sent a little after the period start).
+//     request is sent a little after the period start);
+//   * expect_bad_replies = DEVICE: that device's faulted replies count as
+//     bad replies, not timeouts; every other device has none.
+// Replies the simulator (built on libmodbus) cannot send, such as protocol id
+// 7 or a wrong MBAP length, come from the raw server of
+// test_modbus_hostile_server.cc.
 // check_values: every value equals what the simulator served, computed here
 // from the same deterministic plant (io/plant_source.h) through the point's
 // encoding and decoding: the value of the period's row, or of the next row
@@ -76,6 +82,7 @@ struct Scenario {
   double expect_step_w_m2 = 0;
   bool expect_pump_stop = false;
   std::string dead_device;
+  std::string bad_replies_device;  // a device whose faulted replies count as bad replies
   bool rtu = false;
 };
 
@@ -104,6 +111,7 @@ Scenario LoadScenario(const std::string& name) {
   s.expect_step_w_m2 = t["expect_step_w_m2"].value_or(0.0);
   s.expect_pump_stop = t["expect_pump_stop"].value_or(false);
   s.dead_device = t["dead_device"].value_or(std::string());
+  s.bad_replies_device = t["expect_bad_replies"].value_or(std::string());
   s.rtu = t["rtu"].value_or(false);
   return s;
 }
@@ -475,6 +483,13 @@ TEST_P(ModbusScenarioTest, Run) {
   for (const DeviceStats& st : stats) {
     if (st.name != sc.dead_device) {
       EXPECT_GT(st.requests, static_cast<std::uint64_t>(sc.periods / 2)) << st.name;
+    }
+    // Replies that are not the request's are told apart from timeouts.
+    if (st.name == sc.bad_replies_device) {
+      EXPECT_GT(st.bad_replies, 0u) << st.name;
+      EXPECT_EQ(st.timeouts, 0u) << st.name;
+    } else {
+      EXPECT_EQ(st.bad_replies, 0u) << st.name;
     }
   }
   EXPECT_LE(log.size(), 4 + 3 * faults.size() + (sc.dead_device.empty() ? 0 : 2)) << log_text;

@@ -37,6 +37,8 @@ TEST(SimFault, ParsesTheTextForm) {
   EXPECT_EQ(f.delay_ms, 750);
   ASSERT_TRUE(ParseFault("weather:freeze:for=5:from=0", &f, &error)) << error;
   EXPECT_EQ(f.kind, FaultKind::kFreeze);
+  ASSERT_TRUE(ParseFault("weather:wrong_unit:from=0:for=5", &f, &error)) << error;
+  EXPECT_EQ(f.kind, FaultKind::kWrongUnit);
 }
 
 TEST(SimFault, RejectsBadText) {

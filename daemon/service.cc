@@ -581,6 +581,7 @@ int Service::Run() {
   if (!config_.modbus.devices.empty()) {
     PollerOptions poller_options;
     poller_options.period_s = config_.poll.period_s;
+    poller_options.area_m2 = config_.plant.area_m2;
     poller_ = std::make_unique<ModbusPoller>(
         config_.modbus, poller_options, *clock_,
         [](int priority, const std::string& line) { LogToStderr(priority, line); });

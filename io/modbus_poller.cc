@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/physical_limits.h"
 #include "io/modbus_tcp_read.h"
 #include "io/register_codec.h"
 
@@ -289,7 +290,10 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
       const auto c_index = static_cast<std::size_t>(p.channel);
       result->read_mask |= 1u << c_index;
       result->value[c_index] = WireToChannelUnit(p.channel, v.value);
-      if (v.rejected) result->rejected_mask |= 1u << c_index;
+      if (v.rejected ||
+          !PhysicalLimitOf(p.channel, options_.area_m2).Contains(result->value[c_index])) {
+        result->rejected_mask |= 1u << c_index;
+      }
     }
   }
   device->failures = 0;

@@ -78,6 +78,10 @@ struct PollerOptions {
   int frozen_after_polls = 12;  // polls with bit-identical registers before a device counts as
                                 // frozen (its channels rejected); 0 disables the check
   ReadPlanOptions plan;         // coalescing of points into reads
+  // Collector area for the area-scaled physical limits of flow and power
+  // (core/physical_limits.h): a decoded value outside its channel's limits
+  // is rejected like one outside the point's valid range. 0: unknown.
+  double area_m2 = 0.0;
 };
 
 class ModbusPoller {

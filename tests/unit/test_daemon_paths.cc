@@ -1,0 +1,416 @@
+// The daemon's less travelled paths, through the real `pvtwin run` (and
+// `pvtwin sim`) processes on a real SQLite file: the systemd notifications,
+// SIGHUP reload, a calibration over its time limit, a worse calibration
+// rejected, live aggregation with a non-default poll period and fluid, and a
+// soak with devices offline for 1, 10, 60 and 600 simulated minutes across a
+// nightly calibration and a restart.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <regex>
+#include <thread>
+
+#include "config/config_edit.h"
+#include "core/clock.h"
+#include "io/child_process.h"
+#include "tests/support/files.h"
+#include "tests/support/run_pvtwin.h"
+
+namespace pvtwin {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadFile;
+using testing::RunPvtwin;
+using testing::ScratchDir;
+
+const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
+// 2024-06-01 00:00 UTC.
+constexpr std::int64_t kJune1 = 1717200000;
+constexpr std::int64_t kDay = 86400;
+
+bool WaitFor(double timeout_s, const std::function<bool()>& done) {
+  const double deadline = WallNowS() + timeout_s;
+  while (WallNowS() < deadline) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return done();
+}
+
+// A reader of the daemon's database, as a dashboard would hold one.
+class Db {
+ public:
+  explicit Db(const fs::path& path) {
+    sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READONLY, nullptr);
+    sqlite3_busy_timeout(db_, 5000);
+  }
+  ~Db() { sqlite3_close(db_); }
+  Db(const Db&) = delete;
+  Db& operator=(const Db&) = delete;
+  std::string Text(const std::string& sql) const {
+    sqlite3_stmt* st = nullptr;
+    std::string result;
+    if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &st, nullptr) == SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0) != nullptr) {
+      result = reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
+    }
+    sqlite3_finalize(st);
+    return result;
+  }
+  double Number(const std::string& sql) const {
+    const std::string t = Text(sql);
+    return t.empty() ? -1.0 : std::stod(t);
+  }
+
+ private:
+  sqlite3* db_ = nullptr;
+};
+
+// The systemd notification socket: a datagram socket whose path goes into
+// the daemon's NOTIFY_SOCKET, as systemd sets it for Type=notify units.
+class NotifySocket {
+ public:
+  explicit NotifySocket(const fs::path& path) : path_(path) {
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", path.c_str());
+    EXPECT_EQ(::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0) << path;
+  }
+  ~NotifySocket() { ::close(fd_); }
+  // Messages until one contains `what`, for at most timeout_s; all of them
+  // are kept in received().
+  bool WaitFor(const std::string& what, double timeout_s) {
+    const double deadline = WallNowS() + timeout_s;
+    while (WallNowS() < deadline) {
+      char buf[4096];
+      const ssize_t n = ::recv(fd_, buf, sizeof buf, MSG_DONTWAIT);
+      if (n > 0) {
+        received_.emplace_back(buf, static_cast<std::size_t>(n));
+        if (received_.back().find(what) != std::string::npos) return true;
+        continue;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+  std::string received() const {
+    std::string all;
+    for (const std::string& m : received_) all += "[" + m + "] ";
+    return all;
+  }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+  std::vector<std::string> received_;
+};
+
+class DaemonPaths : public ::testing::Test {
+ protected:
+  std::string DbPath() const { return (dir_ / "pvtwin.db").string(); }
+  std::string Log() const { return ReadFile(dir_ / "daemon.log"); }
+
+  // `days` of the example plant's history up to `end`, imported at 1 min.
+  void ImportHistory(std::int64_t end, int days) {
+    fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
+    auto run = RunPvtwin(dir_.path(), "sim --config sim.toml --export history.csv --days " +
+                                          std::to_string(days) + " --step 60 --start " +
+                                          std::to_string(end - days * kDay));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    run = RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + DbPath());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+  }
+
+  // A config without devices: the daemon works on the imported data.
+  void WriteConfig(const DaemonSettings& settings, const std::string& plant_extra = "") {
+    std::string text, error;
+    ASSERT_TRUE(EditConfig(PlantOnly(plant_extra), {}, settings, &text, &error)) << error;
+    std::ofstream(dir_ / "pvtwin.toml") << text;
+  }
+  static std::string PlantOnly(const std::string& extra) {
+    return "[plant]\nlatitude_deg = 47.358\nlongitude_deg = 16.128\ntilt_deg = 20\n"
+           "azimuth_deg = 180\narea_m2 = 1.8\n" +
+           extra;
+  }
+
+  void StartDaemon(std::int64_t sim_start, double speed, std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv = {PVTWIN_BINARY, "run",         "--config",
+                                     (dir_ / "pvtwin.toml").string(),
+                                     "--speed",     std::to_string(speed),
+                                     "--sim-start", std::to_string(sim_start),
+                                     "--wall-anchor", std::to_string(anchor_)};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    std::string error;
+    ASSERT_TRUE(daemon_.Start(argv, (dir_ / "daemon.log").string(), &error)) << error;
+    // Ready: the store exists, so a reader can open it.
+    ASSERT_TRUE(WaitFor(20, [&] { return Log().find("info: ready: ") != std::string::npos; }))
+        << Log();
+  }
+
+  DaemonSettings Settings() const {
+    DaemonSettings s;
+    s.db_path = DbPath();
+    s.timezone = "UTC";
+    return s;
+  }
+
+  ScratchDir dir_{"daemon_paths"};
+  double anchor_ = WallNowS();
+  ChildProcess daemon_;
+};
+
+TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
+  WriteConfig(Settings());
+  NotifySocket notify(dir_ / "notify.sock");
+  ::setenv("NOTIFY_SOCKET", (dir_ / "notify.sock").c_str(), 1);
+  ::setenv("WATCHDOG_USEC", "1000000", 1);  // the unit's WatchdogSec=1
+  StartDaemon(kJune1, 1.0);
+  ::unsetenv("NOTIFY_SOCKET");
+  ::unsetenv("WATCHDOG_USEC");
+  ASSERT_TRUE(notify.WaitFor("READY=1", 20)) << notify.received() << Log();
+  // Pinged at least twice as often as the watchdog interval.
+  ASSERT_TRUE(notify.WaitFor("WATCHDOG=1", 2)) << notify.received();
+  ASSERT_TRUE(notify.WaitFor("WATCHDOG=1", 2)) << notify.received();
+
+  // SIGHUP: the edited variant is taken, systemd hears RELOADING then READY.
+  DaemonSettings changed = Settings();
+  changed.variant = "1N1Cwr";
+  WriteConfig(changed);
+  ::kill(daemon_.pid(), SIGHUP);
+  ASSERT_TRUE(notify.WaitFor("RELOADING=1", 10)) << notify.received();
+  ASSERT_TRUE(notify.WaitFor("READY=1", 10)) << notify.received();
+  ASSERT_TRUE(WaitFor(10, [&] { return Log().find("variant is now 1N1Cwr") != std::string::npos; }))
+      << Log();
+
+  // A reload with an invalid config keeps the running one.
+  const std::string valid = ReadFile(dir_ / "pvtwin.toml");
+  std::ofstream(dir_ / "pvtwin.toml")
+      << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
+  ::kill(daemon_.pid(), SIGHUP);
+  ASSERT_TRUE(WaitFor(10, [&] {
+    return Log().find("reload failed; the old config stays") != std::string::npos;
+  })) << Log();
+  EXPECT_NE(Log().find("period_s = 7: must be a whole number of seconds that divides 60"),
+            std::string::npos)
+      << Log();
+
+  ::kill(daemon_.pid(), SIGTERM);
+  EXPECT_TRUE(notify.WaitFor("STOPPING=1", 10)) << notify.received();
+  EXPECT_EQ(daemon_.Stop(0, 10.0), 0) << Log();
+}
+
+TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
+  ImportHistory(kJune1, 4);
+  WriteConfig(Settings());
+  StartDaemon(kJune1, 60.0, {"--calibration-timeout", "0.01"});
+  const Db db(DbPath());
+  ASSERT_TRUE(WaitFor(30, [&] {
+    return db.Number("SELECT count(*) FROM calibration WHERE status = 'timeout'") >= 1;
+  })) << Log();
+  EXPECT_NE(db.Text("SELECT reason FROM calibration WHERE status = 'timeout'").find("limit 0 s"),
+            std::string::npos);
+  int code = 0;
+  EXPECT_FALSE(daemon_.Finished(&code)) << "the daemon stopped: " << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
+TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
+  ImportHistory(kJune1, 5);
+  DaemonSettings settings = Settings();
+  settings.calibrate_at = "00:30";  // UTC, 30 simulated minutes after the start
+  WriteConfig(settings);
+  // First run: no parameters yet, so it calibrates at once and accepts.
+  StartDaemon(kJune1, 600.0);
+  {
+    const Db db(DbPath());
+    ASSERT_TRUE(WaitFor(60, [&] {
+      return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
+    })) << Log();
+  }
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  // The training days now read 40 % less heat than the plant made (a failed
+  // heat meter); the held-out last day is left as it was.
+  {
+    sqlite3* raw = nullptr;
+    sqlite3_open(DbPath().c_str(), &raw);
+    ASSERT_EQ(sqlite3_exec(raw,
+                           ("UPDATE measurement_1min SET q_th_w = 0.6 * q_th_w WHERE ts < " +
+                            std::to_string(kJune1 - kDay))
+                               .c_str(),
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(raw);
+  }
+  anchor_ = WallNowS();
+  StartDaemon(kJune1, 600.0);
+  const Db db(DbPath());
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Number("SELECT count(*) FROM calibration WHERE status = 'rejected'") >= 1;
+  })) << Log();
+  const std::string reason = db.Text("SELECT reason FROM calibration WHERE status = 'rejected'");
+  EXPECT_NE(reason.find("exceeds the current"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("parameters kept"), std::string::npos) << reason;
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE accepted = 1"), 1);
+  // Forecasts still come from the first calibration.
+  EXPECT_EQ(db.Number("SELECT count(DISTINCT calibration_id) FROM forecast"), 1);
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
+// Live polling through `pvtwin sim`, the daemon configured with another
+// poll period and fluid than the defaults.
+class LiveDaemon : public DaemonPaths {
+ protected:
+  void StartSim(std::int64_t start, double speed, const std::vector<std::string>& faults) {
+    fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
+    std::vector<std::string> argv = {PVTWIN_BINARY,       "sim", "--config",
+                                     (dir_ / "sim.toml").string(), "--ephemeral-ports",
+                                     "--speed",           std::to_string(speed),
+                                     "--start",           std::to_string(start),
+                                     "--wall-anchor",     std::to_string(anchor_)};
+    for (const std::string& f : faults) {
+      argv.push_back("--fault");
+      argv.push_back(f);
+    }
+    std::string error;
+    ASSERT_TRUE(sim_.StartPiped(argv, (dir_ / "sim.log").string(), &error)) << error;
+    ASSERT_TRUE(sim_.ReadUntil("ready", 20.0, &sim_lines_)) << ReadFile(dir_ / "sim.log");
+  }
+  // The example map with the plant's fluid set; without_heat_meter drops the
+  // q_th_w point, so that the daemon computes Q_u = ṁ·c_p·ΔT itself.
+  void WriteLiveConfig(const DaemonSettings& settings, const std::string& fluid_cp,
+                       bool without_heat_meter = false) {
+    std::string text, error;
+    std::string map = ReadFile(kExampleMap);
+    map = std::regex_replace(map, std::regex("area_m2 = 1.8\n"),
+                             "area_m2 = 1.8\nfluid_cp_j_kgk = " + fluid_cp + "\n");
+    if (without_heat_meter) {
+      const std::string table = "[[modbus.point]]";
+      const std::size_t q = map.find("channel = \"q_th_w\"");
+      ASSERT_NE(q, std::string::npos);
+      const std::size_t begin = map.rfind(table, q);
+      const std::size_t end = map.find(table, q);
+      map.erase(begin, end - begin);
+    }
+    ASSERT_TRUE(EditConfig(map, ParseListeningLines(sim_lines_), settings, &text, &error))
+        << error;
+    std::ofstream(dir_ / "pvtwin.toml") << text;
+  }
+  void TearDown() override {
+    daemon_.Stop(SIGTERM, 10.0);
+    sim_.SendLine("quit");
+    sim_.Stop(0, 5.0);
+  }
+  ChildProcess sim_;
+  std::vector<std::string> sim_lines_;
+};
+
+TEST_F(LiveDaemon, AggregatesWithTheConfiguredPeriodAndFluid) {
+  const std::int64_t t0 = kJune1 + 10 * 3600;  // a June morning
+  StartSim(t0, 60.0, {});
+  DaemonSettings settings = Settings();
+  settings.poll_period_s = 10;
+  WriteLiveConfig(settings, "4186", true);  // water, Q_u from flow and ΔT
+  StartDaemon(t0, 60.0);
+  const Db db(DbPath());
+  const std::string full = " FROM measurement_1min WHERE ts > " + std::to_string(t0 + 60);
+  ASSERT_TRUE(WaitFor(30, [&] { return db.Number("SELECT count(*)" + full) >= 3; }))
+      << Log() << ReadFile(dir_ / "sim.log");
+  // Six 10 s samples a minute, and no sample between the periods.
+  EXPECT_EQ(db.Number("SELECT min(n_samples)" + full), 6);
+  EXPECT_EQ(db.Number("SELECT max(n_samples)" + full), 6);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM sample_5s WHERE ts % 10 != 0"), 0);
+  // Q_u is the mean of ṁ·c_p·ΔT of the minute's samples with c_p = 4186.
+  const double worst = db.Number(
+      "SELECT max(abs(m.q_th_w - s.q) / max(abs(s.q), 1))" + std::string(" FROM measurement_1min m") +
+      " JOIN (SELECT ts - ts % 60 AS minute, avg(flow_kg_s * 4186 * (t_out_c - t_in_c)) AS q"
+      " FROM sample_5s GROUP BY minute) s ON s.minute = m.ts WHERE m.ts > " +
+      std::to_string(t0 + 60) + " AND m.q_th_w IS NOT NULL");
+  EXPECT_GE(worst, 0.0);
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(db.Number("SELECT max(abs(q_th_w))" + full), 10.0) << "no heat to compare";
+}
+
+// Each device offline for 1, 10, 60 and 600 simulated minutes while the
+// daemon forecasts every 5 minutes and calibrates at 02:00, then a restart:
+// the daemon never exits on its own, and every poll period has a row
+// (values, or NULL where the device was away).
+TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
+  const std::int64_t t0 = kJune1 - 4 * 3600;  // 20:00 UTC; calibration at 02:00 UTC
+  ImportHistory(t0 - 120, 3);
+  constexpr double kSpeed = 600.0;
+  const auto drop = [](const char* device, int from_min, int for_min) {
+    return std::string(device) + ":drop:from=" + std::to_string(from_min * 60) +
+           ":for=" + std::to_string(for_min * 60);
+  };
+  StartSim(t0, kSpeed,
+           {drop("collector", 5, 1), drop("weather", 10, 10), drop("collector", 30, 60),
+            drop("weather", 100, 600)});
+  DaemonSettings settings = Settings();
+  settings.refresh_min = 5;
+  WriteLiveConfig(settings, "3650");
+  StartDaemon(t0, kSpeed);
+  const Db db(DbPath());
+  const std::int64_t end1 = t0 + 12 * 3600;  // past the 600-minute outage and 02:00
+  ASSERT_TRUE(WaitFor(150, [&] {
+    int code = 0;
+    return daemon_.Finished(&code) ||
+           db.Number("SELECT max(ts) FROM sample_5s") >= static_cast<double>(end1);
+  })) << Log();
+  int code = 0;
+  ASSERT_FALSE(daemon_.Finished(&code)) << "exit " << code << ": " << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  const std::int64_t last1 = static_cast<std::int64_t>(db.Number("SELECT max(ts) FROM sample_5s"));
+
+  anchor_ = WallNowS();  // the restart, 30 simulated minutes later
+  StartDaemon(last1 + 1800, kSpeed);
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Number("SELECT max(ts) FROM sample_5s") >= static_cast<double>(last1 + 3600);
+  })) << Log();
+  ASSERT_FALSE(daemon_.Finished(&code)) << "exit " << code << ": " << Log();
+  const std::int64_t last2 = static_cast<std::int64_t>(db.Number("SELECT max(ts) FROM sample_5s"));
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+
+  // Every period of both runs has its row.
+  const auto rows = [&](std::int64_t from, std::int64_t to) {
+    return db.Number("SELECT count(*) FROM sample_5s WHERE ts >= " + std::to_string(from) +
+                     " AND ts <= " + std::to_string(to));
+  };
+  const std::int64_t first1 = static_cast<std::int64_t>(
+      db.Number("SELECT min(ts) FROM sample_5s WHERE ts >= " + std::to_string(t0)));
+  EXPECT_EQ(rows(first1, last1), static_cast<double>((last1 - first1) / 5 + 1));
+  const std::int64_t first2 = static_cast<std::int64_t>(
+      db.Number("SELECT min(ts) FROM sample_5s WHERE ts > " + std::to_string(last1)));
+  EXPECT_EQ(rows(first2, last2), static_cast<double>((last2 - first2) / 5 + 1));
+  // The outages are NULLs, not values: the 600-minute weather outage.
+  const std::string outage = " FROM sample_5s WHERE ts >= " + std::to_string(t0 + 110 * 60) +
+                             " AND ts < " + std::to_string(t0 + 690 * 60);
+  EXPECT_GT(db.Number("SELECT count(*)" + outage), 6000);
+  EXPECT_EQ(db.Number("SELECT count(t_amb_c)" + outage), 0);
+  // The collector was online then. At 600× a period lasts 8 ms of wall
+  // time, so a poll thread scheduled late now and then misses its period's
+  // delivery (the value is never carried into the next one): a few NULLs.
+  EXPECT_LT(db.Number("SELECT count(*)" + outage + " AND t_in_c IS NULL"),
+            0.01 * db.Number("SELECT count(*)" + outage));
+  // Forecasts every 5 minutes, the nightly calibration ran, nothing crashed.
+  EXPECT_GT(db.Number("SELECT count(DISTINCT issued_at) FROM forecast"), 100);
+  EXPECT_GE(db.Number("SELECT count(*) FROM calibration WHERE run_at >= " +
+                      std::to_string(kJune1 + 2 * 3600)),
+            1);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE status IN ('crashed', 'failed')"),
+            0)
+      << db.Text("SELECT group_concat(reason, ' | ') FROM calibration");
+  EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
+}
+
+}  // namespace
+}  // namespace pvtwin

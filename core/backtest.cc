@@ -571,7 +571,9 @@ std::string FormatStepTable(std::span<const BacktestResult> runs) {
   std::vector<std::string> head = {"time step"};
   for (const BacktestResult& r : runs) head.push_back(StepLabel(r.step_s));
   rows.push_back(head);
-  for (const auto& [variant, n] : keys) {
+  for (const auto& key : keys) {
+    const std::string& variant = key.first;  // named: clang 14 cannot capture a binding
+    const int n = key.second;
     std::vector<std::string> runtime = {variant + " n=" + std::to_string(n) +
                                         ": calibration runtime (s)"};
     std::vector<std::string> mae_q = {"  mean MAE_Qu (W/m²)"};

@@ -48,7 +48,9 @@ for name in "${harnesses[@]}"; do
 done
 
 step "3/3 test suite under AddressSanitizer and UndefinedBehaviorSanitizer"
-cmake -S . -B build-sanitize -DPVTWIN_WERROR=ON -DPVTWIN_SANITIZE=ON -DPVTWIN_LTO=OFF \
+# No -Werror here: GCC 12 warns falsely (maybe-uninitialized in std::regex,
+# std::function) under -fsanitize; build/ above enforces the warnings.
+cmake -S . -B build-sanitize -DPVTWIN_WERROR=OFF -DPVTWIN_SANITIZE=ON -DPVTWIN_LTO=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build-sanitize -j"$jobs"
 export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/series.h"
 #include "core/variant.h"
@@ -40,6 +41,21 @@ inline Series MakeConstantSeries(std::size_t rows, double step_s, const Constant
   fill(Channel::kTBackC, in.t_back_c);
   fill(Channel::kValid, 1.0);
   return s;
+}
+
+// 2024-06-01 00:00 UTC: a start for series whose rows need the sun. The 'I'
+// variants weight the beam with the IAM at its angle of incidence, computed
+// from the plant's site and the row times unless an aoi_deg column is given.
+inline constexpr std::int64_t kJune1_2024UtcS = 1717200000;
+
+// Adds the in-plane diffuse irradiance that the 'I' variants need to split
+// g_poa_w_m2 into beam and diffuse parts (core/irradiance.h,
+// SplitMeasuredPoa): `fraction` of g_poa_w_m2 on every row.
+inline void AddPoaDiffuse(Series* s, double fraction) {
+  const std::vector<double>& g_poa = (*s)[Channel::kGPoaWM2];
+  std::vector<double> diffuse(g_poa.size());
+  for (std::size_t i = 0; i < g_poa.size(); ++i) diffuse[i] = fraction * g_poa[i];
+  (*s)[Channel::kGPoaDiffuseWM2] = diffuse;
 }
 
 // The parsed variant; a bad name fails the calling test.

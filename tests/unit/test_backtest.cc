@@ -171,12 +171,21 @@ TEST_F(Backtest, FourJobsInDayVariantOrderAndSameNumbersOnTwoThreads) {
   EXPECT_EQ(r2.averages[0].mae_q_th_w_m2, r1.averages[0].mae_q_th_w_m2);
 }
 
-TEST_F(Backtest, TruthVariantPredictsNoiseFreeTestDaysWithinThreeWattsPerSquareMetre) {
+// The truth variant fitted on noise-free data from itself predicts the test
+// days almost exactly. Measured (seed kSeed): MAE P_el 0.000015 and 0.0059,
+// MAE Q_u 0.0007 and 0.0067 W/m² on the two test days, what the fit's
+// stopping tolerance leaves. The bound is 3 × the worst measured day,
+// 0.02 W/m²; the old bound of 3 W/m² was 450 × that and let a fit that
+// missed the truth pass.
+TEST_F(Backtest, TruthVariantPredictsNoiseFreeTestDaysAlmostExactly) {
+  constexpr double kBoundWM2 = 3.0 * 0.0067;
   for (const BacktestDay& d : one_thread_->days) {
     if (d.variant != "2N1Ccolwr") continue;
     ASSERT_TRUE(d.ok) << d.failure_reason;
-    EXPECT_LT(d.test.mae_p_el_w_m2, 3.0) << SolarDate(d.day_start_s, one_thread_->solar_offset_s);
-    EXPECT_LT(d.test.mae_q_th_w_m2, 3.0) << SolarDate(d.day_start_s, one_thread_->solar_offset_s);
+    EXPECT_LT(d.test.mae_p_el_w_m2, kBoundWM2)
+        << SolarDate(d.day_start_s, one_thread_->solar_offset_s);
+    EXPECT_LT(d.test.mae_q_th_w_m2, kBoundWM2)
+        << SolarDate(d.day_start_s, one_thread_->solar_offset_s);
   }
 }
 

@@ -132,6 +132,29 @@ TEST_F(CliModel, CalibrateThenSimulateRoundTrip) {
   EXPECT_NE(calib.find(expected), std::string::npos) << expected << "\n" << calib;
 }
 
+// A parameter that the fit drives to a bound is reported as such, not as
+// identified. On the htw saar day 3, 2N1CcolwrI drives u_front_w_m2k and
+// f_th to their upper bounds (why: test_identification.cc,
+// IdentifyRealData); the other free parameters stay inside.
+TEST_F(CliModel, CalibratePrintsParametersAtTheirBound) {
+  const ProcessResult run =
+      RunPvtwin(dir_, "calibrate --config " + Data("plant.toml") + " --csv " +
+                          Data("day3_clear_medium_dT.csv") + " --variant 2N1CcolwrI");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  int at_bound = 0;
+  for (const std::string& line : Lines(run.out)) {
+    if (line.find("at upper bound") == std::string::npos &&
+        line.find("at lower bound") == std::string::npos) {
+      continue;
+    }
+    ++at_bound;
+    const bool known = line.rfind("  u_front_w_m2k ", 0) == 0 || line.rfind("  f_th ", 0) == 0;
+    EXPECT_TRUE(known) << line;
+    EXPECT_NE(line.find("at upper bound"), std::string::npos) << line;
+  }
+  EXPECT_EQ(at_bound, 2) << run.out;
+}
+
 TEST_F(CliModel, CalibrateOnTooLittleDataExitsTwo) {
   const ProcessResult run = RunPvtwin(
       dir_,

@@ -36,6 +36,11 @@ TEST(DiagnosisStats, StudentTMatchesClosedForms) {
   for (double t : {-4.0, -1.0, 0.3, 1.5, 6.0}) {
     EXPECT_NEAR(StudentTCdf(t, 2.0), 0.5 + t / (2.0 * std::sqrt(2.0 + t * t)), 1e-12) << t;
   }
+  // ν = 4: F(t) = 1/2 + (3/4)·x·(1 − x²/3), x = t/√(4 + t²).
+  for (double t : {-3.0, -0.8, 0.4, 2.2294816, 5.0}) {
+    const double x = t / std::sqrt(4.0 + t * t);
+    EXPECT_NEAR(StudentTCdf(t, 4.0), 0.5 + 0.75 * x * (1.0 - x * x / 3.0), 1e-12) << t;
+  }
 }
 
 TEST(DiagnosisStats, PairedTestMatchesAHandComputedCase) {
@@ -44,7 +49,14 @@ TEST(DiagnosisStats, PairedTestMatchesAHandComputedCase) {
   // Exact one-sided p: sign patterns with W+ ≥ 14 are those whose negative
   // ranks sum to ≤ 1: none negative, or only the rank-1 one → 2/32.
   // Sign test: 4 of 5 positive → P(Bin(5, ½) ≥ 4) = 6/32.
-  // Paired t: mean 1.3, sd √1.7, t = 1.3/(√1.7/√5) = 2.229493.
+  // Paired t: mean 1.3, sd √1.7, t = 1.3/(√1.7/√5) = 1.3/0.5830952 = 2.2294816,
+  // ν = 4. One-sided p = 1 − F₄(t) with the closed form of Student's t for
+  // ν = 4: F₄(t) = 1/2 + (3/4)·x·(1 − x²/3), x = t/√(4 + t²)
+  //   t² = 4.9705882, x = 2.2294816/√8.9705882 = 2.2294816/2.9950940 = 0.7443778
+  //   F₄ = 0.5 + 0.75·0.7443778·(1 − 0.5540984/3) = 0.5 + 0.5582834·0.8153005
+  //      = 0.9551687 → p = 0.0448313,
+  // in agreement with the tabulated value 0.04483 (a t-table places t = 2.2295
+  // between t₀.₀₅ = 2.132 and t₀.₀₂₅ = 2.776 at ν = 4).
   const std::vector<double> before = {10, 12, 9, 11, 14};
   const std::vector<double> after = {9, 10, 9.5, 8, 13};
   const PairedTest t = OneSidedPairedTest(before, after);
@@ -55,8 +67,8 @@ TEST(DiagnosisStats, PairedTestMatchesAHandComputedCase) {
   EXPECT_NEAR(t.wilcoxon_p, 2.0 / 32.0, 1e-12);
   EXPECT_NEAR(t.sign_p, 6.0 / 32.0, 1e-12);
   EXPECT_NEAR(t.mean_difference, 1.3, 1e-12);
-  EXPECT_NEAR(t.t_stat, 1.3 / (std::sqrt(1.7) / std::sqrt(5.0)), 1e-9);
-  EXPECT_NEAR(t.t_p, 1.0 - StudentTCdf(t.t_stat, 4.0), 1e-12);
+  EXPECT_NEAR(t.t_stat, 2.2294816, 1e-7);
+  EXPECT_NEAR(t.t_p, 0.0448313, 1e-7);
 }
 
 TEST(DiagnosisStats, WilcoxonExtremesAndZeros) {

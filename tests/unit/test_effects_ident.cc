@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "core/effects.h"
 #include "core/identification.h"
@@ -31,16 +32,36 @@ struct IdentCase {
   Param checked;     // parameter whose truth must come back
   double tolerance;  // absolute, in the parameter's unit
   std::uint64_t seed;
+  // Start value of `checked` for the fit; NaN: the reference start value
+  // (params.h). Either way the start must be more than `tolerance` from the
+  // truth, or recovering the truth would prove nothing.
+  double start = std::numeric_limits<double>::quiet_NaN();
+  // Fit to ftol = xtol = 1e-9 instead of the defaults, for a parameter that
+  // moves the objective by less than the default ftol_rel (1e-3).
+  bool converge_fully = false;
+  // The base model must leave a held-out gap of more than kGapSe standard
+  // errors of the noise floor; false where the measured gap is within the
+  // noise at the effect's typical magnitude (said at the case).
+  bool gap_visible = true;
 };
+
+// A gap "well above the noise": the noise alone moves a held-out MAE by
+// about one standard error (sd of the rows' absolute errors / √rows, ≈ 0.025
+// W/m² here, 2 % of the floor); four of them is far outside that.
+constexpr double kGapSe = 4.0;
 
 struct Fit {
   IdentSummary summary;
   double heldout_w_m2 = 0.0;
+  // Standard error of heldout_w_m2 from the row-to-row scatter of the
+  // held-out absolute errors (|e_P_el| + |e_Q_u|)/A: sd/√rows.
+  double heldout_se_w_m2 = 0.0;
 };
 
 // Fits `variant` on the first kTrainDays and scores it on the rest.
 Fit FitAndScore(const Series& data, const Plant& plant, const ModelSpec& spec,
-                const ParamVector* fixed_params = nullptr) {
+                const ParamVector* fixed_params = nullptr, const ParamVector* start = nullptr,
+                bool converge_fully = false) {
   const std::int64_t split_s = data.time_s[0] + kTrainDays * 86400;
   std::size_t split = 0;
   while (split < data.size() && data.time_s[split] < split_s) ++split;
@@ -54,8 +75,13 @@ Fit FitAndScore(const Series& data, const Plant& plant, const ModelSpec& spec,
   if (fixed_params != nullptr) {
     params = *fixed_params;
   } else {
-    fit.summary =
-        Identify(train_d, MakeMeasurements(train, train_d), StartParams(plant), IdentOptions{});
+    IdentOptions options;
+    if (converge_fully) {
+      options.optimizer.ftol_rel = 1e-9;
+      options.optimizer.xtol_rel = 1e-9;
+    }
+    fit.summary = Identify(train_d, MakeMeasurements(train, train_d),
+                           start != nullptr ? *start : StartParams(plant), options);
     EXPECT_TRUE(fit.summary.ok) << fit.summary.BriefReport();
     params = fit.summary.params;
   }
@@ -68,6 +94,17 @@ Fit FitAndScore(const Series& data, const Plant& plant, const ModelSpec& spec,
   SimOutputs out;
   Simulate(all_d, params, &out);
   fit.heldout_w_m2 = ComputeErrors(held, out, plant.area_m2).objective_w_m2();
+  double sum = 0.0, sum_sq = 0.0;
+  for (std::uint32_t r : held.rows) {
+    const double e =
+        (std::fabs(out.p_el_w[r] - held.p_el_w[r]) + std::fabs(out.q_th_w[r] - held.q_th_w[r])) /
+        plant.area_m2;
+    sum += e;
+    sum_sq += e * e;
+  }
+  const double n = static_cast<double>(held.rows.size());
+  const double var = (sum_sq - sum * sum / n) / (n - 1.0);
+  fit.heldout_se_w_m2 = std::sqrt(var / n);
   return fit;
 }
 
@@ -85,20 +122,26 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
   Series data = MakeSyntheticPlantData(plant, options);
   ApplyPaperCorrections(&data);
 
+  ParamVector start = StartParams(plant);
+  const std::size_t checked = static_cast<std::size_t>(c.checked);
+  if (!std::isnan(c.start)) start[checked] = c.start;
+  ASSERT_GT(std::fabs(start[checked] - options.truth[checked]), c.tolerance)
+      << "the fit would pass by staying at its start value";
+
   const auto t0 = std::chrono::steady_clock::now();
   const Fit truth = FitAndScore(data, plant, with, &options.truth);
-  const Fit fit_with = FitAndScore(data, plant, with);
-  const Fit fit_base = FitAndScore(data, plant, base);
+  const Fit fit_with = FitAndScore(data, plant, with, nullptr, &start, c.converge_fully);
+  const Fit fit_base = FitAndScore(data, plant, base, nullptr, nullptr, c.converge_fully);
   const double runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double value = fit_with.summary.params[static_cast<std::size_t>(c.checked)];
   const double truth_value = options.truth[static_cast<std::size_t>(c.checked)];
   std::printf(
-      "%-16s truth %-28s held-out MAE: truth %.3f, with %.3f, base %.3f W/m2; %s = %.4g "
-      "(truth %.4g); %.1f s\n",
+      "%-16s truth %-28s held-out MAE: truth %.3f (se %.4f), with %.3f, base %.3f W/m2; %s = "
+      "%.4g (truth %.4g, start %.4g); %.1f s\n",
       std::string(Info(c.effect).name).c_str(), with.Name().c_str(), truth.heldout_w_m2,
-      fit_with.heldout_w_m2, fit_base.heldout_w_m2, std::string(Info(c.checked).name).c_str(),
-      value, truth_value, runtime_s);
+      truth.heldout_se_w_m2, fit_with.heldout_w_m2, fit_base.heldout_w_m2,
+      std::string(Info(c.checked).name).c_str(), value, truth_value, start[checked], runtime_s);
   EXPECT_NEAR(value, truth_value, c.tolerance) << fit_with.summary.BriefReport();
   if (c.effect == Effect::kShading) {
     // Identifiable is what the sun path crosses: the obstacle's edge
@@ -122,8 +165,10 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
     // reading into η_PV; with it, η_PV comes back unbiased.
     const std::size_t eta = static_cast<std::size_t>(Param::kEtaPvRef);
     EXPECT_GT(fit_base.summary.params[eta] - truth_value, 0.5 * 0.06 * truth_value);
-  } else {
-    EXPECT_GT(fit_base.heldout_w_m2, fit_with.heldout_w_m2);
+  } else if (c.gap_visible) {
+    EXPECT_GT(fit_base.heldout_w_m2, truth.heldout_w_m2 + kGapSe * truth.heldout_se_w_m2)
+        << "the base model's held-out MAE is within " << kGapSe
+        << " noise standard errors of the floor";
   }
   EXPECT_LT(fit_with.heldout_w_m2, 1.1 * truth.heldout_w_m2 + 0.1);
 }
@@ -131,11 +176,24 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
 INSTANTIATE_TEST_SUITE_P(
     AllEffects, EffectIdentification,
     ::testing::Values(IdentCase{Effect::kCapacitance, "1Nwr", Param::kCPvJM2K, 5e3, 101},
-                      IdentCase{Effect::kSecondNode, "1N1Cwr", Param::kUCollWM2K, 15.0, 102},
+                      // U_coll: started 8× above the truth; the fit returns 17.1
+                      // (truth 12) with a standard error of 29 % (0.021 of the
+                      // log range): tolerance 9 ≈ 2 standard errors. With the
+                      // default tolerances the fit stops at 26, hence
+                      // converge_fully. The base model's gap is 0.058 W/m²
+                      // (2.3 noise standard errors): not well above the noise
+                      // at U_coll = 12.
+                      IdentCase{Effect::kSecondNode, "1N1Cwr", Param::kUCollWM2K, 9.0, 102, 100.0,
+                                /*converge_fully=*/true, /*gap_visible=*/false},
                       IdentCase{Effect::kWind, "1N1Cr", Param::kRRefWind, 0.01, 103},
                       IdentCase{Effect::kSkyRadiation, "1N1Cw", Param::kEpsPvt, 0.02, 104},
                       IdentCase{Effect::kIam, "1N1Cwr", Param::kEtaPvRef, 0.005, 105},
-                      IdentCase{Effect::kFlowDependentU, "1N1Cwr", Param::kNFlow, 0.2, 106},
+                      // The base model absorbs this effect into r0/r1: its
+                      // held-out MAE is 1.325 against a floor of 1.300 W/m²
+                      // (1 noise standard error); no gap is required.
+                      IdentCase{Effect::kFlowDependentU, "1N1Cwr", Param::kNFlow, 0.2, 106,
+                                std::numeric_limits<double>::quiet_NaN(),
+                                /*converge_fully=*/false, /*gap_visible=*/false},
                       IdentCase{Effect::kTransportDelay, "1N1Cwr", Param::kTransportDelayS, 30.0,
                                 107},
                       IdentCase{Effect::kPvClipping, "1N1Cwr", Param::kPLimitWM2, 2.0, 108},

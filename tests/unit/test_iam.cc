@@ -50,19 +50,33 @@ TEST(Iam, IsMonotoneDecreasingAndWithinUnitInterval) {
   EXPECT_TRUE(std::isnan(IamSoukaSafwat(std::nan(""), kB0)));
 }
 
+// Hand values (paper 2.5), tilt β = 45°, beam at θ = 30°, b0 = 0.05:
+//   θ_eff,sky = 59.68 − 0.1388·45 + 0.001497·45² = 59.68 − 6.246 + 3.031425 = 56.465425°
+//   θ_eff,gnd = 90 − 0.5788·45 + 0.002693·45² = 90 − 26.046 + 5.453325 = 69.407325°
+//   beam:   K(30°) = 1 − 0.05·(2/√3 − 1) = 1 − 0.05·0.1547005384 = 0.9922649731
+//           600·0.9922649731 = 595.3589838486
+//   sky:    cos 56.465425° = 0.5524400912, 1/cos = 1.8101510299,
+//           K = 1 − 0.05·0.8101510299 = 0.9594924485; 150·K = 143.9238672758
+//   ground: linear segment, K = 0.95·(1 − 9.407325/30) = 0.95·0.6864225 = 0.652101375;
+//           20·K = 13.0420275
+//   I_at = 595.3589838486 + 143.9238672758 + 13.0420275 = 752.3248786244 W/m²
+// Were the three parts weighted at one angle (the beam's, say) the sum would
+// be 0.9922649731·770 = 764.04 W/m²: the test tells the two apart.
 TEST(Iam, AbsorbedIrradianceWeightsEachPartAtItsOwnAngle) {
-  const PoaComponents poa{600.0, 150.0, 20.0};
   const EffectiveDiffuseAngles angles = BrandemuehlBeckmanAngles(DegToRad(45.0));
+  EXPECT_NEAR(angles.sky_rad, DegToRad(56.465425), 1e-12);
+  EXPECT_NEAR(angles.ground_rad, DegToRad(69.407325), 1e-12);
   const double aoi_rad = DegToRad(30.0);
-  const double expected = IamSoukaSafwat(aoi_rad, kB0) * 600.0 +
-                          IamSoukaSafwat(angles.sky_rad, kB0) * 150.0 +
-                          IamSoukaSafwat(angles.ground_rad, kB0) * 20.0;
-  EXPECT_DOUBLE_EQ(AbsorbedIrradianceWM2(poa, aoi_rad, angles, kB0), expected);
+  // Each part alone, then all three.
+  EXPECT_NEAR(AbsorbedIrradianceWM2({600.0, 0.0, 0.0}, aoi_rad, angles, kB0), 595.3589838486, 1e-9);
+  EXPECT_NEAR(AbsorbedIrradianceWM2({0.0, 150.0, 0.0}, aoi_rad, angles, kB0), 143.9238672758, 1e-9);
+  EXPECT_NEAR(AbsorbedIrradianceWM2({0.0, 0.0, 20.0}, aoi_rad, angles, kB0), 13.0420275, 1e-9);
+  const PoaComponents poa{600.0, 150.0, 20.0};
+  EXPECT_NEAR(AbsorbedIrradianceWM2(poa, aoi_rad, angles, kB0), 752.3248786244, 1e-9);
   // With b0 = 0 nothing is lost below 60°: beam and sky (56.5°) pass fully,
-  // ground (69.4°) follows the linear segment: 1 − 9.407/30 = 0.68642.
-  EXPECT_NEAR(AbsorbedIrradianceWM2(poa, aoi_rad, angles, 0.0),
-              600.0 + 150.0 + 20.0 * (1.0 - (69.407325 - 60.0) / 30.0), 1e-9);
-  EXPECT_LT(AbsorbedIrradianceWM2(poa, aoi_rad, angles, kB0), poa.global_w_m2());
+  // ground (69.4°) follows the linear segment: 1 − 9.407325/30 = 0.6864225,
+  // 600 + 150 + 20·0.6864225 = 763.72845.
+  EXPECT_NEAR(AbsorbedIrradianceWM2(poa, aoi_rad, angles, 0.0), 763.72845, 1e-9);
 }
 
 TEST(Iam, AbsorbedIrradianceIgnoresTheAngleOfAZeroBeam) {

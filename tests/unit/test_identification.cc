@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "config/plant_config.h"
 #include "core/identification.h"
@@ -147,6 +148,50 @@ TEST(IdentOptions, IsValidNamesFieldValueAndRule) {
   EXPECT_FALSE(SetIdentAlgorithm("gradient_descent", &o));
 }
 
+// ISO 9806 steady-state equivalents of a fitted model, for comparison with
+// the collector's datasheet: the model run at constant conditions (G = 1000
+// W/m² of beam at normal incidence, wind 3.5 m/s as from the test bench's
+// blower, the bench's flow, sky long-wave at ambient so that ISO's c4 term
+// vanishes) at two mean fluid temperatures T_m = (T_in + T_out)/2, and the
+// straight line of ISO 9806's steady-state form through the two points:
+//   η_th = Q_u/(A·G) = η0(u) − (c1 + c3·u)·(T_m − T_amb)/G.
+struct IsoEquivalents {
+  double eta0 = 0.0;        // zero-loss efficiency at u = 3.5 m/s
+  double loss_w_m2k = 0.0;  // c1 + c3·u at u = 3.5 m/s
+};
+
+constexpr double kBenchWindMS = 3.5;  // PROVENANCE.md: blower, ≈ 3.5 m/s
+
+IsoEquivalents IsoEquivalentsOf(const Plant& plant, const ModelSpec& spec, const ParamVector& p) {
+  constexpr double kGWM2 = 1000.0, kTAmbC = 25.0;
+  double eta[2], x[2];
+  const double t_in_c[2] = {kTAmbC - 5.0, kTAmbC + 20.0};
+  for (int k = 0; k < 2; ++k) {
+    testing::ConstantInputs in;
+    in.g_poa_w_m2 = kGWM2;
+    in.t_in_c = t_in_c[k];
+    in.t_amb_c = kTAmbC;
+    in.t_back_c = kTAmbC;
+    in.t_sky_c = kTAmbC;
+    in.wind_m_s = kBenchWindMS;
+    in.mdot_kg_s = 0.033;
+    Series s = testing::MakeConstantSeries(48, 900.0, in);  // 12 h: steady
+    testing::AddPoaDiffuse(&s, 0.0);
+    s[Channel::kAoiRad].assign(s.size(), 0.0);
+    Drivers d;
+    std::string error;
+    EXPECT_TRUE(PrepareDrivers(s, plant, spec, &d, &error)) << error;
+    SimOutputs out;
+    Simulate(d, p, &out);
+    const std::size_t last = s.size() - 1;
+    const double t_m_c = 0.5 * (t_in_c[k] + out.t_out_c[last]);
+    eta[k] = out.q_th_w[last] / (plant.area_m2 * kGWM2);
+    x[k] = (t_m_c - kTAmbC) / kGWM2;
+  }
+  const double slope = (eta[1] - eta[0]) / (x[1] - x[0]);
+  return {eta[0] - slope * x[0], -slope};
+}
+
 // Real data (htw saar, PROVENANCE.md): identify on the day with the fluid
 // ~8 K above ambient, predict the day near ambient. Thresholds are about
 // 1.5 × what this model reaches (README, "Real data"), so a regression in
@@ -177,6 +222,59 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
       ComputeErrors(MakeMeasurements(test, dtest), sim, config.plant.area_m2);
   EXPECT_LT(held_out.nmae_p_el, 0.02);
   EXPECT_LT(held_out.nmae_q_th, 0.18);
+
+  // Bounds. Two parameters run to their upper bound on this day; both are
+  // reported as such (IdentSummary::estimates[].at_bound, which `pvtwin
+  // calibrate` prints as "at upper bound": test_cli_model.cc checks the
+  // printout). Any other parameter at a bound fails here.
+  //  * u_front_w_m2k → 1e3: in the paper's wind form (2.8) 1/U_front,w =
+  //    1/U_front + r_refwind·v^n, U_front → ∞ leaves the front resistance to
+  //    the wind term alone. With the blower's near-constant 3.5 m/s the
+  //    still-air part cannot be told from the wind part; the paper's own
+  //    fits wander the same way (Fig. 8, U_front 2.6e2 … 1e5).
+  //  * f_th → 1.2: F_th > 1 absorbs more than the incident irradiance, which
+  //    is not physical. It pairs with u_back ≈ 25 W/(m²K) on a rear-insulated
+  //    collector: one day at T_m − T_amb ≈ 8 K does not separate gain from
+  //    loss, and the fit trades more of both (see the ISO 9806 equivalents).
+  const std::set<Param> known_at_upper_bound = {Param::kUFrontWM2K, Param::kFTh};
+  for (const ParamEstimate& e : s.estimates) {
+    if (!e.free || e.undetermined) continue;
+    const std::string name(Info(e.param).name);
+    if (known_at_upper_bound.count(e.param) > 0) {
+      EXPECT_TRUE(e.at_bound) << name << " = " << e.value
+                              << " left its bound: update the comment above";
+      EXPECT_NEAR(e.value, e.upper, 1e-3 * (e.upper - e.lower)) << name;
+    } else {
+      EXPECT_FALSE(e.at_bound) << name << " = " << e.value << " at a bound of [" << e.lower << ", "
+                               << e.upper << "]";
+    }
+  }
+
+  // Datasheet (PROVENANCE.md, values quoted by IDEAS for "PVT A").
+  auto fitted = [&s](Param p) { return s.params[static_cast<std::size_t>(p)]; };
+  // η_PV,ref against the nameplate η_el = 0.1687. 5 %: the module's power
+  // tolerance (a few %) plus the bench's MPP tracking and wiring. Fit: 0.1634.
+  EXPECT_NEAR(fitted(Param::kEtaPvRef), 0.1687, 0.05 * 0.1687);
+  // Thermal side through its ISO 9806 equivalents at the bench's wind:
+  //   η0(u) = η0·(1 − c6·u) = 0.475·(1 − 0.003·3.5) = 0.4700
+  //   c1 + c3·u = 7.411 + 1.7·3.5 = 13.36 W/(m²K)
+  // The fit gives η0 = 0.430 (−8.6 %) and 16.6 W/(m²K) (+24 %). The low η0
+  // is in the data, not the fit: the measured heat of day 1, at T_m ≈ T_amb,
+  // is 0.42·G on average (G > 300 W/m², valid rows, IAM losses of the
+  // day's angles included), where the datasheet would give ≈ 0.47. The loss coefficient is set by
+  // one day at a reduced temperature (T_m − T_amb)/G ≈ 0.011 m²K/W (ISO 9806 tests span ≈ 0 …
+  // 0.08), so it is only loosely determined, and it trades off against the
+  // F_th at its bound above. Bounds: η0 within 10 %, the loss within 50 %.
+  const IsoEquivalents iso = IsoEquivalentsOf(config.plant, spec, s.params);
+  EXPECT_NEAR(iso.eta0, 0.4700, 0.10 * 0.4700);
+  EXPECT_NEAR(iso.loss_w_m2k, 13.36, 0.50 * 13.36);
+  // Heat capacity: the datasheet's C = 42 200 J/(m²K) is the whole
+  // collector's; 2N1Ccol puts one capacitance on the collector node and
+  // none on the PV laminate, and identifies 15 700 J/(m²K) (0.37 × C) here.
+  // This is a known disagreement, not asserted as agreement: it is recorded
+  // so that a change shows up in the test's XML output.
+  ::testing::Test::RecordProperty("c_coll_over_datasheet_c",
+                                  std::to_string(fitted(Param::kCCollJM2K) / 42200.0));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "core/synthetic_plant.h"
 #include "core/thermal_model.h"
 #include "core/units.h"
 #include "tests/support/synthetic_series.h"
@@ -15,14 +16,19 @@ namespace pvtwin {
 namespace {
 
 // Six hours of a varying day: irradiance ramps and cloud steps, changing inlet
-// temperature and flow including pump stops, gusty wind.
+// temperature and flow including pump stops, gusty wind. From 06:00 UTC on
+// 2024-06-01 (07:04 local solar time at the design example's site), with
+// 30 % diffuse in the clear hours and all diffuse under the cloud, so that
+// the 'I' variant has a real sun path and a beam/diffuse split.
 Series VaryingSeries(double step_s) {
   const std::size_t rows = static_cast<std::size_t>(6 * 3600 / step_s);
-  Series s = testing::MakeConstantSeries(rows, step_s, {});
+  Series s = testing::MakeConstantSeries(rows, step_s, {}, testing::kJune1_2024UtcS + 6 * 3600);
+  s[Channel::kGPoaDiffuseWM2].resize(rows);
   for (std::size_t i = 0; i < rows; ++i) {
     const double t_h = static_cast<double>(i) * step_s / 3600.0;
     const bool cloud = std::fmod(t_h, 1.0) > 0.7;
     s[Channel::kGPoaWM2][i] = 950.0 * std::sin(kPi * (t_h + 0.5) / 7.0) * (cloud ? 0.3 : 1.0);
+    s[Channel::kGPoaDiffuseWM2][i] = (cloud ? 1.0 : 0.3) * s[Channel::kGPoaWM2][i];
     s[Channel::kTInC][i] = 15.0 + 30.0 * t_h / 6.0;
     s[Channel::kMdotKgS][i] = std::fmod(t_h, 2.0) < 0.25 ? 0.0 : 0.02 + 0.02 * (t_h / 6.0);
     s[Channel::kWindMS][i] = 3.0 + 2.5 * std::sin(7.0 * t_h);
@@ -41,8 +47,7 @@ Drivers DriversOf(const Series& s, const Plant& plant, const ModelSpec& spec) {
 }
 
 std::vector<std::string> AllTestedVariants() {
-  std::vector<std::string> v = PaperVariants();
-  v.erase(std::remove(v.begin(), v.end(), "2N1CcolwrI"), v.end());  // needs sun geometry
+  std::vector<std::string> v = PaperVariants();  // 2N1CcolwrI included
   v.push_back("2N1Ccolr");
   v.push_back("1N1Cr+wind");
   v.push_back("2N2C+wind+transport_delay");
@@ -64,7 +69,7 @@ ParamVector Sample(const Plant& plant, std::mt19937_64& rng, int mode) {
 }
 
 TEST(ModelSweep, FiniteAndBoundedAcrossBoundsAndSteps) {
-  const Plant plant;
+  const Plant plant = DesignExamplePlant();
   std::mt19937_64 rng(7);
   for (double step_s : {5.0, 60.0, 300.0, 900.0}) {
     const Series s = VaryingSeries(step_s);
@@ -79,6 +84,15 @@ TEST(ModelSweep, FiniteAndBoundedAcrossBoundsAndSteps) {
     for (const std::string& v : AllTestedVariants()) {
       const ModelSpec spec = testing::SpecOf(v);
       const Drivers d = DriversOf(s, plant, spec);
+      if (spec.iam) {  // the sun geometry is there: the IAM takes a share of the beam
+        double g_abs_sum = 0.0, g_poa_sum = 0.0;
+        for (std::size_t i = 0; i < d.size(); ++i) {
+          g_abs_sum += d.g_abs_w_m2[i];
+          g_poa_sum += d.g_poa_w_m2[i];
+        }
+        ASSERT_TRUE(std::isfinite(g_abs_sum)) << v;
+        EXPECT_LT(g_abs_sum, 0.99 * g_poa_sum) << v;
+      }
       SimOutputs out;
       for (int sample = 0; sample < 12; ++sample) {
         const ParamVector p = Sample(plant, rng, std::min(sample, 2));
@@ -111,7 +125,7 @@ TEST(ModelSweep, FiniteAndBoundedAcrossBoundsAndSteps) {
 
 // A variant's outputs change with every parameter it uses and with no other.
 TEST(ModelSweep, OutputsDependOnExactlyTheUsedParameters) {
-  const Plant plant;
+  const Plant plant = DesignExamplePlant();
   const Series s = VaryingSeries(60.0);
   for (const std::string& v : AllTestedVariants()) {
     const ModelSpec spec = testing::SpecOf(v);

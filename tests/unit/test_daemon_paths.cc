@@ -266,6 +266,45 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
   EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
 }
 
+// The README's workflow that once crash-looped the daemon: history with a
+// 15-minute outage of the plane-of-array pyranometer (GHI and DHI logged)
+// imported, then `pvtwin run` without devices calibrates and forecasts.
+TEST_F(DaemonPaths, APyranometerOutageInTheHistoryIsForecastAround) {
+  fs::copy_file(kExampleMap, dir_ / "sim.toml");
+  auto run = RunPvtwin(dir_.path(), "sim --config sim.toml --export full.csv --days 3 --step 60 "
+                                    "--start " + std::to_string(kJune1 - 3 * kDay));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  // Blank g_poa_w_m2 (5th column) for 15 minutes at noon of every day.
+  std::ifstream in(dir_ / "full.csv");
+  std::ofstream out(dir_ / "gaps.csv");
+  std::string line;
+  for (int row = -1; std::getline(in, line); ++row) {
+    const int minute_of_day = row % 1440;
+    if (row >= 0 && minute_of_day >= 720 && minute_of_day < 735) {
+      std::size_t comma = 0;
+      for (int k = 0; k < 4; ++k) comma = line.find(',', comma) + 1;
+      line.erase(comma, line.find(',', comma) - comma);
+    }
+    out << line << "\n";
+  }
+  out.close();
+  ASSERT_NE(ReadFile(dir_ / "full.csv").substr(0, 60).find("g_poa_w_m2"), std::string::npos);
+  run = RunPvtwin(dir_.path(), "import --config sim.toml --csv gaps.csv --db " + DbPath());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  WriteConfig(Settings());
+  StartDaemon(kJune1, 60.0);
+  const Db db(DbPath());
+  ASSERT_EQ(db.Number("SELECT count(*) FROM measurement_1min WHERE g_poa_w_m2 IS NULL AND "
+                      "ghi_w_m2 > 100"),
+            45);  // the outages, at noon with the sun up
+  ASSERT_TRUE(WaitFor(60, [&] { return db.Number("SELECT count(*) FROM forecast") >= 1440; }))
+      << Log();
+  int code = 0;
+  EXPECT_FALSE(daemon_.Finished(&code)) << "exit " << code << ": " << Log();
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE accepted = 1"), 1);
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
 // Live polling through `pvtwin sim`, the daemon configured with another
 // poll period and fluid than the defaults.
 class LiveDaemon : public DaemonPaths {

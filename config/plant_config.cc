@@ -108,7 +108,8 @@ void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
       r.Reject("at", kClockRule);
     }
   }
-  constexpr std::string_view kZoneRule = "expected a zone of the tz database, e.g. \"Europe/Vienna\"";
+  constexpr std::string_view kZoneRule =
+      "expected a zone of the tz database, e.g. \"Europe/Vienna\"";
   std::string zone;
   if (r.String("timezone", kOptional, &zone, kZoneRule)) {
     if (TimeZoneExists(zone)) {

@@ -9,10 +9,10 @@ namespace pvtwin {
 
 struct Diagnostic {
   std::string file;
-  int line = 0;         // 1-based; 0 when the problem is not tied to a line
-  std::string field;    // config key or CSV column
-  std::string value;    // the offending value as written (may be empty)
-  std::string rule;     // what was expected
+  int line = 0;       // 1-based; 0 when the problem is not tied to a line
+  std::string field;  // config key or CSV column
+  std::string value;  // the offending value as written (may be empty)
+  std::string rule;   // what was expected
 
   // "file:line: field = value: rule", leaving out the parts that are empty;
   // field and value as PrintableExcerpt shows them.

@@ -78,17 +78,16 @@ bool SplitFields(std::string_view line, std::vector<std::string_view>* fields,
         fields->push_back(storage->back());
       }
       pos = line.find(',', i + 1);
-      if (!Trim(line.substr(i + 1, pos == std::string_view::npos ? std::string_view::npos
-                                                                 : pos - i - 1))
+      if (!Trim(line.substr(i + 1,
+                            pos == std::string_view::npos ? std::string_view::npos : pos - i - 1))
                .empty()) {
         *why = "text after a closing quote";
         return false;
       }
     } else {
       const std::size_t comma = line.find(',', pos);
-      fields->push_back(Trim(line.substr(pos, comma == std::string_view::npos
-                                                  ? std::string_view::npos
-                                                  : comma - pos)));
+      fields->push_back(Trim(line.substr(
+          pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos)));
       pos = comma;
     }
     if (pos == std::string_view::npos) return true;
@@ -399,7 +398,7 @@ class CsvParser {
   std::vector<std::string_view> fields_;  // the current row, split
   std::deque<std::string> unescaped_;     // its quoted fields that held ""
   std::array<std::size_t, kNumChannels> out_of_limits_{};
-  int previous_line_ = 0;                 // line of the last row read
+  int previous_line_ = 0;  // line of the last row read
   Series series_;
   Diagnostics errors_;
   Diagnostics warnings_;

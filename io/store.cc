@@ -170,18 +170,19 @@ struct Store::Impl {
     const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
     const auto who = [] { return "uid " + std::to_string(::geteuid()); };
     if (::access(path.c_str(), F_OK) == 0 && ::access(path.c_str(), W_OK) != 0) {
-      *error = path + ": permission denied: the database file is read-only for " + who() +
-               " (" + std::strerror(errno) + ")";
+      *error = path + ": permission denied: the database file is read-only for " + who() + " (" +
+               std::strerror(errno) + ")";
       return false;
     }
     // WAL needs the -wal and -shm files beside the database.
     if (::access(dir.c_str(), W_OK) != 0) {
-      *error = path + ": permission denied: " + who() + " cannot create files in " +
-               dir.string() + " (" + std::strerror(errno) + "); the store needs its -wal and -shm files there";
+      *error = path + ": permission denied: " + who() + " cannot create files in " + dir.string() +
+               " (" + std::strerror(errno) + "); the store needs its -wal and -shm files there";
       return false;
     }
     if (sqlite3_db_readonly(db, "main") == 1) {
-      *error = path + ": read-only: SQLite opened the database read-only (a read-only file system?)";
+      *error =
+          path + ": read-only: SQLite opened the database read-only (a read-only file system?)";
       return false;
     }
     return true;
@@ -391,8 +392,8 @@ bool Store::BackupTo(const std::string& target_path, std::string* error) {
   Impl& db = *impl_;
   std::lock_guard lock(db.mutex);
   sqlite3* target = nullptr;
-  int rc = sqlite3_open_v2(target_path.c_str(), &target,
-                           SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  int rc = sqlite3_open_v2(target_path.c_str(), &target, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
+                           nullptr);
   if (rc == SQLITE_OK) {
     sqlite3_backup* backup = sqlite3_backup_init(target, "main", db.db, "main");
     if (backup == nullptr) {
@@ -403,7 +404,8 @@ bool Store::BackupTo(const std::string& target_path, std::string* error) {
     }
   }
   if (rc != SQLITE_OK) {
-    *error = target_path + ": backup failed: " + (target ? sqlite3_errmsg(target) : "out of memory");
+    *error =
+        target_path + ": backup failed: " + (target ? sqlite3_errmsg(target) : "out of memory");
   }
   sqlite3_close(target);
   return rc == SQLITE_OK;

@@ -45,6 +45,11 @@ class RawDb {
     sqlite3_finalize(stmt);
     return rows;
   }
+  // The first cell of the first row as text ("" if NULL or no row).
+  std::string Text(const std::string& sql) {
+    const std::vector<std::vector<std::string>> rows = Rows(sql);
+    return rows.empty() || rows[0].empty() || rows[0][0] == "NULL" ? "" : rows[0][0];
+  }
   // The first cell of the first row as a number (NaN if NULL or no row).
   double Number(const std::string& sql) {
     sqlite3_stmt* stmt = nullptr;

@@ -23,6 +23,8 @@
 #include "io/child_process.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/sqlite_db.h"
+#include "tests/support/wait.h"
 
 namespace pvtwin {
 namespace {
@@ -31,49 +33,13 @@ namespace fs = std::filesystem;
 using testing::ReadFile;
 using testing::RunPvtwin;
 using testing::ScratchDir;
+using testing::WaitFor;
+using Db = testing::RawDb;
 
 const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
 // 2024-06-01 00:00 UTC.
 constexpr std::int64_t kJune1 = 1717200000;
 constexpr std::int64_t kDay = 86400;
-
-bool WaitFor(double timeout_s, const std::function<bool()>& done) {
-  const double deadline = WallNowS() + timeout_s;
-  while (WallNowS() < deadline) {
-    if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return done();
-}
-
-// A reader of the daemon's database, as a dashboard would hold one.
-class Db {
- public:
-  explicit Db(const fs::path& path) {
-    sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READONLY, nullptr);
-    sqlite3_busy_timeout(db_, 5000);
-  }
-  ~Db() { sqlite3_close(db_); }
-  Db(const Db&) = delete;
-  Db& operator=(const Db&) = delete;
-  std::string Text(const std::string& sql) const {
-    sqlite3_stmt* st = nullptr;
-    std::string result;
-    if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &st, nullptr) == SQLITE_OK &&
-        sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0) != nullptr) {
-      result = reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
-    }
-    sqlite3_finalize(st);
-    return result;
-  }
-  double Number(const std::string& sql) const {
-    const std::string t = Text(sql);
-    return t.empty() ? -1.0 : std::stod(t);
-  }
-
- private:
-  sqlite3* db_ = nullptr;
-};
 
 // The systemd notification socket: a datagram socket whose path goes into
 // the daemon's NOTIFY_SOCKET, as systemd sets it for Type=notify units.
@@ -144,10 +110,10 @@ class DaemonPaths : public ::testing::Test {
   }
 
   void StartDaemon(std::int64_t sim_start, double speed, std::vector<std::string> extra = {}) {
-    std::vector<std::string> argv = {PVTWIN_BINARY, "run",         "--config",
-                                     (dir_ / "pvtwin.toml").string(),
-                                     "--speed",     std::to_string(speed),
-                                     "--sim-start", std::to_string(sim_start),
+    std::vector<std::string> argv = {PVTWIN_BINARY,   "run",
+                                     "--config",      (dir_ / "pvtwin.toml").string(),
+                                     "--speed",       std::to_string(speed),
+                                     "--sim-start",   std::to_string(sim_start),
                                      "--wall-anchor", std::to_string(anchor_)};
     argv.insert(argv.end(), extra.begin(), extra.end());
     std::string error;
@@ -213,7 +179,7 @@ TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
   ImportHistory(kJune1, 4);
   WriteConfig(Settings());
   StartDaemon(kJune1, 60.0, {"--calibration-timeout", "0.01"});
-  const Db db(DbPath());
+  Db db(DbPath());
   ASSERT_TRUE(WaitFor(30, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE status = 'timeout'") >= 1;
   })) << Log();
@@ -232,7 +198,7 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
   // First run: no parameters yet, so it calibrates at once and accepts.
   StartDaemon(kJune1, 600.0);
   {
-    const Db db(DbPath());
+    Db db(DbPath());
     ASSERT_TRUE(WaitFor(60, [&] {
       return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
     })) << Log();
@@ -253,7 +219,7 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
   }
   anchor_ = WallNowS();
   StartDaemon(kJune1, 600.0);
-  const Db db(DbPath());
+  Db db(DbPath());
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE status = 'rejected'") >= 1;
   })) << Log();
@@ -271,8 +237,10 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
 // imported, then `pvtwin run` without devices calibrates and forecasts.
 TEST_F(DaemonPaths, APyranometerOutageInTheHistoryIsForecastAround) {
   fs::copy_file(kExampleMap, dir_ / "sim.toml");
-  auto run = RunPvtwin(dir_.path(), "sim --config sim.toml --export full.csv --days 3 --step 60 "
-                                    "--start " + std::to_string(kJune1 - 3 * kDay));
+  auto run = RunPvtwin(dir_.path(),
+                       "sim --config sim.toml --export full.csv --days 3 --step 60 "
+                       "--start " +
+                           std::to_string(kJune1 - 3 * kDay));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   // Blank g_poa_w_m2 (5th column) for 15 minutes at noon of every day.
   std::ifstream in(dir_ / "full.csv");
@@ -293,7 +261,7 @@ TEST_F(DaemonPaths, APyranometerOutageInTheHistoryIsForecastAround) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   WriteConfig(Settings());
   StartDaemon(kJune1, 60.0);
-  const Db db(DbPath());
+  Db db(DbPath());
   ASSERT_EQ(db.Number("SELECT count(*) FROM measurement_1min WHERE g_poa_w_m2 IS NULL AND "
                       "ghi_w_m2 > 100"),
             45);  // the outages, at noon with the sun up
@@ -311,11 +279,17 @@ class LiveDaemon : public DaemonPaths {
  protected:
   void StartSim(std::int64_t start, double speed, const std::vector<std::string>& faults) {
     fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
-    std::vector<std::string> argv = {PVTWIN_BINARY,       "sim", "--config",
-                                     (dir_ / "sim.toml").string(), "--ephemeral-ports",
-                                     "--speed",           std::to_string(speed),
-                                     "--start",           std::to_string(start),
-                                     "--wall-anchor",     std::to_string(anchor_)};
+    std::vector<std::string> argv = {PVTWIN_BINARY,
+                                     "sim",
+                                     "--config",
+                                     (dir_ / "sim.toml").string(),
+                                     "--ephemeral-ports",
+                                     "--speed",
+                                     std::to_string(speed),
+                                     "--start",
+                                     std::to_string(start),
+                                     "--wall-anchor",
+                                     std::to_string(anchor_)};
     for (const std::string& f : faults) {
       argv.push_back("--fault");
       argv.push_back(f);
@@ -340,8 +314,7 @@ class LiveDaemon : public DaemonPaths {
       const std::size_t end = map.find(table, q);
       map.erase(begin, end - begin);
     }
-    ASSERT_TRUE(EditConfig(map, ParseListeningLines(sim_lines_), settings, &text, &error))
-        << error;
+    ASSERT_TRUE(EditConfig(map, ParseListeningLines(sim_lines_), settings, &text, &error)) << error;
     std::ofstream(dir_ / "pvtwin.toml") << text;
   }
   void TearDown() override {
@@ -360,7 +333,7 @@ TEST_F(LiveDaemon, AggregatesWithTheConfiguredPeriodAndFluid) {
   settings.poll_period_s = 10;
   WriteLiveConfig(settings, "4186", true);  // water, Q_u from flow and ΔT
   StartDaemon(t0, 60.0);
-  const Db db(DbPath());
+  Db db(DbPath());
   const std::string full = " FROM measurement_1min WHERE ts > " + std::to_string(t0 + 60);
   ASSERT_TRUE(WaitFor(30, [&] { return db.Number("SELECT count(*)" + full) >= 3; }))
       << Log() << ReadFile(dir_ / "sim.log");
@@ -370,7 +343,8 @@ TEST_F(LiveDaemon, AggregatesWithTheConfiguredPeriodAndFluid) {
   EXPECT_EQ(db.Number("SELECT count(*) FROM sample_5s WHERE ts % 10 != 0"), 0);
   // Q_u is the mean of ṁ·c_p·ΔT of the minute's samples with c_p = 4186.
   const double worst = db.Number(
-      "SELECT max(abs(m.q_th_w - s.q) / max(abs(s.q), 1))" + std::string(" FROM measurement_1min m") +
+      "SELECT max(abs(m.q_th_w - s.q) / max(abs(s.q), 1))" +
+      std::string(" FROM measurement_1min m") +
       " JOIN (SELECT ts - ts % 60 AS minute, avg(flow_kg_s * 4186 * (t_out_c - t_in_c)) AS q"
       " FROM sample_5s GROUP BY minute) s ON s.minute = m.ts WHERE m.ts > " +
       std::to_string(t0 + 60) + " AND m.q_th_w IS NOT NULL");
@@ -398,7 +372,7 @@ TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
   settings.refresh_min = 5;
   WriteLiveConfig(settings, "3650");
   StartDaemon(t0, kSpeed);
-  const Db db(DbPath());
+  Db db(DbPath());
   const std::int64_t end1 = t0 + 12 * 3600;  // past the 600-minute outage and 02:00
   ASSERT_TRUE(WaitFor(150, [&] {
     int code = 0;
@@ -452,8 +426,7 @@ TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
   EXPECT_GE(db.Number("SELECT count(*) FROM calibration WHERE run_at >= " +
                       std::to_string(kJune1 + 2 * 3600)),
             1);
-  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE status IN ('crashed', 'failed')"),
-            0)
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE status IN ('crashed', 'failed')"), 0)
       << db.Text("SELECT group_concat(reason, ' | ') FROM calibration");
   EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
 }

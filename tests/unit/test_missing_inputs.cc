@@ -42,8 +42,8 @@ std::vector<Channel> InputChannels(const Series& s) {
   std::vector<Channel> inputs;
   for (const ChannelInfo& info : kChannels) {
     const Channel c = info.channel;
-    if (c == Channel::kPElW || c == Channel::kQThW || c == Channel::kValid ||
-        c == Channel::kTPvC || c == Channel::kTOutC || !s.Has(c)) {
+    if (c == Channel::kPElW || c == Channel::kQThW || c == Channel::kValid || c == Channel::kTPvC ||
+        c == Channel::kTOutC || !s.Has(c)) {
       continue;
     }
     inputs.push_back(c);
@@ -59,10 +59,14 @@ struct Gap {
 std::vector<Gap> Gaps(std::size_t rows, double step_s) {
   const auto per = [&](double seconds) { return static_cast<std::size_t>(seconds / step_s); };
   const std::size_t hour = per(3600), day = per(86400);
-  return {{"one row at the start", 0, 1},     {"one row in the middle", rows / 2, 1},
-          {"one row at the end", rows - 1, 1}, {"an hour at the start", 0, hour},
-          {"an hour at noon", per(12 * 3600), hour}, {"an hour at the end", rows - hour, hour},
-          {"the first day", 0, day},          {"the last day", rows - day, day}};
+  return {{"one row at the start", 0, 1},
+          {"one row in the middle", rows / 2, 1},
+          {"one row at the end", rows - 1, 1},
+          {"an hour at the start", 0, hour},
+          {"an hour at noon", per(12 * 3600), hour},
+          {"an hour at the end", rows - hour, hour},
+          {"the first day", 0, day},
+          {"the last day", rows - day, day}};
 }
 
 // The paper's nine variants, and 1N1Cr with each effect of the library.
@@ -70,7 +74,8 @@ std::vector<ModelSpec> VariantsUnderTest() {
   std::vector<ModelSpec> v;
   for (const std::string& name : PaperVariants()) v.push_back(testing::SpecOf(name));
   const ModelSpec base = testing::SpecOf("1N1Cr");
-  for (std::size_t e = 0; e < kNumEffects; ++e) v.push_back(WithEffect(base, static_cast<Effect>(e)));
+  for (std::size_t e = 0; e < kNumEffects; ++e)
+    v.push_back(WithEffect(base, static_cast<Effect>(e)));
   return v;
 }
 
@@ -110,8 +115,8 @@ TEST(MissingInputs, EveryVariantEffectAndChannelSimulatesAroundTheGap) {
               spec.Has(Extension::kTransportDelay) || spec.Has(Extension::kClockOffset);
           const bool near_gap = i + 3 >= gap.first && i < gap.first + gap.count + 3;
           if (!in_gap && !(reads_neighbours && near_gap)) {
-            ASSERT_TRUE(has_output) << name << ", " << ChannelName(c) << " missing on "
-                                    << gap.what << ": row " << i << " has no output";
+            ASSERT_TRUE(has_output) << name << ", " << ChannelName(c) << " missing on " << gap.what
+                                    << ": row " << i << " has no output";
           }
         }
       }
@@ -128,8 +133,9 @@ class MissingInputsCli : public ::testing::Test {
     fs::copy_file(fs::path(PVTWIN_SOURCE_DIR) / "config/examples/sim-plant.toml",
                   dir_ / "sim.toml");
     // 2024-06-01 00:00 UTC, three days at 1 min.
-    const ProcessResult exported = RunPvtwin(
-        dir_.path(), "sim --config sim.toml --export full.csv --days 3 --step 60 --start 1717200000");
+    const ProcessResult exported =
+        RunPvtwin(dir_.path(),
+                  "sim --config sim.toml --export full.csv --days 3 --step 60 --start 1717200000");
     ASSERT_EQ(exported.exit_code, 0) << exported.err;
     std::ifstream in(dir_ / "full.csv");
     std::ofstream out(dir_ / "gap.csv");

@@ -88,8 +88,9 @@ TEST(PhysicalLimits, StoreReadsLeaveOutRowsOtherProgramsWroteOutOfLimits) {
   std::unique_ptr<Store> store = Store::Open(path, options, &error);
   ASSERT_TRUE(store) << error;
   testing::RawDb db(path);
-  db.Exec("INSERT INTO weather_forecast(ts, g_poa_w_m2, t_amb_c, wind_m_s) VALUES "
-          "(1717236000, 500, 20, 2), (1717236060, 510, 1e30, -4)");
+  db.Exec(
+      "INSERT INTO weather_forecast(ts, g_poa_w_m2, t_amb_c, wind_m_s) VALUES "
+      "(1717236000, 500, 20, 2), (1717236060, 510, 1e30, -4)");
   Series weather;
   ASSERT_TRUE(store->ReadWeatherForecast(1717236000, 1717236120, &weather, &error)) << error;
   ASSERT_EQ(weather.size(), 2u);
@@ -101,9 +102,10 @@ TEST(PhysicalLimits, StoreReadsLeaveOutRowsOtherProgramsWroteOutOfLimits) {
 
 TEST(Messages, AHugeOrBinaryCellIsCutAndEscaped) {
   const std::string huge(1 << 20, '9');
-  std::istringstream in("time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n"
-                        "2024-06-01T10:00:00Z,27.87,30.76,0.0332,750.08," +
-                        huge + ",177.78\n");
+  std::istringstream in(
+      "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n"
+      "2024-06-01T10:00:00Z,27.87,30.76,0.0332,750.08," +
+      huge + ",177.78\n");
   Series s;
   Diagnostics errors;
   EXPECT_FALSE(ParseCanonicalCsv(in, "big.csv", CsvReadOptions{}, &s, &errors, nullptr));

@@ -20,6 +20,7 @@
 #include "io/store.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/wait.h"
 
 namespace pvtwin {
 namespace {
@@ -29,6 +30,7 @@ using testing::ReadFile;
 using testing::RunCommand;
 using testing::RunPvtwin;
 using testing::ScratchDir;
+using testing::WaitFor;
 
 constexpr char kPlant[] =
     "[plant]\nlatitude_deg = 47.358\nlongitude_deg = 16.128\ntilt_deg = 20\n"
@@ -44,15 +46,6 @@ void MakeForeignDb(const fs::path& path) {
                          nullptr, nullptr, nullptr),
             SQLITE_OK);
   sqlite3_close(db);
-}
-
-bool WaitFor(double timeout_s, const std::function<bool()>& done) {
-  const double deadline = WallNowS() + timeout_s;
-  while (WallNowS() < deadline) {
-    if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return done();
 }
 
 TEST(StoreGuard, AForeignDatabaseIsRefusedAndLeftUnchanged) {
@@ -93,13 +86,12 @@ TEST(StoreGuard, ADamagedDatabaseIsRefusedBeforeAnythingIsWritten) {
   const std::string before = ReadFile(path);
   std::string error;
   EXPECT_EQ(Store::Open(path.string(), &error), nullptr);
-  EXPECT_NE(error.find("the database is damaged (PRAGMA quick_check"), std::string::npos)
-      << error;
+  EXPECT_NE(error.find("the database is damaged (PRAGMA quick_check"), std::string::npos) << error;
   EXPECT_EQ(ReadFile(path), before);
   // The command line says so too, with exit 1.
   std::ofstream(dir / "pvtwin.toml") << kPlant;
-  const testing::ProcessResult run = RunPvtwin(
-      dir.path(), "export --config pvtwin.toml --db pvtwin.db --from 0 --to 2000000000");
+  const testing::ProcessResult run =
+      RunPvtwin(dir.path(), "export --config pvtwin.toml --db pvtwin.db --from 0 --to 2000000000");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("damaged"), std::string::npos) << run.err;
 }
@@ -111,8 +103,8 @@ TEST(StoreGuard, AStoreTheUserCannotWriteIsNamedAsSuch) {
     std::string error;
     ASSERT_TRUE(Store::Open((dir / "pvtwin.db").string(), &error)) << error;
   }
-  fs::permissions(dir / "pvtwin.db", fs::perms::owner_read | fs::perms::group_read |
-                                         fs::perms::others_read);
+  fs::permissions(dir / "pvtwin.db",
+                  fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
   fs::permissions(dir.path(), fs::perms::all);
   fs::permissions(dir / "pvtwin.toml", fs::perms::owner_read | fs::perms::others_read);
   // root may write anything: run as nobody then (setpriv, util-linux).
@@ -135,9 +127,9 @@ class DaemonStoreGuard : public ::testing::Test {
   }
   bool Start(ChildProcess* daemon, const std::string& log) {
     std::string error;
-    const bool started = daemon->Start(
-        {PVTWIN_BINARY, "run", "--config", (dir_ / "pvtwin.toml").string()},
-        (dir_ / log).string(), &error);
+    const bool started =
+        daemon->Start({PVTWIN_BINARY, "run", "--config", (dir_ / "pvtwin.toml").string()},
+                      (dir_ / log).string(), &error);
     EXPECT_TRUE(started) << error;
     return started;
   }
@@ -147,9 +139,9 @@ class DaemonStoreGuard : public ::testing::Test {
 TEST_F(DaemonStoreGuard, ASecondDaemonOnTheSameStoreExitsWithOne) {
   ChildProcess first, second;
   ASSERT_TRUE(Start(&first, "first.log"));
-  ASSERT_TRUE(WaitFor(20, [&] { return ReadFile(dir_ / "first.log").find("ready") !=
-                                       std::string::npos; }))
-      << ReadFile(dir_ / "first.log");
+  ASSERT_TRUE(WaitFor(20, [&] {
+    return ReadFile(dir_ / "first.log").find("ready") != std::string::npos;
+  })) << ReadFile(dir_ / "first.log");
   ASSERT_TRUE(Start(&second, "second.log"));
   int exit_code = -100;
   ASSERT_TRUE(WaitFor(20, [&] { return second.Finished(&exit_code); }));
@@ -164,8 +156,8 @@ TEST_F(DaemonStoreGuard, ASecondDaemonOnTheSameStoreExitsWithOne) {
 TEST_F(DaemonStoreGuard, DeletingTheStoreStopsTheDaemonAndSavesItsContent) {
   ChildProcess daemon;
   ASSERT_TRUE(Start(&daemon, "daemon.log"));
-  ASSERT_TRUE(WaitFor(20, [&] { return ReadFile(dir_ / "daemon.log").find("ready") !=
-                                       std::string::npos; }));
+  ASSERT_TRUE(WaitFor(
+      20, [&] { return ReadFile(dir_ / "daemon.log").find("ready") != std::string::npos; }));
   fs::remove(dir_ / "pvtwin.db");
   int exit_code = -100;
   ASSERT_TRUE(WaitFor(20, [&] { return daemon.Finished(&exit_code); }))

@@ -125,6 +125,25 @@ void ReadForecast(SectionReader& r, ForecastConfig* forecast) {
   r.Number("refresh_min", kOptional, Closed(1, 1440), &forecast->refresh_min);
 }
 
+void ReadSim(SectionReader& r, SimConfig* sim) {
+  r.Choice("operation", kOptional, {"irradiance", "differential", "heat_pump"}, &sim->operation);
+  const bool on = r.Number("pump_dt_on_k", kOptional, LeftOpen(0, 30), &sim->pump_dt_on_k);
+  const bool off = r.Number("pump_dt_off_k", kOptional, Closed(0, 30), &sim->pump_dt_off_k);
+  if ((on || off) && !(sim->pump_dt_off_k < sim->pump_dt_on_k)) {
+    r.Reject(off ? "pump_dt_off_k" : "pump_dt_on_k",
+             "pump_dt_off_k (" + FormatNumber(sim->pump_dt_off_k) +
+                 ") must be below pump_dt_on_k (" + FormatNumber(sim->pump_dt_on_k) + ")");
+  }
+  r.Number("brine_below_ambient_k", kOptional, Closed(0, 30), &sim->brine_below_ambient_k);
+  const bool lo = r.Number("brine_min_c", kOptional, Closed(-20, 30), &sim->brine_min_c);
+  const bool hi = r.Number("brine_max_c", kOptional, Closed(-20, 30), &sim->brine_max_c);
+  if ((lo || hi) && !(sim->brine_min_c <= sim->brine_max_c)) {
+    r.Reject(hi ? "brine_max_c" : "brine_min_c", "brine_min_c (" + FormatNumber(sim->brine_min_c) +
+                                                     ") must not exceed brine_max_c (" +
+                                                     FormatNumber(sim->brine_max_c) + ")");
+  }
+}
+
 void ReadDocument(const toml::table& root, const SourceText& source, const std::string& file,
                   Config* config, Diagnostics* errors) {
   using SectionFn = void (*)(SectionReader&, Config*);
@@ -138,6 +157,7 @@ void ReadDocument(const toml::table& root, const SourceText& source, const std::
       {"poll", [](SectionReader& r, Config* c) { ReadPoll(r, &c->poll); }},
       {"calibration", [](SectionReader& r, Config* c) { ReadCalibration(r, &c->calibration); }},
       {"forecast", [](SectionReader& r, Config* c) { ReadForecast(r, &c->forecast); }},
+      {"sim", [](SectionReader& r, Config* c) { ReadSim(r, &c->sim); }},
   };
 
   if (!root.contains("plant")) {

@@ -9,6 +9,9 @@
 //   [poll]         period_s
 //   [calibration]  variant, window_days, step_s, at, timezone
 //   [forecast]     horizon_h, refresh_min
+//   [sim]          optional; how `pvtwin sim` operates the simulated plant:
+//                  operation, pump_dt_on_k, pump_dt_off_k, brine_below_ambient_k,
+//                  brine_min_c, brine_max_c (SimConfig). Ignored by the daemon.
 //   [[modbus.*]]   the Modbus register map (config/modbus_config.h).
 //
 // Every problem is reported as one Diagnostic "file:line: key = value: rule",
@@ -47,6 +50,17 @@ struct ForecastConfig {
   double refresh_min = 60;  // re-issue period, [1, 1440]
 };
 
+// [sim]: the simulated plant's solar loop (core/weather_generator.h,
+// PumpControl). Defaults are WeatherOptions' defaults.
+struct SimConfig {
+  std::string operation = "irradiance";  // irradiance | differential | heat_pump
+  double pump_dt_on_k = 5.0;             // (0, 30], > pump_dt_off_k
+  double pump_dt_off_k = 2.0;            // [0, 30]
+  double brine_below_ambient_k = 5.0;    // [0, 30]
+  double brine_min_c = 0.0;              // [-20, 30], ≤ brine_max_c
+  double brine_max_c = 10.0;             // [-20, 30]
+};
+
 // The whole configuration. Plain values only: a loaded Config does not refer
 // back to the file and is meant to be held as const.
 struct Config {
@@ -55,6 +69,7 @@ struct Config {
   PollConfig poll;
   CalibrationConfig calibration;
   ForecastConfig forecast;
+  SimConfig sim;
   ModbusConfig modbus;
   std::string source_path;  // the file it was read from
 };

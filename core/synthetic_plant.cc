@@ -66,6 +66,24 @@ ParamVector TruthParamsFor(const Plant& plant, const ModelSpec& spec) {
   return p;
 }
 
+AbsorberSensorParams SensorParamsFromTruth(const ModelSpec& truth_spec, const ParamVector& truth) {
+  auto get = [&truth](Param name) { return truth[static_cast<std::size_t>(name)]; };
+  AbsorberSensorParams a;
+  a.absorbed_fraction = (1.0 - get(Param::kEtaPvRef)) * get(Param::kFTh);
+  a.u_front_w_m2k = get(Param::kUFrontWM2K);
+  a.u_back_w_m2k = get(Param::kUBackWM2K);
+  a.u_wind_w_m2k = truth_spec.Has(Extension::kWind) ? get(Param::kUWindWM2K) : 0.0;
+  a.n_wind = get(Param::kNWind);
+  a.eps_lw = truth_spec.sky ? get(Param::kEpsPvt) : 0.0;
+  a.r_internal_m2k_w = truth_spec.nodes == 2 ? 1.0 / get(Param::kUCollWM2K) : 0.0;
+  a.r0_fluid_m2k_w = get(Param::kR0FluidM2KW);
+  a.r1_fluid = get(Param::kR1Fluid);
+  a.c_j_m2k = (truth_spec.c_pv ? get(Param::kCPvJM2K) : 0.0) +
+              (truth_spec.c_coll ? get(Param::kCCollJM2K) : 0.0);
+  if (a.c_j_m2k <= 0.0) a.c_j_m2k = get(Param::kCCollJM2K);  // a static truth: the sensor's own lag
+  return a;
+}
+
 std::string_view DisturbanceName(DisturbanceKind kind) {
   switch (kind) {
     case DisturbanceKind::kFailingPump:
@@ -140,7 +158,9 @@ void InjectDefects(const DataDefects& defects, Series* s) {
 }  // namespace
 
 Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options) {
-  Series s = GenerateWeather(plant, options.weather);
+  WeatherOptions weather = options.weather;
+  weather.absorber = SensorParamsFromTruth(options.truth_spec, options.truth);
+  Series s = GenerateWeather(plant, weather);
   const std::size_t n = s.size();
   // The plant's physics: the real flow and irradiance under disturbances, the
   // true irradiance (irradiance_bias is a sensor error, applied below).

@@ -36,6 +36,13 @@ Plant DesignExamplePlant();
 // known answer of synthetic tests.
 ParamVector ReferenceTruthParams(const Plant& plant);
 
+// The absorber sensor of the plant's controller (absorber_sensor.h) with the
+// truth's parameters: (1 − η_PV,ref)·F_th, U_front, U_back, the physical wind
+// form if the truth has it (the paper's 'w' form is left out: the sensor is
+// a close estimate, not the truth), ε if it has sky radiation, the fluid
+// coupling r0/r1 with 1/U_coll in series for two nodes, C_PV + C_coll.
+AbsorberSensorParams SensorParamsFromTruth(const ModelSpec& truth_spec, const ParamVector& truth);
+
 // Weather and operation from `weather`, outputs p_el_w, q_th_w, t_out_c and
 // t_pv_c from `truth_spec` with `truth`, then noise on p_el_w, q_th_w and
 // t_out_c (q_th_w stays consistent with flow and the noisy outlet: the heat

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "core/irradiance.h"
+#include "core/pump_controller.h"
 #include "core/solar_position.h"
 #include "core/units.h"
 
@@ -165,10 +166,148 @@ double LocalSolarDayNumber(double time_s, double longitude_rad) {
   return std::floor((time_s + longitude_rad / kTwoPi * kSecondsPerDay) / kSecondsPerDay);
 }
 
+// Local solar time in hours [0, 24) from the hour angle (0 at solar noon,
+// 15° per hour, positive in the afternoon).
+double SolarHour(double hour_angle_rad) {
+  double hour = 12.0 + RadToDeg(hour_angle_rad) / 15.0;
+  hour = std::fmod(hour, 24.0);
+  return hour < 0.0 ? hour + 24.0 : hour;
+}
+
 // Saturation vapour pressure over water, Magnus form (WMO 2008), hPa.
 double SaturationVapourPressureHpa(double t_c) {
   return 6.112 * std::exp(17.62 * t_c / (243.12 + t_c));
 }
+
+// The weather of one row, as the plant's operation sees it.
+struct RowWeather {
+  double g_poa_w_m2 = 0.0;
+  double t_amb_c = 0.0;
+  double wind_m_s = 0.0;
+  double lw_down_w_m2 = 0.0;
+  double solar_hour = 12.0;  // local solar time, [0, 24)
+};
+
+struct RowOperation {
+  double mdot_kg_s = 0.0;
+  double t_in_c = 0.0;
+};
+
+// The solar loop of WeatherOptions::pump_control: pump, tank or brine, and
+// the absorber sensor, advanced one row at a time (one continuous run).
+class PlantOperation {
+ public:
+  PlantOperation(const Plant& plant, const WeatherOptions& options, double dt_s)
+      : plant_(plant),
+        options_(options),
+        dt_s_(dt_s),
+        nominal_flow_kg_s_(options.flow_kg_s_per_m2 * plant.area_m2),
+        tank_relax_(1.0 - std::exp(-dt_s / options.tank_load_time_constant_s)),
+        t_tank_c_(options.t_in_base_c),
+        brine_smooth_(3600.0, dt_s, 0.0) {
+    control_.dt_on_k = options.pump_dt_on_k;
+    control_.dt_off_k = options.pump_dt_off_k;
+    control_.min_dwell_s = options.pump_min_dwell_s;
+    state_.since_switch_s = options.pump_min_dwell_s;
+  }
+
+  // flow_x, mixing_x: this row's flow and mixing noise (unit normal).
+  RowOperation Next(const RowWeather& w, double flow_x, double mixing_x) {
+    if (options_.pump_control == PumpControl::kIrradiance)
+      return NextIrradiance(w, flow_x, mixing_x);
+    return NextThermostat(w, flow_x, mixing_x);
+  }
+
+ private:
+  double Flow(const RowWeather& w, double flow_x) const {
+    if (!state_.pump_on) return 0.0;
+    double share = 1.0;
+    if (options_.flow_mode == FlowMode::kVariable)
+      share = std::clamp(w.g_poa_w_m2 / 800.0, 0.3, 1.0);
+    return nominal_flow_kg_s_ * share * (1.0 + 0.01 * flow_x);
+  }
+
+  // The original operation, kept bit for bit: irradiance hysteresis, tank
+  // gaining tank_gain_fraction of the irradiance while pumping.
+  RowOperation NextIrradiance(const RowWeather& w, double flow_x, double mixing_x) {
+    state_.since_switch_s += dt_s_;
+    if (state_.since_switch_s >= options_.pump_min_dwell_s) {
+      if (!state_.pump_on && w.g_poa_w_m2 > options_.pump_on_w_m2) {
+        state_.pump_on = true;
+        state_.since_switch_s = 0.0;
+      } else if (state_.pump_on && w.g_poa_w_m2 < options_.pump_off_w_m2) {
+        state_.pump_on = false;
+        state_.since_switch_s = 0.0;
+      }
+    }
+    RowOperation row;
+    row.mdot_kg_s = Flow(w, flow_x);
+    const double gain_k = state_.pump_on ? options_.tank_gain_fraction * w.g_poa_w_m2 * dt_s_ /
+                                               options_.tank_heat_capacity_j_m2k
+                                         : 0.0;
+    t_tank_c_ += gain_k - tank_relax_ * (t_tank_c_ - options_.t_in_base_c);
+    row.t_in_c = t_tank_c_ + 0.15 * mixing_x;
+    return row;
+  }
+
+  // Inlet of the thermostat modes: the tank, after the heat the fluid took
+  // in the previous row and the load; or the brine.
+  double NextInletC(const RowWeather& w) {
+    if (options_.pump_control == PumpControl::kHeatPumpSource) {
+      const double target_c = std::clamp(w.t_amb_c - options_.brine_below_ambient_k,
+                                         options_.brine_min_c, options_.brine_max_c);
+      if (first_row_) brine_smooth_ = LowPass(3600.0, dt_s_, target_c);
+      return brine_smooth_.Update(target_c);
+    }
+    t_tank_c_ += last_q_u_w_ * dt_s_ / (options_.tank_heat_capacity_j_m2k * plant_.area_m2) -
+                 tank_relax_ * (t_tank_c_ - options_.t_in_base_c);
+    return t_tank_c_;
+  }
+
+  bool HeatPumpRuns(const RowWeather& w) const {
+    if (options_.pump_control != PumpControl::kHeatPumpSource) return true;
+    return w.solar_hour >= options_.heat_pump_from_h && w.solar_hour < options_.heat_pump_to_h;
+  }
+
+  // Differential thermostat on the absorber sensor (its value at the row's
+  // start) against the inlet, then the absorber over the row.
+  RowOperation NextThermostat(const RowWeather& w, double flow_x, double mixing_x) {
+    RowOperation row;
+    row.t_in_c = NextInletC(w) + 0.15 * mixing_x;
+    AbsorberSensorInput in;
+    in.g_poa_w_m2 = w.g_poa_w_m2;
+    in.t_amb_c = w.t_amb_c;
+    in.wind_m_s = w.wind_m_s;
+    in.lw_down_w_m2 = w.lw_down_w_m2;
+    in.t_in_c = row.t_in_c;
+    in.area_m2 = plant_.area_m2;
+    in.fluid_cp_j_kgk = plant_.fluid_cp_j_kgk;
+    in.dt_s = dt_s_;
+    if (first_row_) t_abs_c_ = AbsorberSteadyStateC(options_.absorber, in);
+    first_row_ = false;
+    state_ =
+        StepDifferentialControl(control_, state_, {t_abs_c_, row.t_in_c, HeatPumpRuns(w), dt_s_});
+    row.mdot_kg_s = Flow(w, flow_x);
+    in.mdot_kg_s = row.mdot_kg_s;
+    const AbsorberSensorOutput next = StepAbsorberSensor(options_.absorber, in, t_abs_c_);
+    t_abs_c_ = next.t_abs_c;
+    last_q_u_w_ = next.q_u_w;
+    return row;
+  }
+
+  const Plant& plant_;
+  const WeatherOptions& options_;
+  double dt_s_;
+  double nominal_flow_kg_s_;
+  double tank_relax_;
+  double t_tank_c_;
+  LowPass brine_smooth_;
+  DifferentialControlParams control_;
+  DifferentialControlState state_;
+  double t_abs_c_ = 0.0;
+  double last_q_u_w_ = 0.0;
+  bool first_row_ = true;
+};
 
 bool Fail(std::string* why, const std::string& message) {
   if (why != nullptr) *why = message;
@@ -232,6 +371,60 @@ std::string_view DayTypeName(DayType type) {
   return "?";
 }
 
+std::string_view PumpControlName(PumpControl control) {
+  switch (control) {
+    case PumpControl::kIrradiance:
+      return "irradiance";
+    case PumpControl::kDifferential:
+      return "differential";
+    case PumpControl::kHeatPumpSource:
+      return "heat_pump";
+  }
+  return "?";
+}
+
+std::optional<PumpControl> PumpControlFromName(std::string_view name) {
+  for (const PumpControl control :
+       {PumpControl::kIrradiance, PumpControl::kDifferential, PumpControl::kHeatPumpSource}) {
+    if (PumpControlName(control) == name) return control;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+bool ThermostatOptionsValid(const WeatherOptions& o, std::string* why) {
+  if (!(o.pump_dt_off_k >= 0.0 && o.pump_dt_off_k < o.pump_dt_on_k)) {
+    return Fail(why,
+                Describe("pump_dt_off_k", o.pump_dt_off_k, "must be >= 0 and below pump_dt_on_k"));
+  }
+  if (!(o.brine_below_ambient_k >= 0.0 && o.brine_below_ambient_k <= 30.0)) {
+    return Fail(why,
+                Describe("brine_below_ambient_k", o.brine_below_ambient_k, "must be in [0, 30]"));
+  }
+  if (!(o.brine_min_c >= -20.0 && o.brine_min_c <= o.brine_max_c && o.brine_max_c <= 30.0)) {
+    return Fail(why, Describe("brine_min_c", o.brine_min_c,
+                              "must be in [-20, brine_max_c] with brine_max_c <= 30"));
+  }
+  if (!(o.heat_pump_from_h >= 0.0 && o.heat_pump_from_h < o.heat_pump_to_h &&
+        o.heat_pump_to_h <= 24.0)) {
+    return Fail(why, Describe("heat_pump_from_h", o.heat_pump_from_h,
+                              "must be in [0, heat_pump_to_h) with heat_pump_to_h <= 24"));
+  }
+  const AbsorberSensorParams& a = o.absorber;
+  if (!(a.absorbed_fraction >= 0.0 && a.absorbed_fraction <= 1.0 && a.u_front_w_m2k > 0.0 &&
+        a.u_back_w_m2k >= 0.0 && a.u_wind_w_m2k >= 0.0 && a.eps_lw >= 0.0 &&
+        a.r_internal_m2k_w >= 0.0 && a.r0_fluid_m2k_w >= 0.0 && a.r1_fluid > 0.0 &&
+        a.c_j_m2k > 0.0)) {
+    return Fail(why, Describe("absorber.u_front_w_m2k", a.u_front_w_m2k,
+                              "absorber sensor parameters must be physical (fraction in [0, 1], "
+                              "U_front, r1_fluid, C > 0, others >= 0)"));
+  }
+  return true;
+}
+
+}  // namespace
+
 bool WeatherOptions::IsValid(std::string* why) const {
   if (num_days <= 0) return Fail(why, Describe("num_days", num_days, "must be > 0"));
   if (!(step_s >= 1.0 && step_s <= 3600.0) || step_s != std::floor(step_s)) {
@@ -275,6 +468,7 @@ bool WeatherOptions::IsValid(std::string* why) const {
     return Fail(why,
                 Describe("tank_load_time_constant_s", tank_load_time_constant_s, "must be > 0"));
   }
+  if (pump_control != PumpControl::kIrradiance) return ThermostatOptionsValid(*this, why);
   return true;
 }
 
@@ -379,10 +573,7 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
   // Operation.
   UnitAr1 flow_noise(5.0 * 60.0, dt_s, &pump_rng);
   UnitAr1 tank_mixing(10.0 * 60.0, dt_s, &tank_rng);
-  bool pump_on = false;
-  double since_switch_s = options.pump_min_dwell_s;
-  double t_tank_c = options.t_in_base_c;
-  const double tank_relax = 1.0 - std::exp(-dt_s / options.tank_load_time_constant_s);
+  PlantOperation operation(plant, options, dt_s);
 
   const double abs_lat_deg = std::abs(RadToDeg(plant.latitude_rad));
   const double t_annual_c = 28.0 - 0.38 * abs_lat_deg;
@@ -390,7 +581,6 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
   const double cos_tilt = std::cos(plant.tilt_rad);
   const double sky_view = 0.5 * (1.0 + cos_tilt);
   const double ground_view = 0.5 * (1.0 - cos_tilt);
-  const double nominal_flow_kg_s = options.flow_kg_s_per_m2 * plant.area_m2;
 
   double current_day = std::nan("");
   DayParameters day;
@@ -502,32 +692,17 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
     const double black_body_w_m2 = kStefanBoltzmannW_m2k4 * std::pow(CToK(t_amb_c), 4);
     lw_down[i] = sky_view * eps_sky * black_body_w_m2 + ground_view * black_body_w_m2;
 
-    // Pump with hysteresis and minimum dwell time.
-    since_switch_s += dt_s;
-    if (since_switch_s >= options.pump_min_dwell_s) {
-      if (!pump_on && g_poa[i] > options.pump_on_w_m2) {
-        pump_on = true;
-        since_switch_s = 0.0;
-      } else if (pump_on && g_poa[i] < options.pump_off_w_m2) {
-        pump_on = false;
-        since_switch_s = 0.0;
-      }
-    }
+    // Pump and inlet.
+    RowWeather row_weather;
+    row_weather.g_poa_w_m2 = g_poa[i];
+    row_weather.t_amb_c = t_amb_c;
+    row_weather.wind_m_s = wind[i];
+    row_weather.lw_down_w_m2 = lw_down[i];
+    row_weather.solar_hour = SolarHour(s.hour_angle_rad);
     const double flow_x = flow_noise.Next();
-    double flow_kg_s = 0.0;
-    if (pump_on) {
-      double share = 1.0;
-      if (options.flow_mode == FlowMode::kVariable) share = std::clamp(g_poa[i] / 800.0, 0.3, 1.0);
-      flow_kg_s = nominal_flow_kg_s * share * (1.0 + 0.01 * flow_x);
-    }
-    mdot[i] = flow_kg_s;
-
-    // Tank / inlet temperature: solar gain while pumping, load toward base.
-    const double gain_k =
-        pump_on ? options.tank_gain_fraction * g_poa[i] * dt_s / options.tank_heat_capacity_j_m2k
-                : 0.0;
-    t_tank_c += gain_k - tank_relax * (t_tank_c - options.t_in_base_c);
-    t_in[i] = t_tank_c + 0.15 * tank_mixing.Next();
+    const RowOperation op = operation.Next(row_weather, flow_x, tank_mixing.Next());
+    mdot[i] = op.mdot_kg_s;
+    t_in[i] = op.t_in_c;
 
     valid[i] = 1.0;
   }

@@ -17,10 +17,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/absorber_sensor.h"
 #include "core/plant.h"
 #include "core/series.h"
 
@@ -87,6 +89,31 @@ enum class FlowMode {
   kVariable,  // flow follows in-plane irradiance: nominal · clamp(G/800, 0.3, 1)
 };
 
+// How the simulated plant runs its solar loop (pump and inlet).
+enum class PumpControl {
+  // The pump switches on in-plane irradiance (pump_on/off_w_m2, dwell); a
+  // crude tank warmed by a fraction of the irradiance sets the inlet. The
+  // default: every data set recorded before the other modes came with it.
+  kIrradiance,
+  // A differential thermostat (pump_controller.h): the pump runs while the
+  // collector's absorber sensor (absorber_sensor.h) is warmer than the tank
+  // by pump_dt_on_k, stops below pump_dt_off_k (dwell as above); the tank
+  // gains the heat the sensor model says the fluid takes. A summer plant:
+  // a 25 °C tank takes little from a winter sun.
+  kDifferential,
+  // Uncovered PVT as the source of a brine/water heat pump: the inlet is
+  // brine from the evaporator, following the ambient brine_below_ambient_k
+  // colder, within [brine_min_c, brine_max_c] (smoothed, τ 1 h); the pump
+  // runs while the heat pump runs (heat_pump_from_h … heat_pump_to_h local
+  // solar time) and the absorber is warmer than the brine (ΔT thermostat as
+  // above): heat from the sun and from the ambient air, in every season.
+  kHeatPumpSource,
+};
+
+// "irradiance", "differential", "heat_pump"; nullopt for any other text.
+std::string_view PumpControlName(PumpControl control);
+std::optional<PumpControl> PumpControlFromName(std::string_view name);
+
 struct WeatherOptions {
   // First row, unix s UTC. Default 2024-06-01 00:00 UTC.
   std::int64_t start_time_s = 1717200000;
@@ -125,6 +152,24 @@ struct WeatherOptions {
   double tank_heat_capacity_j_m2k = 4.2e5;          // ≈ 100 l of water per m², > 0
   double tank_gain_fraction = 0.4;                  // [0, 1]
   double tank_load_time_constant_s = 6.0 * 3600.0;  // > 0
+
+  // Control of the solar loop (PumpControl); the fields below serve the
+  // kDifferential and kHeatPumpSource modes only.
+  PumpControl pump_control = PumpControl::kIrradiance;
+  double pump_dt_on_k = 5.0;   // absorber − inlet to start the pump, > pump_dt_off_k
+  double pump_dt_off_k = 2.0;  // … and to stop it, ≥ 0
+  // The collector's absorber sensor: the truth plant's parameters
+  // (MakeSyntheticPlantData sets them from its truth with
+  // SensorParamsFromTruth, synthetic_plant.h).
+  AbsorberSensorParams absorber;
+  // Heat-pump source: brine = clamp(t_amb − brine_below_ambient_k,
+  // brine_min_c, brine_max_c), the heat pump runs between these local solar
+  // hours (from < to).
+  double brine_below_ambient_k = 5.0;  // [0, 30]
+  double brine_min_c = 0.0;            // [-20, brine_max_c]
+  double brine_max_c = 10.0;           // [brine_min_c, 30]
+  double heat_pump_from_h = 6.0;       // [0, heat_pump_to_h)
+  double heat_pump_to_h = 20.0;        // (heat_pump_from_h, 24]
 
   // True if the options can be used; otherwise *why names the field, its
   // value and the rule it breaks.
@@ -166,12 +211,21 @@ std::vector<DayType> DayTypesFor(const WeatherOptions& options);
 //                        increase ε_sky = c + (1 − c) ε_clr (c = cloud fraction),
 //                        plus ground part (1 − cos β)/2 · σ T_a⁴; e_a from a
 //                        day-type relative humidity (60 / 70 / 90 %).
-//   flow_kg_s            pump with hysteresis (pump_on/off_w_m2, min dwell):
+//   flow_kg_s            pump as pump_control says (kIrradiance: hysteresis
+//                        on pump_on/off_w_m2; else the ΔT thermostat on the
+//                        absorber sensor; min dwell in every mode):
 //                        flow_kg_s_per_m2 · area (× irradiance factor in
 //                        variable mode) × (1 + 1 % noise) when on, 0 when off.
-//   t_in_c               tank temperature: rises with tank_gain_fraction of
-//                        the in-plane irradiance while pumping, relaxes to
-//                        t_in_base_c through the load, + mixing noise.
+//   t_in_c               kIrradiance: tank temperature, rises with
+//                        tank_gain_fraction of the in-plane irradiance while
+//                        pumping; kDifferential: tank, rises with the heat
+//                        the absorber sensor model delivers; both relax to
+//                        t_in_base_c through the load. kHeatPumpSource: the
+//                        brine. + mixing noise in every mode.
+//
+// One call is one continuous run: every state (tank, pump, absorber, the
+// weather's slow processes) carries across midnight; a longer num_days with
+// the same options reproduces the shorter run's rows bit for bit.
 //   valid                1.
 //
 // Aborts with a message if !options.IsValid() (a caller bug).

@@ -24,6 +24,7 @@
 
 #include "config/config_edit.h"
 #include "core/clock.h"
+#include "core/units.h"
 #include "daemon/commands.h"
 #include "daemon/demo_config.h"
 #include "daemon/inputs.h"
@@ -45,9 +46,56 @@ struct DemoArgs {
   double speed = 60.0;
   int live_minutes = 30;
   double max_wall_s = 110.0;
+  std::string date;  // UTC day of the live part, YYYY-MM-DD; empty: today
 };
 
 std::string Q(const std::string& s) { return "'" + s + "'"; }
+
+// One line on how the example plant runs its solar loop ([sim] operation).
+std::string OperationSummary(const SimConfig& sim) {
+  char buf[200];
+  if (sim.operation == "heat_pump") {
+    std::snprintf(
+        buf, sizeof buf,
+        "heat-pump source: brine %.0f-%.0f °C (%.0f K below ambient), pump on a %.0f/%.0f K "
+        "collector-brine difference: heat gains from sun and ambient",
+        sim.brine_min_c, sim.brine_max_c, sim.brine_below_ambient_k, sim.pump_dt_on_k,
+        sim.pump_dt_off_k);
+  } else if (sim.operation == "differential") {
+    std::snprintf(buf, sizeof buf, "solar tank: pump on a %.0f/%.0f K collector-tank difference",
+                  sim.pump_dt_on_k, sim.pump_dt_off_k);
+  } else {
+    std::snprintf(buf, sizeof buf, "pump on in-plane irradiance thresholds, crude tank at 25 °C");
+  }
+  return buf;
+}
+
+// The forecast at the plant's first solar noon after from_ts and the day's
+// highest Q_u, from forecast_latest.
+void PrintNoonForecast(Store* store, const Plant& plant, std::int64_t from_ts) {
+  std::vector<Store::ForecastRow> rows;
+  std::string error;
+  if (!store->ReadLatestForecast(from_ts, from_ts + 2 * 86400, &rows, &error) || rows.empty())
+    return;
+  const double noon_utc_s = (12.0 - RadToDeg(plant.longitude_rad) / 15.0) * 3600.0;
+  std::int64_t noon = from_ts / 86400 * 86400 + static_cast<std::int64_t>(noon_utc_s) / 60 * 60;
+  if (noon < rows.front().ts) noon += 86400;
+  const Store::ForecastRow* at_noon = nullptr;
+  const Store::ForecastRow* best = nullptr;
+  for (const Store::ForecastRow& r : rows) {
+    if (at_noon == nullptr && r.ts >= noon) at_noon = &r;
+    if (r.ts >= noon - 43200 && r.ts < noon + 43200 &&
+        (best == nullptr || r.q_th_w > best->q_th_w)) {
+      best = &r;
+    }
+  }
+  if (at_noon == nullptr || best == nullptr) return;
+  std::printf(
+      "      forecast at solar noon (%s): P_el %.0f W, Q_u %.0f W; that day's highest Q_u "
+      "%.0f W at %s\n",
+      FormatIsoUtc(at_noon->ts).c_str(), at_noon->p_el_w, at_noon->q_th_w, best->q_th_w,
+      FormatIsoUtc(best->ts).c_str());
+}
 
 int RunDemo(const DemoArgs& a) {
   const double wall_start = WallNowS();
@@ -71,10 +119,17 @@ int RunDemo(const DemoArgs& a) {
   const fs::path sim_config = dir / "sim.toml";
   std::ofstream(sim_config) << kDemoPlantConfig;
 
-  // Live part of the demo starts at 08:00 UTC today (morning in Europe, sun
-  // up at the example plant); history covers the 14 days before.
-  const std::int64_t t0 = static_cast<std::int64_t>(WallNowS()) / 86400 * 86400 + 8 * 3600;
+  // Live part of the demo starts at 08:00 UTC today or on --date (morning in
+  // Europe, sun up at the example plant); history covers the 14 days before.
+  std::int64_t day_s = static_cast<std::int64_t>(WallNowS()) / 86400 * 86400;
+  if (!a.date.empty() && !ParseTimeOrReport("--date", a.date + "T00:00:00Z", &day_s)) {
+    return kExitBadInput;
+  }
+  const std::int64_t t0 = day_s / 86400 * 86400 + 8 * 3600;
+  Config demo_plant;
+  if (!LoadConfigOrReport(sim_config.string(), &demo_plant)) return kExitRuntime;
   std::printf("pvtwin demo: working in %s\n", dir.string().c_str());
+  std::printf("      plant: %s\n", OperationSummary(demo_plant.sim).c_str());
   std::printf("[1/4] 14 days of plant history from the simulator's truth model ...\n");
   std::fflush(stdout);
   const fs::path history_csv = dir / "history.csv";
@@ -97,10 +152,8 @@ int RunDemo(const DemoArgs& a) {
     return kExitRuntime;
   }
   {
-    Config plant_only;
-    if (!LoadConfigOrReport(sim_config.string(), &plant_only)) return kExitRuntime;
     Series history;
-    if (!LoadCsvOrReport(history_csv.string(), plant_only, &history)) return kExitRuntime;
+    if (!LoadCsvOrReport(history_csv.string(), demo_plant, &history)) return kExitRuntime;
     std::unique_ptr<Store> store = Store::Open(db, &error);
     if (!store || !store->WriteMinutes(history, &error)) {
       std::cerr << db << ": " << error << "\n";
@@ -117,8 +170,8 @@ int RunDemo(const DemoArgs& a) {
   std::vector<std::string> lines;
   const fs::path sim_log = dir / "sim.log";
   if (!sim.StartPiped({exe, "sim", "--config", sim_config.string(), "--ephemeral-ports", "--speed",
-                       std::to_string(a.speed), "--start", std::to_string(t0), "--wall-anchor",
-                       std::to_string(anchor)},
+                       std::to_string(a.speed), "--start", std::to_string(t0), "--run-start",
+                       std::to_string(t0 - 14 * 86400), "--wall-anchor", std::to_string(anchor)},
                       sim_log.string(), &error)) {
     std::cerr << error << "\n";
     return kExitRuntime;
@@ -198,6 +251,8 @@ int RunDemo(const DemoArgs& a) {
     std::printf("      no accepted calibration (%s)\n", last.last_calibration.c_str());
   }
   std::printf("      forecast rows written: %zu (24 h at 1 min)\n", last.last_forecast_rows);
+  if (store) PrintNoonForecast(store.get(), demo_plant.plant, t0);
+  std::printf("      plant: %s\n", OperationSummary(demo_plant.sim).c_str());
   std::printf("      live polling: %llu samples, %llu 1-min rows; runtime %.0f s\n",
               static_cast<unsigned long long>(last.samples_stored),
               static_cast<unsigned long long>(last.minutes_aggregated), WallNowS() - wall_start);
@@ -235,6 +290,9 @@ void RegisterDemo(CLI::App& app) {
   cmd->add_option("--live-minutes", args->live_minutes,
                   "simulated minutes of live polling to aggregate before stopping")
       ->check(CLI::Range(1, 1440));
+  cmd->add_option("--date", args->date,
+                  "UTC day of the live part, YYYY-MM-DD (default: today), e.g. a June day to "
+                  "see the plant in summer");
   cmd->callback([args] { SetExitCode(RunDemo(*args)); });
 }
 

@@ -43,6 +43,8 @@ struct SimArgs {
   std::string csv;
   std::vector<std::string> faults;
   std::string export_path;
+  std::string operation;  // empty: the config's [sim] operation
+  std::string run_start;  // empty: --start
   int days = 14;
   double step_s = 5;
 };
@@ -112,6 +114,13 @@ int RunSim(const SimArgs& a) {
   source_options.plant = config.plant;
   source_options.truth_variant = a.truth_variant;
   source_options.seed = a.seed;
+  const std::string& operation = a.operation.empty() ? config.sim.operation : a.operation;
+  source_options.pump_control = *PumpControlFromName(operation);
+  source_options.pump_dt_on_k = config.sim.pump_dt_on_k;
+  source_options.pump_dt_off_k = config.sim.pump_dt_off_k;
+  source_options.brine_below_ambient_k = config.sim.brine_below_ambient_k;
+  source_options.brine_min_c = config.sim.brine_min_c;
+  source_options.brine_max_c = config.sim.brine_max_c;
   for (const std::string& sky : a.sky) source_options.day_types.push_back(*DayTypeFromName(sky));
   if (a.weather == "replay") {
     if (a.csv.empty()) {
@@ -120,13 +129,6 @@ int RunSim(const SimArgs& a) {
     }
     source_options.replay_csv = a.csv;
   }
-  Diagnostics errors;
-  std::unique_ptr<PlantSource> source = PlantSource::Create(source_options, &errors);
-  if (source == nullptr) {
-    for (const Diagnostic& d : errors) std::cerr << d.ToString() << "\n";
-    return kExitBadInput;
-  }
-
   const double now_s = WallNowS();
   std::int64_t start_s = 0;
   if (!a.start.empty()) {
@@ -136,6 +138,22 @@ int RunSim(const SimArgs& a) {
     start_s = (static_cast<std::int64_t>(now_s) / 86400 - a.days) * 86400;
   } else {
     start_s = static_cast<std::int64_t>(now_s);
+  }
+  // The continuous plant (thermostat operations) starts its run here.
+  source_options.run_start_s = start_s;
+  if (!a.run_start.empty() &&
+      !ParseTimeOrReport("--run-start", a.run_start, &source_options.run_start_s)) {
+    return kExitBadInput;
+  }
+  if (source_options.Continuous() && source_options.run_start_s > start_s) {
+    std::cerr << "--run-start = " << a.run_start << ": must not be after --start\n";
+    return kExitBadInput;
+  }
+  Diagnostics errors;
+  std::unique_ptr<PlantSource> source = PlantSource::Create(source_options, &errors);
+  if (source == nullptr) {
+    for (const Diagnostic& d : errors) std::cerr << d.ToString() << "\n";
+    return kExitBadInput;
   }
   if (!a.export_path.empty()) return RunExport(a, source.get(), start_s);
 
@@ -181,7 +199,8 @@ int RunSim(const SimArgs& a) {
   std::cout << "ready start=" << start_s << " speed=" << (a.stepped ? 0.0 : a.speed) << std::endl;
   LogToStderr(kInfo, "sim: serving " + std::to_string(config.modbus.points.size()) + " points of " +
                          std::to_string(config.modbus.devices.size()) + " device(s), truth " +
-                         a.truth_variant + ", seed " + std::to_string(a.seed));
+                         a.truth_variant + ", seed " + std::to_string(a.seed) + ", operation " +
+                         operation);
 
   // Control lines on stdin until quit, SIGTERM or SIGINT; end of input only
   // stops reading (the simulator may run detached from a terminal).
@@ -262,6 +281,16 @@ void RegisterSim(CLI::App& app) {
       ->check(CLI::IsMember({"clear", "broken_clouds", "overcast"}));
   cmd->add_option("--csv", args->csv, "canonical CSV to replay (--weather replay)");
   cmd->add_option("--fault", args->faults, "DEVICE:KIND:from=S:for=S[:ms=N] (repeatable)");
+  cmd->add_option("--operation", args->operation,
+                  "solar loop of the simulated plant, overrides [sim] operation: irradiance "
+                  "(pump on irradiance thresholds, tank; per-UTC-day runs), differential (pump "
+                  "on collector − tank temperature difference) or heat_pump (brine below "
+                  "ambient from a heat pump); the last two are one continuous run")
+      ->check(CLI::IsMember({"irradiance", "differential", "heat_pump"}));
+  cmd->add_option("--run-start", args->run_start,
+                  "differential / heat_pump: when the continuous run begins, ISO 8601 or unix s, "
+                  "not after --start (default: --start); give the served plant the start of "
+                  "the exported history to make both one run");
   cmd->add_option("--export", args->export_path, "write the plant's history as CSV and exit");
   cmd->add_option("--days", args->days, "days of history for --export (default 14)")
       ->check(CLI::Range(1, 3660));

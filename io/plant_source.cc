@@ -73,16 +73,37 @@ const Series& PlantSource::Chunk(std::int64_t day) {
     });
     chunks_.erase(farthest);
   }
+  Series s =
+      MakeSyntheticPlantData(options_.plant, Weather(day * kDayS, 1, Mix(options_.seed, day)),
+                             spec_, truth_, RealisticSensorNoise(Mix(options_.seed ^ 0x5EED, day)));
+  return chunks_.emplace(day, std::move(s)).first->second;
+}
+
+WeatherOptions PlantSource::Weather(std::int64_t start_s, int days, std::uint64_t seed) const {
   WeatherOptions weather;
-  weather.start_time_s = day * kDayS;
-  weather.num_days = 1;
+  weather.start_time_s = start_s;
+  weather.num_days = days;
   weather.step_s = kPlantSourceStepS;
-  weather.seed = Mix(options_.seed, day);
+  weather.seed = seed;
   weather.flow_mode = FlowMode::kVariable;
   weather.day_types = options_.day_types;
-  Series s = MakeSyntheticPlantData(options_.plant, weather, spec_, truth_,
-                                    RealisticSensorNoise(Mix(options_.seed ^ 0x5EED, day)));
-  return chunks_.emplace(day, std::move(s)).first->second;
+  weather.pump_control = options_.pump_control;
+  weather.pump_dt_on_k = options_.pump_dt_on_k;
+  weather.pump_dt_off_k = options_.pump_dt_off_k;
+  weather.brine_below_ambient_k = options_.brine_below_ambient_k;
+  weather.brine_min_c = options_.brine_min_c;
+  weather.brine_max_c = options_.brine_max_c;
+  return weather;
+}
+
+const Series& PlantSource::Run(std::int64_t until_s) {
+  const std::int64_t start_s = options_.run_start_s;
+  if (!run_.time_s.empty() && until_s <= run_.time_s.back()) return run_;
+  const auto days =
+      static_cast<int>(FloorDiv(std::max(until_s - start_s, std::int64_t{0}), kDayS) + 1);
+  run_ = MakeSyntheticPlantData(options_.plant, Weather(start_s, days, options_.seed), spec_,
+                                truth_, RealisticSensorNoise(Mix(options_.seed ^ 0x5EED, 0)));
+  return run_;
 }
 
 Sample PlantSource::At(double t_s) {
@@ -98,6 +119,12 @@ Sample PlantSource::At(double t_s) {
     return RowOf(replay_, i);
   }
   const auto t = static_cast<std::int64_t>(std::floor(t_s));
+  if (options_.Continuous()) {
+    if (t < options_.run_start_s) return Sample{};
+    const Series& run = Run(t);
+    return RowOf(run, static_cast<std::size_t>((t - options_.run_start_s) /
+                                               static_cast<std::int64_t>(kPlantSourceStepS)));
+  }
   const std::int64_t day = FloorDiv(t, kDayS);
   const Series& chunk = Chunk(day);
   const auto row =
@@ -114,6 +141,14 @@ Series PlantSource::History(std::int64_t start_s, int days) {
     const auto end = std::lower_bound(times.begin(), times.end(), end_s);
     return replay_.Slice(static_cast<std::size_t>(begin - times.begin()),
                          static_cast<std::size_t>(end - times.begin()));
+  }
+  if (options_.Continuous()) {
+    const Series& run = Run(end_s - 1);
+    const auto& times = run.time_s;
+    const auto begin = std::lower_bound(times.begin(), times.end(), start_s);
+    const auto end = std::lower_bound(times.begin(), times.end(), end_s);
+    return run.Slice(static_cast<std::size_t>(begin - times.begin()),
+                     static_cast<std::size_t>(end - times.begin()));
   }
   Series out;
   out.step_s = kPlantSourceStepS;

@@ -87,12 +87,31 @@ struct Job {
   std::size_t train = 0;
 };
 
+// Start of the n-th solar day with data before day_start_s (data_days:
+// sorted starts of the days that hold rows); n calendar days before it when
+// fewer days with data precede it.
+std::int64_t TrainingStartS(const std::vector<std::int64_t>& data_days, std::int64_t day_start_s,
+                            int n) {
+  const auto before = std::lower_bound(data_days.begin(), data_days.end(), day_start_s);
+  if (before - data_days.begin() >= n) return *(before - n);
+  return day_start_s - static_cast<std::int64_t>(n) * kSecondsPerDay;
+}
+
+// Sorted starts of the solar days that hold at least one row of s.
+std::vector<std::int64_t> DaysWithData(const Series& s, std::int64_t offset_s) {
+  std::vector<std::int64_t> days;
+  for (const std::int64_t t : s.time_s) {
+    const std::int64_t d = SolarDayStartS(t, offset_s);
+    if (days.empty() || days.back() != d) days.push_back(d);
+  }
+  return days;
+}
+
 void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
             const ModelSpec& spec, std::int64_t day_start_s, std::int64_t solar_offset_s,
-            BacktestDay* out) {
+            const std::vector<std::int64_t>& data_days, BacktestDay* out) {
   const std::int64_t day_end_s = day_start_s + kSecondsPerDay;
-  const std::int64_t train_start_s =
-      day_start_s - static_cast<std::int64_t>(out->train_days) * kSecondsPerDay;
+  const std::int64_t train_start_s = TrainingStartS(data_days, day_start_s, out->train_days);
   const std::size_t min_rows = static_cast<std::size_t>(std::max(options.ident.min_rows, 0));
   std::string error;
 
@@ -114,7 +133,7 @@ void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
   Slice train;
   const std::string window = "training window " + SolarDate(train_start_s, solar_offset_s) + " … " +
                              SolarDate(day_start_s - 1, solar_offset_s) + " (" +
-                             std::to_string(out->train_days) + " days)";
+                             std::to_string(out->train_days) + " days with data)";
   if (!PrepareSlice(s, s.RowAtOrAfter(train_start_s), s.RowAtOrAfter(day_start_s), plant, spec,
                     &train, &error)) {
     out->failure = BacktestFailure::kTooLittleData;
@@ -373,25 +392,35 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
   // Test days.
   const std::int64_t offset_s = SolarDayOffsetS(plant);
   const int max_n = *std::max_element(options.train_days.begin(), options.train_days.end());
-  const std::int64_t first_day_s =
-      options.first_test_day_s
-          ? SolarDayStartS(*options.first_test_day_s, offset_s)
-          : SolarDayStartS(s.time_s.front(), offset_s) + max_n * kSecondsPerDay;
+  const std::vector<std::int64_t> data_days = DaysWithData(s, offset_s);
   const std::int64_t data_end_s = s.time_s.back() + static_cast<std::int64_t>(s.step_s);
+  std::int64_t first_day_s = 0;
+  if (options.first_test_day_s) {
+    first_day_s = SolarDayStartS(*options.first_test_day_s, offset_s);
+  } else if (data_days.size() > static_cast<std::size_t>(max_n)) {
+    first_day_s = data_days[static_cast<std::size_t>(max_n)];
+  } else {
+    *error = "no test day in the data: they hold " + std::to_string(data_days.size()) +
+             " solar day(s) with data, from " + SolarDate(s.time_s.front(), offset_s) + " to " +
+             SolarDate(data_end_s - 1, offset_s) + "; " + std::to_string(max_n) +
+             " training days + 1 test day are needed";
+    return false;
+  }
   std::vector<std::int64_t> day_starts;
+  int skipped_days = 0;
   for (int k = 0; k < options.test_days; ++k) {
     const std::int64_t d = first_day_s + k * kSecondsPerDay;
-    if (d + kSecondsPerDay > data_end_s) break;
-    day_starts.push_back(d);
+    if (d >= data_end_s) break;
+    if (std::binary_search(data_days.begin(), data_days.end(), d)) {
+      day_starts.push_back(d);
+    } else {
+      ++skipped_days;
+    }
   }
   if (day_starts.empty()) {
-    *error = "no complete test day in the data: the data run from " +
-             SolarDate(s.time_s.front(), offset_s) + " to " + SolarDate(data_end_s - 1, offset_s) +
-             " (local solar days), the first test day " + SolarDate(first_day_s, offset_s) +
-             " does not end before the data do";
-    if (!options.first_test_day_s) {
-      *error += " (" + std::to_string(max_n) + " training days + 1 test day are needed)";
-    }
+    *error = "no test day with data: the data run from " + SolarDate(s.time_s.front(), offset_s) +
+             " to " + SolarDate(data_end_s - 1, offset_s) +
+             " (local solar days), the first test day is " + SolarDate(first_day_s, offset_s);
     return false;
   }
 
@@ -418,7 +447,8 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
   const int total = static_cast<int>(jobs.size());
   auto worker = [&]() {
     for (std::size_t j = next.fetch_add(1); j < jobs.size(); j = next.fetch_add(1)) {
-      RunJob(s, plant, options, specs[jobs[j].variant], days[j].day_start_s, offset_s, &days[j]);
+      RunJob(s, plant, options, specs[jobs[j].variant], days[j].day_start_s, offset_s, data_days,
+             &days[j]);
       std::lock_guard<std::mutex> lock(progress_mutex);
       ++done;
       if (progress) progress(done, total, days[j]);
@@ -446,6 +476,7 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
   out.step_s = s.step_s;
   out.solar_offset_s = offset_s;
   out.test_days = static_cast<int>(day_starts.size());
+  out.skipped_days = skipped_days;
   out.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   *result = std::move(out);
@@ -477,7 +508,8 @@ std::string FormatBacktestTables(const BacktestResult& result) {
   out += ", time step " + StepLabel(result.step_s) + ", wall time " + Fixed(result.wall_time_s, 1) +
          " s\n";
   out +=
-      "Each test day is predicted by a model identified on the n days before it; means over "
+      "Each test day is predicted by a model identified on the n days with data before it; means "
+      "over "
       "the days identified.\n\n";
 
   // Table 6 shape.

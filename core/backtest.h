@@ -14,10 +14,12 @@
 // interval).
 //
 // Protocol of one job (test day d, variant v, n training days):
-//   1. training rows: time in [d − n·86400 s, d); test rows: time in
-//      [d, d + 86400 s). Each slice gets its own drivers (PrepareDrivers) and
-//      measurements (MakeMeasurements); the model starts from the steady state
-//      of the first row of each slice (paper 2.2).
+//   1. training rows: the n most recent solar days with data before d (in
+//      data without gaps: time in [d − n·86400 s, d); in a set of separate
+//      measured days, such as test-bench days, the n measured days before
+//      d); test rows: time in [d, d + 86400 s). Each slice gets its own drivers (PrepareDrivers)
+//      and measurements (MakeMeasurements); the model starts from the steady state of the first row
+//      of each slice (paper 2.2).
 //   2. Fewer than ident.min_rows objective rows in the test day or in the
 //      training window: the job fails (BacktestFailure::kTooLittleData).
 //   3. Identify(training) from StartParams(plant). summary.ok false: the job
@@ -27,11 +29,12 @@
 // Failed jobs are kept in BacktestResult::days and counted, but left out of
 // the averages.
 //
-// Test days: options.test_days consecutive days from the first test day,
-// stopping early at the first day that ends after the data does (last row's
-// time + step). Default first test day: the solar day that contains the first
-// row, plus max(train_days) days, so that every training window starts no
-// earlier than the first (possibly partial) day of data.
+// Test days: of options.test_days consecutive days from the first test day,
+// those with data; days without any row are skipped (counted in
+// BacktestResult::skipped_days), and the last day may end before solar
+// midnight (data that stop at sunset). Default first test day: the
+// (max(train_days) + 1)-th solar day with data, so that every training window
+// holds max(train_days) days of data.
 //
 // Averages (paper: "averaged over the 29 test days"): MAE and runtime are the
 // means over the successful days; nMAE is computed per day (day MAE / mean
@@ -91,7 +94,8 @@ struct BacktestOptions {
   // A time in the first test day (unix s); the test days start at the start
   // of its local solar day. Default: see the file comment.
   std::optional<std::int64_t> first_test_day_s;
-  // Consecutive test days, ≥ 1; fewer if the data end before.
+  // Consecutive test days, ≥ 1; those without data are skipped, and fewer
+  // are run if the data end before.
   int test_days = 29;
   // Identification options of every job (must be valid).
   IdentOptions ident;
@@ -150,6 +154,7 @@ struct BacktestResult {
   double step_s = 0.0;              // the step used
   std::int64_t solar_offset_s = 0;  // SolarDayOffsetS of the plant (labels the days)
   int test_days = 0;                // number of test days evaluated
+  int skipped_days = 0;             // days of the range without any data row
 };
 
 // Runs the backtest. Returns false with *error (nothing in *result) when the

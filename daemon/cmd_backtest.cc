@@ -102,21 +102,22 @@ int RunBacktestCommand(const BacktestArgs& a) {
     options.first_test_day_s =
         SolarDayStartOfDateS(year, month, day, SolarDayOffsetS(config.plant));
   }
+  Series series;
+  if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
+  // Default: the data's own step, as the file holds them.
   const std::vector<double> steps_s =
-      a.steps_s.empty() ? std::vector<double>{config.calibration.step_s} : a.steps_s;
+      a.steps_s.empty() ? std::vector<double>{series.step_s} : a.steps_s;
   bool options_ok = true;
   for (double step_s : steps_s) {
     options.step_s = step_s;
     std::string why;
     if (!options.IsValid(&why)) {
-      std::cerr << "backtest: " << why << "\n";
+      std::cerr << "backtest: " << why
+                << (a.steps_s.empty() ? " (the data's step; give --step)" : "") << "\n";
       options_ok = false;
     }
   }
   if (!options_ok) return kExitBadInput;
-
-  Series series;
-  if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
 
   std::vector<BacktestResult> results;
   for (double step_s : steps_s) {
@@ -132,6 +133,9 @@ int RunBacktestCommand(const BacktestArgs& a) {
     if (!ok) {
       std::cerr << a.csv << ": " << error << "\n";
       return kExitBadInput;
+    }
+    if (result.skipped_days > 0) {
+      std::fprintf(stderr, "%d of the test days hold no data: skipped\n", result.skipped_days);
     }
     std::cout << FormatBacktestTables(result) << "\n";
     results.push_back(std::move(result));
@@ -194,7 +198,7 @@ void RegisterBacktest(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--step", args->steps_s,
                   "time step in s (5 ... 900, a multiple of the data step); several, comma-"
-                  "separated, add a Table 5-shaped comparison (default: [calibration] step_s)")
+                  "separated, add a Table 5-shaped comparison (default: the data's step)")
       ->delimiter(',');
   cmd->add_option("--first-test-day", args->first_test_day,
                   "first test day YYYY-MM-DD, the local solar day of that date (default: the "

@@ -21,6 +21,7 @@
 #include "core/backtest.h"
 #include "core/synthetic_plant.h"
 #include "core/units.h"
+#include "core/variant.h"
 #include "io/csv.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/synthetic_series.h"
@@ -258,8 +259,65 @@ TEST_F(Backtest, TrainingWindowBeforeTheDataIsAFailedDay) {
   ASSERT_EQ(r.days.size(), 1u);
   EXPECT_EQ(r.days[0].failure, BacktestFailure::kTooLittleData);
   EXPECT_EQ(r.days[0].failure_reason,
-            "training window 2024-05-30 … 2024-05-31 (2 days) has 0 objective rows, fewer than "
-            "ident.min_rows = 30");
+            "training window 2024-05-30 … 2024-05-31 (2 days with data) has 0 objective rows, "
+            "fewer than ident.min_rows = 30");
+}
+
+// The rows of `data` outside [from_s, to_s).
+Series Without(const Series& data, std::int64_t from_s, std::int64_t to_s) {
+  Series out;
+  out.step_s = data.step_s;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    if (data.time_s[i] >= from_s && data.time_s[i] < to_s) continue;
+    out.time_s.push_back(data.time_s[i]);
+    for (std::size_t c = 0; c < kNumChannels; ++c) {
+      if (!data.columns[c].empty()) out.columns[c].push_back(data.columns[c][i]);
+    }
+  }
+  return out;
+}
+
+// Separate measured days (a test bench's, or a logger that was off): test
+// days without any row are skipped and counted, and a test day trains on the
+// n most recent days that hold data.
+TEST_F(Backtest, DaysWithoutDataAreSkippedAndTrainingUsesTheDaysWithData) {
+  const std::int64_t offset_s = SolarDayOffsetS(*plant_);
+  const std::int64_t june3_s = SolarDayStartOfDateS(2024, 6, 3, offset_s);
+  const Series gappy = Without(*data_, june3_s, june3_s + 2 * 86400);  // no June 3 and 4
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.variants = {"2N1Ccolwr"};
+  options.train_days = {1};
+  options.test_days = 4;  // June 2 … 5
+  BacktestResult r;
+  std::string error;
+  ASSERT_TRUE(RunBacktest(gappy, *plant_, options, &r, &error)) << error;
+  EXPECT_EQ(r.skipped_days, 2);
+  ASSERT_EQ(r.days.size(), 2u);
+  EXPECT_EQ(SolarDate(r.days[0].day_start_s, offset_s), "2024-06-02");
+  EXPECT_EQ(SolarDate(r.days[1].day_start_s, offset_s), "2024-06-05");
+  // June 5 can only succeed by training on June 2: the calendar day before
+  // it, June 4, holds no row (it would fail with 0 objective rows).
+  for (const BacktestDay& d : r.days) {
+    EXPECT_TRUE(d.ok) << SolarDate(d.day_start_s, offset_s) << ": " << d.failure_reason;
+  }
+}
+
+// Data that end at sunset (a logger stopped for the night): the last day is
+// a test day, not refused for never reaching solar midnight.
+TEST_F(Backtest, ALastDayEndingAtSunsetIsATestDay) {
+  const std::int64_t offset_s = SolarDayOffsetS(*plant_);
+  const std::int64_t june5_sunset_s = kJune1_2024 + 4 * 86400 + 19 * 3600;  // ~21:00 local
+  const Series until_sunset = Without(*data_, june5_sunset_s, kJune1_2024 + 10 * 86400);
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.variants = {"2N1Ccolwr"};
+  options.test_days = 3;  // June 3, 4, 5
+  BacktestResult r;
+  std::string error;
+  ASSERT_TRUE(RunBacktest(until_sunset, *plant_, options, &r, &error)) << error;
+  ASSERT_EQ(r.days.size(), 3u);
+  EXPECT_EQ(SolarDate(r.days[2].day_start_s, offset_s), "2024-06-05");
+  EXPECT_TRUE(r.days[2].ok) << r.days[2].failure_reason;
+  EXPECT_EQ(r.skipped_days, 0);
 }
 
 TEST_F(Backtest, MissingColumnFailsTheWholeRunUpFront) {
@@ -304,14 +362,17 @@ TEST_F(Backtest, CoarserStepAveragesTheData) {
   EXPECT_GT(r.days[0].test.rows, 40u);
 }
 
-TEST_F(Backtest, NoCompleteTestDayIsAnError) {
+TEST_F(Backtest, FewerDaysWithDataThanTrainingPlusTestIsAnError) {
+  // The data touch 6 solar days (June 1 and 6 partly).
   BacktestOptions options = TwoDaysTwoVariants();
-  options.train_days = {5};
+  options.train_days = {6};
   BacktestResult r;
   std::string error;
   EXPECT_FALSE(RunBacktest(*data_, *plant_, options, &r, &error));
-  EXPECT_NE(error.find("no complete test day"), std::string::npos) << error;
-  EXPECT_NE(error.find("5 training days + 1 test day"), std::string::npos) << error;
+  EXPECT_NE(error.find("no test day in the data: they hold 6 solar day(s) with data"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("6 training days + 1 test day"), std::string::npos) << error;
 }
 
 // ---------------------------------------------------------------------------
@@ -445,7 +506,35 @@ TEST_F(BacktestCli, DataShorterThanTrainingPlusTestDayExitsTwo) {
                                       "backtest --config config.toml --csv data.csv --variants "
                                       "1N1C --train-days 9 --step 300");
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_NE(run.err.find("data.csv: no complete test day"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("data.csv: no test day in the data"), std::string::npos) << run.err;
+}
+
+// The README's example on the real htw saar days as shipped (2-min rows,
+// two separate days that end at sunset): day 3 trains, day 1 is predicted,
+// at the data's own step.
+TEST_F(BacktestCli, RunsOnTheShippedHtwSaarDays) {
+  const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+  {
+    std::ifstream day3(data / "day3_clear_medium_dT.csv"), day1(data / "day1_clear_low_dT.csv");
+    std::ofstream both(dir_ / "htwsaar.csv");
+    std::string line;
+    while (std::getline(day3, line)) both << line << "\n";
+    std::getline(day1, line);  // the same header
+    while (std::getline(day1, line)) both << line << "\n";
+  }
+  const ProcessResult run =
+      RunPvtwin(dir_, "backtest --config '" + (data / "plant.toml").string() +
+                          "' --csv htwsaar.csv --variants paper --train-days 1");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("1 test day(s) 2017-08-07 … 2017-08-07"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("time step 2 min"), std::string::npos) << run.out;
+  // Every paper variant identified and scored on the held-out day.
+  for (const std::string& v : PaperVariants()) {
+    const std::size_t row = run.out.find("\n  " + v + " ");
+    ASSERT_NE(row, std::string::npos) << v << "\n" << run.out;
+    const std::string line = run.out.substr(row + 1, run.out.find('\n', row + 1) - row - 1);
+    EXPECT_NE(line.find(" 1       0"), std::string::npos) << line;  // days ok 1, failed 0
+  }
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // pvtwin export: a time range of the SQLite store as canonical CSV.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <vector>
@@ -18,14 +19,30 @@ struct ExportArgs {
   std::string config;
   std::string db;
   std::string from;
-  std::string to;
+  std::string to = "now";
   std::string table = "1min";
   std::string out;
 };
 
+// The poll period of stored samples: their most common spacing (the store
+// does not record it; a config says it).
+double SamplePeriodS(const std::vector<Sample>& samples) {
+  std::vector<std::int64_t> steps;
+  for (std::size_t i = 1; i < samples.size(); ++i)
+    steps.push_back(samples[i].ts_s - samples[i - 1].ts_s);
+  if (steps.empty()) return 5.0;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2),
+                   steps.end());
+  return static_cast<double>(std::max<std::int64_t>(1, steps[steps.size() / 2]));
+}
+
 int RunExport(const ExportArgs& a) {
-  Config config;
-  if (!LoadConfigOrReport(a.config, &config)) return kExitBadInput;
+  Config config;  // without --config: the defaults, enough to read a store
+  if (a.config.empty() && a.db.empty()) {
+    std::cerr << "export: give --db (the SQLite file) or --config (its [storage] path)\n";
+    return kExitBadInput;
+  }
+  if (!a.config.empty() && !LoadConfigOrReport(a.config, &config)) return kExitBadInput;
   std::int64_t from_ts = 0, to_ts = 0;
   if (!ParseTimeOrReport("--from", a.from, &from_ts) || !ParseTimeOrReport("--to", a.to, &to_ts)) {
     return kExitBadInput;
@@ -48,7 +65,8 @@ int RunExport(const ExportArgs& a) {
   if (a.table == "5s") {
     std::vector<Sample> samples;
     ok = store->ReadSamples(from_ts, to_ts, &samples, &error);
-    series = SeriesFromSamples(samples, config.poll.period_s);
+    series = SeriesFromSamples(samples,
+                               a.config.empty() ? SamplePeriodS(samples) : config.poll.period_s);
   } else {
     ok = store->ReadMinutes(from_ts, to_ts, &series, &error);
   }
@@ -74,11 +92,14 @@ void RegisterExport(CLI::App& app) {
       "export",
       "Write a time range [--from, --to) of the SQLite store as canonical CSV: time (ISO 8601\n"
       "UTC, start of the interval) and every channel that has a value in the range. The\n"
-      "1-min table has the averaged, corrected measurements; the 5s table the raw samples.");
-  cmd->add_option("--config", args->config, "TOML config ([storage] path, [poll] period_s)")
+      "1-min table has the averaged, corrected measurements; the 5s table the raw samples.\n"
+      "Example: pvtwin export --db /var/lib/pvtwin/pvtwin.db --from -14d --out last-two-weeks.csv");
+  cmd->add_option("--config", args->config,
+                  "TOML config ([storage] path, [poll] period_s, [plant]); optional with --db");
+  cmd->add_option("--from", args->from,
+                  "first time: ISO 8601, unix seconds, a date (00:00 UTC) or relative (-14d)")
       ->required();
-  cmd->add_option("--from", args->from, "first time, ISO 8601 or unix seconds")->required();
-  cmd->add_option("--to", args->to, "end time (exclusive), ISO 8601 or unix seconds")->required();
+  cmd->add_option("--to", args->to, "end time, exclusive, in the same forms (default: now)");
   cmd->add_option("--table", args->table, "1min (measurement_1min, default) or 5s (sample_5s)")
       ->check(CLI::IsMember({"1min", "5s"}));
   cmd->add_option("--out", args->out, "output CSV (default: standard output)");

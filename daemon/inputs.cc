@@ -1,7 +1,9 @@
 #include "daemon/inputs.h"
 
+#include <cmath>
 #include <iostream>
 
+#include "core/clock.h"
 #include "io/csv.h"
 #include "io/time_format.h"
 
@@ -48,7 +50,8 @@ bool PrepareDriversOrReport(const Series& series, const std::string& csv_path, c
 
 bool ParseTimeOrReport(const std::string& option, const std::string& text, std::int64_t* unix_s) {
   std::string error;
-  if (ParseTime(text, unix_s, &error)) return true;
+  const auto now_s = static_cast<std::int64_t>(std::floor(WallNowS()));
+  if (ParseTimeArgument(text, now_s, unix_s, &error)) return true;
   std::cerr << option << " = " << text << ": " << error << "\n";
   return false;
 }

@@ -1,5 +1,6 @@
 #include "io/time_format.h"
 
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 
@@ -181,6 +182,42 @@ std::string FormatIsoUtc(std::int64_t unix_s) {
                 static_cast<int>(seconds / 3600), static_cast<int>(seconds / 60 % 60),
                 static_cast<int>(seconds % 60));
   return buf;
+}
+
+bool ParseTimeArgument(std::string_view text, std::int64_t now_s, std::int64_t* unix_s,
+                       std::string* error) {
+  constexpr std::string_view kForms =
+      "expected ISO 8601 with Z or an offset, unix seconds, a date YYYY-MM-DD (00:00 UTC), "
+      "\"now\" or a time relative to now such as -14d, -6h, -30m";
+  if (text == "now") {
+    *unix_s = now_s;
+    return true;
+  }
+  // Relative: sign, digits, one unit letter.
+  if (text.size() >= 3 && (text.front() == '-' || text.front() == '+') &&
+      std::string_view("dhms").find(text.back()) != std::string_view::npos) {
+    const std::string_view digits = text.substr(1, text.size() - 2);
+    std::int64_t n = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n);
+    const std::int64_t unit_s = text.back() == 'd'   ? 86400
+                                : text.back() == 'h' ? 3600
+                                : text.back() == 'm' ? 60
+                                                     : 1;
+    if (ec == std::errc() && end == digits.data() + digits.size() && n <= 36500LL * 86400) {
+      *unix_s = now_s + (text.front() == '-' ? -1 : 1) * n * unit_s;
+      return true;
+    }
+    *error = std::string(kForms);
+    return false;
+  }
+  // A date alone: its midnight UTC.
+  if (text.size() == 10 && text[4] == '-' && text[7] == '-') {
+    return ParseTime(std::string(text) + "T00:00:00Z", unix_s, error) ||
+           (*error = std::string(kForms), false);
+  }
+  if (ParseTime(text, unix_s, error)) return true;
+  *error += " (" + std::string(kForms) + ")";
+  return false;
 }
 
 }  // namespace pvtwin

@@ -19,6 +19,15 @@ namespace pvtwin {
 // sets *error to the rule that was broken; *unix_s is untouched.
 bool ParseTime(std::string_view text, std::int64_t* unix_s, std::string* error);
 
+// A time given on the command line (--from, --to, --train-start, ...): what
+// ParseTime accepts, and also
+//   * a date YYYY-MM-DD: its 00:00 UTC;
+//   * "now", or a time relative to now_s: -14d, -6h, -30m, -90s, +1d
+//     (whole numbers; d = 86400 s).
+// On failure returns false with the accepted forms in *error.
+bool ParseTimeArgument(std::string_view text, std::int64_t now_s, std::int64_t* unix_s,
+                       std::string* error);
+
 // "YYYY-MM-DDTHH:MM:SSZ".
 std::string FormatIsoUtc(std::int64_t unix_s);
 

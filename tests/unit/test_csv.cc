@@ -74,6 +74,33 @@ TEST(CsvTimeFormat, RejectsAmbiguousOrMalformedTimes) {
   }
 }
 
+TEST(CsvTimeFormat, CommandLineTimesTakeDatesNowAndRelativeTimes) {
+  const std::int64_t now_s = 1795400000;  // 2026-11-23T03:33:20Z
+  std::int64_t t = 0;
+  std::string error;
+  // `date -u -d 2026-11-22 +%s`
+  ASSERT_TRUE(ParseTimeArgument("2026-11-22", now_s, &t, &error)) << error;
+  EXPECT_EQ(t, 1795305600);
+  ASSERT_TRUE(ParseTimeArgument("-14d", now_s, &t, &error)) << error;
+  EXPECT_EQ(t, now_s - 14 * 86400);
+  ASSERT_TRUE(ParseTimeArgument("-6h", now_s, &t, &error)) << error;
+  EXPECT_EQ(t, now_s - 6 * 3600);
+  ASSERT_TRUE(ParseTimeArgument("+30m", now_s, &t, &error)) << error;
+  EXPECT_EQ(t, now_s + 1800);
+  ASSERT_TRUE(ParseTimeArgument("now", now_s, &t, &error)) << error;
+  EXPECT_EQ(t, now_s);
+  ASSERT_TRUE(ParseTimeArgument("2026-11-22T06:00:00+02:00", now_s, &t, &error)) << error;
+  EXPECT_EQ(t, 1795305600 + 4 * 3600);
+  ASSERT_TRUE(ParseTimeArgument("-14", now_s, &t, &error)) << error;  // unix seconds
+  EXPECT_EQ(t, -14);
+  for (const char* bad : {"yesterday", "-14w", "-d", "2026-13-01", "-1.5d"}) {
+    t = 12345;
+    EXPECT_FALSE(ParseTimeArgument(bad, now_s, &t, &error)) << bad;
+    EXPECT_NE(error.find("-14d"), std::string::npos) << bad << ": " << error;
+    EXPECT_EQ(t, 12345) << bad;
+  }
+}
+
 TEST(CsvTimeFormat, FormatsUtcWithZAndRoundTrips) {
   EXPECT_EQ(FormatIsoUtc(1502094241), "2017-08-07T08:24:01Z");
   EXPECT_EQ(FormatIsoUtc(0), "1970-01-01T00:00:00Z");

@@ -10,6 +10,7 @@
 
 #include "core/units.h"
 #include "io/csv.h"
+#include "io/time_format.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
 
@@ -161,6 +162,30 @@ TEST_F(StoreCli, WithoutDbTheConfiguredPathIsUsed) {
   RawDb db(dir_ / "configured.db");
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 1.0);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "t.db"));
+}
+
+// export needs no config when --db names the store, and takes a date or a
+// time relative to now; the 5 s table's period then comes from the samples.
+TEST_F(StoreCli, ExportWithOnlyTheDbADateAndARelativeTime) {
+  WriteRows("a.csv", Rows(kMinute0, 36, 5.0));  // three minutes of 5 s samples
+  ASSERT_EQ(Pvtwin("import --csv a.csv --db t.db").exit_code, 0);
+  const std::string day = FormatIsoUtc(kMinute0).substr(0, 10);  // YYYY-MM-DD
+  ProcessResult run = RunPvtwin(dir_, "export --db t.db --from " + day + " --out m.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("exported 3 rows of measurement_1min"), std::string::npos) << run.err;
+  run = RunPvtwin(dir_, "export --db t.db --table 5s --from " + day + " --to now --out s.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("exported 36 rows of sample_5s"), std::string::npos) << run.err;
+  // Relative to now: the data lie years back, so the last day holds none.
+  run = RunPvtwin(dir_, "export --db t.db --from -1d --out none.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("exported 0 rows"), std::string::npos) << run.err;
+  run = RunPvtwin(dir_, "export --from -1d");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("give --db"), std::string::npos) << run.err;
+  run = RunPvtwin(dir_, "export --db t.db --from yesterday");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--from = yesterday: expected ISO 8601"), std::string::npos) << run.err;
 }
 
 TEST_F(StoreCli, LongImportsReportProgress) {

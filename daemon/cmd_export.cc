@@ -92,8 +92,7 @@ void RegisterExport(CLI::App& app) {
       "export",
       "Write a time range [--from, --to) of the SQLite store as canonical CSV: time (ISO 8601\n"
       "UTC, start of the interval) and every channel that has a value in the range. The\n"
-      "1-min table has the averaged, corrected measurements; the 5s table the raw samples.\n"
-      "Example: pvtwin export --db /var/lib/pvtwin/pvtwin.db --from -14d --out last-two-weeks.csv");
+      "1-min table has the averaged, corrected measurements; the 5s table the raw samples.");
   cmd->add_option("--config", args->config,
                   "TOML config ([storage] path, [poll] period_s, [plant]); optional with --db");
   cmd->add_option("--from", args->from,

@@ -1,5 +1,12 @@
 #include "daemon/commands.h"
 
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/effect_candidates.h"
+#include "core/variant.h"
+
 namespace pvtwin::cli {
 
 namespace {
@@ -9,7 +16,54 @@ int g_exit_code = kExitOk;
 int ExitCode() { return g_exit_code; }
 void SetExitCode(int code) { g_exit_code = code; }
 
+namespace {
+
+// One example per verb, shown under its --help (the config and CSV paths are
+// the repository's examples and the real htw saar days).
+const std::vector<std::pair<std::string, std::string>>& Examples() {
+  static const std::vector<std::pair<std::string, std::string>> examples = {
+      {"check-config", "pvtwin check-config /etc/pvtwin/pvtwin.toml"},
+      {"calibrate",
+       "pvtwin calibrate --config plant.toml --csv day3.csv --variant 2N1CcolwrI "
+       "--test-csv day1.csv --out params.json"},
+      {"simulate",
+       "pvtwin simulate --config plant.toml --csv day1.csv --variant 2N1CcolwrI "
+       "--params params.json --out pred.csv"},
+      {"bench", "pvtwin bench sim ident"},
+      {"backtest",
+       "pvtwin backtest --config plant.toml --csv data.csv --variants paper --train-days 14"},
+      {"import", "pvtwin import --config /etc/pvtwin/pvtwin.toml --csv history.csv"},
+      {"export",
+       "pvtwin export --db /var/lib/pvtwin/pvtwin.db --from -14d --out last-two-weeks.csv"},
+      {"sim", "pvtwin sim --config config/examples/sim-plant.toml --speed 10"},
+      {"run", "pvtwin run --config /etc/pvtwin/pvtwin.toml"},
+      {"demo", "pvtwin demo --date 2026-06-20"},
+      {"diagnose",
+       "pvtwin diagnose --config plant.toml --csv data.csv --variant 1N1Cwr --report out/"},
+      {"diagnose-selftest", "pvtwin diagnose-selftest --seeds 5 --jobs 2"},
+  };
+  return examples;
+}
+
+// The variant grammar, for the verbs that take a variant.
+std::string VariantHelp() {
+  std::string paper;
+  for (const std::string& v : PaperVariants()) paper += (paper.empty() ? "" : ", ") + v;
+  std::string effects;
+  for (const std::string& e : EffectNames()) effects += (effects.empty() ? "" : ", ") + e;
+  return "Variants: the nine of the paper's Table 6 (" + paper +
+         "): 1N/2N one or two temperature nodes; 1C/2C a capacitance on the PV node (1Cpv, or 1C "
+         "with one node), the collector node (1Ccol) or both (2C); w wind-dependent front loss; r "
+         "sky long-wave radiation; I beam/diffuse split with the incidence-angle modifier. Add "
+         "effects of the library with +name, e.g. 1N1Cwr+transport_delay: " +
+         effects + ".";
+}
+
+}  // namespace
+
 void RegisterCommands(CLI::App& app) {
+  // Every option's default is shown in --help.
+  app.option_defaults()->always_capture_default();
   RegisterCheckConfig(app);
   RegisterCalibrate(app);
   RegisterSimulate(app);
@@ -21,6 +75,14 @@ void RegisterCommands(CLI::App& app) {
   RegisterRun(app);
   RegisterDemo(app);
   RegisterDiagnose(app);
+  for (const auto& [verb, example] : Examples()) {
+    CLI::App* cmd = app.get_subcommand(verb);
+    std::string footer = "\nExample:\n  " + example;
+    if (verb == "calibrate" || verb == "simulate" || verb == "backtest" || verb == "diagnose") {
+      footer += "\n\n" + VariantHelp();
+    }
+    cmd->footer(footer);
+  }
 }
 
 }  // namespace pvtwin::cli

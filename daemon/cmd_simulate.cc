@@ -25,7 +25,10 @@ int RunSimulate(const SimulateArgs& a) {
   if (!ParseVariantOrReport(a.variant, &spec)) return kExitBadInput;
   ParamsFile params;
   params.values = StartParams(config.plant);
-  if (!a.params.empty()) {
+  if (a.params.empty()) {
+    std::cerr << "warning: no --params: simulating with the start values of the paper's Table 3, "
+                 "not identified ones (pvtwin calibrate --out params.json identifies them)\n";
+  } else {
     Diagnostics errors;
     if (!ReadParamsJson(a.params, config.plant, &params, &errors)) {
       for (const Diagnostic& d : errors) std::cerr << d.ToString() << "\n";

@@ -258,6 +258,14 @@ bool IdentOptions::IsValid(std::string* why) const {
   return true;
 }
 
+std::vector<std::string> IdentSummary::AtBounds() const {
+  std::vector<std::string> names;
+  for (const ParamEstimate& e : estimates) {
+    if (e.free && e.at_bound) names.emplace_back(Info(e.param).name);
+  }
+  return names;
+}
+
 std::string IdentSummary::BriefReport() const {
   char buf[320];
   std::snprintf(buf, sizeof(buf),
@@ -265,7 +273,15 @@ std::string IdentSummary::BriefReport() const {
                 variant.c_str(), ok ? "ok" : "FAILED", algorithm.c_str(),
                 std::string(ToString(termination)).c_str(), initial_cost_w_m2, final_cost_w_m2,
                 evaluations, runtime_s, ok ? "" : ": ", ok ? "" : failure_reason.c_str());
-  return buf;
+  std::string report = buf;
+  const std::vector<std::string> bounds = AtBounds();
+  if (ok && !bounds.empty()) {
+    report += "; ok, but " + std::to_string(bounds.size()) +
+              (bounds.size() == 1 ? " parameter" : " parameters") + " at bounds (";
+    for (std::size_t i = 0; i < bounds.size(); ++i) report += (i ? ", " : "") + bounds[i];
+    report += "): the data or the model do not hold them inside their physical range";
+  }
+  return report;
 }
 
 std::string IdentAlgorithmName(const IdentOptions& options) {

@@ -139,8 +139,10 @@ struct IdentSummary {
   std::vector<std::string> notes;        // identifiability findings, in words
   ErrorMetrics train;                    // errors on the training data
 
+  // Names of the free parameters that ended at a bound of their search range.
+  std::vector<std::string> AtBounds() const;
   // One line: variant, ok/FAILED, termination, cost start → end, evaluations,
-  // runtime.
+  // runtime; "ok, but N parameters at bounds (names)" when any are.
   std::string BriefReport() const;
 };
 

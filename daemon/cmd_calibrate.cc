@@ -2,6 +2,7 @@
 #include <sys/prctl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/identification.h"
+#include "core/iso9806.h"
 #include "core/resample.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
@@ -67,10 +69,41 @@ std::string StatusOf(const ParamEstimate& e) {
   if (e.undetermined) return "fixed: not determined by the data";
   if (e.at_bound)
     return e.value - e.lower < e.upper - e.value ? "at lower bound" : "at upper bound";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%s (se %.3g)", e.weak ? "weakly determined" : "identified",
-                e.se_unit);
+  return e.weak ? "weakly determined" : "identified";
+}
+
+// The standard error in the parameter's own unit, from the one in the
+// optimiser's unit coordinates (first order: linear scale x = lo + z·(hi −
+// lo), log scale x = lo·(hi/lo)^z, dx/dz = x·ln(hi/lo)). Empty when fixed.
+std::string PlusMinus(const ParamEstimate& e) {
+  if (!e.free || e.undetermined || !(e.se_unit > 0.0)) return "";
+  const bool log_scale = Info(e.param).scale == ParamScale::kLog;
+  const double se = log_scale ? e.value * std::log(e.upper / e.lower) * e.se_unit
+                              : (e.upper - e.lower) * e.se_unit;
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "± %.3g", se);
   return buf;
+}
+
+// The ISO 9806 quasi-dynamic coefficients of the fit, for a datasheet.
+void PrintIsoEquivalents(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                         const Series& train) {
+  std::vector<double> flows;
+  for (const double f : train[Channel::kMdotKgS]) {
+    if (f > 1e-4) flows.push_back(f);
+  }
+  if (flows.empty()) return;
+  std::nth_element(flows.begin(), flows.begin() + static_cast<std::ptrdiff_t>(flows.size() / 2),
+                   flows.end());
+  const double flow_kg_s = flows[flows.size() / 2];
+  const Iso9806Equivalents iso = Iso9806EquivalentsOf(plant, spec, params, flow_kg_s);
+  if (!iso.ok) return;
+  std::printf(
+      "ISO 9806 equivalents (steady state, 1000 W/m2 beam at normal incidence, ambient 25 C, "
+      "flow %.3g kg/s, wind %.1f m/s): eta0 %.3f, c1 + c3*u %.2f W/(m2K); slopes c3 %.2f "
+      "J/(m3K), c6 %.4f s/m; c4 %.3f; heat capacity %.0f J/(m2K)\n",
+      flow_kg_s, iso.u_ref_m_s, iso.eta0, iso.loss_w_m2k, iso.c3_j_m3k, iso.c6_s_m, iso.c4,
+      iso.c5_j_m2k);
 }
 
 // The "fit" object of params.json. An undefined nMAE (no output to
@@ -94,6 +127,7 @@ std::string FitJson(const IdentSummary& s, const ErrorMetrics* held_out) {
   j["runtime_s"] = s.runtime_s;
   j["train"] = metrics(s.train);
   if (held_out) j["held_out"] = metrics(*held_out);
+  j["at_bounds"] = s.AtBounds();
   j["undetermined"] = nlohmann::ordered_json::array();
   for (const ParamEstimate& e : s.estimates) {
     if (e.undetermined)
@@ -215,15 +249,17 @@ int RunCalibrate(const CalibrateArgs& a) {
     held_out = ComputeErrors(MakeMeasurements(test, test_drivers), sim, config.plant.area_m2);
     PrintErrors(("errors (held out):"), held_out);
   }
-  std::printf("parameters:\n  %-22s %12s  %-16s %12s  %-22s %s\n", "name", "value", "unit", "start",
-              "range", "status");
+  std::printf("parameters:\n  %-22s %12s %-11s %-16s %12s  %-22s %s\n", "name", "value",
+              "std. error", "unit", "start", "range", "status");
   for (const ParamEstimate& e : summary.estimates) {
     const ParamInfo& info = Info(e.param);
     char range[48];
     std::snprintf(range, sizeof(range), "[%.3g, %.3g]", e.lower, e.upper);
-    std::printf("  %-22s %12.5g  %-16s %12.5g  %-22s %s\n", std::string(info.name).c_str(), e.value,
-                std::string(info.unit).c_str(), e.start, range, StatusOf(e).c_str());
+    std::printf("  %-22s %12.5g %-11s %-16s %12.5g  %-22s %s\n", std::string(info.name).c_str(),
+                e.value, PlusMinus(e).c_str(), std::string(info.unit).c_str(), e.start, range,
+                StatusOf(e).c_str());
   }
+  if (summary.ok) PrintIsoEquivalents(config.plant, spec, summary.params, train);
   for (const std::string& note : summary.notes) std::printf("note: %s\n", note.c_str());
   if (!summary.ok) {
     std::fprintf(stderr, "calibration failed: %s\n", summary.failure_reason.c_str());

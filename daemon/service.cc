@@ -23,6 +23,7 @@
 #include "core/sample.h"
 #include "core/thermal_model.h"
 #include "core/variant.h"
+#include "daemon/calibration_acceptance.h"
 #include "daemon/notify.h"
 #include "daemon/store_cli.h"
 #include "io/child_process.h"
@@ -433,19 +434,23 @@ void Service::FinishCalibration(int exit_code) {
   row.heldout_mae_w = fresh->mae_p_el_w + fresh->mae_q_th_w;
   std::optional<ErrorMetrics> current;
   if (have_params_) current = HeldOutErrors(job_test_, config_.plant, spec_, params_);
-  if (current && fresh->objective_w_m2() > current->objective_w_m2()) {
+  std::vector<std::string> at_bounds;
+  for (const auto& name : fit.value("at_bounds", nlohmann::json::array())) {
+    if (name.is_string()) at_bounds.push_back(name.get<std::string>());
+  }
+  const cli::AcceptanceDecision decision = cli::DecideCalibration(
+      fresh->objective_w_m2(),
+      current ? std::optional<double>(current->objective_w_m2()) : std::nullopt, at_bounds,
+      config_.plant.area_m2);
+  row.reason = decision.reason;
+  if (current) row.reason += " (current: calibration " + std::to_string(params_id_) + ")";
+  if (!decision.accept) {
     row.status = "rejected";
-    row.reason = "held-out MAE " + Format("%.2f", row.heldout_mae_w) + " W exceeds the current " +
-                 Format("%.2f", current->mae_p_el_w + current->mae_q_th_w) + " W (calibration " +
-                 std::to_string(params_id_) + "); parameters kept";
     RecordCalibration(row);
     return;
   }
   row.status = "accepted";
   row.accepted = true;
-  row.reason = current ? "held-out MAE " + Format("%.2f", row.heldout_mae_w) + " W ≤ current " +
-                             Format("%.2f", current->mae_p_el_w + current->mae_q_th_w) + " W"
-                       : "first parameters of this database";
   row.id = RecordCalibration(row);
   if (row.id > 0) {
     have_params_ = true;

@@ -97,13 +97,27 @@ std::int64_t TrainingStartS(const std::vector<std::int64_t>& data_days, std::int
   return day_start_s - static_cast<std::int64_t>(n) * kSecondsPerDay;
 }
 
-// Sorted starts of the solar days that hold at least one row of s.
+// Sorted starts of the solar days whose rows reach across solar noon (at
+// least one row before it and one at or after it): a measured day, whole or
+// ending at sunset, not an hour of night at the end of a file.
 std::vector<std::int64_t> DaysWithData(const Series& s, std::int64_t offset_s) {
+  constexpr std::int64_t kNoonS = kSecondsPerDay / 2;
   std::vector<std::int64_t> days;
-  for (const std::int64_t t : s.time_s) {
-    const std::int64_t d = SolarDayStartS(t, offset_s);
-    if (days.empty() || days.back() != d) days.push_back(d);
+  std::int64_t day = 0;
+  bool morning = false, afternoon = false;
+  const auto close_day = [&] {
+    if (morning && afternoon) days.push_back(day);
+  };
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const std::int64_t d = SolarDayStartS(s.time_s[i], offset_s);
+    if (i == 0 || d != day) {
+      if (i > 0) close_day();
+      day = d;
+      morning = afternoon = false;
+    }
+    (s.time_s[i] < d + kNoonS ? morning : afternoon) = true;
   }
+  if (s.size() > 0) close_day();
   return days;
 }
 

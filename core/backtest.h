@@ -29,12 +29,13 @@
 // Failed jobs are kept in BacktestResult::days and counted, but left out of
 // the averages.
 //
+// Days with data: solar days whose rows reach across solar noon (a whole
+// day, or one that ends at sunset; not an hour of night at a file's end).
 // Test days: of options.test_days consecutive days from the first test day,
-// those with data; days without any row are skipped (counted in
-// BacktestResult::skipped_days), and the last day may end before solar
-// midnight (data that stop at sunset). Default first test day: the
-// (max(train_days) + 1)-th solar day with data, so that every training window
-// holds max(train_days) days of data.
+// those with data; the others are skipped (counted in
+// BacktestResult::skipped_days). Default first test day: the
+// (max(train_days) + 1)-th day with data, so that every training window holds
+// max(train_days) days of data.
 //
 // Averages (paper: "averaged over the 29 test days"): MAE and runtime are the
 // means over the successful days; nMAE is computed per day (day MAE / mean
@@ -154,7 +155,7 @@ struct BacktestResult {
   double step_s = 0.0;              // the step used
   std::int64_t solar_offset_s = 0;  // SolarDayOffsetS of the plant (labels the days)
   int test_days = 0;                // number of test days evaluated
-  int skipped_days = 0;             // days of the range without any data row
+  int skipped_days = 0;             // days of the range without data across solar noon
 };
 
 // Runs the backtest. Returns false with *error (nothing in *result) when the

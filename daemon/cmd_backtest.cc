@@ -135,7 +135,8 @@ int RunBacktestCommand(const BacktestArgs& a) {
       return kExitBadInput;
     }
     if (result.skipped_days > 0) {
-      std::fprintf(stderr, "%d of the test days hold no data: skipped\n", result.skipped_days);
+      std::fprintf(stderr, "%d of the test days hold no data across solar noon: skipped\n",
+                   result.skipped_days);
     }
     std::cout << FormatBacktestTables(result) << "\n";
     results.push_back(std::move(result));

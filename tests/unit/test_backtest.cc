@@ -213,13 +213,15 @@ TEST_F(Backtest, AveragesAreMeansOverTheTestDays) {
 }
 
 TEST_F(Backtest, TestDayWithoutDataIsAFailedDayWithItsReason) {
-  // Drop all but 10 rows of the second test day (solar day 2024-06-04).
+  // Drop all but 10 rows around solar noon of the second test day (solar day
+  // 2024-06-04): a day with data, too little of it.
   const std::int64_t offset_s = SolarDayOffsetS(*plant_);
   const std::int64_t day_s = SolarDayStartOfDateS(2024, 6, 4, offset_s);
   std::vector<std::size_t> keep;
   for (std::size_t i = 0; i < data_->size(); ++i) {
     const std::int64_t t = data_->time_s[i];
-    if (t < day_s + 10 * 300 || t >= day_s + 86400) keep.push_back(i);
+    const bool around_noon = t >= day_s + 43200 - 5 * 300 && t < day_s + 43200 + 5 * 300;
+    if (t < day_s || t >= day_s + 86400 || around_noon) keep.push_back(i);
   }
   Series holed;
   holed.step_s = data_->step_s;
@@ -363,16 +365,17 @@ TEST_F(Backtest, CoarserStepAveragesTheData) {
 }
 
 TEST_F(Backtest, FewerDaysWithDataThanTrainingPlusTestIsAnError) {
-  // The data touch 6 solar days (June 1 and 6 partly).
+  // The data reach across the solar noon of 5 days (June 1 … 5; June 6 is
+  // an hour of night).
   BacktestOptions options = TwoDaysTwoVariants();
-  options.train_days = {6};
+  options.train_days = {5};
   BacktestResult r;
   std::string error;
   EXPECT_FALSE(RunBacktest(*data_, *plant_, options, &r, &error));
-  EXPECT_NE(error.find("no test day in the data: they hold 6 solar day(s) with data"),
+  EXPECT_NE(error.find("no test day in the data: they hold 5 solar day(s) with data"),
             std::string::npos)
       << error;
-  EXPECT_NE(error.find("6 training days + 1 test day"), std::string::npos) << error;
+  EXPECT_NE(error.find("5 training days + 1 test day"), std::string::npos) << error;
 }
 
 // ---------------------------------------------------------------------------

@@ -1,17 +1,13 @@
 #include "daemon/calibration_acceptance.h"
 
-#include <cstdio>
+#include "io/quantity_text.h"
 
 namespace pvtwin::cli {
 
 namespace {
 
-// "12.34 W (7.434 W/m²)": the collector's and the per-m² figure side by side.
-std::string Watts(double w_m2, double area_m2) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.4g W (%.4g W/m²)", w_m2 * area_m2, w_m2);
-  return buf;
-}
+// The collector's and the per-m² figure side by side (io/quantity_text.h).
+std::string Watts(double w_m2, double area_m2) { return WattsAndPerM2(w_m2 * area_m2, area_m2); }
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include "daemon/inputs.h"
 #include "io/backtest_report.h"
 #include "io/params_json.h"
+#include "io/quantity_text.h"
 
 namespace pvtwin::cli {
 
@@ -57,12 +58,14 @@ std::vector<std::string> ExpandVariants(const std::vector<std::string>& names) {
   return out;
 }
 
-void PrintProgress(int done, int total, const BacktestDay& day, std::int64_t solar_offset_s) {
+void PrintProgress(int done, int total, const BacktestDay& day, std::int64_t solar_offset_s,
+                   double area_m2) {
   const std::string date = SolarDate(day.day_start_s, solar_offset_s);
   if (day.ok) {
-    std::fprintf(stderr, "[%d/%d] %s %s n=%d: MAE Pel %.2f W/m², Qu %.1f W/m² (%.2f s)\n", done,
-                 total, date.c_str(), day.variant.c_str(), day.train_days, day.test.mae_p_el_w_m2,
-                 day.test.mae_q_th_w_m2, day.runtime_s);
+    std::fprintf(stderr, "[%d/%d] %s %s n=%d: MAE P_el %s, MAE Q_u %s (%.2f s)\n", done, total,
+                 date.c_str(), day.variant.c_str(), day.train_days,
+                 WattsAndPerM2(day.test.mae_p_el_w, area_m2).c_str(),
+                 WattsAndPerM2(day.test.mae_q_th_w, area_m2).c_str(), day.runtime_s);
   } else {
     std::fprintf(stderr, "[%d/%d] %s %s n=%d: FAILED: %s\n", done, total, date.c_str(),
                  day.variant.c_str(), day.train_days, day.failure_reason.c_str());
@@ -127,8 +130,8 @@ int RunBacktestCommand(const BacktestArgs& a) {
     BacktestResult result;
     std::string error;
     const bool ok = RunBacktest(series, config.plant, options, &result, &error,
-                                [offset_s](int done, int total, const BacktestDay& d) {
-                                  PrintProgress(done, total, d, offset_s);
+                                [offset_s, &config](int done, int total, const BacktestDay& d) {
+                                  PrintProgress(done, total, d, offset_s, config.plant.area_m2);
                                 });
     if (!ok) {
       std::cerr << a.csv << ": " << error << "\n";

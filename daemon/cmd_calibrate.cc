@@ -15,6 +15,7 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/params_json.h"
+#include "io/quantity_text.h"
 #include "io/time_format.h"
 
 namespace pvtwin::cli {
@@ -58,10 +59,10 @@ std::string Percent(double fraction) {
   return std::isfinite(fraction) ? buf : "n/a";
 }
 
-void PrintErrors(const char* label, const ErrorMetrics& e) {
-  std::printf("%-26s MAE P_el %7.3f W/m2 (nMAE %s), MAE Q_u %7.3f W/m2 (nMAE %s), %zu rows\n",
-              label, e.mae_p_el_w_m2, Percent(e.nmae_p_el).c_str(), e.mae_q_th_w_m2,
-              Percent(e.nmae_q_th).c_str(), e.rows);
+void PrintErrors(const char* label, const ErrorMetrics& e, double area_m2) {
+  std::printf("%-26s MAE P_el %s, nMAE %s; MAE Q_u %s, nMAE %s; %zu rows\n", label,
+              WattsAndPerM2(e.mae_p_el_w, area_m2).c_str(), Percent(e.nmae_p_el).c_str(),
+              WattsAndPerM2(e.mae_q_th_w, area_m2).c_str(), Percent(e.nmae_q_th).c_str(), e.rows);
 }
 
 std::string StatusOf(const ParamEstimate& e) {
@@ -112,6 +113,8 @@ std::string FitJson(const IdentSummary& s, const ErrorMetrics* held_out) {
   auto metrics = [](const ErrorMetrics& e) {
     nlohmann::ordered_json m;
     m["rows"] = e.rows;
+    m["mae_p_el_w"] = e.mae_p_el_w;
+    m["mae_q_th_w"] = e.mae_q_th_w;
     m["mae_p_el_w_m2"] = e.mae_p_el_w_m2;
     m["mae_q_th_w_m2"] = e.mae_q_th_w_m2;
     m["nmae_p_el"] = e.nmae_p_el;  // NaN is written as null
@@ -241,13 +244,13 @@ int RunCalibrate(const CalibrateArgs& a) {
   std::printf("training data: %s, %s .. %s, step %.0f s\n", a.csv.c_str(),
               FormatIsoUtc(train.time_s.front()).c_str(), FormatIsoUtc(train.time_s.back()).c_str(),
               train.step_s);
-  PrintErrors("errors (training):", summary.train);
+  PrintErrors("errors (training):", summary.train, config.plant.area_m2);
   ErrorMetrics held_out;
   if (!a.test_csv.empty()) {
     SimOutputs sim;
     Simulate(test_drivers, summary.params, &sim);
     held_out = ComputeErrors(MakeMeasurements(test, test_drivers), sim, config.plant.area_m2);
-    PrintErrors(("errors (held out):"), held_out);
+    PrintErrors("errors (held out):", held_out, config.plant.area_m2);
   }
   std::printf("parameters:\n  %-22s %12s %-11s %-16s %12s  %-22s %s\n", "name", "value",
               "std. error", "unit", "start", "range", "status");

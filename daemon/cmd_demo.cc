@@ -31,6 +31,7 @@
 #include "daemon/service.h"
 #include "io/child_process.h"
 #include "io/csv.h"
+#include "io/quantity_text.h"
 #include "io/store.h"
 #include "io/time_format.h"
 
@@ -247,11 +248,13 @@ int RunDemo(const DemoArgs& a) {
   bool found = false;
   if (store) store->LatestAcceptedCalibration(&cal, &found, &error);
   if (found) {
+    const double area_m2 = demo_plant.plant.area_m2;
     std::printf(
-        "      calibration %lld: %s, held-out day MAE P_el %.2f W, Q_u %.2f W, "
+        "      calibration %lld: %s, held-out day MAE P_el %s, MAE Q_u %s, "
         "fit %.1f s, %ld simulations\n",
-        static_cast<long long>(cal.id), cal.variant.c_str(), cal.mae_p_el_w, cal.mae_q_th_w,
-        cal.runtime_s, cal.n_evals);
+        static_cast<long long>(cal.id), cal.variant.c_str(),
+        WattsAndPerM2(cal.mae_p_el_w, area_m2).c_str(),
+        WattsAndPerM2(cal.mae_q_th_w, area_m2).c_str(), cal.runtime_s, cal.n_evals);
   } else {
     std::printf("      no accepted calibration (%s)\n", last.last_calibration.c_str());
   }

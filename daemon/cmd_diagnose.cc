@@ -17,6 +17,7 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/diagnosis_report.h"
+#include "io/quantity_text.h"
 
 namespace pvtwin::cli {
 
@@ -51,13 +52,15 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
     return error.find("identification") != std::string::npos ? kExitRuntime : kExitBadInput;
   }
   std::printf("verdict: %s\n%s\n\n", result.verdict.c_str(), result.verdict_sentence.c_str());
+  const double area_m2 = plant.area_m2;
   std::printf("ladder (held-out, MAE P_el + Q_u):\n");
   for (std::size_t k = 0; k < result.ladder.size(); ++k) {
     const LadderStep& s = result.ladder[k];
     std::printf(
-        "  %-6s %-32s %9.2f W  (P_el %.2f W, Q_u %.2f W)%s\n",
-        k == 0 ? "base" : ("+" + std::to_string(k)).c_str(), s.variant.c_str(), s.heldout_mae_w,
-        s.heldout.mae_p_el_w, s.heldout.mae_q_th_w,
+        "  %-6s %-32s %s; P_el %s, Q_u %s%s\n", k == 0 ? "base" : ("+" + std::to_string(k)).c_str(),
+        s.variant.c_str(), WattsAndPerM2(s.heldout_mae_w, area_m2).c_str(),
+        WattsAndPerM2(s.heldout.mae_p_el_w, area_m2).c_str(),
+        WattsAndPerM2(s.heldout.mae_q_th_w, area_m2).c_str(),
         k == 0 ? ""
                : ("  -" + std::to_string(static_cast<int>(s.shrink_pct + 0.5)) + " %").c_str());
   }
@@ -80,8 +83,9 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
                           .c_str(),
                 100 * g.share_of_abs_error, 100 * g.share_of_rows, g.z);
   }
-  std::printf("noise floor: P_el %.2f W, Q_u %.2f W; final held-out error = %.1f x floor\n",
-              result.noise.mae_p_el_w, result.noise.mae_q_th_w, result.noise.ratio);
+  std::printf("noise floor: P_el %s, Q_u %s; final held-out error = %.1f x floor\n",
+              WattsAndPerM2(result.noise.mae_p_el_w, area_m2).c_str(),
+              WattsAndPerM2(result.noise.mae_q_th_w, area_m2).c_str(), result.noise.ratio);
   for (const std::string& n : result.notes) std::printf("note: %s\n", n.c_str());
   std::fflush(stdout);
   if (!report_dir.empty()) {

@@ -25,6 +25,7 @@
 #include "io/csv.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/synthetic_series.h"
+#include "tests/support/unit_labels.h"
 
 namespace pvtwin {
 namespace {
@@ -465,7 +466,9 @@ TEST_F(BacktestCli, RunsOnACsvAndPrintsOneRowPerVariant) {
   EXPECT_NE(run.out.find("\n  1N1C "), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("\n  1N1Cwr "), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("[2/2] 2024-06-04 "), std::string::npos) << run.err;
-  EXPECT_NE(run.err.find(" n=2: MAE Pel "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(" n=2: MAE P_el "), std::string::npos) << run.err;
+  // Each progress line: P_el and Q_u in W of the collector and W/m².
+  testing::ExpectPowersInWattsAndPerM2(run.err, 1.8, 4);  // area_m2 of config.toml
   const auto report = nlohmann::json::parse(ReadFile(dir_ / "out.json"));
   EXPECT_EQ(report["format"], "pvtwin-backtest-1");
   ASSERT_EQ(report["runs"].size(), 1u);

@@ -15,11 +15,13 @@ TEST(CalibrationAcceptance, FirstParametersAreTakenAndTheirBoundsNamed) {
 TEST(CalibrationAcceptance, AFitInsideItsBoundsNeedsOnlyToBeNoWorse) {
   AcceptanceDecision d = DecideCalibration(6.0, 6.0, {}, 2.0);
   EXPECT_TRUE(d.accept);
-  EXPECT_EQ(d.reason, "held-out MAE (P_el + Q_u) 12 W (6 W/m²) ≤ the current 12 W (6 W/m²)");
+  EXPECT_EQ(d.reason,
+            "held-out MAE (P_el + Q_u) 12.00 W (6.00 W/m²) ≤ the current 12.00 W (6.00 W/m²)");
   d = DecideCalibration(6.01, 6.0, {}, 2.0);
   EXPECT_FALSE(d.accept);
   EXPECT_EQ(d.reason,
-            "held-out MAE (P_el + Q_u) 12.02 W (6.01 W/m²) exceeds the current 12 W (6 W/m²); "
+            "held-out MAE (P_el + Q_u) 12.02 W (6.01 W/m²) exceeds the current 12.00 W "
+            "(6.00 W/m²); "
             "parameters kept");
 }
 
@@ -28,8 +30,8 @@ TEST(CalibrationAcceptance, AFitAtItsBoundsMustBeTwoPercentBetter) {
   AcceptanceDecision d = DecideCalibration(5.94, 6.0, {"f_th", "u_front_w_m2k"}, 1.0);
   EXPECT_FALSE(d.accept);
   EXPECT_EQ(d.reason,
-            "held-out MAE (P_el + Q_u) 5.94 W (5.94 W/m²) exceeds 2 % below the current 6 W "
-            "(6 W/m²); 2 parameters at bounds (f_th, u_front_w_m2k); parameters kept");
+            "held-out MAE (P_el + Q_u) 5.94 W (5.94 W/m²) exceeds 2 % below the current 6.00 W "
+            "(6.00 W/m²); 2 parameters at bounds (f_th, u_front_w_m2k); parameters kept");
   // … 3 % is.
   d = DecideCalibration(5.82, 6.0, {"f_th"}, 1.0);
   EXPECT_TRUE(d.accept);

@@ -8,11 +8,13 @@
 #include <vector>
 
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/unit_labels.h"
 
 namespace pvtwin {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::ExpectPowersInWattsAndPerM2;
 using testing::ProcessResult;
 using testing::ReadFile;
 using testing::RunPvtwin;
@@ -122,14 +124,16 @@ TEST_F(CliModel, CalibrateThenSimulateRoundTrip) {
     sum += std::fabs(p[0] - m[9]);  // p_el_w
     ++rows;
   }
-  const double mae_w_m2 = sum / rows / 1.66;
-  char expected[32];
-  std::snprintf(expected, sizeof(expected), "MAE P_el %7.3f", mae_w_m2);
+  const double mae_w = sum / rows;
+  char expected[64];
+  std::snprintf(expected, sizeof(expected), "MAE P_el %.2f W (%.2f W/m²)", mae_w, mae_w / 1.66);
   const std::string calib =
       RunPvtwin(dir_, "calibrate --config " + Data("plant.toml") + " --csv " +
                           Data("day3_clear_medium_dT.csv") + " --variant 1N1Cwr")
           .out;
   EXPECT_NE(calib.find(expected), std::string::npos) << expected << "\n" << calib;
+  // Training and held-out lines: P_el and Q_u, each in W and W/m² of 1.66 m².
+  ExpectPowersInWattsAndPerM2(calib, 1.66, 2);
 }
 
 // A parameter that the fit drives to a bound is reported as such, not as

@@ -18,6 +18,7 @@
 #include "io/csv.h"
 #include "io/diagnosis_report.h"
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/unit_labels.h"
 
 namespace pvtwin {
 namespace {
@@ -293,6 +294,8 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesTheReports) {
                 " --report out");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("verdict: wind"), std::string::npos) << run.out;
+  // Ladder (sum, P_el, Q_u per step) and noise floor in W and W/m².
+  testing::ExpectPowersInWattsAndPerM2(run.out, plant.area_m2, 3 * 2 + 2);
   const nlohmann::json j = nlohmann::json::parse(testing::ReadFile(dir_ / "out" / "report.json"));
   EXPECT_EQ(j.at("verdict"), "wind");
   EXPECT_EQ(j.at("base_variant"), "1N1Cr");

@@ -67,6 +67,8 @@ int RunExport(const ExportArgs& a) {
     ok = store->ReadSamples(from_ts, to_ts, &samples, &error);
     series = SeriesFromSamples(samples,
                                a.config.empty() ? SamplePeriodS(samples) : config.poll.period_s);
+  } else if (a.table == "interval") {
+    ok = store->ReadIntervalRows(from_ts, to_ts, &series, &error);
   } else {
     ok = store->ReadMinutes(from_ts, to_ts, &series, &error);
   }
@@ -79,8 +81,10 @@ int RunExport(const ExportArgs& a) {
     if (series.Has(info.channel)) channels.push_back(info.channel);
   }
   if (!WriteCsvOrReport(a.out, series, channels)) return kExitRuntime;
-  std::cerr << "exported " << series.size() << " rows of "
-            << (a.table == "5s" ? "sample_5s" : "measurement_1min") << " from " << path << "\n";
+  const char* table = a.table == "5s"         ? "sample_5s"
+                      : a.table == "interval" ? "measurement_interval"
+                                              : "measurement_1min";
+  std::cerr << "exported " << series.size() << " rows of " << table << " from " << path << "\n";
   return kExitOk;
 }
 
@@ -92,15 +96,18 @@ void RegisterExport(CLI::App& app) {
       "export",
       "Write a time range [--from, --to) of the SQLite store as canonical CSV: time (ISO 8601\n"
       "UTC, start of the interval) and every channel that has a value in the range. The\n"
-      "1-min table has the averaged, corrected measurements; the 5s table the raw samples.");
+      "1-min table has the averaged, corrected measurements; the 5s table the raw samples;\n"
+      "the interval table the rows of a coarser logger imported at their own step.");
   cmd->add_option("--config", args->config,
                   "TOML config ([storage] path, [poll] period_s, [plant]); optional with --db");
   cmd->add_option("--from", args->from,
                   "first time: ISO 8601, unix seconds, a date (00:00 UTC) or relative (-14d)")
       ->required();
   cmd->add_option("--to", args->to, "end time, exclusive, in the same forms (default: now)");
-  cmd->add_option("--table", args->table, "1min (measurement_1min, default) or 5s (sample_5s)")
-      ->check(CLI::IsMember({"1min", "5s"}));
+  cmd->add_option("--table", args->table,
+                  "1min (measurement_1min, default), 5s (sample_5s) or interval "
+                  "(measurement_interval: imported data of a coarser logger, at its step)")
+      ->check(CLI::IsMember({"1min", "5s", "interval"}));
   cmd->add_option("--out", args->out, "output CSV (default: standard output)");
   cmd->add_option("--db", args->db, "SQLite file to use instead of [storage] path");
   cmd->callback([args] { SetExitCode(RunExport(*args)); });

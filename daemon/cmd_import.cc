@@ -1,12 +1,15 @@
 // pvtwin import: canonical CSV into the SQLite store. A CSV with a step of 5 s
 // (any whole divisor of 60 s) holds poll samples: they go to sample_5s and
 // their minutes are (re-)aggregated into measurement_1min. A CSV with a step
-// of 60 s holds 1-min rows: they go to measurement_1min directly. Both are
-// upserts, so importing the same or overlapping data again leaves one row per
-// time.
+// of 60 s holds 1-min rows: they go to measurement_1min directly. A CSV of a
+// coarser logger (2, 10, 15 min: any whole number of minutes up to 1 h)
+// goes to measurement_interval at its own step: 1-min rows made from it
+// would invent what happened inside each interval. All are upserts, so
+// importing the same or overlapping data again leaves one row per time.
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
@@ -21,6 +24,7 @@ struct ImportArgs {
   std::string config;
   std::string csv;
   std::string db;
+  std::string timezone;
 };
 
 // Rows per transaction: one day of 5 s samples, one day of 1-min rows.
@@ -107,33 +111,81 @@ int ImportMinutes(Store& store, Series series, const std::string& csv) {
   return kExitOk;
 }
 
+int ImportIntervals(Store& store, Series series, const std::string& csv) {
+  if (!AlignToMinutes(&series, csv)) return kExitBadInput;
+  std::string error;
+  for (std::size_t begin = 0; begin < series.size(); begin += kMinuteBatch) {
+    const std::size_t end = std::min(series.size(), begin + kMinuteBatch);
+    if (!store.WriteIntervalRows(series.Slice(begin, end), &error)) {
+      std::cerr << csv << ": " << error << "\n";
+      return kExitRuntime;
+    }
+    Progress("rows", end, series.size(), kMinuteBatch);
+  }
+  const int step_min = static_cast<int>(series.step_s) / kMinuteS;
+  std::cerr << "imported " << series.size() << " rows of " << step_min
+            << "-min data into measurement_interval of " << store.path()
+            << ", at their own step: 1-min rows made from them would invent the values inside "
+               "each interval, so measurement_1min (what the daemon calibrates on) is left as it "
+               "was. calibrate, backtest and diagnose take the CSV at its step; export --table "
+               "interval gives the rows back.\n";
+  return kExitOk;
+}
+
+enum class ImportKind { kSamples, kMinutes, kIntervals };
+
+// Where rows of this step go; nullopt (and the message) when nowhere.
+std::optional<ImportKind> KindOfStep(double step_s, const std::string& csv) {
+  const bool whole = step_s >= 1.0 && step_s == std::floor(step_s);
+  const auto minute = static_cast<double>(kMinuteS);
+  if (step_s == minute) return ImportKind::kMinutes;
+  if (whole && step_s < minute && std::fmod(minute, step_s) == 0.0) return ImportKind::kSamples;
+  if (whole && step_s > minute && step_s <= 3600.0 && std::fmod(step_s, minute) == 0.0) {
+    return ImportKind::kIntervals;
+  }
+  std::cerr << csv << ": time step = " << step_s
+            << " s (median spacing of the rows): expected poll samples (a whole divisor of 60 s, "
+               "e.g. 5 s), 1-min rows (60 s) or logger intervals of whole minutes up to 1 h "
+               "(e.g. 2, 10, 15 min)\n";
+  return std::nullopt;
+}
+
 int RunImport(const ImportArgs& a) {
   Config config;
   if (!LoadConfigOrReport(a.config, &config)) return kExitBadInput;
+  std::optional<NaiveTimeZone> zone;
+  if (!a.timezone.empty()) {
+    std::string error;
+    zone = NaiveTimeZone::Parse(a.timezone, &error);
+    if (!zone) {
+      std::cerr << "--timezone = " << error << "\n";
+      return kExitBadInput;
+    }
+  }
   Series series;
-  if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
+  if (!LoadCsvOrReport(a.csv, config, &series, zone ? &*zone : nullptr)) return kExitBadInput;
   if (series.size() < 2) {
     std::cerr << a.csv << ": " << series.size()
-              << " data rows: need at least 2 to tell 5 s samples from 1-min rows\n";
+              << " data rows: need at least 2 to tell the time step\n";
     return kExitBadInput;
   }
-  const double step_s = series.step_s;
-  const bool minutes = step_s == static_cast<double>(kMinuteS);
-  const bool samples = !minutes && step_s >= 1.0 && step_s == std::floor(step_s) &&
-                       std::fmod(static_cast<double>(kMinuteS), step_s) == 0.0;
-  if (!minutes && !samples) {
-    std::cerr << a.csv << ": time step = " << step_s
-              << " s (median spacing of the rows): expected 5 s samples (any whole divisor of "
-                 "60 s) or 1-min rows (60 s)\n";
-    return kExitBadInput;
-  }
+  const std::optional<ImportKind> kind = KindOfStep(series.step_s, a.csv);
+  if (!kind) return kExitBadInput;
   StoreOptions options = StoreOptionsFor(config);
-  if (samples) options.aggregate.sample_period_s = step_s;
+  if (*kind == ImportKind::kSamples) options.aggregate.sample_period_s = series.step_s;
   std::unique_ptr<Store> store;
   if (!OpenStoreOrReport(a.db.empty() ? config.storage.path : a.db, options, &store)) {
     return kExitRuntime;
   }
-  return samples ? ImportSamples(*store, series, a.csv) : ImportMinutes(*store, series, a.csv);
+  switch (*kind) {
+    case ImportKind::kSamples:
+      return ImportSamples(*store, series, a.csv);
+    case ImportKind::kMinutes:
+      return ImportMinutes(*store, series, a.csv);
+    case ImportKind::kIntervals:
+      return ImportIntervals(*store, series, a.csv);
+  }
+  return kExitRuntime;
 }
 
 }  // namespace
@@ -146,12 +198,18 @@ void RegisterImport(CLI::App& app) {
       "The time step decides where rows go: 5 s data (any whole divisor of 60 s) are poll\n"
       "samples for sample_5s, and their minutes are aggregated into measurement_1min;\n"
       "1-min data go to measurement_1min directly (rows off the minute are moved to the\n"
-      "nearest minute start, with a warning). Rows are upserted: importing the same or\n"
-      "overlapping data again leaves one row per time. Progress goes to stderr.");
+      "nearest minute start, with a warning); data of a coarser logger (2, 10, 15 min, any\n"
+      "whole number of minutes up to 1 h) go to measurement_interval at their own step, as\n"
+      "1-min rows made from them would invent values. Rows are upserted: importing the same\n"
+      "or overlapping data again leaves one row per time. Progress goes to stderr.");
   cmd->add_option("--config", args->config, "TOML config ([plant] fluid data, [storage] path)")
       ->required();
   cmd->add_option("--csv", args->csv, "canonical CSV to load")->required();
   cmd->add_option("--db", args->db, "SQLite file to use instead of [storage] path");
+  cmd->add_option("--timezone", args->timezone,
+                  "zone of time stamps without Z or offset: a tz database zone such as "
+                  "Europe/Vienna (daylight saving time included) or a fixed offset such as "
+                  "+01:00 (default: none, such time stamps are an error)");
   cmd->callback([args] { SetExitCode(RunImport(*args)); });
 }
 

@@ -22,9 +22,11 @@ bool LoadConfigOrReport(const std::string& path, Config* config) {
   return false;
 }
 
-bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series) {
+bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series,
+                     const NaiveTimeZone* naive_time_zone) {
   Diagnostics errors, warnings;
   CsvReadOptions options;
+  options.naive_time_zone = naive_time_zone;
   options.fluid_density_kg_m3 = config.plant.fluid_density_kg_m3;
   options.area_m2 = config.plant.area_m2;
   const bool ok = ReadCanonicalCsv(path, options, series, &errors, &warnings);

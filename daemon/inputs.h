@@ -11,11 +11,13 @@
 #include "core/series.h"
 #include "core/thermal_model.h"
 #include "core/variant.h"
+#include "io/local_time.h"
 
 namespace pvtwin::cli {
 
 bool LoadConfigOrReport(const std::string& path, Config* config);
-bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series);
+bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series,
+                     const NaiveTimeZone* naive_time_zone = nullptr);
 bool ParseVariantOrReport(const std::string& name, ModelSpec* spec);
 // Drivers of `spec` for `series`; reports the missing columns naming the CSV.
 bool PrepareDriversOrReport(const Series& series, const std::string& csv_path, const Config& config,

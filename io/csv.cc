@@ -11,6 +11,7 @@
 #include <deque>
 #include <fstream>
 #include <istream>
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <string_view>
@@ -279,7 +280,9 @@ class CsvParser {
       const std::string_view cell = fields_[*time_index_];
       std::int64_t time_s = 0;
       std::string rule;
-      if (!ParseTime(cell, &time_s, &rule)) {
+      const std::int64_t after_s =
+          series_.time_s.empty() ? std::numeric_limits<std::int64_t>::min() : series_.time_s.back();
+      if (!ParseTimeIn(cell, options_.naive_time_zone, after_s, &time_s, &rule)) {
         Error(line_no, kTimeColumn, cell, rule);
         return;
       }

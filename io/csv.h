@@ -36,6 +36,8 @@
 
 namespace pvtwin {
 
+class NaiveTimeZone;
+
 inline constexpr std::size_t kMaxCsvErrors = 100;
 
 struct CsvReadOptions {
@@ -43,6 +45,9 @@ struct CsvReadOptions {
   // Collector area for the area-scaled physical limits (flow, P_el, Q_u);
   // 0: unknown, the widest limits (core/physical_limits.h).
   double area_m2 = 0.0;
+  // Zone of `time` cells without Z or offset (io/local_time.h); null: such
+  // cells are an error, a local time says nothing about its instant.
+  const NaiveTimeZone* naive_time_zone = nullptr;
 };
 
 // Reads the file at path. Returns true if it was read without errors; then

@@ -1,9 +1,11 @@
 #include "io/local_time.h"
 
-#include "config/plant_config.h"
-
+#include <charconv>
 #include <cstdlib>
 #include <ctime>
+#include <set>
+
+#include "config/plant_config.h"
 
 namespace pvtwin {
 
@@ -41,6 +43,85 @@ std::int64_t NextLocalTime(std::int64_t now_s, int hour, int minute) {
     prev_day = d;
   }
   return t;  // unreachable for any real zone: every local day has the time or a jump past it
+}
+
+namespace {
+
+// "+01:00", "-0530", "+1", "UTC+01:00": seconds east of UTC.
+std::optional<int> ParseFixedOffset(std::string text) {
+  if (text.rfind("UTC", 0) == 0) text = text.substr(3);
+  if (text.size() < 2 || (text[0] != '+' && text[0] != '-')) return std::nullopt;
+  const int sign = text[0] == '-' ? -1 : 1;
+  std::string digits = text.substr(1);
+  int hours = 0, minutes = 0;
+  const std::size_t colon = digits.find(':');
+  std::string h = digits, m;
+  if (colon != std::string::npos) {
+    h = digits.substr(0, colon);
+    m = digits.substr(colon + 1);
+  } else if (digits.size() == 4) {
+    h = digits.substr(0, 2);
+    m = digits.substr(2);
+  }
+  auto number = [](const std::string& d, int* out) {
+    const auto [end, ec] = std::from_chars(d.data(), d.data() + d.size(), *out);
+    return !d.empty() && d.size() <= 2 && ec == std::errc() && end == d.data() + d.size();
+  };
+  if (!number(h, &hours) || (!m.empty() && !number(m, &minutes)) ||
+      (colon != std::string::npos && m.size() != 2)) {
+    return std::nullopt;
+  }
+  if (hours > 14 || minutes > 59) return std::nullopt;
+  return sign * (hours * 3600 + minutes * 60);
+}
+
+// Seconds east of UTC of the process's zone at the instant t.
+int OffsetAt(std::int64_t t) {
+  const auto tt = static_cast<std::time_t>(t);
+  std::tm tm{};
+  ::localtime_r(&tt, &tm);
+  return static_cast<int>(tm.tm_gmtoff);
+}
+
+}  // namespace
+
+std::optional<NaiveTimeZone> NaiveTimeZone::Parse(const std::string& text, std::string* error) {
+  NaiveTimeZone zone;
+  zone.name_ = text;
+  if (const std::optional<int> offset = ParseFixedOffset(text)) {
+    zone.fixed_offset_s_ = offset;
+    return zone;
+  }
+  std::string why;
+  if (!UseTimeZone(text, &why)) {
+    *error = "\"" + text +
+             "\": expected a zone of the tz database (e.g. \"Europe/Vienna\", daylight saving "
+             "time included) or a fixed offset from UTC (e.g. \"+01:00\")";
+    return std::nullopt;
+  }
+  return zone;
+}
+
+int NaiveTimeZone::Resolve(std::int64_t wall_s, std::int64_t utc_s[2]) const {
+  if (fixed_offset_s_) {
+    utc_s[0] = wall_s - *fixed_offset_s_;
+    return 1;
+  }
+  // The offsets in force a day either side hold every offset that can apply
+  // at wall_s (zones change their offset at most once a day); each gives a
+  // candidate instant, which counts if the zone has that offset then.
+  const std::set<int> offsets = {OffsetAt(wall_s - 86400), OffsetAt(wall_s),
+                                 OffsetAt(wall_s + 86400)};
+  int n = 0;
+  std::set<std::int64_t> found;
+  for (const int offset : offsets) {
+    const std::int64_t t = wall_s - offset;
+    if (OffsetAt(t) == offset) found.insert(t);
+  }
+  for (const std::int64_t t : found) {
+    if (n < 2) utc_s[n++] = t;
+  }
+  return n;
 }
 
 }  // namespace pvtwin

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace pvtwin {
@@ -20,5 +21,28 @@ bool UseTimeZone(const std::string& iana, std::string* error);
 // jumps over it), the first minute after the jump; on a day when it occurs
 // twice (the clock falls back over it), only the first occurrence.
 std::int64_t NextLocalTime(std::int64_t now_s, int hour, int minute);
+
+// The zone of naive time stamps: "2024-06-01 12:00" written by a logger that
+// keeps local time and says nothing about it. Either a zone of the tz
+// database (daylight saving time included; Parse makes it the process's TZ,
+// as UseTimeZone) or a fixed offset from UTC, "+01:00", "-05:30", "UTC+1"
+// (for a logger that keeps standard time all year).
+class NaiveTimeZone {
+ public:
+  // nullopt and *error (naming the accepted forms) when text is neither.
+  static std::optional<NaiveTimeZone> Parse(const std::string& text, std::string* error);
+
+  // The UTC instants at which the local clock reads wall_s (the local date
+  // and time counted as if they were UTC seconds), earliest first: none in
+  // the hour the clocks skip in spring, two in the hour they repeat in
+  // autumn, one otherwise. Returns how many were written to utc_s.
+  int Resolve(std::int64_t wall_s, std::int64_t utc_s[2]) const;
+
+  const std::string& name() const { return name_; }
+
+ private:
+  std::string name_;
+  std::optional<int> fixed_offset_s_;  // set for a fixed offset
+};
 
 }  // namespace pvtwin

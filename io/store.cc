@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <thread>
 #include <unordered_map>
@@ -118,11 +119,17 @@ std::vector<std::string> SchemaV1() {
   };
 }
 
+// Version 2: data of a logger step above 1 min, kept at that step.
+std::vector<std::string> SchemaV2() {
+  return {"CREATE TABLE measurement_interval(ts INTEGER PRIMARY KEY, step_s INTEGER NOT NULL" +
+          ChannelColumnDefs() + ", qc_flags INTEGER NOT NULL DEFAULT 0)"};
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 
@@ -632,6 +639,24 @@ bool Store::ReaggregateMinutes(std::int64_t from_ts, std::int64_t to_ts, int* mi
   return ok;
 }
 
+namespace {
+
+// qc_flags of an imported row: kQcImported, a bit per missing channel and
+// kQcRequiredMissing when a required one is among them.
+std::uint32_t ImportedRowFlags(const Series& rows, std::size_t i) {
+  std::uint32_t f = kQcImported;
+  for (std::size_t c = 0; c < kNumChannels; ++c) {
+    const auto channel = static_cast<Channel>(c);
+    if (channel != Channel::kValid && std::isnan(rows.At(channel, i))) {
+      f |= QcChannelMissingBit(channel);
+    }
+  }
+  if (!RequiredChannelsPresent(f)) f |= kQcRequiredMissing;
+  return f;
+}
+
+}  // namespace
+
 bool Store::WriteMinutes(const Series& rows_1min, std::string* error) {
   MinuteRows minutes;
   minutes.rows = rows_1min;
@@ -643,14 +668,7 @@ bool Store::WriteMinutes(const Series& rows_1min, std::string* error) {
                std::to_string(rows_1min.time_s[i]) + ": not the start of a minute";
       return false;
     }
-    std::uint32_t& f = minutes.qc_flags[i];
-    for (std::size_t c = 0; c < kNumChannels; ++c) {
-      const auto channel = static_cast<Channel>(c);
-      if (channel != Channel::kValid && std::isnan(rows_1min.At(channel, i))) {
-        f |= QcChannelMissingBit(channel);
-      }
-    }
-    if (!RequiredChannelsPresent(f)) f |= kQcRequiredMissing;
+    minutes.qc_flags[i] = ImportedRowFlags(rows_1min, i);
   }
   Impl& db = *impl_;
   std::lock_guard lock(db.mutex);
@@ -692,6 +710,89 @@ bool Store::ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows*
   ApplyPhysicalLimits(&result.rows, db.options.aggregate.area_m2);
   DropEmptyColumns(&result.rows);
   *out = std::move(result);
+  return true;
+}
+
+bool Store::WriteIntervalRows(const Series& rows, std::string* error) {
+  const auto step_s = static_cast<std::int64_t>(rows.step_s);
+  if (static_cast<double>(step_s) != rows.step_s || step_s <= kMinuteS || step_s % kMinuteS != 0) {
+    *error = impl_->path + ": measurement_interval: step " + std::to_string(rows.step_s) +
+             " s is not a whole number of minutes above one";
+    return false;
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (rows.time_s[i] != MinuteStart(rows.time_s[i])) {
+      *error = impl_->path + ": interval row " + std::to_string(i) + " at ts " +
+               std::to_string(rows.time_s[i]) + ": not the start of a minute";
+      return false;
+    }
+  }
+  static const std::string sql = "INSERT OR REPLACE INTO measurement_interval(ts, step_s, " +
+                                 ChannelColumns() + ", qc_flags) VALUES(" +
+                                 Placeholders(kNumChannels + 3) + ")";
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "write " + std::to_string(rows.size()) + " interval rows",
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(sql, &stmt);
+        if (!s.ok()) return s;
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+          sqlite3_reset(stmt);
+          sqlite3_bind_int64(stmt, 1, rows.time_s[i]);
+          sqlite3_bind_int64(stmt, 2, step_s);
+          for (std::size_t c = 0; c < kNumChannels; ++c) {
+            const auto channel = static_cast<Channel>(c);
+            BindReal(stmt, static_cast<int>(c) + 3, ToSql(channel, rows.At(channel, i)));
+          }
+          sqlite3_bind_int64(stmt, static_cast<int>(kNumChannels) + 3, ImportedRowFlags(rows, i));
+          s = db.StepDone(stmt, "write interval row ts " + std::to_string(rows.time_s[i]));
+          if (!s.ok()) return s;
+        }
+        return DbStatus{};
+      },
+      error);
+}
+
+bool Store::ReadIntervalRows(std::int64_t from_ts, std::int64_t to_ts, Series* out,
+                             std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  static const std::string sql = "SELECT ts, step_s, " + ChannelColumns() +
+                                 " FROM measurement_interval WHERE ts >= ? AND ts < ? ORDER BY ts";
+  Series rows;
+  std::map<std::int64_t, std::size_t> steps;  // step_s -> rows
+  const bool ok = db.Run(
+      false, "read interval rows",
+      [&]() -> DbStatus {
+        rows = Series{};
+        steps.clear();
+        return db.SelectRange(
+            sql, from_ts, to_ts,
+            [&rows, &steps](sqlite3_stmt* stmt) {
+              rows.time_s.push_back(sqlite3_column_int64(stmt, 0));
+              ++steps[sqlite3_column_int64(stmt, 1)];
+              for (std::size_t c = 0; c < kNumChannels; ++c) {
+                rows.columns[c].push_back(
+                    FromSql(static_cast<Channel>(c), ColumnReal(stmt, static_cast<int>(c) + 2)));
+              }
+            },
+            "read interval rows");
+      },
+      error);
+  if (!ok) return false;
+  rows.step_s = static_cast<double>(kMinuteS);
+  std::size_t most = 0;
+  for (const auto& [step_s, n] : steps) {
+    if (n > most) {
+      most = n;
+      rows.step_s = static_cast<double>(step_s);
+    }
+  }
+  ApplyPhysicalLimits(&rows, db.options.aggregate.area_m2);
+  DropEmptyColumns(&rows);
+  *out = std::move(rows);
   return true;
 }
 

@@ -45,6 +45,15 @@
 //       forecast inputs that outside programs fill by SQL; pvtwin only reads
 //       them. A NULL is a missing value.
 //
+// Version 2 adds:
+//   measurement_interval(ts INTEGER PRIMARY KEY, step_s INTEGER,
+//                        <channel> REAL ..., qc_flags INTEGER)
+//       rows imported at their own step when that step is a whole number of
+//       minutes above one (2-, 10-, 15-min logger data): the values stand for
+//       the interval [ts, ts + step_s) as the logger gave them. They are not
+//       split into 1-min rows, which would invent what happened inside the
+//       interval; the daemon's calibration reads measurement_1min only.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -93,7 +102,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 1;
+inline constexpr int kStoreSchemaVersion = 2;
 
 struct StoreOptions {
   // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
@@ -176,6 +185,13 @@ class Store {
   // As ReadMinutes, plus n_samples (0 where NULL) and qc_flags per row.
   bool ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows* out,
                       std::string* error);
+  // Upserts rows of a coarser step (measurement_interval): every row's ts a
+  // whole minute, step_s = rows.step_s (a whole number of minutes > 1),
+  // qc_flags kQcImported plus the missing-channel bits as WriteMinutes.
+  bool WriteIntervalRows(const Series& rows, std::string* error);
+  // measurement_interval rows with from_ts <= ts < to_ts; step_s of the
+  // series is the most common step_s among them (60 when there are none).
+  bool ReadIntervalRows(std::int64_t from_ts, std::int64_t to_ts, Series* out, std::string* error);
 
   // Deletes sample_5s rows with ts < cut = now_ts − raw_retention_days·86400
   // (after aggregating their minutes that have no 1-min row), and prunes the

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cstdio>
 
+#include "io/local_time.h"
+
 namespace pvtwin {
 namespace {
 
@@ -79,7 +81,25 @@ bool ParseUnixSeconds(std::string_view text, std::int64_t* unix_s, std::string* 
   return true;
 }
 
-bool ParseIso(std::string_view text, std::int64_t* unix_s, std::string* error) {
+// A naive wall-clock time (as if UTC seconds) in zone: the instant, or in
+// the repeated hour of autumn the earliest one after after_s (rows count
+// forward through the hour twice).
+bool ResolveNaive(std::int64_t wall_s, const NaiveTimeZone& zone, std::int64_t after_s,
+                  std::int64_t* unix_s, std::string* error) {
+  std::int64_t candidates[2] = {0, 0};
+  const int n = zone.Resolve(wall_s, candidates);
+  if (n == 0) {
+    *error = "this local time does not exist in " + zone.name() +
+             " (the clocks skip it in spring); a logger that keeps standard time all year "
+             "needs a fixed offset, e.g. --timezone +01:00";
+    return false;
+  }
+  *unix_s = n == 2 && candidates[0] <= after_s ? candidates[1] : candidates[0];
+  return true;
+}
+
+bool ParseIso(std::string_view text, const NaiveTimeZone* zone, std::int64_t after_s,
+              std::int64_t* unix_s, std::string* error) {
   const char* kRule =
       "expected ISO 8601 time YYYY-MM-DDTHH:MM:SS with Z or ±HH:MM, or unix seconds";
   Cursor c(text);
@@ -101,6 +121,7 @@ bool ParseIso(std::string_view text, std::int64_t* unix_s, std::string* error) {
     }
   }
   int offset_s = 0;
+  bool naive = false;
   if (c.Consume('Z') || c.Consume('z')) {
     offset_s = 0;
   } else if (c.Peek() == '+' || c.Peek() == '-') {
@@ -124,8 +145,13 @@ bool ParseIso(std::string_view text, std::int64_t* unix_s, std::string* error) {
     }
     offset_s = sign * (offset_h * 3600 + offset_min * 60);
   } else if (c.AtEnd()) {
-    *error = "time needs Z or a ±HH:MM offset (local time is ambiguous)";
-    return false;
+    if (zone == nullptr) {
+      *error =
+          "time needs Z or a ±HH:MM offset (local time is ambiguous; --timezone says "
+          "which zone naive times are in)";
+      return false;
+    }
+    naive = true;
   }
   if (!c.AtEnd()) {
     *error = kRule;
@@ -143,28 +169,40 @@ bool ParseIso(std::string_view text, std::int64_t* unix_s, std::string* error) {
     return false;
   }
   const std::int64_t days = std::chrono::sys_days{date}.time_since_epoch().count();
-  *unix_s = days * kSecondsPerDay + hour * 3600 + minute * 60 + second - offset_s;
+  const std::int64_t wall_s = days * kSecondsPerDay + hour * 3600 + minute * 60 + second;
+  if (naive) return ResolveNaive(wall_s, *zone, after_s, unix_s, error);
+  *unix_s = wall_s - offset_s;
+  return true;
+}
+
+}  // namespace
+
+namespace {
+
+// Unix seconds use only a sign, digits and a decimal point; anything else
+// (a '-' after the year, ':', 'T') is read as ISO 8601.
+bool LooksLikeUnixSeconds(std::string_view text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (!(IsDigit(ch) || ch == '.' || (i == 0 && (ch == '-' || ch == '+')))) return false;
+  }
   return true;
 }
 
 }  // namespace
 
 bool ParseTime(std::string_view text, std::int64_t* unix_s, std::string* error) {
+  return ParseTimeIn(text, nullptr, 0, unix_s, error);
+}
+
+bool ParseTimeIn(std::string_view text, const NaiveTimeZone* zone, std::int64_t after_s,
+                 std::int64_t* unix_s, std::string* error) {
   if (text.empty()) {
     *error = "must not be empty";
     return false;
   }
-  // Unix seconds use only a sign, digits and a decimal point; anything else
-  // (a '-' after the year, ':', 'T') is read as ISO 8601.
-  bool numeric = true;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char ch = text[i];
-    if (!(IsDigit(ch) || ch == '.' || (i == 0 && (ch == '-' || ch == '+')))) {
-      numeric = false;
-      break;
-    }
-  }
-  return numeric ? ParseUnixSeconds(text, unix_s, error) : ParseIso(text, unix_s, error);
+  return LooksLikeUnixSeconds(text) ? ParseUnixSeconds(text, unix_s, error)
+                                    : ParseIso(text, zone, after_s, unix_s, error);
 }
 
 std::string FormatIsoUtc(std::int64_t unix_s) {

@@ -19,6 +19,16 @@ namespace pvtwin {
 // sets *error to the rule that was broken; *unix_s is untouched.
 bool ParseTime(std::string_view text, std::int64_t* unix_s, std::string* error);
 
+class NaiveTimeZone;  // io/local_time.h
+
+// As ParseTime, but an ISO 8601 date-time without Z or offset is the local
+// time of zone (when zone is not null): in the hour the clocks repeat in
+// autumn, the earliest instant after after_s (the row before), so rows that
+// count through the hour twice stay in order; a time the clocks skip is an
+// error. Times with Z or an offset, and unix seconds, are as ParseTime.
+bool ParseTimeIn(std::string_view text, const NaiveTimeZone* zone, std::int64_t after_s,
+                 std::int64_t* unix_s, std::string* error);
+
 // A time given on the command line (--from, --to, --train-start, ...): what
 // ParseTime accepts, and also
 //   * a date YYYY-MM-DD: its 00:00 UTC;

@@ -14,6 +14,7 @@
 #include "config/plant_config.h"
 #include "core/units.h"
 #include "io/csv.h"
+#include "io/local_time.h"
 #include "io/time_format.h"
 
 namespace pvtwin {
@@ -61,7 +62,8 @@ TEST(CsvTimeFormat, ParsesIsoUtcOffsetsAndUnixSeconds) {
 
 TEST(CsvTimeFormat, RejectsAmbiguousOrMalformedTimes) {
   EXPECT_EQ(ParseError("2017-08-07T08:24:01"),
-            "time needs Z or a ±HH:MM offset (local time is ambiguous)");
+            "time needs Z or a ±HH:MM offset (local time is ambiguous; --timezone says which zone "
+            "naive times are in)");
   EXPECT_EQ(ParseError("2017-02-29T00:00:00Z"), "no such date");
   EXPECT_EQ(ParseError("2017-13-01T00:00:00Z"), "no such date");
   EXPECT_EQ(ParseError("2017-08-07T24:00:00Z"), "time of day out of range");
@@ -72,6 +74,39 @@ TEST(CsvTimeFormat, RejectsAmbiguousOrMalformedTimes) {
                           "2017-08-07T08:24:00.Z", "1.5e9", "12:00", "-", "1502094241x"}) {
     EXPECT_FALSE(ParseError(bad).empty()) << bad;
   }
+}
+
+// Naive times in a zone: Vienna is UTC+2 in July and UTC+1 in January; a
+// fixed offset ignores the season; a time with Z keeps its own instant.
+TEST(CsvTimeFormat, NaiveTimesTakeTheZoneOfTheirSeason) {
+  std::string error;
+  const std::optional<NaiveTimeZone> vienna = NaiveTimeZone::Parse("Europe/Vienna", &error);
+  ASSERT_TRUE(vienna) << error;
+  const std::optional<NaiveTimeZone> plus_one = NaiveTimeZone::Parse("UTC+01:00", &error);
+  ASSERT_TRUE(plus_one) << error;
+  auto utc = [](const char* text) {
+    std::int64_t t = 0;
+    std::string e;
+    EXPECT_TRUE(ParseTime(text, &t, &e)) << e;
+    return t;
+  };
+  std::int64_t t = 0;
+  ASSERT_TRUE(ParseTimeIn("2024-07-01 12:00", &*vienna, 0, &t, &error)) << error;
+  EXPECT_EQ(t, utc("2024-07-01T10:00:00Z"));
+  ASSERT_TRUE(ParseTimeIn("2024-01-15T12:00:30", &*vienna, 0, &t, &error)) << error;
+  EXPECT_EQ(t, utc("2024-01-15T11:00:30Z"));
+  ASSERT_TRUE(ParseTimeIn("2024-07-01 12:00", &*plus_one, 0, &t, &error)) << error;
+  EXPECT_EQ(t, utc("2024-07-01T11:00:00Z"));
+  ASSERT_TRUE(ParseTimeIn("2024-07-01T12:00:00Z", &*vienna, 0, &t, &error)) << error;
+  EXPECT_EQ(t, utc("2024-07-01T12:00:00Z"));
+  // 02:30 on 2024-10-27 happens twice: first at 00:30 UTC, then at 01:30 UTC.
+  ASSERT_TRUE(ParseTimeIn("2024-10-27 02:30", &*vienna, 0, &t, &error)) << error;
+  EXPECT_EQ(t, utc("2024-10-27T00:30:00Z"));
+  ASSERT_TRUE(ParseTimeIn("2024-10-27 02:30", &*vienna, utc("2024-10-27T00:45:00Z"), &t, &error));
+  EXPECT_EQ(t, utc("2024-10-27T01:30:00Z"));
+  EXPECT_FALSE(ParseTimeIn("2024-03-31 02:30", &*vienna, 0, &t, &error));
+  EXPECT_FALSE(NaiveTimeZone::Parse("+15:00", &error));
+  EXPECT_FALSE(NaiveTimeZone::Parse("Europe/Atlantis", &error));
 }
 
 TEST(CsvTimeFormat, CommandLineTimesTakeDatesNowAndRelativeTimes) {

@@ -62,7 +62,7 @@ std::vector<std::string> WithChannels(std::vector<std::string> head,
 TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   ASSERT_NE(OpenStore(), nullptr);
   RawDb db(DbPath());
-  EXPECT_EQ(db.Number("PRAGMA user_version"), 1.0);
+  EXPECT_EQ(db.Number("PRAGMA user_version"), static_cast<double>(kStoreSchemaVersion));
   EXPECT_EQ(db.Rows("PRAGMA journal_mode")[0][0], "wal");
   // sample_5s and measurement_1min: every canonical channel, named as in
   // core/channels.h (DESIGN.md "SQLite").
@@ -86,11 +86,34 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
       (std::vector<std::string>{"ts", "g_poa_w_m2", "ghi_w_m2", "dhi_w_m2", "g_poa_diffuse_w_m2",
                                 "t_amb_c", "wind_m_s", "t_sky_c", "lw_down_w_m2"}));
   EXPECT_EQ(db.Columns("operation_plan"), (std::vector<std::string>{"ts", "t_in_c", "flow_kg_s"}));
+  // Version 2: rows of a coarser logger at their own step.
+  EXPECT_EQ(db.Columns("measurement_interval"), WithChannels({"ts", "step_s"}, {"qc_flags"}));
   // Primary key of forecast: (issued_at, ts); views are views.
   EXPECT_EQ(db.Rows("SELECT name FROM pragma_table_info('forecast') WHERE pk > 0 ORDER BY pk"),
             (std::vector<std::vector<std::string>>{{"issued_at"}, {"ts"}}));
   EXPECT_EQ(db.Rows("SELECT name FROM sqlite_master WHERE type = 'view' ORDER BY name"),
             (std::vector<std::vector<std::string>>{{"forecast_latest"}, {"forecast_skill"}}));
+}
+
+// A store written by version 1 (no measurement_interval) is migrated on open
+// and keeps its rows.
+TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
+  {
+    auto store = OpenStore();
+    std::string error;
+    ASSERT_TRUE(store->InsertSamples(MakeSamples(kMinute0, 3), &error)) << error;
+  }
+  {
+    RawDb db(DbPath());
+    ASSERT_EQ(db.Exec("DROP TABLE measurement_interval"), SQLITE_OK);
+    ASSERT_EQ(db.Exec("PRAGMA user_version = 1"), SQLITE_OK);
+  }
+  auto store = OpenStore();
+  ASSERT_NE(store, nullptr);
+  RawDb db(DbPath());
+  EXPECT_EQ(db.Number("PRAGMA user_version"), 2.0);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 3.0);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_interval"), 0.0);
 }
 
 TEST_F(StoreTest, ReopeningKeepsDataAndANewerSchemaOrAForeignFileIsRefused) {

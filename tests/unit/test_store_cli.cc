@@ -131,9 +131,10 @@ TEST_F(StoreCli, OneMinuteImportExportsBackToTheSameCsvValues) {
 TEST_F(StoreCli, ExportToAFullDiskLeavesNoPartialFile) {
   WriteRows("m.csv", Rows(kMinute0, 5000, 60.0));  // about 400 kB as CSV
   ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
-  const ProcessResult run = testing::RunCommand(
-      dir_, "trap '' XFSZ; ulimit -f 128; '" + std::string(PVTWIN_BINARY) +
-                "' export --db t.db --out e.csv --from 2024-01-01T00:00:00Z --to 2025-01-01T00:00:00Z --config pvtwin.toml");
+  const ProcessResult run =
+      testing::RunCommand(dir_, "trap '' XFSZ; ulimit -f 128; '" + std::string(PVTWIN_BINARY) +
+                                    "' export --db t.db --out e.csv --from 2024-01-01T00:00:00Z "
+                                    "--to 2025-01-01T00:00:00Z --config pvtwin.toml");
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find("cannot write"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "e.csv"));
@@ -199,10 +200,15 @@ TEST_F(StoreCli, LongImportsReportProgress) {
 }
 
 TEST_F(StoreCli, BadInputsExitWithTwoAndSayWhatIsWrong) {
-  WriteRows("two_min.csv", Rows(kMinute0, 5, 120.0));
-  ProcessResult run = Pvtwin("import --csv two_min.csv --db t.db");
+  // 90 s is neither a poll period (a divisor of 60 s) nor whole minutes.
+  WriteRows("ninety.csv", Rows(kMinute0, 5, 90.0));
+  ProcessResult run = Pvtwin("import --csv ninety.csv --db t.db");
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_NE(run.err.find("two_min.csv: time step = 120 s"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("ninety.csv: time step = 90 s"), std::string::npos) << run.err;
+  run = Pvtwin("import --csv ninety.csv --db t.db --timezone Mars/Olympus");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--timezone = \"Mars/Olympus\": expected a zone"), std::string::npos)
+      << run.err;
   run = Pvtwin("import --csv missing.csv --db t.db");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("missing.csv"), std::string::npos) << run.err;
@@ -218,6 +224,97 @@ TEST_F(StoreCli, BadInputsExitWithTwoAndSayWhatIsWrong) {
   run = Pvtwin("export --db t.db --from yesterday --to 60");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("--from = yesterday"), std::string::npos) << run.err;
+}
+
+// Data of a coarser logger keep their step: each row of a 2- or 15-min CSV
+// is one measurement_interval row with its step_s, nothing is invented in
+// measurement_1min, and export --table interval gives the values back.
+TEST_F(StoreCli, CoarseLoggerDataAreStoredAtTheirOwnStep) {
+  for (const int step_min : {2, 15}) {
+    SCOPED_TRACE(step_min);
+    const double step_s = 60.0 * step_min;
+    const std::string name = std::to_string(step_min) + "min";
+    const Series rows = Rows(kMinute0, 8, step_s);
+    WriteRows(name + ".csv", rows);
+    ProcessResult run = Pvtwin("import --csv " + name + ".csv --db " + name + ".db");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_NE(run.err.find("imported 8 rows of " + std::to_string(step_min) +
+                           "-min data into measurement_interval"),
+              std::string::npos)
+        << run.err;
+    ASSERT_EQ(Pvtwin("import --csv " + name + ".csv --db " + name + ".db").exit_code, 0);
+    RawDb db(dir_ / (name + ".db"));
+    EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_interval"), 8.0);
+    EXPECT_EQ(db.Number("SELECT COUNT(DISTINCT step_s) FROM measurement_interval"), 1.0);
+    EXPECT_EQ(db.Number("SELECT MIN(step_s) FROM measurement_interval"), step_s);
+    EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 0.0);
+    EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 0.0);
+
+    run = Pvtwin("export --db " + name +
+                 ".db --table interval --from 2024-06-01 --to 2024-06-02 "
+                 "--out back.csv");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    Series back;
+    Diagnostics errors;
+    ASSERT_TRUE(ReadCanonicalCsv((dir_ / "back.csv").string(), {}, &back, &errors, nullptr));
+    ASSERT_EQ(back.size(), rows.size());
+    EXPECT_EQ(back.step_s, step_s);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      EXPECT_EQ(back.time_s[i], rows.time_s[i]);
+      for (const Channel c : kWritten) EXPECT_NEAR(back[c][i], rows[c][i], 1e-12) << ChannelName(c);
+    }
+  }
+}
+
+// Naive local time stamps across the autumn change of Europe/Vienna
+// (2024-10-27: 03:00 CEST = 01:00 UTC becomes 02:00 CET, so 02:00–02:59 local
+// happen twice). A logger writing local time every 15 min counts 01:45,
+// 02:00 … 02:45, 02:00 … 02:45, 03:00: with --timezone the rows are 15 min
+// apart in UTC throughout; without it, such a file is refused with its line.
+TEST_F(StoreCli, NaiveLocalTimesAreReadInTheGivenZoneAcrossTheAutumnChange) {
+  const char* locals[] = {"01:45", "02:00", "02:15", "02:30", "02:45", "02:00",
+                          "02:15", "02:30", "02:45", "03:00", "03:15"};
+  std::ostringstream csv;
+  csv << "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
+  for (const char* hhmm : locals) csv << "2024-10-27 " << hhmm << ",20,25,0.02,300,10,50\n";
+  std::ofstream(dir_ / "local.csv") << csv.str();
+
+  ProcessResult run = Pvtwin("import --csv local.csv --db t.db");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("local.csv:2: time"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("--timezone"), std::string::npos) << run.err;
+
+  run = Pvtwin("import --csv local.csv --db t.db --timezone Europe/Vienna");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  RawDb db(dir_ / "t.db");
+  const std::vector<std::vector<std::string>> ts =
+      db.Rows("SELECT ts FROM measurement_interval ORDER BY ts");
+  ASSERT_EQ(ts.size(), 11u);
+  std::int64_t first = 0;
+  std::string error;
+  ASSERT_TRUE(ParseTime("2024-10-26T23:45:00Z", &first, &error));  // 01:45 CEST
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    EXPECT_EQ(std::stoll(ts[i][0]), first + 900 * static_cast<std::int64_t>(i)) << i;
+  }
+
+  // The same file read as a logger on standard time all year (+01:00): the
+  // repeated quarter hours are now rows out of order, named by line.
+  run = Pvtwin("import --csv local.csv --db u.db --timezone +01:00");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("local.csv:7: time"), std::string::npos) << run.err;
+}
+
+// The hour the clocks skip in spring (Europe/Vienna, 2024-03-31 02:00 →
+// 03:00) holds no instant: a time stamp in it is an error naming the line,
+// and the message points to a fixed offset.
+TEST_F(StoreCli, ALocalTimeTheClocksSkipIsAnError) {
+  std::ofstream(dir_ / "spring.csv") << "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n"
+                                        "2024-03-31 01:00,20,25,0.02,300,10,50\n"
+                                        "2024-03-31 02:00,20,25,0.02,300,10,50\n";
+  const ProcessResult run = Pvtwin("import --csv spring.csv --db t.db --timezone Europe/Vienna");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("spring.csv:3: time"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("does not exist in Europe/Vienna"), std::string::npos) << run.err;
 }
 
 }  // namespace

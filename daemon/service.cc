@@ -110,6 +110,28 @@ std::optional<ErrorMetrics> HeldOutErrors(const Series& test, const Plant& plant
   return e;
 }
 
+// The "parameters" list of calibrate's fit JSON as calibration_param rows;
+// entries without a name or a numeric value are skipped.
+std::vector<Store::CalibrationParamRow> ParamRowsOf(const nlohmann::json& fit) {
+  std::vector<Store::CalibrationParamRow> rows;
+  for (const nlohmann::json& p : fit.value("parameters", nlohmann::json::array())) {
+    if (!p.is_object() || !p.contains("name") || !p["name"].is_string() || !p.contains("value") ||
+        !p["value"].is_number()) {
+      continue;
+    }
+    Store::CalibrationParamRow row;
+    row.name = p["name"].get<std::string>();
+    row.value = p["value"].get<double>();
+    row.std_error = p.contains("std_error") && p["std_error"].is_number()
+                        ? p["std_error"].get<double>()
+                        : std::nan("");
+    row.unit = p.value("unit", "");
+    row.status = p.value("status", "");
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
 class Service {
  public:
   explicit Service(const ServiceOptions& options) : options_(options) {}
@@ -421,6 +443,7 @@ void Service::FinishCalibration(int exit_code) {
       nlohmann::json::parse(text, nullptr, false).value("fit", nlohmann::json::object());
   row.n_evals = fit.value("simulations", 0L);
   row.params_json = text;
+  row.params = ParamRowsOf(fit);
   const std::optional<ErrorMetrics> fresh =
       HeldOutErrors(job_test_, config_.plant, spec_, file.values);
   if (!fresh) {

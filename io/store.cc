@@ -125,11 +125,25 @@ std::vector<std::string> SchemaV2() {
           ChannelColumnDefs() + ", qc_flags INTEGER NOT NULL DEFAULT 0)"};
 }
 
+// Version 3: the identified parameters of every calibration, one row each,
+// and their history with the calibration's time and acceptance.
+std::vector<std::string> SchemaV3() {
+  return {
+      "CREATE TABLE calibration_param(calibration_id INTEGER NOT NULL REFERENCES "
+      "calibration(id), name TEXT NOT NULL, value REAL, std_error REAL, unit TEXT, status TEXT, "
+      "PRIMARY KEY(calibration_id, name)) WITHOUT ROWID",
+      "CREATE VIEW parameter_history(run_at, calibration_id, accepted, name, value, std_error, "
+      "unit, status) AS SELECT c.run_at, p.calibration_id, c.accepted, p.name, p.value, "
+      "p.std_error, p.unit, p.status FROM calibration_param p JOIN calibration c ON c.id = "
+      "p.calibration_id",
+  };
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 
@@ -331,6 +345,8 @@ struct Store::Impl {
 
   // Writes the rows of `minutes` into measurement_1min (inside a transaction).
   DbStatus WriteMinuteRows(const MinuteRows& minutes, bool replace, bool imported);
+  DbStatus InsertCalibrationParams(std::int64_t calibration_id,
+                                   const std::vector<CalibrationParamRow>& params);
   // Reads the samples of [from, to) whose minute has no 1-min row yet (all of
   // them if `all`), aggregates and writes them (inside a transaction).
   DbStatus AggregateRange(std::int64_t from_ts, std::int64_t to_ts, bool all, int* minutes_written);
@@ -880,12 +896,37 @@ bool Store::InsertCalibration(CalibrationRow* row, std::string* error) {
         BindReal(stmt, 12, row->heldout_mae_w);
         sqlite3_bind_int(stmt, 13, row->accepted ? 1 : 0);
         s = db.StepDone(stmt, "insert calibration");
-        if (s.ok()) id = sqlite3_last_insert_rowid(db.db);
-        return s;
+        if (!s.ok()) return s;
+        id = sqlite3_last_insert_rowid(db.db);
+        return db.InsertCalibrationParams(id, row->params);
       },
       error);
   if (ok) row->id = id;
   return ok;
+}
+
+DbStatus Store::Impl::InsertCalibrationParams(std::int64_t calibration_id,
+                                              const std::vector<CalibrationParamRow>& params) {
+  if (params.empty()) return {};
+  sqlite3_stmt* stmt = nullptr;
+  DbStatus s = Prepare(
+      "INSERT OR REPLACE INTO calibration_param(calibration_id, name, value, std_error, unit, "
+      "status) VALUES(?, ?, ?, ?, ?, ?)",
+      &stmt);
+  if (!s.ok()) return s;
+  for (const CalibrationParamRow& p : params) {
+    sqlite3_reset(stmt);
+    sqlite3_bind_int64(stmt, 1, calibration_id);
+    sqlite3_bind_text(stmt, 2, p.name.c_str(), -1, SQLITE_TRANSIENT);
+    BindReal(stmt, 3, p.value);
+    BindReal(stmt, 4, p.std_error);
+    sqlite3_bind_text(stmt, 5, p.unit.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(stmt, 6, p.status.c_str(), -1, SQLITE_TRANSIENT);
+    s = StepDone(
+        stmt, "insert parameter " + p.name + " of calibration " + std::to_string(calibration_id));
+    if (!s.ok()) return s;
+  }
+  return {};
 }
 
 bool Store::LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error) {

@@ -54,6 +54,18 @@
 //       split into 1-min rows, which would invent what happened inside the
 //       interval; the daemon's calibration reads measurement_1min only.
 //
+// Version 3 adds:
+//   calibration_param(calibration_id INTEGER, name TEXT, value REAL,
+//                     std_error REAL, unit TEXT, status TEXT,
+//                     PRIMARY KEY(calibration_id, name))
+//       every parameter of every calibration that produced parameters
+//       (accepted or not): value and standard error in the parameter's unit
+//       (std_error NULL when not estimated: fixed, undetermined), status as
+//       `pvtwin calibrate` prints it.
+//   view parameter_history(run_at, calibration_id, accepted, name, value,
+//                          std_error, unit, status)
+//       calibration_param with its calibration's time and acceptance.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -102,7 +114,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 2;
+inline constexpr int kStoreSchemaVersion = 3;
 
 struct StoreOptions {
   // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
@@ -117,6 +129,15 @@ struct StoreOptions {
 
 class Store {
  public:
+  // One identified parameter of a calibration (calibration_param).
+  struct CalibrationParamRow {
+    std::string name;
+    double value = 0.0;
+    double std_error = 0.0;  // in the parameter's unit; NaN (NULL) when not estimated
+    std::string unit;
+    std::string status;  // as calibrate prints it: identified, fixed, at lower bound, ...
+  };
+
   struct CalibrationRow {
     std::int64_t id = 0, run_at = 0;
     std::string variant;
@@ -128,6 +149,7 @@ class Store {
     std::string reason;
     bool accepted = false;
     double heldout_mae_w = 0.0;
+    std::vector<CalibrationParamRow> params;  // written to calibration_param with the row
   };
 
   struct ForecastRow {

@@ -140,6 +140,16 @@ TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Count("SELECT count(*) FROM calibration WHERE status = 'accepted'") >= 1;
   })) << DaemonLog();
+  // Every parameter of the accepted calibration is a calibration_param row,
+  // with the value of its parameters file and the status calibrate prints.
+  EXPECT_GE(db.Count("SELECT count(*) FROM parameter_history WHERE accepted = 1"), 10);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM parameter_history h JOIN calibration c ON c.id = "
+                     "h.calibration_id WHERE h.value IS NOT json_extract(c.params_json, "
+                     "'$.params.' || h.name)"),
+            0);
+  EXPECT_GE(db.Count("SELECT count(*) FROM calibration_param WHERE status = 'identified' AND "
+                     "std_error > 0"),
+            3);
   ASSERT_TRUE(WaitFor(30, [&] { return db.Count("SELECT count(*) FROM forecast_latest") == 1440; }))
       << DaemonLog();
   ASSERT_TRUE(WaitFor(30, [&] {

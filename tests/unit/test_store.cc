@@ -91,11 +91,19 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   // Primary key of forecast: (issued_at, ts); views are views.
   EXPECT_EQ(db.Rows("SELECT name FROM pragma_table_info('forecast') WHERE pk > 0 ORDER BY pk"),
             (std::vector<std::vector<std::string>>{{"issued_at"}, {"ts"}}));
+  // Version 3: the parameters of every calibration and their history.
+  EXPECT_EQ(
+      db.Columns("calibration_param"),
+      (std::vector<std::string>{"calibration_id", "name", "value", "std_error", "unit", "status"}));
+  EXPECT_EQ(db.Columns("parameter_history"),
+            (std::vector<std::string>{"run_at", "calibration_id", "accepted", "name", "value",
+                                      "std_error", "unit", "status"}));
   EXPECT_EQ(db.Rows("SELECT name FROM sqlite_master WHERE type = 'view' ORDER BY name"),
-            (std::vector<std::vector<std::string>>{{"forecast_latest"}, {"forecast_skill"}}));
+            (std::vector<std::vector<std::string>>{
+                {"forecast_latest"}, {"forecast_skill"}, {"parameter_history"}}));
 }
 
-// A store written by version 1 (no measurement_interval) is migrated on open
+// A store written by version 1 is migrated on open to the current version
 // and keeps its rows.
 TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   {
@@ -105,15 +113,19 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   }
   {
     RawDb db(DbPath());
-    ASSERT_EQ(db.Exec("DROP TABLE measurement_interval"), SQLITE_OK);
-    ASSERT_EQ(db.Exec("PRAGMA user_version = 1"), SQLITE_OK);
+    // Back to what version 1 wrote: without the tables and views of 2 and 3.
+    for (const char* sql : {"DROP TABLE measurement_interval", "DROP VIEW parameter_history",
+                            "DROP TABLE calibration_param", "PRAGMA user_version = 1"}) {
+      ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
+    }
   }
   auto store = OpenStore();
   ASSERT_NE(store, nullptr);
   RawDb db(DbPath());
-  EXPECT_EQ(db.Number("PRAGMA user_version"), 2.0);
+  EXPECT_EQ(db.Number("PRAGMA user_version"), static_cast<double>(kStoreSchemaVersion));
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 3.0);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_interval"), 0.0);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM parameter_history"), 0.0);
 }
 
 TEST_F(StoreTest, ReopeningKeepsDataAndANewerSchemaOrAForeignFileIsRefused) {
@@ -328,6 +340,9 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
     r.reason = reason;
     r.accepted = accepted;
     r.heldout_mae_w = accepted ? 23.0 : std::nan("");
+    r.params = {{"u_front_w_m2k", 9.5 + static_cast<double>(run_at - kDay0) / 86400.0, 0.25,
+                 "W/(m²·K)", "identified"},
+                {"eps_pvt", 0.15, std::nan(""), "-", "fixed"}};
     return r;
   };
   Store::CalibrationRow first = make(kDay0, true, "first calibration");
@@ -355,6 +370,17 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
   EXPECT_EQ(
       db.Rows("SELECT heldout_mae_w FROM calibration WHERE id = " + std::to_string(worse.id))[0][0],
       "NULL");
+  // The parameters of all three runs, in time order, with their acceptance;
+  // a parameter without a standard error has NULL.
+  EXPECT_EQ(db.Rows("SELECT run_at - " + std::to_string(kDay0) +
+                    ", accepted, value, std_error, unit, status FROM parameter_history WHERE "
+                    "name = 'u_front_w_m2k' ORDER BY run_at"),
+            (std::vector<std::vector<std::string>>{
+                {"0", "1", "9.5", "0.25", "W/(m²·K)", "identified"},
+                {"86400", "1", "10.5", "0.25", "W/(m²·K)", "identified"},
+                {"172800", "0", "11.5", "0.25", "W/(m²·K)", "identified"}}));
+  EXPECT_EQ(db.Rows("SELECT std_error FROM calibration_param WHERE name = 'eps_pvt' LIMIT 1")[0][0],
+            "NULL");
 }
 
 TEST_F(StoreTest, ForecastLatestPicksTheNewestIssueForEachTime) {

@@ -207,8 +207,7 @@ bool ReadPoint(SectionReader& r, const std::vector<ModbusDevice>& devices, Modbu
   }
   r.Number("offset", kOptional, kScaling, &p->offset);
   r.Number("valid_min", kOptional, kScaling, &p->valid_min);
-  if (r.Number("valid_max", kOptional, kScaling, &p->valid_max) &&
-      !(p->valid_max > p->valid_min)) {
+  if (r.Number("valid_max", kOptional, kScaling, &p->valid_max) && !(p->valid_max > p->valid_min)) {
     r.Reject("valid_max", "must be > valid_min");
   }
   double sentinel = 0.0;

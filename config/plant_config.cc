@@ -125,6 +125,18 @@ void ReadForecast(SectionReader& r, ForecastConfig* forecast) {
   r.Number("refresh_min", kOptional, Closed(1, 1440), &forecast->refresh_min);
 }
 
+void ReadDiagnosis(SectionReader& r, DiagnosisConfig* d) {
+  r.Boolean("enabled", kOptional, &d->enabled);
+  r.Integer("every_days", kOptional, Closed(1, 365), &d->every_days);
+  r.Number("timeout_s", kOptional, Closed(10, 86400), &d->timeout_s);
+  r.Integer("keep", kOptional, Closed(1, 1000), &d->keep);
+}
+
+void ReadMonitor(SectionReader& r, MonitorConfig* m) {
+  r.Integer("drift_days", kOptional, Closed(2, 365), &m->drift_days);
+  r.Integer("alarm_days", kOptional, Closed(1, 60), &m->alarm_days);
+}
+
 void ReadSim(SectionReader& r, SimConfig* sim) {
   r.Choice("operation", kOptional, {"irradiance", "differential", "heat_pump"}, &sim->operation);
   const bool on = r.Number("pump_dt_on_k", kOptional, LeftOpen(0, 30), &sim->pump_dt_on_k);
@@ -157,6 +169,8 @@ void ReadDocument(const toml::table& root, const SourceText& source, const std::
       {"poll", [](SectionReader& r, Config* c) { ReadPoll(r, &c->poll); }},
       {"calibration", [](SectionReader& r, Config* c) { ReadCalibration(r, &c->calibration); }},
       {"forecast", [](SectionReader& r, Config* c) { ReadForecast(r, &c->forecast); }},
+      {"diagnosis", [](SectionReader& r, Config* c) { ReadDiagnosis(r, &c->diagnosis); }},
+      {"monitor", [](SectionReader& r, Config* c) { ReadMonitor(r, &c->monitor); }},
       {"sim", [](SectionReader& r, Config* c) { ReadSim(r, &c->sim); }},
   };
 

@@ -50,6 +50,21 @@ struct ForecastConfig {
   double refresh_min = 60;  // re-issue period, [1, 1440]
 };
 
+// [diagnosis]: the daemon's diagnosis of the sim-to-real gap, run after a
+// calibration on its window (core/diagnosis.h), in a child process.
+struct DiagnosisConfig {
+  bool enabled = true;
+  int every_days = 7;       // [1, 365]: at most one diagnosis per this many days
+  double timeout_s = 1800;  // [10, 86400]: the child is stopped after this
+  int keep = 10;            // [1, 1000] HTML reports kept in <state dir>/reports
+};
+
+// [monitor]: what the daemon checks day by day (core/monitoring.h).
+struct MonitorConfig {
+  int drift_days = 28;  // [2, 365]: accepted calibrations of this many days for the drift check
+  int alarm_days = 3;   // [1, 60]: days below the performance band in a row before an alarm
+};
+
 // [sim]: the simulated plant's solar loop (core/weather_generator.h,
 // PumpControl). Defaults are WeatherOptions' defaults.
 struct SimConfig {
@@ -69,6 +84,8 @@ struct Config {
   PollConfig poll;
   CalibrationConfig calibration;
   ForecastConfig forecast;
+  DiagnosisConfig diagnosis;
+  MonitorConfig monitor;
   SimConfig sim;
   ModbusConfig modbus;
   std::string source_path;  // the file it was read from

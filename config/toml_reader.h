@@ -156,6 +156,19 @@ class SectionReader {
     return true;
   }
 
+  // Reads a TOML boolean (true/false) into *out.
+  bool Boolean(std::string_view key, bool required, bool* out) {
+    const toml::node* node = Find(key, required);
+    if (node == nullptr) return false;
+    const auto* b = node->as_boolean();
+    if (b == nullptr) {
+      Report(key, *node, "expected true or false");
+      return false;
+    }
+    *out = b->get();
+    return true;
+  }
+
   // Reads a non-empty string into *out.
   bool String(std::string_view key, bool required, std::string* out,
               std::string_view type_rule = "expected a string") {

@@ -24,6 +24,7 @@
 #include "core/thermal_model.h"
 #include "core/variant.h"
 #include "daemon/calibration_acceptance.h"
+#include "daemon/monitor.h"
 #include "daemon/notify.h"
 #include "daemon/store_cli.h"
 #include "io/child_process.h"
@@ -145,6 +146,8 @@ class Service {
   void MaybeStartCalibration();
   void CheckCalibration();
   void FinishCalibration(int exit_code);
+  // performance_daily, sensor faults, drift and alarms (daemon/monitor.h).
+  void DailyChecks(bool accepted_now);
   // Inserts the row and returns its id (0 when it could not be stored).
   std::int64_t RecordCalibration(Store::CalibrationRow row);
   bool LoadCurrentParameters();
@@ -392,7 +395,9 @@ void Service::CheckCalibration() {
   if (!child_.running()) return;
   int exit_code = 0;
   if (child_.Finished(&exit_code)) {
+    const std::int64_t before = params_id_;
     FinishCalibration(exit_code);
+    DailyChecks(params_id_ != before);
     return;
   }
   const double ran_s = WallNowS() - child_started_wall_s_;
@@ -404,6 +409,18 @@ void Service::CheckCalibration() {
     row.reason = "abandoned after " + Format("%.0f", ran_s) + " s (limit " +
                  Format("%.0f", options_.calibration_timeout_s) + " s); parameters kept";
     RecordCalibration(row);
+    DailyChecks(false);
+  }
+}
+
+void Service::DailyChecks(bool accepted_now) {
+  cli::DailyCheckInputs in;
+  in.config = &config_;
+  in.spec = spec_;
+  in.now_s = static_cast<std::int64_t>(Now());
+  in.accepted_now = accepted_now;
+  for (const auto& [priority, line] : cli::RunDailyChecks(*store_, in)) {
+    LogToStderr(priority, line);
   }
 }
 

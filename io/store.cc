@@ -139,11 +139,66 @@ std::vector<std::string> SchemaV3() {
   };
 }
 
+// The QC flags of measurement_1min, one named 0/1 column each, for the
+// measurement_qc view (core/aggregate.h).
+std::string QcFlagColumns() {
+  const std::pair<const char*, unsigned> kFlags[] = {
+      {"few_samples", 0},          {"required_missing", 1}, {"rejected_values", 2},
+      {"irradiance_corrected", 3}, {"flow_corrected", 4},   {"thermal_power_computed", 5},
+      {"invalid_samples", 6},      {"imported", 7}};
+  std::string names = "ts", exprs = "ts";
+  for (const auto& [name, bit] : kFlags) {
+    names += std::string(", ") + name;
+    exprs += ", (qc_flags >> " + std::to_string(bit) + ") & 1";
+  }
+  for (const ChannelInfo& info : kChannels) {
+    if (info.channel == Channel::kValid) continue;
+    names += ", missing_" + std::string(info.name);
+    exprs += ", (qc_flags >> " +
+             std::to_string(kQcChannelMissingShift + static_cast<unsigned>(info.channel)) + ") & 1";
+  }
+  return "CREATE VIEW measurement_qc(" + names + ") AS SELECT " + exprs + " FROM measurement_1min";
+}
+
+// Version 4: what the twin watches day by day (core/monitoring.h) and the
+// one list of events an operator reads first.
+std::vector<std::string> SchemaV4() {
+  return {
+      QcFlagColumns(),
+      "CREATE TABLE performance_daily(day INTEGER PRIMARY KEY, e_el_meas_wh REAL, "
+      "e_el_model_wh REAL, e_th_meas_wh REAL, e_th_model_wh REAL, pi_el REAL, pi_th REAL, "
+      "pi_el_low REAL, pi_el_high REAL, pi_th_low REAL, pi_th_high REAL, valid_minutes INTEGER, "
+      "calibration_id INTEGER REFERENCES calibration(id))",
+      "CREATE TABLE qc_event(id INTEGER PRIMARY KEY, channel TEXT NOT NULL, start_ts INTEGER NOT "
+      "NULL, end_ts INTEGER NOT NULL, kind TEXT NOT NULL, detail TEXT)",
+      "CREATE UNIQUE INDEX qc_event_key ON qc_event(channel, kind, start_ts)",
+      "CREATE TABLE monitor_event(id INTEGER PRIMARY KEY, ts INTEGER NOT NULL, kind TEXT NOT "
+      "NULL, severity TEXT NOT NULL, message TEXT)",
+      "CREATE TABLE diagnosis(id INTEGER PRIMARY KEY, run_at INTEGER NOT NULL, calibration_id "
+      "INTEGER, window_start INTEGER, window_end INTEGER, base_variant TEXT, verdict TEXT, "
+      "low_confidence INTEGER, shrink_pct REAL, bias_p_el_w REAL, bias_q_th_w REAL, "
+      "report_json TEXT)",
+      "CREATE VIEW event(ts, kind, severity, message) AS"
+      " SELECT ts, kind, severity, message FROM monitor_event"
+      " UNION ALL SELECT start_ts, 'qc_' || kind, 'warning', channel || ': ' || detail"
+      "  FROM qc_event"
+      " UNION ALL SELECT run_at, 'calibration_' || status,"
+      "  CASE WHEN accepted = 1 THEN 'info' ELSE 'warning' END,"
+      "  'calibration ' || id || ' (' || variant || '): ' || status ||"
+      "  COALESCE(': ' || reason, '') FROM calibration"
+      " UNION ALL SELECT run_at, 'diagnosis',"
+      "  CASE WHEN verdict = 'none' THEN 'info' ELSE 'warning' END,"
+      "  'diagnosis of ' || base_variant || ': ' || verdict ||"
+      "  CASE WHEN low_confidence = 1 THEN ' (low confidence)' ELSE '' END FROM diagnosis"
+      " ORDER BY 1 DESC",
+  };
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}, {4, &SchemaV4}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 
@@ -727,6 +782,183 @@ bool Store::ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows*
   DropEmptyColumns(&result.rows);
   *out = std::move(result);
   return true;
+}
+
+bool Store::WritePerformanceDay(const DayPerformance& d, std::int64_t calibration_id,
+                                std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "write performance_daily",
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "INSERT OR REPLACE INTO performance_daily(day, e_el_meas_wh, e_el_model_wh, "
+            "e_th_meas_wh, e_th_model_wh, pi_el, pi_th, pi_el_low, pi_el_high, pi_th_low, "
+            "pi_th_high, valid_minutes, calibration_id) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, "
+            "?, ?)",
+            &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_int64(stmt, 1, d.day_start_s);
+        const double reals[] = {d.e_el_meas_wh, d.e_el_model_wh, d.e_th_meas_wh, d.e_th_model_wh,
+                                d.pi_el,        d.pi_th,         d.pi_el_low,    d.pi_el_high,
+                                d.pi_th_low,    d.pi_th_high};
+        for (int k = 0; k < 10; ++k) BindReal(stmt, k + 2, reals[k]);
+        sqlite3_bind_int(stmt, 12, d.valid_minutes);
+        if (calibration_id > 0) {
+          sqlite3_bind_int64(stmt, 13, calibration_id);
+        } else {
+          sqlite3_bind_null(stmt, 13);
+        }
+        return db.StepDone(stmt, "write performance day " + std::to_string(d.day_start_s));
+      },
+      error);
+}
+
+bool Store::ReadPerformanceDays(std::int64_t from_ts, std::int64_t to_ts,
+                                std::vector<DayPerformance>* out, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::vector<DayPerformance> days;
+  const bool ok = db.Run(
+      false, "read performance_daily",
+      [&]() -> DbStatus {
+        days.clear();
+        return db.SelectRange(
+            "SELECT day, e_el_meas_wh, e_el_model_wh, e_th_meas_wh, e_th_model_wh, pi_el, pi_th, "
+            "pi_el_low, pi_el_high, pi_th_low, pi_th_high, valid_minutes FROM performance_daily "
+            "WHERE day >= ? AND day < ? ORDER BY day",
+            from_ts, to_ts,
+            [&days](sqlite3_stmt* stmt) {
+              DayPerformance& d = days.emplace_back();
+              d.day_start_s = sqlite3_column_int64(stmt, 0);
+              double* reals[] = {&d.e_el_meas_wh,  &d.e_el_model_wh, &d.e_th_meas_wh,
+                                 &d.e_th_model_wh, &d.pi_el,         &d.pi_th,
+                                 &d.pi_el_low,     &d.pi_el_high,    &d.pi_th_low,
+                                 &d.pi_th_high};
+              for (int k = 0; k < 10; ++k) *reals[k] = ColumnReal(stmt, k + 1);
+              d.valid_minutes = sqlite3_column_int(stmt, 11);
+              d.scored_el = std::isfinite(d.pi_el);
+              d.scored_th = std::isfinite(d.pi_th);
+            },
+            "read performance_daily");
+      },
+      error);
+  if (ok) *out = std::move(days);
+  return ok;
+}
+
+bool Store::RecordSensorFaults(const std::vector<SensorFault>& faults, std::string* error) {
+  if (faults.empty()) return true;
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "record sensor faults",
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "INSERT INTO qc_event(channel, start_ts, end_ts, kind, detail) VALUES(?, ?, ?, ?, ?) "
+            "ON CONFLICT(channel, kind, start_ts) DO UPDATE SET end_ts = MAX(end_ts, "
+            "excluded.end_ts), detail = excluded.detail",
+            &stmt);
+        if (!s.ok()) return s;
+        for (const SensorFault& f : faults) {
+          sqlite3_reset(stmt);
+          sqlite3_bind_text(stmt, 1, f.channel.c_str(), -1, SQLITE_TRANSIENT);
+          sqlite3_bind_int64(stmt, 2, f.start_s);
+          sqlite3_bind_int64(stmt, 3, f.end_s);
+          sqlite3_bind_text(stmt, 4, f.kind.c_str(), -1, SQLITE_TRANSIENT);
+          sqlite3_bind_text(stmt, 5, f.detail.c_str(), -1, SQLITE_TRANSIENT);
+          s = db.StepDone(stmt, "record " + f.kind + " of " + f.channel);
+          if (!s.ok()) return s;
+        }
+        return DbStatus{};
+      },
+      error);
+}
+
+bool Store::InsertMonitorEvent(std::int64_t ts, const std::string& kind,
+                               const std::string& severity, const std::string& message,
+                               std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "insert monitor_event",
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "INSERT INTO monitor_event(ts, kind, severity, message) VALUES(?, ?, ?, ?)", &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_int64(stmt, 1, ts);
+        sqlite3_bind_text(stmt, 2, kind.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(stmt, 3, severity.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(stmt, 4, message.c_str(), -1, SQLITE_TRANSIENT);
+        return db.StepDone(stmt, "insert monitor_event " + kind);
+      },
+      error);
+}
+
+bool Store::ReadAcceptedParameters(std::int64_t since_ts,
+                                   std::map<std::string, std::vector<ParameterPoint>>* out,
+                                   std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::map<std::string, std::vector<ParameterPoint>> points;
+  const bool ok = db.Run(
+      false, "read parameter_history",
+      [&]() -> DbStatus {
+        points.clear();
+        return db.SelectRange(
+            "SELECT name, run_at, value, std_error FROM parameter_history WHERE accepted = 1 AND "
+            "run_at >= ? AND run_at < ? ORDER BY run_at",
+            since_ts, std::numeric_limits<std::int64_t>::max(),
+            [&points](sqlite3_stmt* stmt) {
+              points[ColumnText(stmt, 0)].push_back(
+                  {sqlite3_column_int64(stmt, 1), ColumnReal(stmt, 2), ColumnReal(stmt, 3)});
+            },
+            "read parameter_history");
+      },
+      error);
+  if (ok) *out = std::move(points);
+  return ok;
+}
+
+bool Store::InsertDiagnosis(DiagnosisRow* row, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::int64_t id = 0;
+  const bool ok = db.Run(
+      true, "insert diagnosis",
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "INSERT INTO diagnosis(run_at, calibration_id, window_start, window_end, "
+            "base_variant, verdict, low_confidence, shrink_pct, bias_p_el_w, bias_q_th_w, "
+            "report_json) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_int64(stmt, 1, row->run_at);
+        if (row->calibration_id > 0) {
+          sqlite3_bind_int64(stmt, 2, row->calibration_id);
+        } else {
+          sqlite3_bind_null(stmt, 2);
+        }
+        sqlite3_bind_int64(stmt, 3, row->window_start);
+        sqlite3_bind_int64(stmt, 4, row->window_end);
+        sqlite3_bind_text(stmt, 5, row->base_variant.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(stmt, 6, row->verdict.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_int(stmt, 7, row->low_confidence ? 1 : 0);
+        BindReal(stmt, 8, row->shrink_pct);
+        BindReal(stmt, 9, row->bias_p_el_w);
+        BindReal(stmt, 10, row->bias_q_th_w);
+        sqlite3_bind_text(stmt, 11, row->report_json.c_str(), -1, SQLITE_TRANSIENT);
+        s = db.StepDone(stmt, "insert diagnosis");
+        if (s.ok()) id = sqlite3_last_insert_rowid(db.db);
+        return s;
+      },
+      error);
+  if (ok) row->id = id;
+  return ok;
 }
 
 bool Store::WriteIntervalRows(const Series& rows, std::string* error) {

@@ -66,6 +66,28 @@
 //                          std_error, unit, status)
 //       calibration_param with its calibration's time and acceptance.
 //
+// Version 4 adds (core/monitoring.h says how each is computed):
+//   performance_daily(day INTEGER PRIMARY KEY, e_el_meas_wh, e_el_model_wh,
+//                     e_th_meas_wh, e_th_model_wh, pi_el, pi_th, pi_el_low,
+//                     pi_el_high, pi_th_low, pi_th_high REAL,
+//                     valid_minutes INTEGER, calibration_id INTEGER)
+//       per UTC day (as forecast_skill), measured and expected energies in
+//       Wh; pi NULL when the day is not scored for that output.
+//   qc_event(id, channel, start_ts, end_ts, kind, detail)
+//       sensor faults as intervals [start_ts, end_ts).
+//   monitor_event(id, ts, kind, severity, message)
+//       what the daemon found: parameter drift, performance alarms, device
+//       outages.
+//   diagnosis(id, run_at, calibration_id, window_start, window_end,
+//             base_variant, verdict, low_confidence, shrink_pct,
+//             bias_p_el_w, bias_q_th_w, report_json)
+//   view measurement_qc(ts, few_samples, required_missing, ...,
+//                       missing_<channel> ...)
+//       measurement_1min's qc_flags as one 0/1 column per flag.
+//   view event(ts, kind, severity, message)
+//       newest first: monitor_event, qc_event, every calibration (accepted:
+//       info, otherwise warning) and every diagnosis.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -104,17 +126,19 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "core/aggregate.h"
+#include "core/monitoring.h"
 #include "core/sample.h"
 #include "core/series.h"
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 3;
+inline constexpr int kStoreSchemaVersion = 4;
 
 struct StoreOptions {
   // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
@@ -207,6 +231,36 @@ class Store {
   // As ReadMinutes, plus n_samples (0 where NULL) and qc_flags per row.
   bool ReadMinuteRows(std::int64_t from_ts, std::int64_t to_ts, MinuteRows* out,
                       std::string* error);
+  // --- Monitoring (schema version 4, core/monitoring.h) ---
+  // Upserts the performance_daily row of day.day_start_s.
+  bool WritePerformanceDay(const DayPerformance& day, std::int64_t calibration_id,
+                           std::string* error);
+  // performance_daily rows with from_ts <= day < to_ts, in time order; a day
+  // is scored for an output when its pi is not NULL.
+  bool ReadPerformanceDays(std::int64_t from_ts, std::int64_t to_ts,
+                           std::vector<DayPerformance>* out, std::string* error);
+  // qc_event rows: a fault already recorded with the same channel, kind and
+  // start gets its (longer) end and detail; others are inserted.
+  bool RecordSensorFaults(const std::vector<SensorFault>& faults, std::string* error);
+  // A monitor_event row (drift, alarm, device outage; severity info,
+  // warning or error).
+  bool InsertMonitorEvent(std::int64_t ts, const std::string& kind, const std::string& severity,
+                          const std::string& message, std::string* error);
+  // Parameters of the accepted calibrations with run_at >= since_ts, per
+  // name, in time order.
+  bool ReadAcceptedParameters(std::int64_t since_ts,
+                              std::map<std::string, std::vector<ParameterPoint>>* out,
+                              std::string* error);
+  struct DiagnosisRow {
+    std::int64_t id = 0, run_at = 0, calibration_id = 0;  // calibration_id 0: NULL
+    std::int64_t window_start = 0, window_end = 0;
+    std::string base_variant, verdict;
+    bool low_confidence = false;
+    double shrink_pct = 0.0, bias_p_el_w = 0.0, bias_q_th_w = 0.0;  // NaN: NULL
+    std::string report_json;
+  };
+  bool InsertDiagnosis(DiagnosisRow* row, std::string* error);
+
   // Upserts rows of a coarser step (measurement_interval): every row's ts a
   // whole minute, step_s = rows.step_s (a whole number of minutes > 1),
   // qc_flags kQcImported plus the missing-channel bits as WriteMinutes.

@@ -150,6 +150,14 @@ TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
   EXPECT_GE(db.Count("SELECT count(*) FROM calibration_param WHERE status = 'identified' AND "
                      "std_error > 0"),
             3);
+  // The daily checks after the calibration scored the days of the imported
+  // history with the accepted model (the simulator's own plant: near 1).
+  ASSERT_TRUE(WaitFor(10, [&] {
+    return db.Count("SELECT count(*) FROM performance_daily WHERE pi_el IS NOT NULL") >= 7;
+  })) << DaemonLog();
+  EXPECT_EQ(db.Count("SELECT count(*) FROM performance_daily WHERE pi_el NOT BETWEEN 0.9 AND 1.1"),
+            0);
+  EXPECT_GE(db.Count("SELECT count(*) FROM event WHERE kind = 'calibration_accepted'"), 1);
   ASSERT_TRUE(WaitFor(30, [&] { return db.Count("SELECT count(*) FROM forecast_latest") == 1440; }))
       << DaemonLog();
   ASSERT_TRUE(WaitFor(30, [&] {

@@ -4,6 +4,7 @@
 // errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -98,9 +99,30 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   EXPECT_EQ(db.Columns("parameter_history"),
             (std::vector<std::string>{"run_at", "calibration_id", "accepted", "name", "value",
                                       "std_error", "unit", "status"}));
+  // Version 4: monitoring (DESIGN.md "Operation contracts").
+  EXPECT_EQ(
+      db.Columns("performance_daily"),
+      (std::vector<std::string>{"day", "e_el_meas_wh", "e_el_model_wh", "e_th_meas_wh",
+                                "e_th_model_wh", "pi_el", "pi_th", "pi_el_low", "pi_el_high",
+                                "pi_th_low", "pi_th_high", "valid_minutes", "calibration_id"}));
+  EXPECT_EQ(db.Columns("qc_event"),
+            (std::vector<std::string>{"id", "channel", "start_ts", "end_ts", "kind", "detail"}));
+  EXPECT_EQ(db.Columns("diagnosis"),
+            (std::vector<std::string>{"id", "run_at", "calibration_id", "window_start",
+                                      "window_end", "base_variant", "verdict", "low_confidence",
+                                      "shrink_pct", "bias_p_el_w", "bias_q_th_w", "report_json"}));
+  EXPECT_EQ(db.Columns("event"), (std::vector<std::string>{"ts", "kind", "severity", "message"}));
+  const std::vector<std::string> qc = db.Columns("measurement_qc");
+  ASSERT_GE(qc.size(), 9u);
+  EXPECT_EQ(qc[1], "few_samples");
+  EXPECT_EQ(qc[8], "imported");
+  EXPECT_NE(std::find(qc.begin(), qc.end(), "missing_p_el_w"), qc.end());
   EXPECT_EQ(db.Rows("SELECT name FROM sqlite_master WHERE type = 'view' ORDER BY name"),
-            (std::vector<std::vector<std::string>>{
-                {"forecast_latest"}, {"forecast_skill"}, {"parameter_history"}}));
+            (std::vector<std::vector<std::string>>{{"event"},
+                                                   {"forecast_latest"},
+                                                   {"forecast_skill"},
+                                                   {"measurement_qc"},
+                                                   {"parameter_history"}}));
 }
 
 // A store written by version 1 is migrated on open to the current version
@@ -113,9 +135,12 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   }
   {
     RawDb db(DbPath());
-    // Back to what version 1 wrote: without the tables and views of 2 and 3.
-    for (const char* sql : {"DROP TABLE measurement_interval", "DROP VIEW parameter_history",
-                            "DROP TABLE calibration_param", "PRAGMA user_version = 1"}) {
+    // Back to what version 1 wrote: without the tables and views of 2 to 4.
+    for (const char* sql :
+         {"DROP TABLE measurement_interval", "DROP VIEW parameter_history",
+          "DROP TABLE calibration_param", "DROP VIEW event", "DROP VIEW measurement_qc",
+          "DROP TABLE performance_daily", "DROP TABLE qc_event", "DROP TABLE monitor_event",
+          "DROP TABLE diagnosis", "PRAGMA user_version = 1"}) {
       ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
     }
   }

@@ -1,0 +1,199 @@
+#include "core/monitoring.h"
+
+#include <cmath>
+#include <limits>
+
+#include "core/identification.h"
+#include "core/sky_radiation.h"
+#include "core/thermal_model.h"
+#include "core/units.h"
+
+namespace pvtwin {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::int64_t kDayS = 86400;
+
+// pi and its band for one output; NaN where not scored.
+void ScoreOutput(double meas_wh, double model_wh, double mae_w, double hours, bool scored,
+                 double* pi, double* low, double* high) {
+  if (!scored) {
+    *pi = *low = *high = kNaN;
+    return;
+  }
+  const double bound_wh = mae_w * hours;
+  *pi = meas_wh / model_wh;
+  *low = meas_wh / (model_wh + bound_wh);
+  *high = model_wh > bound_wh ? meas_wh / (model_wh - bound_wh) : kNaN;
+}
+
+}  // namespace
+
+bool ScoreDay(const Series& minutes, std::int64_t day_start_s, const Plant& plant,
+              const ModelSpec& spec, const ParamVector& params, const PerformanceOptions& options,
+              DayPerformance* out, std::string* error) {
+  const Series day = minutes.Between(day_start_s, day_start_s + kDayS);
+  DayPerformance p;
+  p.day_start_s = day_start_s;
+  if (day.size() > 0) {
+    Drivers drivers;
+    if (!PrepareDrivers(day, plant, spec, &drivers, error)) return false;
+    SimOutputs sim;
+    Simulate(drivers, params, &sim);
+    const Measurements meas = MakeMeasurements(day, drivers);
+    const double h = day.step_s / 3600.0;  // hours per row
+    for (const std::uint32_t i : meas.rows) {
+      if (!std::isfinite(sim.p_el_w[i]) || !std::isfinite(sim.q_th_w[i])) continue;
+      ++p.valid_minutes;
+      p.e_el_meas_wh += meas.p_el_w[i] * h;
+      p.e_el_model_wh += sim.p_el_w[i] * h;
+      p.e_th_meas_wh += meas.q_th_w[i] * h;
+      p.e_th_model_wh += sim.q_th_w[i] * h;
+    }
+  }
+  const bool enough = p.valid_minutes >= options.min_valid_minutes;
+  p.scored_el = enough && p.e_el_model_wh >= options.min_el_wh_m2 * plant.area_m2;
+  p.scored_th = enough && p.e_th_model_wh >= options.min_th_wh_m2 * plant.area_m2;
+  const double hours = p.valid_minutes * (day.step_s > 0 ? day.step_s : 60.0) / 3600.0;
+  ScoreOutput(p.e_el_meas_wh, p.e_el_model_wh, options.heldout_mae_p_el_w, hours, p.scored_el,
+              &p.pi_el, &p.pi_el_low, &p.pi_el_high);
+  ScoreOutput(p.e_th_meas_wh, p.e_th_model_wh, options.heldout_mae_q_th_w, hours, p.scored_th,
+              &p.pi_th, &p.pi_th_low, &p.pi_th_high);
+  *out = p;
+  return true;
+}
+
+int DaysBelowBand(std::span<const DayPerformance> days, bool thermal) {
+  int run = 0;
+  for (auto it = days.rbegin(); it != days.rend(); ++it) {
+    const bool scored = thermal ? it->scored_th : it->scored_el;
+    if (!scored) continue;
+    const double high = thermal ? it->pi_th_high : it->pi_el_high;
+    // An unbounded band (NaN high) never lies below 1.
+    if (!(high < 1.0)) break;
+    ++run;
+  }
+  return run;
+}
+
+std::optional<ParameterDrift> DetectDrift(std::span<const ParameterPoint> points) {
+  std::vector<ParameterPoint> known;
+  for (const ParameterPoint& p : points) {
+    if (std::isfinite(p.value) && std::isfinite(p.std_error) && p.std_error >= 0.0) {
+      known.push_back(p);
+    }
+  }
+  if (known.size() < 3) return std::nullopt;
+  int ups = 0, downs = 0;
+  for (std::size_t k = 1; k < known.size(); ++k) {
+    const double step = known[k].value - known[k - 1].value;
+    ups += step > 0.0;
+    downs += step < 0.0;
+  }
+  if (ups > 0 && downs > 0) return std::nullopt;  // not one direction
+  ParameterDrift d;
+  d.first = known.front().value;
+  d.last = known.back().value;
+  d.change = d.last - d.first;
+  d.combined_se = std::hypot(known.front().std_error, known.back().std_error);
+  d.calibrations = static_cast<int>(known.size());
+  if (!(std::fabs(d.change) > 2.0 * d.combined_se)) return std::nullopt;
+  return d;
+}
+
+namespace {
+
+// Runs of rows where `bad(i)` holds, at least min_rows long, as faults.
+template <typename Pred>
+void AddRuns(const Series& s, const std::string& channel, const std::string& kind, int min_rows,
+             Pred bad, const std::string& detail, std::vector<SensorFault>* out) {
+  const std::size_t n = s.size();
+  std::size_t i = 0;
+  while (i < n) {
+    if (!bad(i)) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < n && bad(j) && (j == i || s.time_s[j] - s.time_s[j - 1] <= 60)) ++j;
+    if (static_cast<int>(j - i) >= min_rows) {
+      out->push_back({channel, s.time_s[i], s.time_s[j - 1] + 60, kind,
+                      detail + " for " + std::to_string(j - i) + " min"});
+    }
+    i = j;
+  }
+}
+
+}  // namespace
+
+std::vector<SensorFault> FindSensorFaults(const Series& s, const SensorFaultOptions& o) {
+  std::vector<SensorFault> faults;
+  // Missing: a channel the plant has (some value in the rows) without a
+  // value for a while.
+  for (const ChannelInfo& info : kChannels) {
+    const Channel c = info.channel;
+    if (c == Channel::kValid || c == Channel::kAoiRad || !s.Has(c)) continue;
+    const std::vector<double>& v = s[c];
+    AddRuns(
+        s, std::string(info.name), "missing", o.min_missing_minutes,
+        [&v](std::size_t i) { return std::isnan(v[i]); }, "no value", &faults);
+  }
+  // Frozen: the same 1-min mean again and again. A sensor's noise makes
+  // successive means differ; zero irradiance, power or wind at night is no
+  // fault, so those count only when not zero.
+  const Channel frozen_checked[] = {Channel::kTInC,   Channel::kTOutC,  Channel::kTAmbC,
+                                    Channel::kTPvC,   Channel::kTBackC, Channel::kGPoaWM2,
+                                    Channel::kGhiWM2, Channel::kDhiWM2, Channel::kLwDownWM2,
+                                    Channel::kPElW,   Channel::kWindMS};
+  for (const Channel c : frozen_checked) {
+    if (!s.Has(c)) continue;
+    const std::vector<double>& v = s[c];
+    const bool zero_ok = c == Channel::kGPoaWM2 || c == Channel::kGhiWM2 || c == Channel::kDhiWM2 ||
+                         c == Channel::kPElW || c == Channel::kWindMS;
+    AddRuns(
+        s, std::string(ChannelName(c)), "frozen", o.min_frozen_minutes,
+        [&v, zero_ok](std::size_t i) {
+          return i > 0 && std::isfinite(v[i]) && v[i] == v[i - 1] && !(zero_ok && v[i] == 0.0);
+        },
+        "the same value", &faults);
+  }
+  // Heat without flow: a heat meter that reports Q_u while the flow is zero.
+  if (s.Has(Channel::kQThW) && s.Has(Channel::kMdotKgS)) {
+    const std::vector<double>& q = s[Channel::kQThW];
+    const std::vector<double>& f = s[Channel::kMdotKgS];
+    const double limit = o.heat_without_flow_w;
+    AddRuns(
+        s, "q_th_w", "heat_without_flow", o.min_run_minutes,
+        [&q, &f, limit](std::size_t i) { return f[i] == 0.0 && std::fabs(q[i]) > limit; },
+        "|Q_u| above " + std::to_string(static_cast<int>(limit)) + " W at zero flow", &faults);
+  }
+  // Sky warmer than air in sunshine: a clear sky is colder than the air, and
+  // strong sun means a mostly clear sky; a long-wave sensor (or its
+  // temperature correction) that reads otherwise is wrong.
+  const bool sky = s.Has(Channel::kLwDownWM2) || s.Has(Channel::kTSkyC);
+  const Channel sun = s.Has(Channel::kGhiWM2) ? Channel::kGhiWM2 : Channel::kGPoaWM2;
+  if (sky && s.Has(Channel::kTAmbC) && s.Has(sun)) {
+    const std::vector<double>& g = s[sun];
+    const std::vector<double>& t_amb = s[Channel::kTAmbC];
+    auto t_sky_c = [&s](std::size_t i) {
+      if (s.Has(Channel::kTSkyC) && std::isfinite(s[Channel::kTSkyC][i])) {
+        return s[Channel::kTSkyC][i];
+      }
+      if (!s.Has(Channel::kLwDownWM2)) return kNaN;
+      return KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
+    };
+    AddRuns(
+        s, s.Has(Channel::kLwDownWM2) ? "lw_down_w_m2" : "t_sky_c", "sky_warmer_than_air",
+        o.min_run_minutes,
+        [&](std::size_t i) {
+          return g[i] >= o.sunny_g_w_m2 && t_sky_c(i) > t_amb[i] + o.sky_warmer_k;
+        },
+        "sky temperature above the air's by more than " +
+            std::to_string(static_cast<int>(o.sky_warmer_k)) + " K in sunshine",
+        &faults);
+  }
+  return faults;
+}
+
+}  // namespace pvtwin

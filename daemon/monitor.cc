@@ -1,0 +1,182 @@
+#include "daemon/monitor.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/monitoring.h"
+#include "io/log.h"
+#include "io/params_json.h"
+#include "io/time_format.h"
+
+namespace pvtwin::cli {
+
+namespace {
+
+constexpr std::int64_t kDayS = 86400;
+
+using LogLines = std::vector<std::pair<int, std::string>>;
+
+std::string Fixed(double x, int decimals) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+  return buf;
+}
+
+std::string Day(std::int64_t t) { return FormatIsoUtc(t).substr(0, 10); }
+
+// performance_daily for every whole UTC day of the calibration window that
+// has no row yet, with the accepted parameters. Returns the newest day it
+// scored (-1: none).
+std::int64_t ScoreNewDays(Store& store, const DailyCheckInputs& in,
+                          const Store::CalibrationRow& cal, const ParamVector& params,
+                          LogLines* log) {
+  std::int64_t newest = -1;
+  const std::int64_t today = in.now_s / kDayS * kDayS;
+  const std::int64_t first = today - in.config->calibration.window_days * kDayS;
+  std::string error;
+  std::vector<DayPerformance> done;
+  Series minutes;
+  if (!store.ReadPerformanceDays(first, today, &done, &error) ||
+      !store.ReadMinutes(first, today, &minutes, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+    return newest;
+  }
+  PerformanceOptions options;
+  options.heldout_mae_p_el_w = cal.mae_p_el_w;
+  options.heldout_mae_q_th_w = cal.mae_q_th_w;
+  std::size_t k = 0;
+  for (std::int64_t day = first; day < today; day += kDayS) {
+    while (k < done.size() && done[k].day_start_s < day) ++k;
+    if (k < done.size() && done[k].day_start_s == day) continue;
+    const Series rows = minutes.Between(day, day + kDayS);
+    if (rows.size() == 0) continue;
+    DayPerformance p;
+    if (!ScoreDay(rows, day, in.config->plant, in.spec, params, options, &p, &error)) {
+      log->push_back({kWarning, "performance of " + Day(day) + " not scored: " + error});
+      continue;
+    }
+    if (!store.WritePerformanceDay(p, cal.id, &error)) {
+      log->push_back({kErr, "daily checks: " + error});
+      return newest;
+    }
+    newest = day;
+  }
+  return newest;
+}
+
+// An alarm when the newest scored days lie below their band alarm_days in a
+// row, raised on each night that adds a day to the run (newest_scored: the
+// newest day scored this night).
+void CheckPerformanceAlarm(Store& store, const DailyCheckInputs& in, std::int64_t newest_scored,
+                           LogLines* log) {
+  const int alarm_days = in.config->monitor.alarm_days;
+  const std::int64_t today = in.now_s / kDayS * kDayS;
+  std::vector<DayPerformance> days;
+  std::string error;
+  if (!store.ReadPerformanceDays(today - 3 * alarm_days * kDayS - 14 * kDayS, today, &days,
+                                 &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+    return;
+  }
+  for (const bool thermal : {false, true}) {
+    const int run = DaysBelowBand(days, thermal);
+    if (run < alarm_days) continue;
+    const DayPerformance* last = nullptr;
+    for (auto it = days.rbegin(); it != days.rend() && last == nullptr; ++it) {
+      if (thermal ? it->scored_th : it->scored_el) last = &*it;
+    }
+    if (last->day_start_s != newest_scored) continue;  // raised on the night it was scored
+    const double pi = thermal ? last->pi_th : last->pi_el;
+    const double high = thermal ? last->pi_th_high : last->pi_el_high;
+    const std::string message = std::string(thermal ? "heat" : "electricity") +
+                                " below the calibrated model on " + std::to_string(run) +
+                                " days in a row: on " + Day(last->day_start_s) +
+                                " pi = " + Fixed(pi, 3) + ", at most " + Fixed(high, 3) +
+                                " with the model's held-out error";
+    if (!store.InsertMonitorEvent(in.now_s, thermal ? "performance_low_th" : "performance_low_el",
+                                  "warning", message, &error)) {
+      log->push_back({kErr, "daily checks: " + error});
+    }
+    log->push_back({kWarning, message});
+  }
+}
+
+// Sensor faults of the last two days (a fault that goes on is recorded again
+// with its later end).
+void CheckSensors(Store& store, const DailyCheckInputs& in, LogLines* log) {
+  Series minutes;
+  std::string error;
+  if (!store.ReadMinutes(in.now_s - 2 * kDayS, in.now_s, &minutes, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+    return;
+  }
+  const std::vector<SensorFault> faults = FindSensorFaults(minutes);
+  if (!store.RecordSensorFaults(faults, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+    return;
+  }
+  for (const SensorFault& f : faults) {
+    log->push_back({kWarning, "sensor " + f.channel + ": " + f.kind + " from " +
+                                  FormatIsoUtc(f.start_s) + " (" + f.detail + ")"});
+  }
+}
+
+// Drift of each parameter over the accepted calibrations of drift_days.
+void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::CalibrationRow& cal,
+                LogLines* log) {
+  std::map<std::string, std::vector<ParameterPoint>> history;
+  std::string error;
+  const std::int64_t since = in.now_s - in.config->monitor.drift_days * kDayS;
+  if (!store.ReadAcceptedParameters(since, &history, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+    return;
+  }
+  for (const auto& [name, points] : history) {
+    const std::optional<ParameterDrift> drift = DetectDrift(points);
+    if (!drift) continue;
+    const std::string message =
+        name + " drifted from " + Fixed(drift->first, 4) + " to " + Fixed(drift->last, 4) + " (" +
+        (drift->change > 0 ? "+" : "") + Fixed(drift->change, 4) + ", more than twice its " +
+        "standard error " + Fixed(drift->combined_se, 4) + ") over " +
+        std::to_string(drift->calibrations) + " accepted calibrations since " + Day(since) +
+        " (last: calibration " + std::to_string(cal.id) + ")";
+    if (!store.InsertMonitorEvent(in.now_s, "parameter_drift", "warning", message, &error)) {
+      log->push_back({kErr, "daily checks: " + error});
+    }
+    log->push_back({kWarning, message});
+  }
+}
+
+}  // namespace
+
+std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const DailyCheckInputs& in) {
+  LogLines log;
+  CheckSensors(store, in, &log);
+  Store::CalibrationRow cal;
+  bool found = false;
+  std::string error;
+  if (!store.LatestAcceptedCalibration(&cal, &found, &error)) {
+    log.push_back({kErr, "daily checks: " + error});
+    return log;
+  }
+  if (!found) return log;  // nothing to compare the plant with yet
+  ParamsFile file;
+  Diagnostics errors;
+  if (!ParseParamsJson(cal.params_json, "calibration " + std::to_string(cal.id), in.config->plant,
+                       &file, &errors)) {
+    log.push_back({kErr, "daily checks: the parameters of calibration " + std::to_string(cal.id) +
+                             " are unreadable"});
+    return log;
+  }
+  ModelSpec spec = in.spec;
+  std::string variant_error;
+  ParseVariant(cal.variant, &spec, &variant_error);  // the calibration's own variant
+  DailyCheckInputs with_variant = in;
+  with_variant.spec = spec;
+  const std::int64_t newest = ScoreNewDays(store, with_variant, cal, file.values, &log);
+  CheckPerformanceAlarm(store, in, newest, &log);
+  if (in.accepted_now) CheckDrift(store, in, cal, &log);
+  return log;
+}
+
+}  // namespace pvtwin::cli

@@ -1,0 +1,32 @@
+// The daemon's daily checks (core/monitoring.h), run after each nightly
+// calibration: the performance index of every day of the window not yet
+// scored, sensor faults of the last two days, the drift of the accepted
+// parameters and the performance alarm. Results go to the store
+// (performance_daily, qc_event, monitor_event); what an operator must see is
+// also returned as log lines.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "config/plant_config.h"
+#include "core/variant.h"
+#include "io/store.h"
+
+namespace pvtwin::cli {
+
+struct DailyCheckInputs {
+  const Config* config = nullptr;
+  ModelSpec spec;
+  std::int64_t now_s = 0;
+  // The calibration that ran this night was accepted: its parameters are new
+  // and the drift check looks at them.
+  bool accepted_now = false;
+};
+
+// (journald priority, line) pairs for the log; storage errors included.
+std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const DailyCheckInputs& in);
+
+}  // namespace pvtwin::cli

@@ -1,0 +1,143 @@
+// daemon/monitor.h on a real SQLite file: a week of synthetic 1-min data from
+// a known truth, of which the last four days lost 15 % of P_el and one
+// night's air temperature froze, and the truth's parameters as the accepted
+// calibration. The daily checks score every day, raise the performance alarm
+// for electricity only, record the frozen sensor, and find a drift across
+// accepted calibrations; the event view lists it all, newest first.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/synthetic_plant.h"
+#include "daemon/monitor.h"
+#include "io/log.h"
+#include "io/params_json.h"
+#include "tests/support/files.h"
+#include "tests/support/sqlite_db.h"
+#include "tests/support/synthetic_series.h"
+
+namespace pvtwin::cli {
+namespace {
+
+constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
+constexpr std::int64_t kDayS = 86400;
+constexpr int kDays = 7;
+
+class DailyChecks : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    config_.plant = DesignExamplePlant();
+    config_.calibration.window_days = kDays;
+    config_.monitor.alarm_days = 3;
+    WeatherOptions weather;
+    weather.start_time_s = kJune1;
+    weather.num_days = kDays;
+    weather.step_s = 60.0;
+    weather.seed = 11;
+    weather.day_types = {DayType::kClear};
+    const ParamVector truth = ReferenceTruthParams(config_.plant);
+    Series s = MakeSyntheticPlantData(config_.plant, weather, testing::SpecOf("2N1Ccolwr"), truth,
+                                      RealisticSensorNoise(5));
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (s.time_s[i] >= kJune1 + 3 * kDayS) s[Channel::kPElW][i] *= 0.85;
+      // t_amb frozen 01:00–03:00 of the last day.
+      const std::int64_t t = s.time_s[i] - (kJune1 + (kDays - 1) * kDayS);
+      if (t >= 3600 && t < 3 * 3600) s[Channel::kTAmbC][i] = 11.5;
+    }
+    std::string error;
+    store_ = Store::Open((dir_ / "pvtwin.db").string(), &error);
+    ASSERT_NE(store_, nullptr) << error;
+    ASSERT_TRUE(store_->WriteMinutes(s, &error)) << error;
+    Accept(kJune1, truth, 0.0);
+  }
+
+  // An accepted calibration of truth with u_front_w_m2k shifted by du.
+  void Accept(std::int64_t run_at, ParamVector params, double du) {
+    double& u_front = params[static_cast<std::size_t>(Param::kUFrontWM2K)];
+    u_front += du;
+    Store::CalibrationRow row;
+    row.run_at = run_at;
+    row.variant = "2N1Ccolwr";
+    row.status = "accepted";
+    row.accepted = true;
+    row.mae_p_el_w = 2.0;
+    row.mae_q_th_w = 15.0;
+    row.params_json = FormatParamsJson("2N1Ccolwr", params, {}, "");
+    row.params.push_back({"u_front_w_m2k", u_front, 0.1, "W/(m²·K)", "identified"});
+    std::string error;
+    ASSERT_TRUE(store_->InsertCalibration(&row, &error)) << error;
+  }
+
+  DailyCheckInputs Inputs(bool accepted_now) const {
+    DailyCheckInputs in;
+    in.config = &config_;
+    in.spec = testing::SpecOf("2N1Ccolwr");
+    in.now_s = kJune1 + kDays * kDayS + 2 * 3600;  // 02:00 after the last day
+    in.accepted_now = accepted_now;
+    return in;
+  }
+
+  testing::ScratchDir dir_{"daily_checks"};
+  Config config_;
+  std::unique_ptr<Store> store_;
+};
+
+TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
+  const auto log = RunDailyChecks(*store_, Inputs(false));
+  testing::RawDb db(dir_ / "pvtwin.db");
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily"), kDays);
+  // Days 1–3 as the truth, days 4–7 at 85 % of P_el, heat unchanged.
+  for (int d = 0; d < kDays; ++d) {
+    const std::string day = std::to_string(kJune1 + d * kDayS);
+    const double pi_el = db.Number("SELECT pi_el FROM performance_daily WHERE day = " + day);
+    const double pi_th = db.Number("SELECT pi_th FROM performance_daily WHERE day = " + day);
+    EXPECT_NEAR(pi_el, d < 3 ? 1.0 : 0.85, 0.005) << d;
+    EXPECT_NEAR(pi_th, 1.0, 0.01) << d;
+  }
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily WHERE pi_el_high < 1"), 4);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily WHERE pi_th_high < 1"), 0);
+  // One alarm, for electricity, and its log line.
+  EXPECT_EQ(db.Rows("SELECT kind, severity FROM monitor_event"),
+            (std::vector<std::vector<std::string>>{{"performance_low_el", "warning"}}));
+  bool logged = false;
+  for (const auto& [priority, line] : log) {
+    logged |= priority == kWarning && line.find(
+                                          "electricity below the calibrated model on 4 days "
+                                          "in a row") != std::string::npos;
+  }
+  EXPECT_TRUE(logged);
+  // The frozen air temperature: an interval from the second frozen minute.
+  const std::int64_t last_day = kJune1 + (kDays - 1) * kDayS;
+  EXPECT_EQ(db.Rows("SELECT channel, kind, start_ts - " + std::to_string(last_day) + ", end_ts - " +
+                    std::to_string(last_day) + " FROM qc_event"),
+            (std::vector<std::vector<std::string>>{{"t_amb_c", "frozen", "3660", "10800"}}));
+  // The next night scores nothing again and raises no new alarm.
+  RunDailyChecks(*store_, Inputs(false));
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily"), kDays);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event"), 1);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM qc_event"), 1);
+  // The operator's list: newest first, the calibration included.
+  const auto events = db.Rows("SELECT kind FROM event");
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0][0], "performance_low_el");
+  EXPECT_EQ(events[1][0], "qc_frozen");
+  EXPECT_EQ(events[2][0], "calibration_accepted");
+}
+
+TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
+  const ParamVector truth = ReferenceTruthParams(config_.plant);
+  Accept(kJune1 + 2 * kDayS, truth, 0.3);
+  Accept(kJune1 + 4 * kDayS, truth, 0.6);
+  RunDailyChecks(*store_, Inputs(true));
+  testing::RawDb db(dir_ / "pvtwin.db");
+  const auto drift = db.Rows("SELECT message FROM monitor_event WHERE kind = 'parameter_drift'");
+  ASSERT_EQ(drift.size(), 1u);
+  EXPECT_NE(drift[0][0].find("u_front_w_m2k drifted"), std::string::npos) << drift[0][0];
+  EXPECT_NE(drift[0][0].find("over 3 accepted calibrations"), std::string::npos) << drift[0][0];
+  // Without a new calibration the drift is not raised again.
+  RunDailyChecks(*store_, Inputs(false));
+  EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'parameter_drift'"), 1);
+}
+
+}  // namespace
+}  // namespace pvtwin::cli

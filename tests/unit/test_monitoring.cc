@@ -1,0 +1,176 @@
+// core/monitoring.h: the performance index of a day on synthetic data with a
+// known answer (the truth model scores 1; a module that lost 15 % of its
+// output scores 0.85 and falls below its band), the drift rule on analytic
+// cases, and the sensor faults found where they were planted.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/monitoring.h"
+#include "core/synthetic_plant.h"
+#include "core/units.h"
+#include "tests/support/synthetic_series.h"
+
+namespace pvtwin {
+namespace {
+
+constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
+constexpr std::int64_t kDayS = 86400;
+
+Series ClearDays(const Plant& plant, int days) {
+  WeatherOptions weather;
+  weather.start_time_s = kJune1;
+  weather.num_days = days;
+  weather.step_s = 60.0;
+  weather.seed = 7;
+  weather.day_types = {DayType::kClear};
+  return MakeSyntheticPlantData(plant, weather, testing::SpecOf("2N1Ccolwr"),
+                                ReferenceTruthParams(plant), RealisticSensorNoise(3));
+}
+
+TEST(Performance, TheTruthModelScoresOneWithinItsBand) {
+  const Plant plant = DesignExamplePlant();
+  const Series s = ClearDays(plant, 2);
+  PerformanceOptions options;
+  options.heldout_mae_p_el_w = 1.0;
+  options.heldout_mae_q_th_w = 10.0;
+  DayPerformance p;
+  std::string error;
+  ASSERT_TRUE(ScoreDay(s, kJune1 + kDayS, plant, testing::SpecOf("2N1Ccolwr"),
+                       ReferenceTruthParams(plant), options, &p, &error))
+      << error;
+  EXPECT_EQ(p.day_start_s, kJune1 + kDayS);
+  EXPECT_GT(p.valid_minutes, 600);  // a clear June day
+  ASSERT_TRUE(p.scored_el && p.scored_th);
+  // Only sensor noise separates the truth from the measurement: 0.5 % of
+  // P_el and 5 W of Q_u per minute, independent, average out over a day.
+  EXPECT_NEAR(p.pi_el, 1.0, 0.002);
+  EXPECT_NEAR(p.pi_th, 1.0, 0.005);
+  EXPECT_LT(p.pi_el_low, 1.0);
+  EXPECT_GT(p.pi_el_high, 1.0);
+  EXPECT_LT(p.pi_th_low, 1.0);
+  EXPECT_GT(p.pi_th_high, 1.0);
+  // The band: E_meas / (E_model ± MAE·T), T the scored hours.
+  const double hours = p.valid_minutes / 60.0;
+  EXPECT_NEAR(p.pi_el_low, p.e_el_meas_wh / (p.e_el_model_wh + 1.0 * hours), 1e-12);
+  EXPECT_NEAR(p.pi_th_high, p.e_th_meas_wh / (p.e_th_model_wh - 10.0 * hours), 1e-12);
+  EXPECT_NEAR(p.e_el_meas_wh, p.pi_el * p.e_el_model_wh, 1e-9);
+}
+
+TEST(Performance, ALossOfFifteenPercentFallsBelowTheBandAndRaisesTheRun) {
+  const Plant plant = DesignExamplePlant();
+  Series s = ClearDays(plant, 4);
+  for (double& p : s[Channel::kPElW]) p *= 0.85;  // a string lost, a module soiled
+  PerformanceOptions options;
+  options.heldout_mae_p_el_w = 2.0;  // 1 % of the clear-sky peak
+  options.heldout_mae_q_th_w = 15.0;
+  std::vector<DayPerformance> days;
+  for (int d = 0; d < 4; ++d) {
+    DayPerformance p;
+    std::string error;
+    ASSERT_TRUE(ScoreDay(s, kJune1 + d * kDayS, plant, testing::SpecOf("2N1Ccolwr"),
+                         ReferenceTruthParams(plant), options, &p, &error))
+        << error;
+    EXPECT_NEAR(p.pi_el, 0.85, 0.003) << d;
+    EXPECT_LT(p.pi_el_high, 1.0) << d;
+    EXPECT_GT(p.pi_th_high, 1.0) << d;  // the heat side is untouched
+    days.push_back(p);
+  }
+  EXPECT_EQ(DaysBelowBand(days, false), 4);
+  EXPECT_EQ(DaysBelowBand(days, true), 0);
+  // A day that is not scored (too few minutes) neither breaks nor extends.
+  DayPerformance short_day;
+  short_day.day_start_s = kJune1 + 4 * kDayS;
+  days.push_back(short_day);
+  EXPECT_EQ(DaysBelowBand(days, false), 4);
+}
+
+TEST(Performance, ADayWithTooFewMinutesIsMarkedNotScored) {
+  const Plant plant = DesignExamplePlant();
+  const Series s = ClearDays(plant, 1).Between(kJune1 + 10 * 3600, kJune1 + 11 * 3600);
+  DayPerformance p;
+  std::string error;
+  ASSERT_TRUE(ScoreDay(s, kJune1, plant, testing::SpecOf("2N1Ccolwr"), ReferenceTruthParams(plant),
+                       PerformanceOptions{}, &p, &error));
+  EXPECT_EQ(p.valid_minutes, 60);
+  EXPECT_FALSE(p.scored_el);
+  EXPECT_FALSE(p.scored_th);
+  EXPECT_TRUE(std::isnan(p.pi_el));
+  EXPECT_GT(p.e_el_meas_wh, 0.0);  // the energies are still there
+}
+
+TEST(Drift, OneDirectionBeyondTwiceTheCombinedErrorIsADrift) {
+  const ParameterPoint rising[] = {{0, 10.0, 0.2}, {86400, 10.4, 0.2}, {2 * 86400, 10.9, 0.2}};
+  const std::optional<ParameterDrift> d = DetectDrift(rising);
+  ASSERT_TRUE(d);
+  EXPECT_DOUBLE_EQ(d->change, 0.9);
+  EXPECT_DOUBLE_EQ(d->combined_se, std::hypot(0.2, 0.2));  // 0.283: 0.9 > 0.566
+  EXPECT_EQ(d->calibrations, 3);
+  // Within twice the error: no drift.
+  const ParameterPoint small[] = {{0, 10.0, 0.2}, {1, 10.2, 0.2}, {2, 10.5, 0.2}};
+  EXPECT_FALSE(DetectDrift(small));
+  // Back and forth: no direction.
+  const ParameterPoint zigzag[] = {{0, 10.0, 0.1}, {1, 11.0, 0.1}, {2, 10.5, 0.1}, {3, 12.0, 0.1}};
+  EXPECT_FALSE(DetectDrift(zigzag));
+  // Two calibrations are not a trend; unknown errors do not count.
+  const ParameterPoint two[] = {{0, 10.0, 0.1}, {1, 12.0, 0.1}};
+  EXPECT_FALSE(DetectDrift(two));
+  const ParameterPoint unknown[] = {{0, 10.0, NAN}, {1, 11.0, 0.1}, {2, 12.0, 0.1}};
+  EXPECT_FALSE(DetectDrift(unknown));
+}
+
+TEST(SensorFaults, FoundWherePlanted) {
+  const Plant plant = DesignExamplePlant();
+  Series s = ClearDays(plant, 1);
+  s.Ensure(Channel::kLwDownWM2);
+  auto row = [&s](int hour, int minute) {
+    return static_cast<std::size_t>((hour * 3600 + minute * 60) / 60);
+  };
+  // t_amb frozen 02:00–03:30 (90 min), p_el missing 09:00–09:20, a heat
+  // meter reading 200 W at zero flow 05:00–05:15 (the pump is off at dawn),
+  // the sky 10 K warmer than the air 12:00–12:30 in full sun.
+  for (std::size_t i = row(2, 0); i < row(3, 30); ++i) s[Channel::kTAmbC][i] = 12.34;
+  for (std::size_t i = row(9, 0); i < row(9, 20); ++i) s[Channel::kPElW][i] = NAN;
+  for (std::size_t i = row(5, 0); i < row(5, 15); ++i) {
+    s[Channel::kMdotKgS][i] = 0.0;
+    s[Channel::kQThW][i] = 200.0;
+  }
+  for (std::size_t i = row(12, 0); i < row(12, 30); ++i) {
+    const double t_sky_k = CToK(s[Channel::kTAmbC][i] + 10.0);
+    s[Channel::kLwDownWM2][i] = kStefanBoltzmannW_m2k4 * std::pow(t_sky_k, 4);
+  }
+  const std::vector<SensorFault> faults = FindSensorFaults(s);
+  auto find = [&faults](const std::string& channel, const std::string& kind) {
+    for (const SensorFault& f : faults) {
+      if (f.channel == channel && f.kind == kind) return &f;
+    }
+    return static_cast<const SensorFault*>(nullptr);
+  };
+  const SensorFault* frozen = find("t_amb_c", "frozen");
+  ASSERT_NE(frozen, nullptr);
+  // The first row of the run is where the value was first seen; the run of
+  // identical values starts one row later.
+  EXPECT_EQ(frozen->start_s, kJune1 + 2 * 3600 + 60);
+  EXPECT_EQ(frozen->end_s, kJune1 + 3 * 3600 + 30 * 60);
+  const SensorFault* missing = find("p_el_w", "missing");
+  ASSERT_NE(missing, nullptr);
+  EXPECT_EQ(missing->start_s, kJune1 + 9 * 3600);
+  EXPECT_EQ(missing->end_s, kJune1 + 9 * 3600 + 20 * 60);
+  const SensorFault* heat = find("q_th_w", "heat_without_flow");
+  ASSERT_NE(heat, nullptr);
+  EXPECT_EQ(heat->start_s, kJune1 + 5 * 3600);
+  const SensorFault* sky = find("lw_down_w_m2", "sky_warmer_than_air");
+  ASSERT_NE(sky, nullptr);
+  EXPECT_EQ(sky->start_s, kJune1 + 12 * 3600);
+  EXPECT_EQ(sky->end_s, kJune1 + 12 * 3600 + 30 * 60);
+  // Nothing else: the untouched channels of a synthetic day are healthy
+  // (lw_down is missing outside the planted half hour, which is reported).
+  for (const SensorFault& f : faults) {
+    const bool planted = &f == frozen || &f == missing || &f == heat || &f == sky ||
+                         (f.channel == "lw_down_w_m2" && f.kind == "missing");
+    EXPECT_TRUE(planted) << f.channel << " " << f.kind << " " << f.detail;
+  }
+}
+
+}  // namespace
+}  // namespace pvtwin

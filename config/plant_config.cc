@@ -128,7 +128,7 @@ void ReadForecast(SectionReader& r, ForecastConfig* forecast) {
 void ReadDiagnosis(SectionReader& r, DiagnosisConfig* d) {
   r.Boolean("enabled", kOptional, &d->enabled);
   r.Integer("every_days", kOptional, Closed(1, 365), &d->every_days);
-  r.Number("timeout_s", kOptional, Closed(10, 86400), &d->timeout_s);
+  r.Number("timeout_s", kOptional, Closed(1, 86400), &d->timeout_s);
   r.Integer("keep", kOptional, Closed(1, 1000), &d->keep);
 }
 

@@ -1,5 +1,4 @@
 // pvtwin calibrate: identify a variant's parameters from operation data.
-#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -170,19 +169,6 @@ bool ParamSetOrReport(const std::string& option, const std::vector<std::string>&
     set->set(static_cast<std::size_t>(*p));
   }
   return ok;
-}
-
-// The daemon's calibration child dies with the daemon: a kill -9 of the
-// daemon must not leave a fit running that writes where the next one reads.
-bool DieWithParent(int parent_pid) {
-  if (parent_pid <= 0) return true;
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  // The parent may have died before prctl took effect.
-  if (::getppid() != parent_pid) {
-    std::cerr << "--parent-pid " << parent_pid << ": the parent is gone\n";
-    return false;
-  }
-  return true;
 }
 
 int RunCalibrate(const CalibrateArgs& a) {

@@ -13,6 +13,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "config/config_edit.h"
@@ -101,6 +103,43 @@ void PrintNoonForecast(Store* store, const Plant& plant, std::int64_t from_ts) {
       "%.0f W at %s\n",
       FormatIsoUtc(at_noon->ts).c_str(), at_noon->p_el_w, at_noon->q_th_w, best->q_th_w,
       FormatIsoUtc(best->ts).c_str());
+}
+
+// What the daily checks and the diagnosis left in the store.
+void PrintMonitoring(Store* store, const fs::path& state_dir) {
+  std::vector<DayPerformance> days;
+  std::string error;
+  if (!store->ReadPerformanceDays(0, std::numeric_limits<std::int64_t>::max(), &days, &error)) {
+    return;
+  }
+  double lo_el = INFINITY, hi_el = -INFINITY, lo_th = INFINITY, hi_th = -INFINITY;
+  int scored = 0;
+  for (const DayPerformance& d : days) {
+    if (!d.scored_el) continue;
+    ++scored;
+    lo_el = std::min(lo_el, d.pi_el);
+    hi_el = std::max(hi_el, d.pi_el);
+    if (d.scored_th) {
+      lo_th = std::min(lo_th, d.pi_th);
+      hi_th = std::max(hi_th, d.pi_th);
+    }
+  }
+  if (scored > 0) {
+    std::printf(
+        "      performance index (measured / model): %d days scored, electrical %.3f-%.3f, "
+        "thermal %.3f-%.3f\n",
+        scored, lo_el, hi_el, lo_th, hi_th);
+  }
+  Store::DiagnosisRow diagnosis;
+  bool found = false;
+  if (store->LatestDiagnosis(&diagnosis, &found, &error) && found) {
+    std::printf("      diagnosis of %s: verdict %s; report in %s\n", diagnosis.base_variant.c_str(),
+                diagnosis.verdict.c_str(), (state_dir / "reports").c_str());
+  } else {
+    std::printf(
+        "      diagnosis: still running when the demo stopped (it runs after the "
+        "calibration, in the background)\n");
+  }
 }
 
 int RunDemo(const DemoArgs& a) {
@@ -260,6 +299,7 @@ int RunDemo(const DemoArgs& a) {
   }
   std::printf("      forecast rows written: %zu (24 h at 1 min)\n", last.last_forecast_rows);
   if (store) PrintNoonForecast(store.get(), demo_plant.plant, t0);
+  if (store) PrintMonitoring(store.get(), fs::path(db).parent_path());
   std::printf("      plant: %s\n", OperationSummary(demo_plant.sim).c_str());
   std::printf("      live polling: %llu samples, %llu 1-min rows; runtime %.0f s\n",
               static_cast<unsigned long long>(last.samples_stored),
@@ -270,8 +310,12 @@ int RunDemo(const DemoArgs& a) {
       "    round(q_th_w, 1) AS q_th_w, round(t_out_c, 1) AS t_out_c FROM forecast_latest\n"
       "    WHERE ts %% 3600 = 0 ORDER BY ts;\"\n"
       "  sqlite3 %s \"SELECT id, status, reason FROM calibration;\"\n"
-      "  sqlite3 %s \"SELECT * FROM forecast_skill;\"\n",
-      Q(db).c_str(), Q(db).c_str(), Q(db).c_str());
+      "  sqlite3 %s \"SELECT * FROM forecast_skill;\"\n"
+      "  sqlite3 %s \"SELECT datetime(ts, 'unixepoch'), kind, severity, message FROM event;\"\n"
+      "  sqlite3 %s \"SELECT date(day, 'unixepoch') AS day, round(pi_el, 3) AS pi_el,\n"
+      "    round(pi_th, 3) AS pi_th, valid_minutes FROM performance_daily;\"\n"
+      "  sqlite3 %s \"SELECT name, value, std_error, unit, status FROM parameter_history;\"\n",
+      Q(db).c_str(), Q(db).c_str(), Q(db).c_str(), Q(db).c_str(), Q(db).c_str(), Q(db).c_str());
   if (last.forecasts == 0) {
     std::cerr << "demo: stopped after " << static_cast<long>(WallNowS() - wall_start)
               << " s without a forecast; see the log above\n";

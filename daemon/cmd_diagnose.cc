@@ -3,7 +3,9 @@
 // pvtwin diagnose-selftest: the proof on withheld effects
 // (core/diagnosis_selftest.h).
 #include <atomic>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <mutex>
@@ -11,13 +13,17 @@
 #include <thread>
 #include <vector>
 
+#include "core/clock.h"
 #include "core/diagnosis.h"
 #include "core/diagnosis_selftest.h"
 #include "core/synthetic_plant.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
+#include "daemon/store_cli.h"
 #include "io/diagnosis_report.h"
 #include "io/quantity_text.h"
+#include "io/store.h"
+#include "io/time_format.h"
 
 namespace pvtwin::cli {
 
@@ -26,6 +32,13 @@ namespace {
 struct DiagnoseArgs {
   std::string config;
   std::string csv;
+  std::string db;
+  std::string from;
+  std::string to = "now";
+  bool record = false;
+  std::int64_t calibration_id = 0;
+  std::int64_t run_at = 0;  // 0: now
+  int parent_pid = 0;
   std::string variant;
   int train_days = 0;
   int heldout_days = 0;
@@ -37,12 +50,12 @@ struct DiagnoseArgs {
   int threads = 0;
 };
 
-// The diagnosis of a series, input-agnostic (CSV today, the store later):
-// runs, prints the summary on stdout and writes the report.
+// The diagnosis of a series (from a CSV or the store): runs, prints the
+// summary on stdout, writes the report and leaves the result in *out.
 int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& spec,
                    const DiagnosisOptions& options, const std::string& source,
-                   const std::string& report_dir) {
-  DiagnosisResult result;
+                   const std::string& report_dir, DiagnosisResult* out) {
+  DiagnosisResult& result = *out;
   std::string error;
   const bool ok = Diagnose(series, plant, spec, options, &result, &error,
                            [](const std::string& line) { std::cerr << line << "\n"; });
@@ -98,9 +111,100 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
   return kExitOk;
 }
 
+// Mean predicted − measured of the base model over the held-out rows of the
+// trace; NaN without rows.
+double MeanBias(const std::vector<double>& predicted, const std::vector<double>& measured) {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < predicted.size() && i < measured.size(); ++i) {
+    if (std::isfinite(predicted[i]) && std::isfinite(measured[i])) {
+      sum += predicted[i] - measured[i];
+      ++n;
+    }
+  }
+  return n > 0 ? sum / n : std::nan("");
+}
+
+// The diagnosis row of the store (Store::DiagnosisRow, DESIGN.md).
+bool RecordDiagnosis(Store& store, const DiagnosisResult& r, std::int64_t from_ts,
+                     std::int64_t to_ts, const DiagnoseArgs& a) {
+  Store::DiagnosisRow row;
+  row.run_at = a.run_at > 0 ? a.run_at : static_cast<std::int64_t>(WallNowS());
+  row.calibration_id = a.calibration_id;
+  row.window_start = from_ts;
+  row.window_end = to_ts;
+  row.base_variant = r.base_variant;
+  row.verdict = r.verdict;
+  row.low_confidence = r.low_confidence;
+  row.shrink_pct =
+      r.ladder.size() > 1 && r.ladder.front().heldout_mae_w > 0.0
+          ? 100.0 * (1.0 - r.ladder.back().heldout_mae_w / r.ladder.front().heldout_mae_w)
+          : 0.0;
+  row.bias_p_el_w = MeanBias(r.trace.p_el_base_w, r.trace.p_el_meas_w);
+  row.bias_q_th_w = MeanBias(r.trace.q_th_base_w, r.trace.q_th_meas_w);
+  row.report_json = DiagnosisReportJson(r);
+  std::string error;
+  if (!store.InsertDiagnosis(&row, &error)) {
+    std::cerr << error << "\n";
+    return false;
+  }
+  std::cerr << "recorded diagnosis " << row.id << " in " << store.path() << "\n";
+  return true;
+}
+
+// The store's 1-min rows of [--from, --to) (default: the [calibration]
+// window up to now).
+bool ReadStoreWindow(const DiagnoseArgs& a, const Config& config, std::unique_ptr<Store>* store,
+                     Series* series, std::int64_t* from_out, std::int64_t* to_out) {
+  std::int64_t& from_ts = *from_out;
+  std::int64_t& to_ts = *to_out;
+  if (!ParseTimeOrReport("--to", a.to, &to_ts)) return false;
+  from_ts = to_ts - static_cast<std::int64_t>(config.calibration.window_days) * 86400;
+  if (!a.from.empty() && !ParseTimeOrReport("--from", a.from, &from_ts)) return false;
+  if (to_ts <= from_ts) {
+    std::cerr << "--to = " << a.to << ": must be later than --from\n";
+    return false;
+  }
+  if (!std::filesystem::exists(a.db)) {
+    std::cerr << "--db = " << a.db << ": no such database\n";
+    return false;
+  }
+  if (!OpenStoreOrReport(a.db, StoreOptionsFor(config), store)) return false;
+  std::string error;
+  if (!(*store)->ReadMinutes(from_ts, to_ts, series, &error)) {
+    std::cerr << error << "\n";
+    return false;
+  }
+  if (series->size() == 0) {
+    std::cerr << "--db = " << a.db << ": no measurement_1min rows in " << FormatIsoUtc(from_ts)
+              << " .. " << FormatIsoUtc(to_ts) << "\n";
+    return false;
+  }
+  return true;
+}
+
 int RunDiagnose(const DiagnoseArgs& a) {
+  if (!DieWithParent(a.parent_pid)) return kExitRuntime;
+  if (a.csv.empty() == a.db.empty()) {
+    std::cerr << "diagnose: give either --csv (a canonical CSV) or --db (the store's "
+                 "measurement_1min)\n";
+    return kExitBadInput;
+  }
+  if (a.record && a.db.empty()) {
+    std::cerr << "--record: only with --db (the diagnosis row goes to that store)\n";
+    return kExitBadInput;
+  }
+  Config config;
+  if (!LoadConfigOrReport(a.config, &config)) return kExitBadInput;
+  const std::string variant =
+      a.variant.empty() && !a.db.empty() ? config.calibration.variant : a.variant;
+  if (variant.empty()) {
+    std::cerr << "--variant: required with --csv (with --db the default is [calibration] "
+                 "variant)\n";
+    return kExitBadInput;
+  }
   ModelSpec spec;
-  if (!ParseVariantOrReport(a.variant, &spec)) return kExitBadInput;
+  if (!ParseVariantOrReport(variant, &spec)) return kExitBadInput;
   DiagnosisOptions options;
   options.train_days = a.train_days;
   options.heldout_days = a.heldout_days;
@@ -114,13 +218,21 @@ int RunDiagnose(const DiagnoseArgs& a) {
     std::cerr << "diagnose: " << why << "\n";
     return kExitBadInput;
   }
-  Config config;
-  if (!LoadConfigOrReport(a.config, &config)) return kExitBadInput;
   Series series;
-  if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
+  std::unique_ptr<Store> store;
+  std::int64_t from_ts = 0, to_ts = 0;
+  if (!a.db.empty()) {
+    if (!ReadStoreWindow(a, config, &store, &series, &from_ts, &to_ts)) return kExitBadInput;
+  } else if (!LoadCsvOrReport(a.csv, config, &series)) {
+    return kExitBadInput;
+  }
+  const std::string source = a.db.empty() ? a.csv : a.db;
   Drivers drivers;
-  if (!PrepareDriversOrReport(series, a.csv, config, spec, &drivers)) return kExitBadInput;
-  return DiagnoseSeries(series, config.plant, spec, options, a.csv, a.report);
+  if (!PrepareDriversOrReport(series, source, config, spec, &drivers)) return kExitBadInput;
+  DiagnosisResult result;
+  const int rc = DiagnoseSeries(series, config.plant, spec, options, source, a.report, &result);
+  if (rc != kExitOk || !a.record) return rc;
+  return RecordDiagnosis(*store, result, from_ts, to_ts, a) ? kExitOk : kExitRuntime;
 }
 
 struct SelftestArgs {
@@ -247,8 +359,25 @@ void RegisterDiagnose(CLI::App& app) {
       "with --report. Exit 0 success, 2 bad input, 1 the base fit failed or the report could\n"
       "not be written.");
   cmd->add_option("--config", args->config, "TOML config with the [plant] section")->required();
-  cmd->add_option("--csv", args->csv, "canonical CSV with the measurements")->required();
-  cmd->add_option("--variant", args->variant, "base model variant, e.g. 1N1Cwr")->required();
+  cmd->add_option("--csv", args->csv, "canonical CSV with the measurements");
+  cmd->add_option("--db", args->db,
+                  "instead of --csv: the measurement_1min rows of this SQLite store");
+  cmd->add_option("--from", args->from,
+                  "with --db: first time, ISO 8601, a date or relative such as -14d (default: "
+                  "--to minus [calibration] window_days)");
+  cmd->add_option("--to", args->to, "with --db: end time, exclusive (default: now)");
+  cmd->add_flag("--record", args->record,
+                "with --db: write the result as a row of the store's diagnosis table");
+  cmd->add_option("--calibration-id", args->calibration_id,
+                  "with --record: the calibration whose window is diagnosed");
+  cmd->add_option("--run-at", args->run_at,
+                  "with --record: the row's run_at, unix s (default: now; pvtwin run passes its "
+                  "clock)");
+  cmd->add_option("--parent-pid", args->parent_pid,
+                  "exit when the process with this pid ends (used by pvtwin run)");
+  cmd->add_option("--variant", args->variant,
+                  "base model variant, e.g. 1N1Cwr (required with --csv; with --db the default is "
+                  "[calibration] variant)");
   cmd->add_option("--train-days", args->train_days,
                   "training days from the first day of data (default: two thirds of the days)")
       ->check(CLI::NonNegativeNumber);

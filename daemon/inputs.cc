@@ -1,6 +1,10 @@
 #include "daemon/inputs.h"
 
+#include <sys/prctl.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <csignal>
 #include <iostream>
 
 #include "core/clock.h"
@@ -20,6 +24,17 @@ bool LoadConfigOrReport(const std::string& path, Config* config) {
   if (LoadConfig(path, config, &errors)) return true;
   Report(errors);
   return false;
+}
+
+bool DieWithParent(int parent_pid) {
+  if (parent_pid <= 0) return true;
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  // The parent may have died before prctl took effect.
+  if (::getppid() != parent_pid) {
+    std::cerr << "--parent-pid " << parent_pid << ": the parent is gone\n";
+    return false;
+  }
+  return true;
 }
 
 bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series,

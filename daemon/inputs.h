@@ -16,6 +16,11 @@
 namespace pvtwin::cli {
 
 bool LoadConfigOrReport(const std::string& path, Config* config);
+// A child of the daemon (calibration, diagnosis) dies with it: a kill -9 of
+// the daemon must not leave a child running that writes where the next one
+// reads. parent_pid <= 0: not a child, nothing to do. False (and a message)
+// when the parent is already gone.
+bool DieWithParent(int parent_pid);
 bool LoadCsvOrReport(const std::string& path, const Config& config, Series* series,
                      const NaiveTimeZone* naive_time_zone = nullptr);
 bool ParseVariantOrReport(const std::string& name, ModelSpec* spec);

@@ -25,6 +25,7 @@
 #include "core/variant.h"
 #include "daemon/calibration_acceptance.h"
 #include "daemon/monitor.h"
+#include "daemon/nightly_diagnosis.h"
 #include "daemon/notify.h"
 #include "daemon/store_cli.h"
 #include "io/child_process.h"
@@ -148,6 +149,8 @@ class Service {
   void FinishCalibration(int exit_code);
   // performance_daily, sensor faults, drift and alarms (daemon/monitor.h).
   void DailyChecks(bool accepted_now);
+  // The nightly diagnosis child (daemon/nightly_diagnosis.h), when due.
+  void MaybeStartDiagnosis();
   // Inserts the row and returns its id (0 when it could not be stored).
   std::int64_t RecordCalibration(Store::CalibrationRow row);
   bool LoadCurrentParameters();
@@ -185,6 +188,7 @@ class Service {
   std::int64_t params_id_ = 0;
   ParamVector params_{};
   std::string params_json_;
+  std::unique_ptr<cli::NightlyDiagnosis> diagnosis_;
   // Forecast and housekeeping.
   double next_forecast_s_ = 0.0;
   double next_retention_s_ = 0.0;
@@ -398,6 +402,7 @@ void Service::CheckCalibration() {
     const std::int64_t before = params_id_;
     FinishCalibration(exit_code);
     DailyChecks(params_id_ != before);
+    MaybeStartDiagnosis();
     return;
   }
   const double ran_s = WallNowS() - child_started_wall_s_;
@@ -411,6 +416,21 @@ void Service::CheckCalibration() {
     RecordCalibration(row);
     DailyChecks(false);
   }
+}
+
+void Service::MaybeStartDiagnosis() {
+  if (!have_params_ || !diagnosis_) return;
+  cli::NightlyDiagnosis::Job job;
+  job.exe = options_.exe_path.empty() ? SelfExecutable() : options_.exe_path;
+  job.config_path = options_.config_path;
+  job.db_path = config_.storage.path;
+  job.variant = spec_.Name();
+  job.step_s = Format("%.0f", config_.calibration.step_s);
+  job.window_start = job_.window_start;
+  job.window_end = job_.window_end;
+  job.calibration_id = params_id_;
+  job.now_s = static_cast<std::int64_t>(Now());
+  diagnosis_->MaybeStart(config_.diagnosis, *store_, job, LogToStderr);
 }
 
 void Service::DailyChecks(bool accepted_now) {
@@ -599,6 +619,10 @@ void Service::Shutdown() {
     row.reason = "the daemon stopped during the fit";
     RecordCalibration(row);
   }
+  if (diagnosis_ && diagnosis_->running()) {
+    diagnosis_->Stop();
+    LogToStderr(kInfo, "the running diagnosis was stopped with the daemon");
+  }
   if (!pending_.empty()) {
     LogToStderr(kErr, std::to_string(pending_.size()) + " samples could not be stored");
   }
@@ -622,6 +646,8 @@ int Service::Run() {
     return 1;
   }
   work_dir_ = fs::path(config_.storage.path).parent_path() / "calibration";
+  diagnosis_ =
+      std::make_unique<cli::NightlyDiagnosis>(fs::path(config_.storage.path).parent_path());
   LoadCurrentParameters();
   if (!config_.modbus.devices.empty()) {
     PollerOptions poller_options;
@@ -667,6 +693,7 @@ int Service::Run() {
     StoreSamples();
     Aggregate();
     CheckCalibration();
+    diagnosis_->Check(config_.diagnosis, *store_, LogToStderr);
     MaybeStartCalibration();
     if (Now() >= next_forecast_s_) IssueForecast();
     if (Now() >= next_retention_s_) {

@@ -961,6 +961,43 @@ bool Store::InsertDiagnosis(DiagnosisRow* row, std::string* error) {
   return ok;
 }
 
+bool Store::LatestDiagnosis(DiagnosisRow* row, bool* found, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  DiagnosisRow result;
+  bool any = false;
+  const bool ok = db.Run(
+      false, "read latest diagnosis",
+      [&]() -> DbStatus {
+        any = false;
+        return db.SelectRange(
+            "SELECT id, run_at, calibration_id, window_start, window_end, base_variant, verdict, "
+            "low_confidence, shrink_pct, bias_p_el_w, bias_q_th_w FROM diagnosis WHERE run_at >= "
+            "? AND run_at < ? ORDER BY run_at DESC, id DESC LIMIT 1",
+            std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max(),
+            [&](sqlite3_stmt* stmt) {
+              any = true;
+              result.id = sqlite3_column_int64(stmt, 0);
+              result.run_at = sqlite3_column_int64(stmt, 1);
+              result.calibration_id = sqlite3_column_int64(stmt, 2);
+              result.window_start = sqlite3_column_int64(stmt, 3);
+              result.window_end = sqlite3_column_int64(stmt, 4);
+              result.base_variant = ColumnText(stmt, 5);
+              result.verdict = ColumnText(stmt, 6);
+              result.low_confidence = sqlite3_column_int(stmt, 7) != 0;
+              result.shrink_pct = ColumnReal(stmt, 8);
+              result.bias_p_el_w = ColumnReal(stmt, 9);
+              result.bias_q_th_w = ColumnReal(stmt, 10);
+            },
+            "read latest diagnosis");
+      },
+      error);
+  if (!ok) return false;
+  *found = any;
+  if (any) *row = std::move(result);
+  return true;
+}
+
 bool Store::WriteIntervalRows(const Series& rows, std::string* error) {
   const auto step_s = static_cast<std::int64_t>(rows.step_s);
   if (static_cast<double>(step_s) != rows.step_s || step_s <= kMinuteS || step_s % kMinuteS != 0) {

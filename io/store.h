@@ -260,6 +260,9 @@ class Store {
     std::string report_json;
   };
   bool InsertDiagnosis(DiagnosisRow* row, std::string* error);
+  // The newest diagnosis row (largest run_at) without its report_json;
+  // *found false when there is none.
+  bool LatestDiagnosis(DiagnosisRow* row, bool* found, std::string* error);
 
   // Upserts rows of a coarser step (measurement_interval): every row's ts a
   // whole minute, step_s = rows.step_s (a whole number of minutes > 1),

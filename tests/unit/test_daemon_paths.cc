@@ -233,6 +233,50 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
   EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
 }
 
+// After the first calibration the daemon diagnoses its window in a child:
+// the diagnosis row names the calibration and the window, the HTML report is
+// kept under reports/, the verdict is logged, and the daemon goes on.
+TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
+  ImportHistory(kJune1, 4);
+  WriteConfig(Settings());
+  StartDaemon(kJune1, 60.0);
+  Db db(DbPath());
+  ASSERT_TRUE(WaitFor(180, [&] { return db.Number("SELECT count(*) FROM diagnosis") >= 1; }))
+      << Log();
+  EXPECT_EQ(db.Number("SELECT count(*) FROM diagnosis d JOIN calibration c ON c.id = "
+                      "d.calibration_id WHERE c.accepted = 1 AND d.window_start = c.window_start "
+                      "AND d.window_end = c.window_end AND d.base_variant = c.variant"),
+            1)
+      << Log();
+  EXPECT_NE(db.Text("SELECT verdict FROM diagnosis"), "");
+  EXPECT_NE(db.Text("SELECT report_json FROM diagnosis").find("\"verdict\""), std::string::npos);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM event WHERE kind = 'diagnosis'"), 1);
+  ASSERT_TRUE(WaitFor(10, [&] { return Log().find("diagnosis: verdict ") != std::string::npos; }))
+      << Log();
+  EXPECT_TRUE(fs::exists(dir_ / "reports" / "diagnosis-2024-06-01.html")) << Log();
+  int code = 0;
+  EXPECT_FALSE(daemon_.Finished(&code)) << "the daemon stopped: " << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
+// A diagnosis over [diagnosis] timeout_s is stopped, logged and recorded as
+// an event; no diagnosis row is written and the daemon goes on.
+TEST_F(DaemonPaths, ADiagnosisOverItsTimeLimitIsStoppedAndTheDaemonGoesOn) {
+  ImportHistory(kJune1, 14);  // 14 days at 1 min: seconds of diagnosis
+  WriteConfig(Settings());
+  std::ofstream(dir_ / "pvtwin.toml", std::ios::app) << "\n[diagnosis]\ntimeout_s = 1\n";
+  StartDaemon(kJune1, 60.0);
+  Db db(DbPath());
+  ASSERT_TRUE(WaitFor(120, [&] {
+    return db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'diagnosis_timeout'") >= 1;
+  })) << Log();
+  EXPECT_NE(Log().find("diagnosis stopped after"), std::string::npos) << Log();
+  EXPECT_EQ(db.Number("SELECT count(*) FROM diagnosis"), 0);
+  int code = 0;
+  EXPECT_FALSE(daemon_.Finished(&code)) << "the daemon stopped: " << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
 // The README's workflow that once crash-looped the daemon: history with a
 // 15-minute outage of the plane-of-array pyranometer (GHI and DHI logged)
 // imported, then `pvtwin run` without devices calibrates and forecasts.

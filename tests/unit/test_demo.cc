@@ -8,6 +8,7 @@
 
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/sqlite_db.h"
 
 namespace pvtwin {
 namespace {
@@ -27,6 +28,18 @@ TEST(Demo, ALiveRunCutShortByItsTimeLimitStillSucceedsAndCountsItsForecasts) {
   EXPECT_EQ(run.err.find("without a forecast"), std::string::npos) << run.err;
   EXPECT_EQ(run.out.find("| forecast written"), std::string::npos)
       << "status lines count the forecasts";
+  // The daily checks ran after the calibration: the seeded history's days
+  // are scored against the calibrated model (the simulator's own plant, so
+  // close to 1), the parameters have their history, the events their view,
+  // and the summary says so with the SQL to read them.
+  testing::RawDb db(dir / "d" / "pvtwin.db");
+  EXPECT_GE(db.Number("SELECT count(*) FROM performance_daily WHERE pi_el BETWEEN 0.95 AND 1.05"),
+            10);
+  EXPECT_GE(db.Number("SELECT count(*) FROM parameter_history WHERE accepted = 1"), 10);
+  EXPECT_GE(db.Number("SELECT count(*) FROM event WHERE kind = 'calibration_accepted'"), 1);
+  EXPECT_NE(run.out.find("performance index (measured / model): "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("FROM performance_daily"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("FROM event"), std::string::npos) << run.out;
 }
 
 }  // namespace

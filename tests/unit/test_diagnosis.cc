@@ -328,6 +328,18 @@ TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("no_wind.csv"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("wind"), std::string::npos) << run.err;
+  // The store instead of a CSV: one source, an existing file, --record only there.
+  run = testing::RunPvtwin(
+      dir_, "diagnose --config " + PlantConfig() + " --csv no_wind.csv --db x.db --variant 1N");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("give either --csv"), std::string::npos) << run.err;
+  run = testing::RunPvtwin(
+      dir_, "diagnose --config " + PlantConfig() + " --csv no_wind.csv --variant 1N --record");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--record: only with --db"), std::string::npos) << run.err;
+  run = testing::RunPvtwin(dir_, "diagnose --config " + PlantConfig() + " --db nowhere.db");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--db = nowhere.db: no such database"), std::string::npos) << run.err;
   run = testing::RunPvtwin(
       dir_, "diagnose --config " + PlantConfig() + " --csv no_wind.csv --variant 1N9C");
   EXPECT_EQ(run.exit_code, 2);

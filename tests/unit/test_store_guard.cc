@@ -67,7 +67,7 @@ TEST(StoreGuard, ADamagedDatabaseIsRefusedBeforeAnythingIsWritten) {
     std::string error;
     std::unique_ptr<Store> store = Store::Open(path.string(), &error);
     ASSERT_TRUE(store) << error;
-    std::vector<Sample> samples(2000);
+    std::vector<Sample> samples(20000);  // most of the file, whatever tables the schema adds
     for (std::size_t i = 0; i < samples.size(); ++i) {
       samples[i].ts_s = 1717236000 + 5 * static_cast<std::int64_t>(i);
       samples[i].Set(Channel::kTAmbC, 20.0);

@@ -1,0 +1,164 @@
+#include "daemon/nightly_diagnosis.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+#include <vector>
+
+#include "core/clock.h"
+#include "io/log.h"
+#include "io/time_format.h"
+
+namespace pvtwin::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::int64_t kDayS = 86400;
+
+// The first line of the child's output that starts with prefix, without it.
+std::string LineAfter(const fs::path& path, const std::string& prefix) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(prefix, 0) == 0) return line.substr(prefix.size());
+  }
+  return "";
+}
+
+std::string LastLine(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
+// Keeps the newest `keep` diagnosis-<date>.html (names sort by date).
+void PruneReports(const fs::path& dir, int keep) {
+  std::vector<fs::path> reports;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.starts_with("diagnosis-") && name.ends_with(".html")) reports.push_back(e.path());
+  }
+  std::sort(reports.begin(), reports.end());
+  for (std::size_t k = 0; k + static_cast<std::size_t>(keep) < reports.size(); ++k) {
+    fs::remove(reports[k], ec);
+  }
+}
+
+}  // namespace
+
+void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, const Job& job,
+                                  const LogFn& log) {
+  if (!config.enabled || child_.running() || job.calibration_id <= 0) return;
+  Store::DiagnosisRow last;
+  bool found = false;
+  std::string error;
+  if (!store.LatestDiagnosis(&last, &found, &error)) {
+    log(kErr, "diagnosis not started: " + error);
+    return;
+  }
+  // An hour's slack: the nightly runs drift by the calibration's runtime.
+  if (found && job.now_s - last.run_at < config.every_days * kDayS - 3600) return;
+  const fs::path work = state_dir_ / "diagnosis";
+  std::error_code ec;
+  fs::remove_all(work, ec);
+  fs::create_directories(work, ec);
+  const std::vector<std::string> argv = {job.exe,
+                                         "diagnose",
+                                         "--config",
+                                         job.config_path,
+                                         "--db",
+                                         job.db_path,
+                                         "--variant",
+                                         job.variant,
+                                         "--from",
+                                         std::to_string(job.window_start),
+                                         "--to",
+                                         std::to_string(job.window_end),
+                                         "--record",
+                                         "--calibration-id",
+                                         std::to_string(job.calibration_id),
+                                         "--run-at",
+                                         std::to_string(job.now_s),
+                                         "--step",
+                                         job.step_s,
+                                         "--threads",
+                                         "1",
+                                         "--report",
+                                         (work / "report").string(),
+                                         "--parent-pid",
+                                         std::to_string(::getpid())};
+  if (!child_.Start(argv, (work / "diagnose.log").string(), &error)) {
+    Event(store, "diagnosis_failed", "diagnosis not started: " + error, log);
+    return;
+  }
+  started_wall_s_ = WallNowS();
+  job_now_s_ = job.now_s;
+  log(kInfo, "diagnosis of " + job.variant + " started on " + FormatIsoUtc(job.window_start) +
+                 " .. " + FormatIsoUtc(job.window_end));
+}
+
+void NightlyDiagnosis::Check(const DiagnosisConfig& config, Store& store, const LogFn& log) {
+  if (!child_.running()) return;
+  int exit_code = 0;
+  if (child_.Finished(&exit_code)) {
+    Finish(exit_code, config, store, log);
+    return;
+  }
+  const double ran_s = WallNowS() - started_wall_s_;
+  if (ran_s > config.timeout_s) {
+    child_.Kill();
+    Event(store, "diagnosis_timeout",
+          "diagnosis stopped after " + std::to_string(static_cast<long>(ran_s)) +
+              " s ([diagnosis] "
+              "timeout_s = " +
+              std::to_string(static_cast<long>(config.timeout_s)) + ")",
+          log);
+  }
+}
+
+void NightlyDiagnosis::Finish(int exit_code, const DiagnosisConfig& config, Store& store,
+                              const LogFn& log) {
+  const fs::path work = state_dir_ / "diagnosis";
+  if (exit_code != 0) {
+    Event(store, "diagnosis_failed",
+          "diagnosis " +
+              (exit_code < 0 ? "ended by signal " + std::to_string(-exit_code)
+                             : "exited with " + std::to_string(exit_code)) +
+              ": " + LastLine(work / "diagnose.log"),
+          log);
+    return;
+  }
+  const fs::path reports = state_dir_ / "reports";
+  std::error_code ec;
+  fs::create_directories(reports, ec);
+  const fs::path kept = reports / ("diagnosis-" + FormatIsoUtc(job_now_s_).substr(0, 10) + ".html");
+  fs::copy_file(work / "report" / "report.html", kept, fs::copy_options::overwrite_existing, ec);
+  if (ec) log(kWarning, "diagnosis report not kept: " + kept.string() + ": " + ec.message());
+  PruneReports(reports, config.keep);
+  const std::string verdict = LineAfter(work / "diagnose.log", "verdict: ");
+  log(verdict == "none" ? kInfo : kWarning, "diagnosis: verdict " +
+                                                (verdict.empty() ? std::string("?") : verdict) +
+                                                "; report " + kept.string());
+}
+
+void NightlyDiagnosis::Event(Store& store, const std::string& kind, const std::string& message,
+                             const LogFn& log) {
+  log(kWarning, message);
+  std::string error;
+  if (!store.InsertMonitorEvent(job_now_s_, kind, "warning", message, &error)) {
+    log(kErr, "recording the event failed: " + error);
+  }
+}
+
+void NightlyDiagnosis::Stop() {
+  if (child_.running()) child_.Kill();
+}
+
+}  // namespace pvtwin::cli

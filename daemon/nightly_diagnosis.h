@@ -1,0 +1,56 @@
+// The daemon's diagnosis of the sim-to-real gap (core/diagnosis.h), run after
+// a nightly calibration on its window as a child process
+// (`pvtwin diagnose --db … --record`), so that a slow or failing diagnosis
+// never holds up polling: at most once every [diagnosis] every_days, stopped
+// after timeout_s. The child writes its diagnosis row itself; the HTML report
+// is kept as <state dir>/reports/diagnosis-<date>.html, the newest `keep` of
+// them. Failures and timeouts become monitor_event rows and log lines.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "config/plant_config.h"
+#include "io/child_process.h"
+#include "io/store.h"
+
+namespace pvtwin::cli {
+
+using LogFn = std::function<void(int priority, const std::string& line)>;
+
+class NightlyDiagnosis {
+ public:
+  struct Job {
+    std::string exe, config_path, db_path, variant;
+    std::string step_s = "60";  // the calibration's model step
+    std::int64_t window_start = 0, window_end = 0;
+    std::int64_t calibration_id = 0;
+    std::int64_t now_s = 0;  // the daemon's clock (simulated under --speed)
+  };
+
+  // state_dir holds reports/ and the child's scratch folder diagnosis/.
+  explicit NightlyDiagnosis(std::filesystem::path state_dir) : state_dir_(std::move(state_dir)) {}
+
+  // Starts the child when enabled and the newest diagnosis row is at least
+  // every_days old (none running).
+  void MaybeStart(const DiagnosisConfig& config, Store& store, const Job& job, const LogFn& log);
+  // Non-blocking: a finished child's report is kept and its verdict logged;
+  // a child past timeout_s is killed.
+  void Check(const DiagnosisConfig& config, Store& store, const LogFn& log);
+  // Kills a running child (daemon shutdown).
+  void Stop();
+  bool running() const { return child_.running(); }
+
+ private:
+  void Finish(int exit_code, const DiagnosisConfig& config, Store& store, const LogFn& log);
+  void Event(Store& store, const std::string& kind, const std::string& message, const LogFn& log);
+
+  std::filesystem::path state_dir_;
+  ChildProcess child_;
+  double started_wall_s_ = 0.0;
+  std::int64_t job_now_s_ = 0;
+};
+
+}  // namespace pvtwin::cli

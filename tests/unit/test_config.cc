@@ -143,6 +143,44 @@ TEST(ConfigLoad, BoundariesOfTheRanges) {
   EXPECT_EQ(errors_for("[forecast]\nhorizon_h = 0\n"), 1u);
   // A value out of the int range must not wrap around.
   EXPECT_EQ(errors_for("[storage]\nraw_retention_days = 9999999999\n"), 1u);
+  EXPECT_EQ(errors_for("[diagnosis]\nenabled = false\nevery_days = 1\ntimeout_s = 1\nkeep = 1\n"
+                       "[monitor]\ndrift_days = 2\nalarm_days = 60\n"),
+            0u);
+}
+
+// The [diagnosis] and [monitor] sections: defaults, values, and each bad
+// value named with file, line, key and rule.
+TEST(ConfigLoad, DiagnosisAndMonitorSections) {
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseConfig(kMinimalPlant, "config.toml", &config, &errors));
+  EXPECT_TRUE(config.diagnosis.enabled);
+  EXPECT_EQ(config.diagnosis.every_days, 7);
+  EXPECT_EQ(config.diagnosis.timeout_s, 1800);
+  EXPECT_EQ(config.diagnosis.keep, 10);
+  EXPECT_EQ(config.monitor.drift_days, 28);
+  EXPECT_EQ(config.monitor.alarm_days, 3);
+  ASSERT_TRUE(ParseConfig(std::string(kMinimalPlant) +
+                              "[diagnosis]\nenabled = false\nevery_days = 14\n[monitor]\n"
+                              "alarm_days = 5\n",
+                          "config.toml", &config, &errors));
+  EXPECT_FALSE(config.diagnosis.enabled);
+  EXPECT_EQ(config.diagnosis.every_days, 14);
+  EXPECT_EQ(config.monitor.alarm_days, 5);
+  errors.clear();
+  EXPECT_FALSE(ParseConfig(std::string(kMinimalPlant) +
+                               "[diagnosis]\nenabled = \"yes\"\nevery_days = 0\ntimeout_s = 0.5\n"
+                               "[monitor]\ndrift_days = 1\nalarm_days = 2.5\n",
+                           "config.toml", &config, &errors));
+  ASSERT_EQ(errors.size(), 5u);
+  EXPECT_EQ(errors[0].ToString(), "config.toml:8: enabled = \"yes\": expected true or false");
+  EXPECT_NE(errors[1].ToString().find("config.toml:9: every_days = 0: "), std::string::npos)
+      << errors[1].ToString();
+  EXPECT_NE(errors[2].ToString().find("config.toml:10: timeout_s = 0.5: "), std::string::npos)
+      << errors[2].ToString();
+  EXPECT_NE(errors[3].ToString().find("config.toml:12: drift_days = 1: "), std::string::npos)
+      << errors[3].ToString();
+  EXPECT_EQ(errors[4].ToString(), "config.toml:13: alarm_days = 2.5: expected an integer");
 }
 
 }  // namespace

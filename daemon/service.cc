@@ -189,6 +189,8 @@ class Service {
   ParamVector params_{};
   std::string params_json_;
   std::unique_ptr<cli::NightlyDiagnosis> diagnosis_;
+  std::mutex device_events_mutex_;
+  std::vector<std::pair<int, std::string>> device_events_;  // poller state changes, for events
   // Forecast and housekeeping.
   double next_forecast_s_ = 0.0;
   double next_retention_s_ = 0.0;
@@ -582,6 +584,22 @@ void Service::UpdateDeviceStatus() {
   int up = 0;
   const std::vector<DeviceStats> stats = poller_->Stats();
   for (const DeviceStats& d : stats) up += d.connected ? 1 : 0;
+  // The poller's state changes (a device down, back, answering with
+  // exceptions, frozen) become events here, on the main thread: a busy
+  // database must never hold up a poll thread.
+  std::vector<std::pair<int, std::string>> changes;
+  {
+    std::lock_guard lock(device_events_mutex_);
+    changes.swap(device_events_);
+  }
+  for (const auto& [priority, line] : changes) {
+    std::string error;
+    const char* severity = priority <= kErr ? "error" : priority <= kWarning ? "warning" : "info";
+    if (!store_->InsertMonitorEvent(static_cast<std::int64_t>(Now()), "device", severity, line,
+                                    &error)) {
+      LogToStderr(kWarning, "recording the device event failed: " + error);
+    }
+  }
   status_.devices = static_cast<int>(stats.size());
   status_.devices_up = up;
 }
@@ -653,9 +671,12 @@ int Service::Run() {
     PollerOptions poller_options;
     poller_options.period_s = config_.poll.period_s;
     poller_options.area_m2 = config_.plant.area_m2;
-    poller_ = std::make_unique<ModbusPoller>(
-        config_.modbus, poller_options, *clock_,
-        [](int priority, const std::string& line) { LogToStderr(priority, line); });
+    poller_ = std::make_unique<ModbusPoller>(config_.modbus, poller_options, *clock_,
+                                             [this](int priority, const std::string& line) {
+                                               LogToStderr(priority, line);
+                                               std::lock_guard lock(device_events_mutex_);
+                                               device_events_.emplace_back(priority, line);
+                                             });
     poller_->Start([this](const Sample& s) { queue_.Push(s); });
   } else {
     LogToStderr(kNotice,

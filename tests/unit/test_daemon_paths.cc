@@ -468,6 +468,15 @@ TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
             1)
       << "no forecast after the 600-minute outage";
   EXPECT_GT(db.Number("SELECT count(DISTINCT issued_at) FROM forecast"), 24);
+  // The operator's event list has the weather station going down and back.
+  EXPECT_GE(db.Number("SELECT count(*) FROM event WHERE kind = 'device' AND severity IN "
+                      "('warning', 'error') AND message LIKE '%weather%'"),
+            1)
+      << Log();
+  EXPECT_GE(db.Number("SELECT count(*) FROM event WHERE kind = 'device' AND severity = 'info' "
+                      "AND message LIKE '%weather%'"),
+            1)
+      << Log();
   EXPECT_GE(db.Number("SELECT count(*) FROM calibration WHERE run_at >= " +
                       std::to_string(kJune1 + 2 * 3600)),
             1);

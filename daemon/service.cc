@@ -182,6 +182,14 @@ class Service {
   double child_started_wall_s_ = 0.0;
   Store::CalibrationRow job_;
   Series job_test_;
+  cli::HeldOutChoice job_held_out_;
+  // "last 2 days held out, 312 rows with the pump on in sunshine".
+  std::string HeldOutText() const {
+    return (job_held_out_.days == 1 ? std::string("last day")
+                                    : "last " + std::to_string(job_held_out_.days) + " days") +
+           " held out, " + std::to_string(job_held_out_.informative_rows) +
+           " rows with the pump on in sunshine";
+  }
   double next_calibration_s_ = 0.0;
   // Current parameters.
   bool have_params_ = false;
@@ -336,8 +344,14 @@ void Service::MaybeStartCalibration() {
       next_calibration_s_ = std::min(next_calibration_s_, now + kUncalibratedRetryS);
     return;
   }
-  const Series train = window.Between(begin, end - kDayS);
-  job_test_ = window.Between(end - kDayS, end);
+  // Held out: the last days, as many as it takes (up to 3) to hold two hours
+  // with the pump running in sunshine; an overcast pump-off day cannot tell
+  // two parameter sets apart.
+  const cli::HeldOutChoice held_out = cli::ChooseHeldOutDays(window, end);
+  const std::int64_t test_start = end - held_out.days * kDayS;
+  const Series train = window.Between(begin, test_start);
+  job_test_ = window.Between(test_start, end);
+  job_held_out_ = held_out;
 
   // Each run has its own directory, so a child left over from a killed
   // daemon can never write where the next run reads; the newest few are kept
@@ -394,7 +408,7 @@ void Service::MaybeStartCalibration() {
   job_ = row;
   status_.calibrating = true;
   LogToStderr(kInfo, "calibration of " + spec_.Name() + " started on " + FormatIsoUtc(begin) +
-                         " .. " + FormatIsoUtc(end) + " (last day held out)");
+                         " .. " + FormatIsoUtc(end) + " (" + HeldOutText() + ")");
 }
 
 void Service::CheckCalibration() {
@@ -487,7 +501,8 @@ void Service::FinishCalibration(int exit_code) {
       HeldOutErrors(job_test_, config_.plant, spec_, file.values);
   if (!fresh) {
     row.status = "rejected";
-    row.reason = "the held-out day has no usable rows to judge the new parameters";
+    row.reason =
+        "the held-out days have no usable rows to judge the new parameters (" + HeldOutText() + ")";
     RecordCalibration(row);
     return;
   }
@@ -500,11 +515,14 @@ void Service::FinishCalibration(int exit_code) {
   for (const auto& name : fit.value("at_bounds", nlohmann::json::array())) {
     if (name.is_string()) at_bounds.push_back(name.get<std::string>());
   }
+  const double tolerance_w_m2 =
+      current ? cli::HeldOutDifferenceSe(job_test_, config_.plant, spec_, file.values, params_)
+              : 0.0;
   const cli::AcceptanceDecision decision = cli::DecideCalibration(
       fresh->objective_w_m2(),
       current ? std::optional<double>(current->objective_w_m2()) : std::nullopt, at_bounds,
-      config_.plant.area_m2);
-  row.reason = decision.reason;
+      config_.plant.area_m2, tolerance_w_m2);
+  row.reason = decision.reason + "; " + HeldOutText();
   if (current) row.reason += " (current: calibration " + std::to_string(params_id_) + ")";
   if (!decision.accept) {
     row.status = "rejected";

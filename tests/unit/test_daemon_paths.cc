@@ -227,6 +227,9 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
   EXPECT_NE(reason.find(" exceeds "), std::string::npos) << reason;
   EXPECT_NE(reason.find("the current"), std::string::npos) << reason;
   EXPECT_NE(reason.find("parameters kept"), std::string::npos) << reason;
+  // Judged on the last day, which holds hours of the pump running in sunshine.
+  EXPECT_NE(reason.find("last day held out, "), std::string::npos) << reason;
+  EXPECT_NE(reason.find(" rows with the pump on in sunshine"), std::string::npos) << reason;
   EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE accepted = 1"), 1);
   // Forecasts still come from the first calibration.
   EXPECT_EQ(db.Number("SELECT count(DISTINCT calibration_id) FROM forecast"), 1);

@@ -91,6 +91,7 @@ void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
     }
   }
   r.Integer("window_days", kOptional, Closed(1, 60), &calibration->window_days);
+  r.Boolean("refit_full_window", kOptional, &calibration->refit_full_window);
   double step_s = calibration->step_s;
   if (r.Number("step_s", kOptional, Closed(5, 900), &step_s)) {
     if (step_s != std::floor(step_s) || std::fmod(86400.0, step_s) != 0.0) {

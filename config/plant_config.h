@@ -43,6 +43,9 @@ struct CalibrationConfig {
   double step_s = 60;                      // model step: whole seconds in [5, 900] dividing 86400
   std::string at = "02:00";                // local time of the nightly run, HH:MM
   std::string timezone = "Europe/Vienna";  // IANA zone that `at` refers to
+  // After a fit passes the held-out check, fit again on the whole window
+  // (held-out days included) and forecast with that.
+  bool refit_full_window = true;
 };
 
 struct ForecastConfig {

@@ -72,6 +72,16 @@ void RemoveOldRunDirectories(const fs::path& dir, std::size_t keep) {
   }
 }
 
+// The last line of the child's output: why it failed, in its own words.
+std::string LastLine(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
 std::string Format(const char* fmt, double a) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), fmt, a);
@@ -147,6 +157,12 @@ class Service {
   void MaybeStartCalibration();
   void CheckCalibration();
   void FinishCalibration(int exit_code);
+  // Writes data to job_dir_/csv_name and starts `pvtwin calibrate` on it.
+  bool StartCalibrateChild(const Series& data, const std::string& csv_name, std::string* error);
+  void StartRefit();
+  void FinishRefit(int exit_code);
+  // Daily checks and the diagnosis, once the night's calibration is done.
+  void AfterCalibration();
   // performance_daily, sensor faults, drift and alarms (daemon/monitor.h).
   void DailyChecks(bool accepted_now);
   // The nightly diagnosis child (daemon/nightly_diagnosis.h), when due.
@@ -182,6 +198,10 @@ class Service {
   double child_started_wall_s_ = 0.0;
   Store::CalibrationRow job_;
   Series job_test_;
+  Series job_window_;  // the whole window, for the refit
+  enum class JobKind { kHeldOut, kRefit };
+  JobKind job_kind_ = JobKind::kHeldOut;
+  bool accepted_tonight_ = false;
   cli::HeldOutChoice job_held_out_;
   // "last 2 days held out, 312 rows with the pump on in sunshine".
   std::string HeldOutText() const {
@@ -358,29 +378,40 @@ void Service::MaybeStartCalibration() {
   // for the operator.
   job_dir_ = work_dir_ / ("run-" + std::to_string(row.run_at));
   RemoveOldRunDirectories(work_dir_, kKeptCalibrationRuns);
-  std::error_code ec;
-  fs::create_directories(job_dir_, ec);
-  const fs::path train_csv = job_dir_ / "train.csv";
-  const fs::path new_json = job_dir_ / "new-params.json";
-  const fs::path log_path = job_dir_ / "calibrate.log";
-  std::vector<Channel> channels;
-  for (const ChannelInfo& info : kChannels) {
-    if (train.Has(info.channel)) channels.push_back(info.channel);
-  }
-  fs::remove(new_json, ec);
-  fs::remove(log_path, ec);
-  if (!WriteCsv(train_csv.string(), train, channels, &error)) {
+  if (!StartCalibrateChild(train, "train.csv", &error)) {
     row.status = "failed";
     row.reason = error;
     RecordCalibration(row);
     return;
   }
+  job_ = row;
+  job_window_ = window;
+  job_kind_ = JobKind::kHeldOut;
+  status_.calibrating = true;
+  LogToStderr(kInfo, "calibration of " + spec_.Name() + " started on " + FormatIsoUtc(begin) +
+                         " .. " + FormatIsoUtc(end) + " (" + HeldOutText() + ")");
+}
+
+bool Service::StartCalibrateChild(const Series& data, const std::string& csv_name,
+                                  std::string* error) {
+  std::error_code ec;
+  fs::create_directories(job_dir_, ec);
+  const fs::path csv = job_dir_ / csv_name;
+  const fs::path new_json = job_dir_ / "new-params.json";
+  const fs::path log_path = job_dir_ / "calibrate.log";
+  std::vector<Channel> channels;
+  for (const ChannelInfo& info : kChannels) {
+    if (data.Has(info.channel)) channels.push_back(info.channel);
+  }
+  fs::remove(new_json, ec);
+  fs::remove(log_path, ec);
+  if (!WriteCsv(csv.string(), data, channels, error)) return false;
   std::vector<std::string> argv = {options_.exe_path.empty() ? SelfExecutable() : options_.exe_path,
                                    "calibrate",
                                    "--config",
                                    options_.config_path,
                                    "--csv",
-                                   train_csv.string(),
+                                   csv.string(),
                                    "--variant",
                                    spec_.Name(),
                                    "--step",
@@ -393,45 +424,100 @@ void Service::MaybeStartCalibration() {
                                    std::to_string(::getpid())};
   if (have_params_) {
     const fs::path current = job_dir_ / "current-params.json";
-    if (WriteTextFileAtomically(current.string(), params_json_, &error)) {
+    if (WriteTextFileAtomically(current.string(), params_json_, error)) {
       argv.push_back("--start");
       argv.push_back(current.string());
     }
   }
-  if (!child_.Start(argv, log_path.string(), &error)) {
-    row.status = "failed";
-    row.reason = error;
-    RecordCalibration(row);
-    return;
-  }
+  if (!child_.Start(argv, log_path.string(), error)) return false;
   child_started_wall_s_ = WallNowS();
-  job_ = row;
-  status_.calibrating = true;
-  LogToStderr(kInfo, "calibration of " + spec_.Name() + " started on " + FormatIsoUtc(begin) +
-                         " .. " + FormatIsoUtc(end) + " (" + HeldOutText() + ")");
+  return true;
 }
 
 void Service::CheckCalibration() {
   if (!child_.running()) return;
   int exit_code = 0;
   if (child_.Finished(&exit_code)) {
-    const std::int64_t before = params_id_;
-    FinishCalibration(exit_code);
-    DailyChecks(params_id_ != before);
-    MaybeStartDiagnosis();
+    if (job_kind_ == JobKind::kRefit) {
+      FinishRefit(exit_code);
+    } else {
+      const std::int64_t before = params_id_;
+      FinishCalibration(exit_code);  // may start the refit
+      accepted_tonight_ = params_id_ != before;
+    }
+    if (!child_.running()) AfterCalibration();
     return;
   }
   const double ran_s = WallNowS() - child_started_wall_s_;
   if (ran_s > options_.calibration_timeout_s) {
     child_.Kill();
-    Store::CalibrationRow row = job_;
-    row.status = "timeout";
-    row.runtime_s = ran_s;
-    row.reason = "abandoned after " + Format("%.0f", ran_s) + " s (limit " +
-                 Format("%.0f", options_.calibration_timeout_s) + " s); parameters kept";
-    RecordCalibration(row);
-    DailyChecks(false);
+    if (job_kind_ == JobKind::kRefit) {
+      LogToStderr(kWarning, "the refit of calibration " + std::to_string(params_id_) +
+                                " ran over its time limit; the held-out-checked parameters stay");
+    } else {
+      Store::CalibrationRow row = job_;
+      row.status = "timeout";
+      row.runtime_s = ran_s;
+      row.reason = "abandoned after " + Format("%.0f", ran_s) + " s (limit " +
+                   Format("%.0f", options_.calibration_timeout_s) + " s); parameters kept";
+      RecordCalibration(row);
+      accepted_tonight_ = false;
+    }
+    AfterCalibration();
   }
+}
+
+void Service::AfterCalibration() {
+  status_.calibrating = false;
+  DailyChecks(accepted_tonight_);
+  MaybeStartDiagnosis();
+}
+
+// After the held-out check the fit is repeated on the whole window (the
+// held-out days carry the newest information), warm-started from the
+// accepted parameters.
+void Service::StartRefit() {
+  std::string error;
+  job_dir_ = job_dir_ / "refit";
+  if (!StartCalibrateChild(job_window_, "window.csv", &error)) {
+    LogToStderr(kWarning, "the refit on the whole window did not start (" + error +
+                              "); the held-out-checked parameters stay");
+    return;
+  }
+  job_kind_ = JobKind::kRefit;
+  status_.calibrating = true;
+}
+
+void Service::FinishRefit(int exit_code) {
+  job_kind_ = JobKind::kHeldOut;
+  const fs::path new_json = job_dir_ / "new-params.json";
+  std::ifstream in(new_json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ParamsFile file;
+  Diagnostics errors;
+  if (exit_code != 0 || !ParseParamsJson(text, new_json.string(), config_.plant, &file, &errors)) {
+    LogToStderr(kWarning, "the refit of calibration " + std::to_string(params_id_) +
+                              " on the whole window failed (" +
+                              (exit_code != 0 ? LastLine(job_dir_ / "calibrate.log")
+                                              : std::string("unreadable parameters")) +
+                              "); the held-out-checked parameters stay");
+    return;
+  }
+  const nlohmann::json fit =
+      nlohmann::json::parse(text, nullptr, false).value("fit", nlohmann::json::object());
+  const std::string note = "; refit on the whole window (held-out days included) in " +
+                           Format("%.1f", WallNowS() - child_started_wall_s_) + " s";
+  std::string error;
+  if (!store_->UpdateCalibrationParams(params_id_, text, ParamRowsOf(fit), note, &error)) {
+    LogToStderr(kWarning, "storing the refit failed (" + error +
+                              "); the held-out-checked "
+                              "parameters stay");
+    return;
+  }
+  params_ = file.values;
+  params_json_ = text;
+  LogToStderr(kInfo, "calibration " + std::to_string(params_id_) + note.substr(1));
+  IssueForecast();
 }
 
 void Service::MaybeStartDiagnosis() {
@@ -458,16 +544,6 @@ void Service::DailyChecks(bool accepted_now) {
   for (const auto& [priority, line] : cli::RunDailyChecks(*store_, in)) {
     LogToStderr(priority, line);
   }
-}
-
-// The last line of the child's output: why it failed, in its own words.
-std::string LastLine(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line, last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  return last;
 }
 
 void Service::FinishCalibration(int exit_code) {
@@ -538,6 +614,7 @@ void Service::FinishCalibration(int exit_code) {
     params_ = file.values;
     params_json_ = text;
     IssueForecast();
+    if (config_.calibration.refit_full_window) StartRefit();
   }
 }
 
@@ -647,7 +724,12 @@ void Service::Shutdown() {
   if (poller_) poller_->Stop();
   StoreSamples();
   if (store_) Aggregate();
-  if (child_.running()) {
+  if (child_.running() && job_kind_ == JobKind::kRefit) {
+    child_.Kill();
+    LogToStderr(kInfo,
+                "the refit was stopped with the daemon; the held-out-checked parameters "
+                "stay");
+  } else if (child_.running()) {
     child_.Kill();
     Store::CalibrationRow row = job_;
     row.status = "abandoned";

@@ -1174,6 +1174,35 @@ bool Store::InsertCalibration(CalibrationRow* row, std::string* error) {
   return ok;
 }
 
+bool Store::UpdateCalibrationParams(std::int64_t id, const std::string& params_json,
+                                    const std::vector<CalibrationParamRow>& params,
+                                    const std::string& reason_note, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "update calibration " + std::to_string(id),
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "UPDATE calibration SET params_json = ?, reason = COALESCE(reason, '') || ? WHERE id "
+            "= ?",
+            &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_text(stmt, 1, params_json.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(stmt, 2, reason_note.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_int64(stmt, 3, id);
+        s = db.StepDone(stmt, "update calibration " + std::to_string(id));
+        if (!s.ok()) return s;
+        s = db.Prepare("DELETE FROM calibration_param WHERE calibration_id = ?", &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_int64(stmt, 1, id);
+        s = db.StepDone(stmt, "replace the parameters of calibration " + std::to_string(id));
+        if (!s.ok()) return s;
+        return db.InsertCalibrationParams(id, params);
+      },
+      error);
+}
+
 DbStatus Store::Impl::InsertCalibrationParams(std::int64_t calibration_id,
                                               const std::vector<CalibrationParamRow>& params) {
   if (params.empty()) return {};

@@ -281,6 +281,12 @@ class Store {
   bool PruneForecasts(std::int64_t from_ts, std::int64_t to_ts, std::string* error);
 
   bool InsertCalibration(CalibrationRow* row, std::string* error);  // sets row->id
+  // Replaces the parameters of calibration id (params_json and its
+  // calibration_param rows) and appends reason_note to its reason: the
+  // daemon's refit on the whole window after the held-out check.
+  bool UpdateCalibrationParams(std::int64_t id, const std::string& params_json,
+                               const std::vector<CalibrationParamRow>& params,
+                               const std::string& reason_note, std::string* error);
   bool LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error);
 
   // Upserts one forecast issue (all rows in one transaction).

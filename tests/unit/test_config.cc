@@ -160,6 +160,10 @@ TEST(ConfigLoad, DiagnosisAndMonitorSections) {
   EXPECT_EQ(config.diagnosis.keep, 10);
   EXPECT_EQ(config.monitor.drift_days, 28);
   EXPECT_EQ(config.monitor.alarm_days, 3);
+  EXPECT_TRUE(config.calibration.refit_full_window);
+  ASSERT_TRUE(ParseConfig(std::string(kMinimalPlant) + "[calibration]\nrefit_full_window = false\n",
+                          "config.toml", &config, &errors));
+  EXPECT_FALSE(config.calibration.refit_full_window);
   ASSERT_TRUE(ParseConfig(std::string(kMinimalPlant) +
                               "[diagnosis]\nenabled = false\nevery_days = 14\n[monitor]\n"
                               "alarm_days = 5\n",

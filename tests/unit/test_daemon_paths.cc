@@ -236,6 +236,60 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
   EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
 }
 
+// A fit that passes the held-out check is fitted again on the whole window
+// (the held-out days included), and the forecast is issued again with it;
+// the calibration row and its parameter rows hold the refit.
+TEST_F(DaemonPaths, AnAcceptedFitIsRefitOnTheWholeWindow) {
+  ImportHistory(kJune1, 4);
+  WriteConfig(Settings());
+  StartDaemon(kJune1, 60.0);
+  Db db(DbPath());
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Number(
+               "SELECT count(*) FROM calibration WHERE accepted = 1 AND reason LIKE "
+               "'%; refit on the whole window (held-out days included) in %'") == 1;
+  })) << Log();
+  std::vector<fs::path> refits;
+  for (const auto& e : fs::recursive_directory_iterator(dir_ / "calibration")) {
+    if (e.path().filename() == "new-params.json" && e.path().parent_path().filename() == "refit") {
+      refits.push_back(e.path());
+    }
+  }
+  ASSERT_EQ(refits.size(), 1u);
+  EXPECT_EQ(db.Text("SELECT params_json FROM calibration WHERE accepted = 1"), ReadFile(refits[0]));
+  EXPECT_EQ(db.Number("SELECT count(*) FROM parameter_history h JOIN calibration c ON c.id = "
+                      "h.calibration_id WHERE h.value IS NOT json_extract(c.params_json, "
+                      "'$.params.' || h.name)"),
+            0);
+  // The forecast is issued again after the refit (in the same minute here,
+  // so its rows replace the first issue's).
+  ASSERT_TRUE(WaitFor(10, [&] {
+    const std::string log = Log();
+    const std::size_t refit = log.find("refit on the whole window");
+    return refit != std::string::npos && log.find("forecast issued", refit) != std::string::npos;
+  })) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
+// Without the refit the held-out-checked parameters are the ones used.
+TEST_F(DaemonPaths, TheRefitCanBeTurnedOff) {
+  ImportHistory(kJune1, 4);
+  WriteConfig(Settings());
+  const std::string text = ReadFile(dir_ / "pvtwin.toml");
+  std::ofstream(dir_ / "pvtwin.toml") << std::regex_replace(
+      text, std::regex("\\[calibration\\]\n"), "[calibration]\nrefit_full_window = false\n");
+  StartDaemon(kJune1, 60.0);
+  Db db(DbPath());
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
+  })) << Log();
+  ASSERT_TRUE(WaitFor(10, [&] { return Log().find("forecast issued") != std::string::npos; }))
+      << Log();
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE reason LIKE '%refit%'"), 0);
+  EXPECT_EQ(Log().find("refit"), std::string::npos) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
 // After the first calibration the daemon diagnoses its window in a child:
 // the diagnosis row names the calibration and the window, the HTML report is
 // kept under reports/, the verdict is logged, and the daemon goes on.

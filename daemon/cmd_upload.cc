@@ -185,6 +185,7 @@ void RegisterUpload(CLI::App& app) {
       "locally. --init creates or migrates the central schema; --once sends what is queued\n"
       "(resumable: a later run continues where this one stopped) and exits; without them it\n"
       "uploads every [upload] interval_s until SIGTERM, like the daemon's upload thread.\n"
+      "[upload] defaults: interval_s = 60, batch_rows = 5000, forecast_days = 7.\n"
       "Exit 0 success, 1 server unreachable or refusing, 2 bad config.");
   cmd->add_option("--config", args->config, "the daemon's TOML config with [upload]")->required();
   cmd->add_option("--db", args->db, "SQLite file (overrides [storage] path)");

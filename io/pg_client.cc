@@ -72,8 +72,12 @@ std::unique_ptr<PgConnection> PgConnection::Connect(const std::string& conninfo,
   assert(error != nullptr);
   // Later entries override earlier ones: defaults, then the config's
   // string (expanded), then the password.
-  std::vector<const char*> keys = {"connect_timeout", "application_name", "dbname"};
-  std::vector<const char*> values = {"10", application_name.c_str(), conninfo.c_str()};
+  // TCP keepalives notice a server that vanished without closing the
+  // connection within about a minute (the upload thread would wait on it).
+  std::vector<const char*> keys = {"connect_timeout",     "application_name", "keepalives_idle",
+                                   "keepalives_interval", "keepalives_count", "dbname"};
+  std::vector<const char*> values = {"10", application_name.c_str(), "30", "10",
+                                     "3",  conninfo.c_str()};
   if (!password.empty()) {
     keys.push_back("password");
     values.push_back(password.c_str());

@@ -30,7 +30,7 @@ const std::vector<UploadTable>& UploadTables() {
       {"diagnosis", {"id"}, {"id"}, {}, {}},
       {"performance_daily", {"day"}, {"day"}, {}, {}},
       {"qc_event", {"id"}, {"id"}, {}, {}},
-      {"forecast", {"issued_at", "ts"}, {"ts"}, "issued_at", "ts"},
+      {"forecast", {"ts", "issued_at"}, {"ts"}, "issued_at", "ts"},
   };
   return tables;
 }
@@ -346,9 +346,16 @@ bool Uploader::Impl::InstallTable(const UploadTable& spec, std::string* error) {
   if (installed) return true;
   const std::string k1 = std::string(spec.local_key[0]);
   const std::string k2 = spec.local_key.size() > 1 ? std::string(spec.local_key[1]) : "";
+  assert(spec.newest_column.empty() ||
+         (spec.local_key.size() == 2 && spec.central_key.size() == 1 &&
+          spec.central_key[0] == spec.local_key[0] && spec.local_key[1] == spec.newest_column));
   const std::string new_k2 = k2.empty() ? "''" : "NEW." + k2;
+  // The key's old entry goes; with newest_column (local key = central key,
+  // newest_column) so do the entries of older rows of the same central key:
+  // the queue keeps one entry per central row however often it is re-issued.
+  const std::string same = spec.newest_column.empty() ? " = " : " <= ";
   const std::string body = " ON " + name + " BEGIN DELETE FROM upload_queue WHERE table_name = '" +
-                           name + "' AND k1 = NEW." + k1 + " AND k2 = " + new_k2 +
+                           name + "' AND k1 = NEW." + k1 + " AND k2" + same + new_k2 +
                            "; INSERT INTO upload_queue(table_name, k1, k2) VALUES('" + name +
                            "', NEW." + k1 + ", " + new_k2 + "); END";
   // The rows already stored; of a table with newest_column only the newest
@@ -656,7 +663,7 @@ bool Uploader::Connect(PgError* error) {
   if (!u.pg) return false;
   u.server = u.pg->Describe();
   bool complete = false;
-  bool ok = u.pg->Exec("SET statement_timeout = '300s'", error) &&
+  bool ok = u.pg->Exec("SET statement_timeout = '120s'", error) &&
             u.CentralSchemaComplete(&complete, error) && (complete || u.MigrateCentral(error));
   // One uploader per plant_id at a time (session lock, ends with the
   // connection).

@@ -75,7 +75,9 @@ struct UploadTable {
   // When set: a central row is only replaced by a row at least as new in
   // this column, only the locally newest row per central key is sent, and
   // rows of keep_column older than forecast_days before the newest value
-  // of this column are neither sent nor kept centrally.
+  // of this column are neither sent nor kept centrally. Then local_key is
+  // {central key column, newest_column}, so that the queue holds one entry
+  // per central row.
   std::string_view newest_column;
   std::string_view keep_column;
 };

@@ -311,6 +311,9 @@ TEST_F(Upload, ReaggregatedMinutesCalibrationStatusAndForecastsUpdateTheirCentra
   const std::int64_t day = kMorning - 8 * 3600;  // 00:00 UTC
   Import("plant", day, 1, 60, 1);
   const std::int64_t issue = day + 12 * 3600;
+  // From here on the store's triggers queue what changes.
+  const auto init = RunPvtwin(dir_.path(), "upload --init --config plant.toml");
+  ASSERT_EQ(init.exit_code, 0) << init.err;
   {
     RawDb db(Db("plant"));
     ASSERT_EQ(db.Exec("INSERT INTO calibration(run_at, variant, status, accepted) VALUES(" +
@@ -328,8 +331,15 @@ TEST_F(Upload, ReaggregatedMinutesCalibrationStatusAndForecastsUpdateTheirCentra
       }
     }
   }
+  {
+    // One queue entry per ts: a later issue replaces the earlier one's.
+    RawDb db(Db("plant"));
+    EXPECT_EQ(db.Number("SELECT count(*) FROM upload_queue WHERE table_name = 'forecast'"),
+              120 + 120 + 60);
+  }
   auto run = UploadOnce("plant");
   ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("rows/s, ETA"), std::string::npos) << run.err;  // the progress line
   ExpectPlantEqual("plant", 2);
   EXPECT_EQ(Central("SELECT count(*) FROM forecast"), 120 + 60);
   EXPECT_EQ(Central("SELECT count(*) FROM forecast WHERE issued_at = " + std::to_string(issue)),
@@ -506,6 +516,24 @@ TEST_F(Upload, MissingSchemaPermissionIsAClearErrorAndInitLetsARestrictedRoleUpl
   run = UploadOnce("plant");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("upload: 720 rows"), std::string::npos) << run.err;
+  ExpectPlantEqual("plant");
+}
+
+TEST_F(Upload, WithoutOnceItFollowsRowsOtherProcessesWriteUntilSigterm) {
+  WritePlant("plant", "");
+  Import("plant", kMorning - 86400, 1, 60, 1, 360);
+  ChildProcess upload;
+  std::string error;
+  ASSERT_TRUE(upload.Start({PVTWIN_BINARY, "upload", "--config", (dir_ / "plant.toml").string()},
+                           (dir_ / "plant.log").string(), &error))
+      << error;
+  ASSERT_TRUE(WaitFor(20, [&] { return Central("SELECT count(*) FROM measurement_1min") == 360; }))
+      << Log("plant");
+  // The next six hours, imported by another process while it runs.
+  Import("plant", kMorning - 86400, 1, 60, 1, 720);
+  ASSERT_TRUE(WaitFor(20, [&] { return Central("SELECT count(*) FROM measurement_1min") == 720; }))
+      << Log("plant");
+  EXPECT_EQ(upload.Stop(SIGTERM, 10.0), 0) << Log("plant");
   ExpectPlantEqual("plant");
 }
 

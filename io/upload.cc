@@ -444,10 +444,19 @@ bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
       }
     }
   }
-  if (*complete) {
+  if (central.count("pvtwin_schema")) {
     std::vector<std::vector<std::string>> version;
     if (!pg->Query("SELECT max(version) FROM pvtwin_schema", {}, &version, error)) return false;
-    *complete = !version.empty() && version[0][0] == std::to_string(kCentralSchemaVersion);
+    const int found = version.empty() ? 0 : std::atoi(version[0][0].c_str());
+    if (found > kCentralSchemaVersion) {
+      *error = {PgFault::kRefused,
+                "the central schema is version " + std::to_string(found) +
+                    ", newer than this pvtwin knows (" + std::to_string(kCentralSchemaVersion) +
+                    "); upgrade pvtwin",
+                ""};
+      return false;
+    }
+    *complete = *complete && found == kCentralSchemaVersion;
   }
   return true;
 }

@@ -517,6 +517,11 @@ TEST_F(Upload, MissingSchemaPermissionIsAClearErrorAndInitLetsARestrictedRoleUpl
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("upload: 720 rows"), std::string::npos) << run.err;
   ExpectPlantEqual("plant");
+  // A central schema from a newer pvtwin is refused, not migrated back.
+  ASSERT_EQ(pg_.Text("INSERT INTO pvtwin_schema(version) VALUES(2)", "fleet"), "");
+  run = UploadOnce("plant");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("newer than this pvtwin knows"), std::string::npos) << run.err;
 }
 
 TEST_F(Upload, WithoutOnceItFollowsRowsOtherProcessesWriteUntilSigterm) {

@@ -1,5 +1,6 @@
 #include "config/plant_config.h"
 
+#include <libpq-fe.h>
 #include <sys/stat.h>
 #include <toml++/toml.h>
 
@@ -157,6 +158,53 @@ void ReadSim(SectionReader& r, SimConfig* sim) {
   }
 }
 
+// plant_id: what the fleet's dashboards show and the central key, so plain
+// characters only.
+bool IsPlantId(std::string_view id) {
+  return id.size() <= 64 && std::all_of(id.begin(), id.end(), [](char c) {
+           return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                  c == '_' || c == '-' || c == '.';
+         });
+}
+
+// url: parsed by libpq itself (URI or key=value), so the check sees what the
+// connection will see; a password in it is refused without echoing it.
+void CheckUploadUrl(SectionReader& r, const std::string& url) {
+  char* why = nullptr;
+  PQconninfoOption* options = PQconninfoParse(url.c_str(), &why);
+  if (options == nullptr) {
+    std::string rule = "not a libpq connection string (postgresql://... or key=value)";
+    if (why != nullptr) {
+      std::string detail = why;
+      while (!detail.empty() && detail.back() == '\n') detail.pop_back();
+      rule += ": " + detail;
+      PQfreemem(why);
+    }
+    r.RejectHidden("url", rule);
+    return;
+  }
+  for (const PQconninfoOption* o = options; o->keyword != nullptr; ++o) {
+    if (std::string_view(o->keyword) == "password" && o->val != nullptr && *o->val != '\0') {
+      r.RejectHidden("url",
+                     "holds a password; the config is readable by the pvtwin group: put the "
+                     "password in password_file, the systemd credential pgpassword, or ~/.pgpass");
+    }
+  }
+  PQconninfoFree(options);
+}
+
+void ReadUpload(SectionReader& r, UploadConfig* upload) {
+  upload->enabled = true;
+  if (r.String("url", kRequired, &upload->url)) CheckUploadUrl(r, upload->url);
+  r.String("password_file", kOptional, &upload->password_file);
+  if (r.String("plant_id", kRequired, &upload->plant_id) && !IsPlantId(upload->plant_id)) {
+    r.Reject("plant_id", "expected up to 64 letters, digits, '_', '-' or '.'");
+  }
+  r.Number("interval_s", kOptional, Closed(1, 86400), &upload->interval_s);
+  r.Integer("batch_rows", kOptional, Closed(1, 100000), &upload->batch_rows);
+  r.Integer("forecast_days", kOptional, Closed(1, 3650), &upload->forecast_days);
+}
+
 void ReadDocument(const toml::table& root, const SourceText& source, const std::string& file,
                   Config* config, Diagnostics* errors) {
   using SectionFn = void (*)(SectionReader&, Config*);
@@ -173,6 +221,7 @@ void ReadDocument(const toml::table& root, const SourceText& source, const std::
       {"diagnosis", [](SectionReader& r, Config* c) { ReadDiagnosis(r, &c->diagnosis); }},
       {"monitor", [](SectionReader& r, Config* c) { ReadMonitor(r, &c->monitor); }},
       {"sim", [](SectionReader& r, Config* c) { ReadSim(r, &c->sim); }},
+      {"upload", [](SectionReader& r, Config* c) { ReadUpload(r, &c->upload); }},
   };
 
   if (!root.contains("plant")) {

@@ -7,11 +7,17 @@
 //                  Extension: elevation_m (default 0).
 //   [storage]      path, raw_retention_days
 //   [poll]         period_s
-//   [calibration]  variant, window_days, step_s, at, timezone
+//   [calibration]  variant, window_days, step_s, at, timezone, refit_full_window
 //   [forecast]     horizon_h, refresh_min
+//   [diagnosis]    enabled, every_days, timeout_s, keep (the nightly diagnosis)
+//   [monitor]      drift_days, alarm_days (the daily checks)
 //   [sim]          optional; how `pvtwin sim` operates the simulated plant:
 //                  operation, pump_dt_on_k, pump_dt_off_k, brine_below_ambient_k,
 //                  brine_min_c, brine_max_c (SimConfig). Ignored by the daemon.
+//   [upload]       optional; replication of the store into a central
+//                  PostgreSQL (io/upload.h): url, password_file, plant_id
+//                  (required with [upload]), interval_s, batch_rows,
+//                  forecast_days. The url must not hold a password.
 //   [[modbus.*]]   the Modbus register map (config/modbus_config.h).
 //
 // Every problem is reported as one Diagnostic "file:line: key = value: rule",
@@ -79,6 +85,20 @@ struct SimConfig {
   double brine_max_c = 10.0;             // [-20, 30]
 };
 
+// [upload]: the fleet database (DESIGN.md "Fleet contract"). The password
+// never sits in the config: it comes from password_file, from the systemd
+// credential $CREDENTIALS_DIRECTORY/pgpassword, or from libpq's own
+// PGPASSFILE / ~/.pgpass, in that order.
+struct UploadConfig {
+  bool enabled = false;       // the config has an [upload] section
+  std::string url;            // postgresql:// URI or libpq key=value string, no password
+  std::string password_file;  // file whose first line is the password (optional)
+  std::string plant_id;       // this plant's key in every central table
+  double interval_s = 60;     // seconds between upload rounds, [1, 86400]
+  int batch_rows = 5000;      // rows per PostgreSQL transaction, [1, 100000]
+  int forecast_days = 7;      // forecast rows kept centrally, days back from now, [1, 3650]
+};
+
 // The whole configuration. Plain values only: a loaded Config does not refer
 // back to the file and is meant to be held as const.
 struct Config {
@@ -90,6 +110,7 @@ struct Config {
   DiagnosisConfig diagnosis;
   MonitorConfig monitor;
   SimConfig sim;
+  UploadConfig upload;
   ModbusConfig modbus;
   std::string source_path;  // the file it was read from
 };

@@ -192,6 +192,14 @@ class SectionReader {
     if (const toml::node* node = table_.get(key)) Report(key, *node, rule);
   }
 
+  // As Reject, with the value left out of the message (a secret).
+  void RejectHidden(std::string_view key, std::string_view rule) {
+    if (const toml::node* node = table_.get(key)) {
+      errors_->push_back({file_, static_cast<int>(node->source().begin.line), std::string(key),
+                          "(value not shown)", std::string(rule)});
+    }
+  }
+
   // Reads a string that must be one of `choices`; the rule lists them.
   bool Choice(std::string_view key, bool required, const std::vector<std::string_view>& choices,
               std::string* out) {

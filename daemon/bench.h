@@ -18,5 +18,7 @@ void BenchDaemon(double seconds);
 void BenchPoll(int cycles, std::uint64_t seed);
 void BenchEffects(int repeats, std::uint64_t seed);
 void BenchDiagnosis(std::uint64_t seed);
+// A 30-day backlog of 1-min rows into a PostgreSQL started for the purpose.
+void BenchUpload(std::uint64_t seed);
 
 }  // namespace pvtwin::cli

@@ -88,11 +88,14 @@ void RegisterBench(CLI::App& app) {
       "         (CPU at real time; latency over max(400, --repeats) accelerated cycles)\n"
       "  effects each effect of the library: fit time and held-out MAE of base + effect\n"
       "         on 14 + 7 days of synthetic truth data with that effect\n"
-      "  diagnose one gap diagnosis, 14 + 7 days at 1 min, every effect, both cores");
-  cmd->add_option("what", args->what,
-                  "what to benchmark: sim, ident, table6, store, daemon, poll, effects, diagnose")
+      "  diagnose one gap diagnosis, 14 + 7 days at 1 min, every effect, both cores\n"
+      "  upload a 30-day backlog of 1-min rows into a PostgreSQL the bench starts itself:\n"
+      "         rows/s and the uploader's CPU time (needs Debian's postgresql package)");
+  cmd->add_option(
+         "what", args->what,
+         "what to benchmark: sim, ident, table6, store, daemon, poll, effects, diagnose, upload")
       ->check(CLI::IsMember(
-          {"sim", "ident", "table6", "store", "daemon", "poll", "effects", "diagnose"}));
+          {"sim", "ident", "table6", "store", "daemon", "poll", "effects", "diagnose", "upload"}));
   cmd->add_option("--repeats", args->repeats, "runs per figure (median)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
@@ -108,6 +111,7 @@ void RegisterBench(CLI::App& app) {
       if (w == "poll") BenchPoll(std::max(args->repeats, 400), args->seed);
       if (w == "effects") BenchEffects(std::min(args->repeats, 3), args->seed);
       if (w == "diagnose") BenchDiagnosis(args->seed);
+      if (w == "upload") BenchUpload(args->seed);
     }
     SetExitCode(kExitOk);
   });

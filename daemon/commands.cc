@@ -42,6 +42,7 @@ const std::vector<std::pair<std::string, std::string>>& Examples() {
       {"diagnose",
        "pvtwin diagnose --config plant.toml --csv data.csv --variant 1N1Cwr --report out/"},
       {"diagnose-selftest", "pvtwin diagnose-selftest --seeds 5 --jobs 2"},
+      {"upload", "pvtwin upload --once --config /etc/pvtwin/pvtwin.toml"},
   };
   return examples;
 }
@@ -76,6 +77,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterRun(app);
   RegisterDemo(app);
   RegisterDiagnose(app);
+  RegisterUpload(app);
   for (const auto& [verb, example] : Examples()) {
     CLI::App* cmd = app.get_subcommand(verb);
     std::string footer = "\nExample:\n  " + example;

@@ -28,5 +28,6 @@ void RegisterSim(CLI::App& app);
 void RegisterRun(CLI::App& app);
 void RegisterDemo(CLI::App& app);
 void RegisterDiagnose(CLI::App& app);
+void RegisterUpload(CLI::App& app);
 
 }  // namespace pvtwin::cli

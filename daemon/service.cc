@@ -28,6 +28,7 @@
 #include "daemon/nightly_diagnosis.h"
 #include "daemon/notify.h"
 #include "daemon/store_cli.h"
+#include "daemon/upload_worker.h"
 #include "io/child_process.h"
 #include "io/csv.h"
 #include "io/local_time.h"
@@ -176,6 +177,7 @@ class Service {
   // when the database file was deleted or replaced under the daemon.
   bool StoreStillAtPath();
   void UpdateDeviceStatus();
+  void StartUpload();
   double Now() const { return clock_->NowS(); }
 
   ServiceOptions options_;
@@ -186,6 +188,8 @@ class Service {
   StoreLock store_lock_;  // declared before store_: released after it is closed
   std::unique_ptr<Store> store_;
   std::unique_ptr<ModbusPoller> poller_;
+  // [upload]: its own thread, so the loop never waits for the server.
+  std::unique_ptr<UploadWorker> upload_;
   SampleQueue queue_;
   std::vector<Sample> pending_;
   bool store_failing_ = false;
@@ -253,6 +257,11 @@ bool Service::LoadAndApplyConfig(bool initial) {
                   "reload: the 1-min aggregation uses the new [plant] fluid_cp_j_kgk after a "
                   "restart");
     }
+    if (config.upload.enabled != config_.upload.enabled ||
+        config.upload.url != config_.upload.url ||
+        config.upload.plant_id != config_.upload.plant_id)
+      LogToStderr(kWarning, "reload: [upload] changes take effect after a restart");
+    config.upload = config_.upload;
     if (config.modbus.devices.size() != config_.modbus.devices.size() ||
         config.modbus.points.size() != config_.modbus.points.size())
       LogToStderr(kWarning, "reload: [[modbus.*]] changes take effect after a restart");
@@ -674,6 +683,20 @@ void Service::IssueForecast() {
                          std::to_string(params_id_) + "; " + inputs);
 }
 
+void Service::StartUpload() {
+  UploadSettings settings;
+  settings.store_path = config_.storage.path;
+  settings.url = config_.upload.url;
+  settings.password_file = config_.upload.password_file;
+  settings.plant_id = config_.upload.plant_id;
+  settings.batch_rows = config_.upload.batch_rows;
+  settings.forecast_days = config_.upload.forecast_days;
+  upload_ = std::make_unique<UploadWorker>(
+      settings, config_.upload.interval_s,
+      [](int priority, const std::string& line) { LogToStderr(priority, line); });
+  upload_->Start();
+}
+
 void Service::UpdateDeviceStatus() {
   if (!poller_) return;
   int up = 0;
@@ -744,6 +767,8 @@ void Service::Shutdown() {
   if (!pending_.empty()) {
     LogToStderr(kErr, std::to_string(pending_.size()) + " samples could not be stored");
   }
+  // Last: rows stored above stay queued for the next start.
+  if (upload_) upload_->Stop();
 }
 
 int Service::Run() {
@@ -783,6 +808,7 @@ int Service::Run() {
                 "no [[modbus.device]] in the config: polling is off; calibrations and "
                 "forecasts use the data imported into the database");
   }
+  if (config_.upload.enabled) StartUpload();
   const double now = Now();
   next_calibration_s_ = !have_params_ && options_.calibrate_when_uncalibrated
                             ? now

@@ -187,5 +187,39 @@ TEST(ConfigLoad, DiagnosisAndMonitorSections) {
   EXPECT_EQ(errors[4].ToString(), "config.toml:13: alarm_days = 2.5: expected an integer");
 }
 
+TEST(ConfigLoad, UploadSectionIsOptionalWithDocumentedDefaults) {
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseConfig(kMinimalPlant, "config.toml", &config, &errors));
+  EXPECT_FALSE(config.upload.enabled);
+  const std::string text = std::string(kMinimalPlant) +
+                           "[upload]\nurl = \"postgresql://pvtwin@fleet.example.org/fleet\"\n"
+                           "plant_id = \"north-1\"\n";
+  ASSERT_TRUE(ParseConfig(text, "config.toml", &config, &errors)) << errors.front().ToString();
+  EXPECT_TRUE(config.upload.enabled);
+  EXPECT_EQ(config.upload.url, "postgresql://pvtwin@fleet.example.org/fleet");
+  EXPECT_EQ(config.upload.plant_id, "north-1");
+  EXPECT_EQ(config.upload.password_file, "");
+  EXPECT_DOUBLE_EQ(config.upload.interval_s, 60);
+  EXPECT_EQ(config.upload.batch_rows, 5000);
+  EXPECT_EQ(config.upload.forecast_days, 7);
+}
+
+TEST(ConfigLoad, UploadUrlWithAPasswordIsRejectedInEveryFormWithoutShowingIt) {
+  for (const std::string url : {"postgresql://u:pw1234@h/db", "postgresql://u@h/db?password=pw1234",
+                                "host=h dbname=db password=pw1234", "host=h password='pw1234'"}) {
+    Config config;
+    Diagnostics errors;
+    const std::string text =
+        std::string(kMinimalPlant) + "[upload]\nurl = \"" + url + "\"\nplant_id = \"p\"\n";
+    ASSERT_FALSE(ParseConfig(text, "config.toml", &config, &errors)) << url;
+    ASSERT_EQ(errors.size(), 1u) << url;
+    EXPECT_EQ(errors[0].line, 8) << url;
+    EXPECT_EQ(errors[0].field, "url");
+    EXPECT_NE(errors[0].rule.find("holds a password"), std::string::npos);
+    EXPECT_EQ(errors[0].ToString().find("pw1234"), std::string::npos) << errors[0].ToString();
+  }
+}
+
 }  // namespace
 }  // namespace pvtwin

@@ -1,0 +1,123 @@
+#include "daemon/upload_worker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "core/clock.h"
+
+namespace pvtwin {
+
+namespace {
+
+std::string Seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.0f s", s);
+  return buf;
+}
+
+}  // namespace
+
+UploadWorker::UploadWorker(const UploadSettings& settings, double interval_s, LogFn log)
+    : settings_(settings), interval_s_(interval_s), log_(std::move(log)) {}
+
+UploadWorker::~UploadWorker() { Stop(); }
+
+void UploadWorker::Start() {
+  thread_ = std::thread([this] { Loop(); });
+}
+
+void UploadWorker::Stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void UploadWorker::Wait(double s) {
+  std::unique_lock lock(mutex_);
+  wake_.wait_for(lock, std::chrono::duration<double>(s), [this] { return stop_; });
+}
+
+bool UploadWorker::Round(PgError* error) {
+  bool more = true;
+  while (more) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stop_) return true;
+    }
+    std::int64_t rows = 0;
+    if (!uploader_->UploadBatches(&rows, &more, error)) return false;
+    rows_ += rows;
+    if (state_.load() != UploadState::kConnected) Enter(UploadState::kConnected, {});
+  }
+  uploader_->RecordState(UploadState::kConnected, "", true);
+  return true;
+}
+
+void UploadWorker::Enter(UploadState next, const PgError& error) {
+  const UploadState before = state_.exchange(next);
+  if (uploader_) uploader_->RecordState(next, error.message, next == UploadState::kConnected);
+  if (before == next) return;
+  const std::string server = uploader_ ? uploader_->server() : settings_.url;
+  switch (next) {
+    case UploadState::kConnected:
+      if (before == UploadState::kStarting) {
+        log_(kNotice, "upload: connected to " + server + " as plant_id " + settings_.plant_id);
+      } else {
+        log_(kNotice, "upload: recovered (" + std::string(UploadStateName(before)) + " for " +
+                          Seconds(WallNowS() - down_since_s_) + "), connected to " + server +
+                          "; the queued rows follow");
+      }
+      break;
+    case UploadState::kAuthFailed:
+      log_(kErr, "upload: authentication failed: " + error.message +
+                     " (password from [upload] password_file, the credential pgpassword or "
+                     "~/.pgpass); rows stay queued in the store, retried with backoff");
+      break;
+    case UploadState::kRefused:
+      log_(kErr, "upload: refused: " + error.message +
+                     "; rows stay queued in the store, retried with backoff");
+      break;
+    case UploadState::kDown:
+      log_(kWarning, "upload: server down: " + error.message +
+                         "; rows stay queued in the store, retried with backoff");
+      break;
+    case UploadState::kStarting:
+      break;
+  }
+  if (next != UploadState::kConnected && before == UploadState::kConnected) {
+    down_since_s_ = WallNowS();
+  } else if (next != UploadState::kConnected && before == UploadState::kStarting) {
+    down_since_s_ = WallNowS();
+  }
+}
+
+void UploadWorker::Loop() {
+  const double cap_s = std::clamp(5.0 * interval_s_, 5.0, 300.0);
+  double backoff_s = 1.0;
+  for (;;) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stop_) break;
+    }
+    PgError error;
+    if (!uploader_) {
+      std::string why;
+      uploader_ = Uploader::Open(settings_, &why);
+      if (!uploader_) error = {PgFault::kLocal, why, ""};
+    }
+    if (uploader_ && Round(&error)) {
+      backoff_s = 1.0;
+      Wait(interval_s_);
+      continue;
+    }
+    Enter(StateForFault(error.fault), error);
+    Wait(backoff_s);
+    backoff_s = std::min(2.0 * backoff_s, cap_s);
+  }
+}
+
+}  // namespace pvtwin

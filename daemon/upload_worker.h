@@ -1,0 +1,59 @@
+// The upload of the store into the central PostgreSQL as a thread of its
+// own (io/upload.h does the work): the daemon's loop never waits for the
+// server. While the server is down, unreachable or refusing, the thread
+// retries with exponential backoff (1 s doubling up to
+// clamp(5·interval_s, 5 s, 300 s)) and the rows wait in the store's queue;
+// the log gets one line per change of state (connected, down, recovered,
+// auth failure, refused), not one per retry, and upload_connection in the
+// store says the same for the operator.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "io/log.h"
+#include "io/upload.h"
+
+namespace pvtwin {
+
+class UploadWorker {
+ public:
+  UploadWorker(const UploadSettings& settings, double interval_s, LogFn log);
+  ~UploadWorker();  // stops and joins
+  UploadWorker(const UploadWorker&) = delete;
+  UploadWorker& operator=(const UploadWorker&) = delete;
+
+  void Start();
+  // Asks the thread to stop after the batch it is sending, and joins it.
+  void Stop();
+
+  UploadState state() const { return state_.load(); }
+  std::int64_t rows_uploaded() const { return rows_.load(); }
+
+ private:
+  void Loop();
+  // One round: batches until nothing is pending. False after a fault.
+  bool Round(PgError* error);
+  void Enter(UploadState next, const PgError& error);
+  // Sleeps s seconds or until Stop.
+  void Wait(double s);
+
+  UploadSettings settings_;
+  double interval_s_;
+  LogFn log_;
+  std::unique_ptr<Uploader> uploader_;
+  std::thread thread_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::atomic<UploadState> state_{UploadState::kStarting};
+  std::atomic<std::int64_t> rows_{0};
+  double down_since_s_ = 0.0;
+};
+
+}  // namespace pvtwin

@@ -1,0 +1,569 @@
+// The upload into a central PostgreSQL (io/upload.h) against a real server
+// (io/pg_scratch_server.h) and the real pvtwin processes: daemons
+// (`pvtwin run`, some polling `pvtwin sim` on loopback) and `pvtwin upload
+// --once`. Every scenario ends by comparing the central rows with the
+// plant's SQLite rows, value by value.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "config/config_edit.h"
+#include "core/clock.h"
+#include "io/child_process.h"
+#include "io/pg_scratch_server.h"
+#include "tests/support/files.h"
+#include "tests/support/run_pvtwin.h"
+#include "tests/support/sqlite_db.h"
+#include "tests/support/wait.h"
+
+namespace pvtwin {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::RawDb;
+using testing::ReadFile;
+using testing::RunCommand;
+using testing::RunPvtwin;
+using testing::ScratchDir;
+using testing::WaitFor;
+
+const fs::path kSimPlant = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
+// 2024-06-01 08:00 UTC: a June morning at the example plant.
+constexpr std::int64_t kMorning = 1717228800;
+constexpr double kSpeed = 120.0;
+
+// A local cell as SQLite holds it.
+struct Cell {
+  int type = SQLITE_NULL;
+  std::int64_t i = 0;
+  double x = 0.0;
+  std::string text;
+};
+
+// Rows of `sql` from the store, typed.
+std::vector<std::vector<Cell>> LocalRows(const fs::path& db_path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+  sqlite3_busy_timeout(db, 5000);
+  sqlite3_stmt* stmt = nullptr;
+  std::vector<std::vector<Cell>> rows;
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr), SQLITE_OK)
+      << sql << ": " << sqlite3_errmsg(db);
+  while (stmt != nullptr && sqlite3_step(stmt) == SQLITE_ROW) {
+    std::vector<Cell>& row = rows.emplace_back();
+    for (int c = 0; c < sqlite3_column_count(stmt); ++c) {
+      Cell cell;
+      cell.type = sqlite3_column_type(stmt, c);
+      cell.i = sqlite3_column_int64(stmt, c);
+      cell.x = sqlite3_column_double(stmt, c);
+      const unsigned char* t = sqlite3_column_text(stmt, c);
+      cell.text = t ? reinterpret_cast<const char*>(t) : "";
+      row.push_back(cell);
+    }
+  }
+  sqlite3_finalize(stmt);
+  sqlite3_close_v2(db);
+  return rows;
+}
+
+// The columns of a local table, comma separated.
+std::string LocalColumns(const fs::path& db_path, const std::string& table) {
+  std::string cols;
+  for (const auto& row :
+       LocalRows(db_path, "SELECT name FROM pragma_table_info('" + table + "') ORDER BY cid")) {
+    cols += (cols.empty() ? "" : ", ") + row[0].text;
+  }
+  return cols;
+}
+
+// A central cell equals a local one: NULL for NULL, the same integer, the
+// same double (PostgreSQL prints the shortest text that reads back exactly),
+// the same text.
+bool SameCell(const Cell& local, const std::string& central) {
+  switch (local.type) {
+    case SQLITE_NULL:
+      return central == "NULL";
+    case SQLITE_INTEGER:
+      return central == std::to_string(local.i) ||
+             std::strtod(central.c_str(), nullptr) == static_cast<double>(local.i);
+    case SQLITE_FLOAT:
+      return std::strtod(central.c_str(), nullptr) == local.x;
+    default:
+      return central == local.text;
+  }
+}
+
+// Every row of the local query equals the central one of the same position
+// (both ordered by key); returns the number of rows compared.
+std::size_t ExpectSameRows(const PgScratchServer& pg, const fs::path& db,
+                           const std::string& plant_id, const std::string& table,
+                           const std::string& local_where, const std::string& order) {
+  const std::string cols = LocalColumns(db, table);
+  const auto local =
+      LocalRows(db, "SELECT " + cols + " FROM " + table + " " + local_where + " ORDER BY " + order);
+  const auto central = pg.Query("SELECT " + cols + " FROM " + table + " WHERE plant_id = '" +
+                                    plant_id + "' ORDER BY " + order,
+                                "fleet");
+  EXPECT_EQ(local.size(), central.size()) << table << " of " << plant_id;
+  if (local.size() != central.size()) return 0;
+  std::size_t differing = 0;
+  for (std::size_t r = 0; r < local.size(); ++r) {
+    for (std::size_t c = 0; c < local[r].size(); ++c) {
+      if (!SameCell(local[r][c], central[r][c]) && differing++ < 5) {
+        ADD_FAILURE() << table << " of " << plant_id << " row " << r << " column " << c
+                      << ": local " << local[r][c].text << ", central " << central[r][c];
+      }
+    }
+  }
+  EXPECT_EQ(differing, 0u) << table << " of " << plant_id;
+  return local.size();
+}
+
+int CountLines(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) {
+    ++n;
+  }
+  return n;
+}
+
+class Upload : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (PgScratchServer::FindBinDir().empty()) {
+      GTEST_SKIP() << "PostgreSQL is not installed (no initdb/pg_ctl in /usr/lib/postgresql/*/bin "
+                      "or on PATH): apt-get install postgresql";
+    }
+    std::string error;
+    ASSERT_TRUE(pg_.Start(&error)) << error;
+    ASSERT_EQ(pg_.Text("CREATE DATABASE fleet"), "");
+    std::ofstream(dir_ / "pgpassword") << pg_.password() << "\n";
+  }
+
+  // A plant config: the example plant, no Modbus devices unless
+  // modbus_text is given (then it is the whole config with devices), the
+  // store in the scratch directory, [upload] to the test server.
+  fs::path WritePlant(const std::string& name, const std::string& upload_extra,
+                      const std::string& modbus_text = "") {
+    std::string text = modbus_text;
+    if (text.empty()) {
+      std::istringstream in(ReadFile(kSimPlant));
+      std::string line;
+      while (std::getline(in, line) && !line.starts_with("[[modbus")) text += line + "\n";
+      text += "[storage]\npath = \"" + (dir_ / (name + ".db")).string() +
+              "\"\n[calibration]\ntimezone = \"UTC\"\n";
+    }
+    text += "\n[upload]\nurl = \"" + pg_.Conninfo("fleet") + "\"\npassword_file = \"" +
+            (dir_ / "pgpassword").string() + "\"\nplant_id = \"" + name + "\"\ninterval_s = 1\n" +
+            upload_extra;
+    const fs::path config = dir_ / (name + ".toml");
+    std::ofstream(config) << text;
+    return config;
+  }
+  fs::path Db(const std::string& name) const { return dir_ / (name + ".db"); }
+
+  // History of the simulated plant as 1-min rows (or samples) in the store:
+  // whole days, or their first keep_rows rows.
+  void Import(const std::string& name, std::int64_t start, int days, int step_s, int seed,
+              int keep_rows = -1) {
+    const std::string csv = name + "-" + std::to_string(seed) + ".csv";
+    const auto exported = RunPvtwin(
+        dir_.path(), "sim --config '" + kSimPlant.string() + "' --export " + csv + " --days " +
+                         std::to_string(days) + " --step " + std::to_string(step_s) + " --start " +
+                         std::to_string(start) + " --seed " + std::to_string(seed));
+    ASSERT_EQ(exported.exit_code, 0) << exported.err;
+    if (keep_rows >= 0) {
+      std::istringstream in(ReadFile(dir_ / csv));
+      std::ofstream out(dir_ / csv, std::ios::trunc);
+      std::string line;
+      for (int i = 0; i <= keep_rows && std::getline(in, line); ++i) out << line << "\n";
+    }
+    ImportCsv(name, csv);
+  }
+  void ImportCsv(const std::string& name, const std::string& csv) {
+    const auto imported = RunPvtwin(dir_.path(), "import --config " + name + ".toml --csv " + csv);
+    ASSERT_EQ(imported.exit_code, 0) << imported.err;
+  }
+
+  testing::ProcessResult UploadOnce(const std::string& name, const std::string& env = "") {
+    return RunCommand(dir_.path(), env + " '" + std::string(PVTWIN_BINARY) +
+                                       "' upload --once --config " + name + ".toml");
+  }
+
+  bool StartDaemon(ChildProcess* daemon, const std::string& name,
+                   const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> argv = {PVTWIN_BINARY, "run", "--config",
+                                     (dir_ / (name + ".toml")).string()};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    std::string error;
+    const bool ok = daemon->Start(argv, (dir_ / (name + ".log")).string(), &error);
+    EXPECT_TRUE(ok) << error;
+    return ok;
+  }
+  std::string Log(const std::string& name) const { return ReadFile(dir_ / (name + ".log")); }
+
+  double Pending(const std::string& name) {
+    RawDb db(Db(name));
+    return db.Number("SELECT coalesce(sum(rows_pending), 0) FROM upload_status");
+  }
+  long long Central(const std::string& sql) {
+    const std::string t = pg_.Text(sql, "fleet");
+    return t.empty() || t.starts_with("ERROR") ? -1 : std::stoll(t);
+  }
+
+  // measurement_1min, calibration and forecast (the newest issue per ts
+  // within forecast_days of the newest issue) equal centrally and locally.
+  void ExpectPlantEqual(const std::string& name, int forecast_days = 7) {
+    const fs::path db = Db(name);
+    EXPECT_GT(ExpectSameRows(pg_, db, name, "measurement_1min", "", "ts"), 0u);
+    ExpectSameRows(pg_, db, name, "calibration", "", "id");
+    ExpectSameRows(pg_, db, name, "forecast",
+                   "f WHERE issued_at = (SELECT max(issued_at) FROM forecast g WHERE g.ts = f.ts)"
+                   " AND ts >= (SELECT max(issued_at) FROM forecast) - " +
+                       std::to_string(forecast_days * 86400),
+                   "ts");
+  }
+
+  ScratchDir dir_{"upload"};
+  PgScratchServer pg_;
+};
+
+TEST_F(Upload, TwoDaemonsUploadTwoPlantsIntoOneDatabase) {
+  // 1.5 days each: too little to calibrate, so each daemon records a
+  // skipped calibration and no fit competes for the CPU.
+  for (const auto& [name, seed] : {std::pair<std::string, int>{"north", 1}, {"south", 2}}) {
+    WritePlant(name, "batch_rows = 700\n");
+    Import(name, kMorning - 86400, 2, 60, seed, 2160);
+  }
+  ChildProcess north, south;
+  ASSERT_TRUE(StartDaemon(&north, "north"));
+  ASSERT_TRUE(StartDaemon(&south, "south"));
+  for (const std::string name : {"north", "south"}) {
+    ASSERT_TRUE(WaitFor(30, [&] {
+      return Central("SELECT count(*) FROM calibration WHERE plant_id = '" + name + "'") >= 1 &&
+             Pending(name) == 0;
+    })) << Log(name);
+  }
+  EXPECT_EQ(north.Stop(SIGTERM, 10.0), 0) << Log("north");
+  EXPECT_EQ(south.Stop(SIGTERM, 10.0), 0) << Log("south");
+  EXPECT_EQ(Central("SELECT count(*) FROM measurement_1min"), 2 * 2160);
+  ExpectPlantEqual("north");
+  ExpectPlantEqual("south");
+  // Different weather seeds: the plants' rows are their own.
+  EXPECT_EQ(Central("SELECT count(*) FROM measurement_1min n JOIN measurement_1min s "
+                    "USING (ts) WHERE n.plant_id = 'north' AND s.plant_id = 'south' "
+                    "AND n.p_el_w IS NOT DISTINCT FROM s.p_el_w AND n.p_el_w > 0"),
+            0);
+  const auto latest =
+      pg_.Query("SELECT plant_id, measurement_ts FROM plant_latest ORDER BY plant_id", "fleet");
+  ASSERT_EQ(latest.size(), 2u);
+  const std::string last_ts = std::to_string(kMorning - 86400 + 2160 * 60 - 60);
+  EXPECT_EQ(latest[0], (std::vector<std::string>{"north", last_ts}));
+  EXPECT_EQ(latest[1], (std::vector<std::string>{"south", last_ts}));
+  EXPECT_NE(Log("north").find("upload: connected to"), std::string::npos) << Log("north");
+}
+
+TEST_F(Upload, DaemonKilledBetweenCentralCommitAndHighWaterMarkLeavesNoDuplicateAndNoGap) {
+  WritePlant("plant", "batch_rows = 500\n");
+  Import("plant", kMorning - 86400, 1, 60, 1);
+  ChildProcess daemon;
+  // The second central COMMIT ends the process before its mark moves.
+  ::setenv("PVTWIN_UPLOAD_TEST_KILL_AFTER_COMMIT", "2", 1);
+  const bool started = StartDaemon(&daemon, "plant");
+  ::unsetenv("PVTWIN_UPLOAD_TEST_KILL_AFTER_COMMIT");
+  ASSERT_TRUE(started);
+  int exit_code = 0;
+  ASSERT_TRUE(WaitFor(30, [&] { return daemon.Finished(&exit_code); })) << Log("plant");
+  EXPECT_EQ(exit_code, -SIGKILL);
+  // The central database holds rows the store still counts as pending.
+  const long long central = Central(
+      "SELECT (SELECT count(*) FROM measurement_1min) + "
+      "(SELECT count(*) FROM calibration)");
+  double uploaded = 0;
+  {
+    RawDb db(Db("plant"));
+    uploaded = db.Number("SELECT sum(rows_uploaded) FROM upload_state");
+    EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
+  }
+  EXPECT_GT(central, static_cast<long long>(uploaded));
+  ASSERT_TRUE(StartDaemon(&daemon, "plant"));
+  // The daemon records a (skipped) calibration a loop pass after its start.
+  ASSERT_TRUE(WaitFor(30, [&] {
+    RawDb db(Db("plant"));
+    return db.Number("SELECT count(*) FROM calibration") >= 1 &&
+           Central("SELECT count(*) FROM calibration") ==
+               static_cast<long long>(db.Number("SELECT count(*) FROM calibration")) &&
+           Pending("plant") == 0 && Central("SELECT count(*) FROM measurement_1min") == 1440;
+  })) << Log("plant");
+  EXPECT_EQ(daemon.Stop(SIGTERM, 10.0), 0) << Log("plant");
+  EXPECT_EQ(Central("SELECT count(*) FROM measurement_1min"), 1440);
+  ExpectPlantEqual("plant");
+}
+
+TEST_F(Upload, ReaggregatedMinutesCalibrationStatusAndForecastsUpdateTheirCentralRows) {
+  WritePlant("plant", "batch_rows = 400\nforecast_days = 2\n");
+  const std::int64_t day = kMorning - 8 * 3600;  // 00:00 UTC
+  Import("plant", day, 1, 60, 1);
+  const std::int64_t issue = day + 12 * 3600;
+  // From here on the store's triggers queue what changes.
+  const auto init = RunPvtwin(dir_.path(), "upload --init --config plant.toml");
+  ASSERT_EQ(init.exit_code, 0) << init.err;
+  {
+    RawDb db(Db("plant"));
+    ASSERT_EQ(db.Exec("INSERT INTO calibration(run_at, variant, status, accepted) VALUES(" +
+                      std::to_string(day) + ", '1N1Cwr', 'running', 0)"),
+              SQLITE_OK);
+    // Three issues: an old one (pruned centrally: more than forecast_days
+    // before the newest), and two that overlap (the newer wins each ts).
+    for (const std::int64_t at : {issue - 5 * 86400, issue - 3600, issue}) {
+      for (int k = 0; k < 120; ++k) {
+        const std::int64_t ts = at + 60 * k;
+        ASSERT_EQ(db.Exec("INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w) VALUES(" +
+                          std::to_string(at) + ", " + std::to_string(ts) + ", " +
+                          std::to_string(at % 1000 + k) + ".25, 1.5)"),
+                  SQLITE_OK);
+      }
+    }
+  }
+  {
+    // One queue entry per ts: a later issue replaces the earlier one's.
+    RawDb db(Db("plant"));
+    EXPECT_EQ(db.Number("SELECT count(*) FROM upload_queue WHERE table_name = 'forecast'"),
+              120 + 120 + 60);
+  }
+  auto run = UploadOnce("plant");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("rows/s, ETA"), std::string::npos) << run.err;  // the progress line
+  ExpectPlantEqual("plant", 2);
+  EXPECT_EQ(Central("SELECT count(*) FROM forecast"), 120 + 60);
+  EXPECT_EQ(Central("SELECT count(*) FROM forecast WHERE issued_at = " + std::to_string(issue)),
+            120);
+
+  // Samples of another weather seed for 10 minutes at 12:00: the import
+  // re-aggregates (replaces) those minutes in a new process.
+  const auto exported =
+      RunPvtwin(dir_.path(), "sim --config '" + kSimPlant.string() +
+                                 "' --export samples.csv --days 1 --step 5 --start " +
+                                 std::to_string(day) + " --seed 7");
+  ASSERT_EQ(exported.exit_code, 0) << exported.err;
+  {
+    std::istringstream in(ReadFile(dir_ / "samples.csv"));
+    std::ofstream out(dir_ / "noon.csv");
+    std::string line;
+    std::getline(in, line);
+    out << line << "\n";
+    for (int i = 0; std::getline(in, line); ++i) {
+      if (i >= 12 * 720 && i < 12 * 720 + 120) out << line << "\n";
+    }
+  }
+  const std::string noon = std::to_string(day + 12 * 3600);
+  const std::string before =
+      pg_.Text("SELECT t_out_c FROM measurement_1min WHERE ts = " + noon, "fleet");
+  ImportCsv("plant", "noon.csv");
+  {
+    RawDb db(Db("plant"));
+    ASSERT_EQ(db.Exec("UPDATE calibration SET status = 'accepted', accepted = 1"), SQLITE_OK);
+    EXPECT_EQ(db.Number("SELECT sum(rows_pending) FROM upload_status"), 10 + 1);
+  }
+  run = UploadOnce("plant");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(pg_.Text("SELECT t_out_c FROM measurement_1min WHERE ts = " + noon, "fleet"), before);
+  ExpectPlantEqual("plant", 2);
+  EXPECT_EQ(pg_.Text("SELECT status FROM calibration", "fleet"), "accepted");
+  EXPECT_EQ(pg_.Text("SELECT calibration_id FROM plant_latest", "fleet"), "1");
+  EXPECT_EQ(Central("SELECT count(*) FROM measurement_1min"), 1440);
+}
+
+// The daemon with a simulated plant on loopback, on an accelerated clock.
+class UploadLive : public Upload {
+ protected:
+  void SetUp() override {
+    Upload::SetUp();
+    if (IsSkipped() || HasFatalFailure()) return;
+    fs::copy_file(kSimPlant, dir_ / "sim.toml");
+    anchor_ = WallNowS();
+    std::string error;
+    ASSERT_TRUE(
+        sim_.StartPiped({PVTWIN_BINARY, "sim", "--config", (dir_ / "sim.toml").string(),
+                         "--ephemeral-ports", "--speed", std::to_string(kSpeed), "--start",
+                         std::to_string(kMorning), "--wall-anchor", std::to_string(anchor_)},
+                        (dir_ / "sim.log").string(), &error))
+        << error;
+    ASSERT_TRUE(sim_.ReadUntil("ready", 20.0, &listening_)) << ReadFile(dir_ / "sim.log");
+  }
+  void TearDown() override {
+    sim_.SendLine("quit");
+    sim_.Stop(0, 5.0);
+  }
+  fs::path WriteLivePlant(const std::string& upload_extra) {
+    DaemonSettings settings;
+    settings.db_path = Db("plant").string();
+    std::string text, error;
+    EXPECT_TRUE(
+        EditConfig(ReadFile(kSimPlant), ParseListeningLines(listening_), settings, &text, &error))
+        << error;
+    return WritePlant("plant", upload_extra, text);
+  }
+  std::vector<std::string> LiveArgs() const {
+    return {"--speed",       std::to_string(kSpeed), "--sim-start", std::to_string(kMorning),
+            "--wall-anchor", std::to_string(anchor_)};
+  }
+
+  ChildProcess sim_;
+  std::vector<std::string> listening_;
+  double anchor_ = 0.0;
+};
+
+TEST_F(UploadLive, ServerStoppedAndRestartedMidRunLosesAndDuplicatesNothing) {
+  WriteLivePlant("batch_rows = 300\n");
+  Import("plant", kMorning - 86400, 1, 60, 1);
+  ChildProcess daemon;
+  ASSERT_TRUE(StartDaemon(&daemon, "plant", LiveArgs()));
+  const std::string live = " WHERE ts >= " + std::to_string(kMorning);
+  ASSERT_TRUE(WaitFor(30, [&] {
+    return Central("SELECT count(*) FROM measurement_1min" + live) >= 2;
+  })) << Log("plant");
+  pg_.Stop();
+  double samples_at_stop = 0;
+  {
+    RawDb db(Db("plant"));
+    samples_at_stop = db.Number("SELECT count(*) FROM sample_5s");
+  }
+  // The plant keeps polling while the server is away (2 simulated minutes a second).
+  ASSERT_TRUE(WaitFor(20, [&] {
+    RawDb db(Db("plant"));
+    return db.Number("SELECT count(*) FROM sample_5s") > samples_at_stop + 60 &&
+           db.Text("SELECT state FROM upload_connection") == "down";
+  })) << Log("plant");
+  std::string error;
+  ASSERT_TRUE(pg_.Resume(&error)) << error;
+  ASSERT_TRUE(WaitFor(30, [&] {
+    RawDb db(Db("plant"));
+    return db.Text("SELECT state FROM upload_connection") == "connected" &&
+           Central("SELECT max(ts) FROM measurement_1min") >
+               static_cast<long long>(kMorning) + 60 * 12;
+  })) << Log("plant");
+  EXPECT_EQ(daemon.Stop(SIGTERM, 10.0), 0) << Log("plant");
+  const std::string log = Log("plant");
+  EXPECT_EQ(CountLines(log, "upload: server down"), 1) << log;
+  EXPECT_EQ(CountLines(log, "upload: recovered"), 1) << log;
+  // The minutes aggregated at the stop follow with the next upload.
+  const auto run = UploadOnce("plant");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  ExpectPlantEqual("plant");
+}
+
+TEST_F(UploadLive, WrongPasswordIsOneLoggedErrorAndThePlantKeepsPollingAndForecasting) {
+  WriteLivePlant("");
+  std::ofstream(dir_ / "pgpassword") << "not-" << pg_.password() << "\n";
+  // Two days: the daemon calibrates at once and then forecasts.
+  Import("plant", kMorning - 2 * 86400, 2, 60, 1);
+  ChildProcess daemon;
+  ASSERT_TRUE(StartDaemon(&daemon, "plant", LiveArgs()));
+  ASSERT_TRUE(WaitFor(90, [&] {
+    RawDb db(Db("plant"));
+    return db.Number("SELECT count(*) FROM forecast") > 0 &&
+           db.Number("SELECT count(*) FROM sample_5s") > 60;
+  })) << Log("plant");
+  {
+    RawDb db(Db("plant"));
+    EXPECT_EQ(db.Text("SELECT DISTINCT state FROM upload_status"), "auth_failed");
+    EXPECT_NE(db.Text("SELECT last_error FROM upload_connection").find("password authentication"),
+              std::string::npos);
+    EXPECT_GT(db.Number("SELECT sum(rows_pending) FROM upload_status"), 2880);
+  }
+  EXPECT_EQ(daemon.Stop(SIGTERM, 10.0), 0) << Log("plant");
+  EXPECT_EQ(CountLines(Log("plant"), "upload: authentication failed"), 1) << Log("plant");
+  EXPECT_EQ(Central("SELECT count(*) FROM plant"), -1);  // nothing reached the server
+}
+
+TEST_F(Upload, MissingSchemaPermissionIsAClearErrorAndInitLetsARestrictedRoleUpload) {
+  WritePlant("admin", "");
+  const std::string restricted_password = "r" + pg_.password();
+  ASSERT_EQ(pg_.Text("CREATE ROLE plant LOGIN PASSWORD '" + restricted_password + "'"), "");
+  std::ofstream(dir_ / "plant-password") << restricted_password << "\n";
+  // The plant's config: the restricted role, which may not CREATE in public.
+  std::string text = ReadFile(dir_ / "admin.toml");
+  const std::string user = "user=postgres", file = (dir_ / "pgpassword").string();
+  text.replace(text.find(user), user.size(), "user=plant");
+  text.replace(text.find(file), file.size(), (dir_ / "plant-password").string());
+  text.replace(text.find("plant_id = \"admin\""), 18, "plant_id = \"plant\"");
+  text.replace(text.find("admin.db"), 8, "plant.db");
+  std::ofstream(dir_ / "plant.toml") << text;
+  Import("plant", kMorning - 86400, 1, 60, 1, 720);
+
+  auto run = UploadOnce("plant");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("permission denied for schema public"), std::string::npos) << run.err;
+  {
+    RawDb db(Db("plant"));
+    EXPECT_EQ(db.Text("SELECT state FROM upload_connection"), "refused");
+    EXPECT_EQ(db.Number("SELECT sum(rows_pending) FROM upload_status"), 720);
+  }
+  // The administrator creates the schema; the role gets rights on the tables.
+  const auto init = RunPvtwin(dir_.path(), "upload --init --config admin.toml");
+  ASSERT_EQ(init.exit_code, 0) << init.err;
+  EXPECT_NE(init.err.find("central schema version 1 ready"), std::string::npos) << init.err;
+  ASSERT_EQ(pg_.Text("GRANT SELECT, INSERT, UPDATE, DELETE ON ALL TABLES IN SCHEMA public TO plant",
+                     "fleet"),
+            "");
+  run = UploadOnce("plant");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("upload: 720 rows"), std::string::npos) << run.err;
+  ExpectPlantEqual("plant");
+  // A central schema from a newer pvtwin is refused, not migrated back.
+  ASSERT_EQ(pg_.Text("INSERT INTO pvtwin_schema(version) VALUES(2)", "fleet"), "");
+  run = UploadOnce("plant");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("newer than this pvtwin knows"), std::string::npos) << run.err;
+}
+
+TEST_F(Upload, WithoutOnceItFollowsRowsOtherProcessesWriteUntilSigterm) {
+  WritePlant("plant", "");
+  Import("plant", kMorning - 86400, 1, 60, 1, 360);
+  ChildProcess upload;
+  std::string error;
+  ASSERT_TRUE(upload.Start({PVTWIN_BINARY, "upload", "--config", (dir_ / "plant.toml").string()},
+                           (dir_ / "plant.log").string(), &error))
+      << error;
+  ASSERT_TRUE(WaitFor(20, [&] { return Central("SELECT count(*) FROM measurement_1min") == 360; }))
+      << Log("plant");
+  // The next six hours, imported by another process while it runs.
+  Import("plant", kMorning - 86400, 1, 60, 1, 720);
+  ASSERT_TRUE(WaitFor(20, [&] { return Central("SELECT count(*) FROM measurement_1min") == 720; }))
+      << Log("plant");
+  EXPECT_EQ(upload.Stop(SIGTERM, 10.0), 0) << Log("plant");
+  ExpectPlantEqual("plant");
+}
+
+TEST_F(Upload, UnreachableServerIsExitCodeOneAndBadConfigIsTwo) {
+  WritePlant("plant", "");
+  Import("plant", kMorning - 86400, 1, 60, 1, 360);
+  pg_.Stop();
+  auto run = UploadOnce("plant");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("upload: connect:"), std::string::npos) << run.err;
+  {
+    RawDb db(Db("plant"));
+    EXPECT_EQ(db.Text("SELECT state FROM upload_connection"), "down");
+    EXPECT_EQ(db.Number("SELECT sum(rows_pending) FROM upload_status"), 360);
+  }
+  // A password in the URL is refused at its line, without showing it.
+  std::string text = ReadFile(dir_ / "plant.toml");
+  text.replace(text.find("url = \""), 7, "url = \"password=hunter2 ");
+  std::ofstream(dir_ / "bad.toml") << text;
+  run = RunPvtwin(dir_.path(), "upload --once --config bad.toml");
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_NE(run.err.find("url = (value not shown): holds a password"), std::string::npos)
+      << run.err;
+  EXPECT_EQ(run.err.find("hunter2"), std::string::npos) << run.err;
+}
+
+}  // namespace
+}  // namespace pvtwin

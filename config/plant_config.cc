@@ -137,6 +137,15 @@ void ReadDiagnosis(SectionReader& r, DiagnosisConfig* d) {
 void ReadMonitor(SectionReader& r, MonitorConfig* m) {
   r.Integer("drift_days", kOptional, Closed(2, 365), &m->drift_days);
   r.Integer("alarm_days", kOptional, Closed(1, 60), &m->alarm_days);
+  r.Number("datasheet_eta0", kOptional, Closed(0, 1), &m->datasheet_eta0);
+  r.Number("datasheet_c1_w_m2k", kOptional, Closed(0, 100), &m->datasheet_c1_w_m2k);
+  r.Number("datasheet_c2_w_m2k2", kOptional, Closed(0, 1), &m->datasheet_c2_w_m2k2);
+  r.Number("datasheet_c3_j_m3k", kOptional, Closed(0, 100), &m->datasheet_c3_j_m3k);
+  r.Number("datasheet_c4", kOptional, Closed(0, 1), &m->datasheet_c4);
+  r.Number("datasheet_c5_j_m2k", kOptional, Closed(0, 1e6), &m->datasheet_c5_j_m2k);
+  r.Number("datasheet_c6_s_m", kOptional, Closed(0, 1), &m->datasheet_c6_s_m);
+  r.Number("datasheet_kd", kOptional, Closed(0, 1.5), &m->datasheet_kd);
+  r.Number("power_check_safety_factor", kOptional, LeftOpen(0, 1), &m->power_check_safety_factor);
 }
 
 void ReadSim(SectionReader& r, SimConfig* sim) {

@@ -10,7 +10,9 @@
 //   [calibration]  variant, window_days, step_s, at, timezone, refit_full_window
 //   [forecast]     horizon_h, refresh_min
 //   [diagnosis]    enabled, every_days, timeout_s, keep (the nightly diagnosis)
-//   [monitor]      drift_days, alarm_days (the daily checks)
+//   [monitor]      drift_days, alarm_days, datasheet_eta0, datasheet_c1_w_m2k …
+//                  datasheet_c6_s_m, datasheet_kd, power_check_safety_factor
+//                  (the daily checks)
 //   [sim]          optional; how `pvtwin sim` operates the simulated plant:
 //                  operation, pump_dt_on_k, pump_dt_off_k, brine_below_ambient_k,
 //                  brine_min_c, brine_max_c (SimConfig). Ignored by the daemon.
@@ -72,6 +74,17 @@ struct DiagnosisConfig {
 struct MonitorConfig {
   int drift_days = 28;  // [2, 365]: accepted calibrations of this many days for the drift check
   int alarm_days = 3;   // [1, 60]: days below the performance band in a row before an alarm
+  // The collector's datasheet (ISO 9806) for the nightly power check
+  // (core/monitoring.h); datasheet_eta0 = 0 (default): no check.
+  double datasheet_eta0 = 0.0;             // [0, 1]
+  double datasheet_c1_w_m2k = 0.0;         // [0, 100]
+  double datasheet_c2_w_m2k2 = 0.0;        // [0, 1]
+  double datasheet_c3_j_m3k = 0.0;         // [0, 100]
+  double datasheet_c4 = 0.0;               // [0, 1]
+  double datasheet_c5_j_m2k = 0.0;         // [0, 1e6]
+  double datasheet_c6_s_m = 0.0;           // [0, 1]
+  double datasheet_kd = 1.0;               // [0, 1.5]
+  double power_check_safety_factor = 0.9;  // (0, 1]
 };
 
 // [sim]: the simulated plant's solar loop (core/weather_generator.h,

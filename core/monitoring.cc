@@ -1,10 +1,13 @@
 #include "core/monitoring.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "core/iam.h"
 #include "core/identification.h"
 #include "core/sky_radiation.h"
+#include "core/solar_position.h"
 #include "core/thermal_model.h"
 #include "core/units.h"
 
@@ -100,6 +103,108 @@ std::optional<ParameterDrift> DetectDrift(std::span<const ParameterPoint> points
   d.calibrations = static_cast<int>(known.size());
   if (!(std::fabs(d.change) > 2.0 * d.combined_se)) return std::nullopt;
   return d;
+}
+
+namespace {
+
+// Means of one clock hour's usable rows.
+struct HourMeans {
+  int rows = 0;
+  double g = 0, t_amb = 0, t_m = 0, wind = 0, lw = 0, q_w = 0, k_b = 0;
+  double t_m_first = 0, t_m_last = 0;  // means of the first and last 10 rows
+  double max_aoi_rad = 0;
+  bool has_wind = false, has_lw = false;
+};
+
+}  // namespace
+
+PowerCheckResult CheckPowerAgainstDatasheet(const Series& s, const Plant& plant,
+                                            const CollectorDatasheet& d,
+                                            const PowerCheckOptions& o) {
+  PowerCheckResult r;
+  r.ratio = kNaN;
+  if (!(d.eta0 > 0.0) || s.size() == 0 || !s.Has(Channel::kGPoaWM2) || !s.Has(Channel::kTAmbC) ||
+      !s.Has(Channel::kTInC) || !s.Has(Channel::kTOutC) || !s.Has(Channel::kMdotKgS)) {
+    return r;
+  }
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  site.elevation_m = plant.elevation_m;
+  std::vector<double> times(s.time_s.begin(), s.time_s.end());
+  for (double& t : times) t += 0.5 * s.step_s;  // the middle of each row's interval
+  std::vector<SolarPosition> sun;
+  ComputeSolarPositions(times, site, &sun);
+  const bool has_q = s.Has(Channel::kQThW);
+  const bool has_wind = s.Has(Channel::kWindMS);
+  const bool has_lw = s.Has(Channel::kLwDownWM2);
+  double sum_meas = 0.0, sum_est = 0.0;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const std::int64_t hour = s.time_s[i] / 3600;
+    std::vector<std::size_t> rows;
+    std::size_t j = i;
+    for (; j < s.size() && s.time_s[j] / 3600 == hour; ++j) {
+      const double q = has_q ? s[Channel::kQThW][j] : kNaN;
+      const bool ok = s.At(Channel::kValid, j) != 0.0 && s[Channel::kMdotKgS][j] > 1e-4 &&
+                      std::isfinite(s[Channel::kGPoaWM2][j]) &&
+                      std::isfinite(s[Channel::kTAmbC][j]) && std::isfinite(s[Channel::kTInC][j]) &&
+                      std::isfinite(s[Channel::kTOutC][j]) && (!has_q || std::isfinite(q)) &&
+                      (!has_wind || std::isfinite(s[Channel::kWindMS][j])) &&
+                      (!has_lw || std::isfinite(s[Channel::kLwDownWM2][j]));
+      if (ok) rows.push_back(j);
+    }
+    i = j;
+    const int minutes = static_cast<int>(static_cast<double>(rows.size()) * s.step_s / 60.0);
+    if (minutes < o.min_minutes || rows.size() < 4) continue;
+    HourMeans h;
+    const std::size_t edge = std::max<std::size_t>(1, std::min<std::size_t>(10, rows.size() / 4));
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const std::size_t row = rows[k];
+      const double t_m = 0.5 * (s[Channel::kTInC][row] + s[Channel::kTOutC][row]);
+      const double q = has_q ? s[Channel::kQThW][row]
+                             : s[Channel::kMdotKgS][row] * plant.fluid_cp_j_kgk *
+                                   (s[Channel::kTOutC][row] - s[Channel::kTInC][row]);
+      const double aoi = AngleOfIncidenceRad(sun[row].zenith_rad, sun[row].azimuth_rad,
+                                             plant.tilt_rad, plant.azimuth_rad);
+      h.g += s[Channel::kGPoaWM2][row];
+      h.t_amb += s[Channel::kTAmbC][row];
+      h.t_m += t_m;
+      h.q_w += q;
+      h.k_b += aoi < 0.5 * kPi ? IamSoukaSafwat(aoi, plant.iam_b0) : 0.0;
+      h.max_aoi_rad = std::max(h.max_aoi_rad, aoi);
+      if (has_wind) h.wind += s[Channel::kWindMS][row];
+      if (has_lw) h.lw += s[Channel::kLwDownWM2][row];
+      if (k < edge) h.t_m_first += t_m / static_cast<double>(edge);
+      if (k >= rows.size() - edge) h.t_m_last += t_m / static_cast<double>(edge);
+    }
+    const double n = static_cast<double>(rows.size());
+    h.g /= n, h.t_amb /= n, h.t_m /= n, h.q_w /= n, h.k_b /= n, h.wind /= n, h.lw /= n;
+    const double span_h =
+        static_cast<double>(s.time_s[rows.back()] - s.time_s[rows.front()]) / 3600.0;
+    const double dtm_dt_k_h = span_h > 0.0 ? (h.t_m_last - h.t_m_first) / span_h : 0.0;
+    if (h.g < o.min_g_w_m2 || h.t_amb < o.min_t_amb_c || (has_wind && h.wind > o.max_wind_m_s) ||
+        std::fabs(dtm_dt_k_h) > o.max_dtm_dt_k_h || RadToDeg(h.max_aoi_rad) > o.max_aoi_deg) {
+      continue;
+    }
+    const double dt = h.t_m - h.t_amb;
+    const double u = has_wind ? h.wind : 0.0;
+    const double sky = has_lw ? h.lw - kStefanBoltzmannW_m2k4 * std::pow(CToK(h.t_amb), 4) : 0.0;
+    const double k_hem = 0.85 * h.k_b + 0.15 * d.kd;
+    const double est = d.eta0 * k_hem * h.g - d.c6_s_m * u * h.g -
+                       (d.c1_w_m2k + d.c3_j_m3k * u) * dt - d.c2_w_m2k2 * dt * dt + d.c4 * sky -
+                       d.c5_j_m2k * dtm_dt_k_h / 3600.0;
+    sum_meas += h.q_w / plant.area_m2;
+    sum_est += est;
+    ++r.intervals;
+  }
+  if (r.intervals == 0) return r;
+  r.measured_w_m2 = sum_meas / r.intervals;
+  r.estimated_w_m2 = sum_est / r.intervals;
+  r.ratio = r.measured_w_m2 / r.estimated_w_m2;
+  r.enough = r.intervals >= o.min_intervals;
+  r.pass = r.enough && r.measured_w_m2 >= o.safety_factor * r.estimated_w_m2;
+  return r;
 }
 
 namespace {

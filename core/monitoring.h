@@ -90,6 +90,57 @@ struct ParameterDrift {
 std::optional<ParameterDrift> DetectDrift(std::span<const ParameterPoint> points);
 
 // ---------------------------------------------------------------------------
+// Power check of the thermal output against the collector's datasheet, in
+// the manner of ISO 24194:2022 (the performance check of collector fields):
+// hourly means, the standard's filters (in-plane irradiance ≥ 800 W/m²,
+// ambient ≥ 5 °C, wind ≤ 10 m/s, |dT_m/dt| ≤ 5 K/h; an angle of incidence ≤
+// 80° as SunPeek adds), the pump running the whole hour, and the datasheet's
+// estimate of the power per m² (ISO 9806 quasi-dynamic form):
+//   q_est = η0·K_hem·G − c6·u·G − (c1 + c3·u)·ΔT − c2·ΔT² + c4·(E_L − σ·T_a⁴)
+//           − c5·dT_m/dt,        ΔT = T_m − T_a, T_m = (T_in + T_out)/2,
+//   K_hem = 0.85·K_b(θ) + 0.15·K_d (ISO 9806 annex B with η0,b = η0,hem),
+//   K_b from the plant's IAM (b0).
+// ISO 24194 covers glazed collectors (formula 1: c3 = c4 = c6 = 0); the wind
+// and long-wave terms of an uncovered PVT collector's datasheet make the same
+// check meaningful for it. The check passes when the measured power over the
+// valid hours is at least safety_factor times the estimate.
+
+struct CollectorDatasheet {
+  double eta0 = 0.0;       // η0,hem; 0: no datasheet, no check
+  double c1_w_m2k = 0.0;   // a1
+  double c2_w_m2k2 = 0.0;  // a2
+  double c3_j_m3k = 0.0;   // wind dependence of the heat loss
+  double c4 = 0.0;         // long-wave irradiance dependence
+  double c5_j_m2k = 0.0;   // effective heat capacity (a5)
+  double c6_s_m = 0.0;     // wind dependence of η0
+  double kd = 1.0;         // diffuse incidence angle modifier
+};
+
+struct PowerCheckOptions {
+  double safety_factor = 0.9;  // the guarantee's allowance (pipes, measurement, other)
+  int min_intervals = 20;      // ISO 24194 6.2: at least 20 valid hours
+  int min_minutes = 50;        // minutes of an hour with the pump on and every input
+  double min_g_w_m2 = 800.0;
+  double min_t_amb_c = 5.0;
+  double max_wind_m_s = 10.0;
+  double max_dtm_dt_k_h = 5.0;
+  double max_aoi_deg = 80.0;
+};
+
+struct PowerCheckResult {
+  int intervals = 0;            // valid hours
+  double measured_w_m2 = 0.0;   // mean over them
+  double estimated_w_m2 = 0.0;  // mean over them
+  double ratio = 0.0;           // measured / estimated (NaN without intervals)
+  bool enough = false;          // intervals >= min_intervals
+  bool pass = false;            // enough and measured >= safety_factor · estimated
+};
+
+PowerCheckResult CheckPowerAgainstDatasheet(const Series& minutes, const Plant& plant,
+                                            const CollectorDatasheet& datasheet,
+                                            const PowerCheckOptions& options = {});
+
+// ---------------------------------------------------------------------------
 // Sensor faults in 1-min rows, as intervals [start_s, end_s).
 
 struct SensorFault {

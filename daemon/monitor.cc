@@ -147,11 +147,61 @@ void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::Calibrati
   }
 }
 
+// The datasheet's power check over the calibration window; an event when
+// its outcome differs from the last one recorded (pass: info, fail: warning).
+void CheckDatasheetPower(Store& store, const DailyCheckInputs& in, LogLines* log) {
+  const MonitorConfig& m = in.config->monitor;
+  if (!(m.datasheet_eta0 > 0.0)) return;
+  Series minutes;
+  std::string error;
+  const std::int64_t from = in.now_s - in.config->calibration.window_days * kDayS;
+  if (!store.ReadMinutes(from, in.now_s, &minutes, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+    return;
+  }
+  CollectorDatasheet d;
+  d.eta0 = m.datasheet_eta0;
+  d.c1_w_m2k = m.datasheet_c1_w_m2k;
+  d.c2_w_m2k2 = m.datasheet_c2_w_m2k2;
+  d.c3_j_m3k = m.datasheet_c3_j_m3k;
+  d.c4 = m.datasheet_c4;
+  d.c5_j_m2k = m.datasheet_c5_j_m2k;
+  d.c6_s_m = m.datasheet_c6_s_m;
+  d.kd = m.datasheet_kd;
+  PowerCheckOptions options;
+  options.safety_factor = m.power_check_safety_factor;
+  const PowerCheckResult r = CheckPowerAgainstDatasheet(minutes, in.config->plant, d, options);
+  if (!r.enough) {
+    log->push_back({kInfo, "datasheet power check: " + std::to_string(r.intervals) + " of " +
+                               std::to_string(options.min_intervals) +
+                               " hours needed pass its filters in the window; no verdict"});
+    return;
+  }
+  const std::string message = "datasheet power check over " + std::to_string(r.intervals) +
+                              " hours: measured " + Fixed(r.measured_w_m2, 1) +
+                              " W/m², datasheet " + Fixed(r.estimated_w_m2, 1) + " W/m², ratio " +
+                              Fixed(r.ratio, 3) + (r.pass ? " ≥ " : " < ") +
+                              Fixed(options.safety_factor, 2) + (r.pass ? ": passed" : ": failed");
+  const std::string severity = r.pass ? "info" : "warning";
+  log->push_back({r.pass ? kInfo : kWarning, message});
+  std::string last;
+  bool found = false;
+  if (!store.LatestMonitorEventSeverity("power_check", &last, &found, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+    return;
+  }
+  if (found && last == severity) return;  // no change
+  if (!store.InsertMonitorEvent(in.now_s, "power_check", severity, message, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+  }
+}
+
 }  // namespace
 
 std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const DailyCheckInputs& in) {
   LogLines log;
   CheckSensors(store, in, &log);
+  CheckDatasheetPower(store, in, &log);
   Store::CalibrationRow cal;
   bool found = false;
   std::string error;

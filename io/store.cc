@@ -898,6 +898,38 @@ bool Store::InsertMonitorEvent(std::int64_t ts, const std::string& kind,
       error);
 }
 
+bool Store::LatestMonitorEventSeverity(const std::string& kind, std::string* severity, bool* found,
+                                       std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::string result;
+  bool any = false;
+  const bool ok = db.Run(
+      false, "read monitor_event",
+      [&]() -> DbStatus {
+        any = false;
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(
+            "SELECT severity FROM monitor_event WHERE kind = ? ORDER BY ts DESC, id DESC LIMIT 1",
+            &stmt);
+        if (!s.ok()) return s;
+        sqlite3_bind_text(stmt, 1, kind.c_str(), -1, SQLITE_TRANSIENT);
+        const int rc = sqlite3_step(stmt);
+        if (rc == SQLITE_ROW) {
+          any = true;
+          result = ColumnText(stmt, 0);
+        }
+        sqlite3_reset(stmt);
+        return rc == SQLITE_ROW || rc == SQLITE_DONE ? DbStatus{}
+                                                     : db.Fail(rc, "read monitor_event");
+      },
+      error);
+  if (!ok) return false;
+  *found = any;
+  if (any) *severity = result;
+  return true;
+}
+
 bool Store::ReadAcceptedParameters(std::int64_t since_ts,
                                    std::map<std::string, std::vector<ParameterPoint>>* out,
                                    std::string* error) {

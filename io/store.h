@@ -246,6 +246,9 @@ class Store {
   // warning or error).
   bool InsertMonitorEvent(std::int64_t ts, const std::string& kind, const std::string& severity,
                           const std::string& message, std::string* error);
+  // The newest monitor_event of kind: its severity; *found false when none.
+  bool LatestMonitorEventSeverity(const std::string& kind, std::string* severity, bool* found,
+                                  std::string* error);
   // Parameters of the accepted calibrations with run_at >= since_ts, per
   // name, in time order.
   bool ReadAcceptedParameters(std::int64_t since_ts,

@@ -139,5 +139,29 @@ TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
   EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'parameter_drift'"), 1);
 }
 
+// The datasheet power check: a datasheet that promises far more heat than
+// the plant makes fails (a warning event), the same outcome the next night
+// adds no event, and a modest datasheet passes (an info event: the change).
+TEST_F(DailyChecks, TheDatasheetPowerCheckRecordsEachChangeOfItsOutcome) {
+  config_.monitor.datasheet_eta0 = 0.95;  // no such collector
+  RunDailyChecks(*store_, Inputs(false));
+  testing::RawDb db(dir_ / "pvtwin.db");
+  const auto failed =
+      db.Rows("SELECT severity, message FROM monitor_event WHERE kind = 'power_check'");
+  ASSERT_EQ(failed.size(), 1u);
+  EXPECT_EQ(failed[0][0], "warning");
+  EXPECT_NE(failed[0][1].find(": failed"), std::string::npos) << failed[0][1];
+  RunDailyChecks(*store_, Inputs(false));
+  EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'power_check'"), 1);
+  config_.monitor.datasheet_eta0 = 0.2;
+  config_.monitor.datasheet_c1_w_m2k = 5.0;
+  RunDailyChecks(*store_, Inputs(false));
+  const auto passed = db.Rows(
+      "SELECT severity, message FROM monitor_event WHERE kind = 'power_check' ORDER BY id DESC");
+  ASSERT_EQ(passed.size(), 2u);
+  EXPECT_EQ(passed[0][0], "info");
+  EXPECT_NE(passed[0][1].find(": passed"), std::string::npos) << passed[0][1];
+}
+
 }  // namespace
 }  // namespace pvtwin::cli

@@ -5,10 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
+#include "config/plant_config.h"
+#include "core/iam.h"
 #include "core/monitoring.h"
+#include "core/solar_position.h"
 #include "core/synthetic_plant.h"
 #include "core/units.h"
+#include "io/csv.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
@@ -170,6 +175,101 @@ TEST(SensorFaults, FoundWherePlanted) {
                          (f.channel == "lw_down_w_m2" && f.kind == "missing");
     EXPECT_TRUE(planted) << f.channel << " " << f.kind << " " << f.detail;
   }
+}
+
+// The power check on an analytic case: a synthetic series built from the
+// datasheet equation itself passes with the ratio 1 (within the hourly
+// averaging); 20 % less heat fails at a safety factor of 0.9; the filters
+// leave out hours below 800 W/m² and hours below 5 °C.
+TEST(PowerCheck, TheDatasheetsOwnEquationPassesAndALossFails) {
+  const Plant plant = DesignExamplePlant();
+  CollectorDatasheet d;
+  d.eta0 = 0.5;
+  d.c1_w_m2k = 10.0;
+  d.c3_j_m3k = 1.5;
+  d.c6_s_m = 0.005;
+  Series s = ClearDays(plant, 20);
+  // Replace Q_u by the datasheet's: steady hours, the heat as the equation says.
+  std::vector<SolarPosition> sun;
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  std::vector<double> mid(s.time_s.begin(), s.time_s.end());
+  for (double& t : mid) t += 30.0;
+  ComputeSolarPositions(mid, site, &sun);
+  std::vector<double>& q = s[Channel::kQThW];
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double aoi = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
+                                           plant.azimuth_rad);
+    const double k_b = aoi < kPi / 2 ? IamSoukaSafwat(aoi, plant.iam_b0) : 0.0;
+    const double g = s[Channel::kGPoaWM2][i], u = s[Channel::kWindMS][i];
+    const double dt = 0.5 * (s[Channel::kTInC][i] + s[Channel::kTOutC][i]) - s[Channel::kTAmbC][i];
+    q[i] = plant.area_m2 * (d.eta0 * (0.85 * k_b + 0.15 * d.kd) * g - d.c6_s_m * u * g -
+                            (d.c1_w_m2k + d.c3_j_m3k * u) * dt);
+    s[Channel::kLwDownWM2][i] = NAN;  // no long-wave term (c4 = 0): not needed
+  }
+  s.columns[static_cast<std::size_t>(Channel::kLwDownWM2)].clear();
+  PowerCheckOptions o;
+  const PowerCheckResult ok = CheckPowerAgainstDatasheet(s, plant, d, o);
+  ASSERT_GE(ok.intervals, 20);
+  EXPECT_TRUE(ok.enough);
+  EXPECT_TRUE(ok.pass);
+  // Hourly means of products differ from products of hourly means only a little.
+  EXPECT_NEAR(ok.ratio, 1.0, 0.01);
+  EXPECT_GE(ok.measured_w_m2 / plant.area_m2, 0.0);
+  for (double& v : q) v *= 0.8;
+  const PowerCheckResult low = CheckPowerAgainstDatasheet(s, plant, d, o);
+  EXPECT_EQ(low.intervals, ok.intervals);
+  EXPECT_NEAR(low.ratio, 0.8 * ok.ratio, 1e-9);
+  EXPECT_FALSE(low.pass);
+  // The filters: no hour passes above 2000 W/m², none at 40 °C minimum ambient.
+  o.min_g_w_m2 = 2000.0;
+  EXPECT_EQ(CheckPowerAgainstDatasheet(s, plant, d, o).intervals, 0);
+  o.min_g_w_m2 = 800.0;
+  o.min_t_amb_c = 40.0;
+  EXPECT_EQ(CheckPowerAgainstDatasheet(s, plant, d, o).intervals, 0);
+  // No datasheet, no check.
+  EXPECT_EQ(CheckPowerAgainstDatasheet(s, plant, CollectorDatasheet{}, {}).intervals, 0);
+}
+
+// Real data: the htw saar collector against its own datasheet (PROVENANCE.md:
+// η0 = 0.475, c1 = 7.411 W/m²K, c3 = 1.7 J/m³K, c4 = 0.437, c6 = 0.003 s/m,
+// C = 42 200 J/m²K). Each clear day holds 4 hours that pass the filters;
+// measured against the datasheet's estimate they give 0.76 (day 1, inlet
+// near ambient) and 0.71 (day 3, inlet 7 K above): the collector delivered
+// about a quarter less heat than its datasheet at these conditions, and less
+// the warmer it ran (its identified η0 is 10 % below the datasheet's, README).
+TEST(PowerCheck, TheHtwSaarCollectorAgainstItsDatasheet) {
+  Config config;
+  Diagnostics errors;
+  const std::string dir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
+  ASSERT_TRUE(LoadConfig(dir + "plant.toml", &config, &errors));
+  CollectorDatasheet d;
+  d.eta0 = 0.475;
+  d.c1_w_m2k = 7.411;
+  d.c3_j_m3k = 1.7;
+  d.c4 = 0.437;
+  d.c5_j_m2k = 42200;
+  d.c6_s_m = 0.003;
+  PowerCheckOptions o;
+  o.min_intervals = 3;
+  int intervals = 0;
+  double sum_ratio = 0.0;
+  for (const char* day : {"day1_clear_low_dT.csv", "day3_clear_medium_dT.csv"}) {
+    CsvReadOptions read;
+    read.fluid_density_kg_m3 = config.plant.fluid_density_kg_m3;
+    Series s;
+    ASSERT_TRUE(ReadCanonicalCsv(dir + day, read, &s, &errors, nullptr)) << day;
+    const PowerCheckResult r = CheckPowerAgainstDatasheet(s, config.plant, d, o);
+    std::printf("%s: %d hours, measured %.1f W/m², datasheet %.1f W/m², ratio %.3f\n", day,
+                r.intervals, r.measured_w_m2, r.estimated_w_m2, r.ratio);
+    intervals += r.intervals;
+    if (r.intervals > 0) sum_ratio += r.ratio * r.intervals;
+  }
+  ASSERT_GE(intervals, 3);
+  const double ratio = sum_ratio / intervals;
+  EXPECT_GT(ratio, 0.65);
+  EXPECT_LT(ratio, 0.85);
 }
 
 }  // namespace

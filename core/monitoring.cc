@@ -1,15 +1,19 @@
 #include "core/monitoring.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "core/iam.h"
 #include "core/identification.h"
+#include "core/irradiance.h"
 #include "core/sky_radiation.h"
 #include "core/solar_position.h"
 #include "core/thermal_model.h"
 #include "core/units.h"
+#include "core/weather_generator.h"
 
 namespace pvtwin {
 
@@ -17,6 +21,14 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::int64_t kDayS = 86400;
+
+// Day of the year (1 … 366) of a unix time, UTC.
+double DayOfYear(std::int64_t t_s) {
+  const std::chrono::sys_days day{std::chrono::days{t_s / kDayS}};
+  const std::chrono::year_month_day ymd{day};
+  const std::chrono::sys_days jan1{ymd.year() / std::chrono::January / 1};
+  return static_cast<double>((day - jan1).count() + 1);
+}
 
 // pi and its band for one output; NaN where not scored.
 void ScoreOutput(double meas_wh, double model_wh, double mae_w, double hours, bool scored,
@@ -230,10 +242,80 @@ void AddRuns(const Series& s, const std::string& channel, const std::string& kin
   }
 }
 
+// The irradiance checks: above the clear sky, and the plane's sensor against
+// the horizontal pair.
+void FindIrradianceFaults(const Series& s, const Plant& plant, const SensorFaultOptions& o,
+                          std::vector<SensorFault>* faults) {
+  const bool poa = s.Has(Channel::kGPoaWM2);
+  const bool pair = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
+  if (!poa && !s.Has(Channel::kGhiWM2)) return;
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  site.elevation_m = plant.elevation_m;
+  std::vector<double> times(s.time_s.begin(), s.time_s.end());
+  for (double& t : times) t += 0.5 * s.step_s;
+  std::vector<SolarPosition> sun;
+  ComputeSolarPositions(times, site, &sun);
+  const std::size_t n = s.size();
+  std::vector<double> clear_poa(n, 0.0), clear_ghi(n, 0.0), transposed(n, kNaN);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double aoi = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
+                                           plant.azimuth_rad);
+    ClearSkyInput in;
+    in.zenith_rad = sun[i].zenith_rad;
+    in.day_of_year = DayOfYear(s.time_s[i]);
+    in.elevation_m = plant.elevation_m;
+    in.linke_turbidity = 2.0;
+    const ClearSkyIrradiance c = ClearSkyIneichenPerez(in);
+    clear_ghi[i] = c.ghi_w_m2;
+    clear_poa[i] = TransposeIsotropicSky({c.ghi_w_m2, c.dhi_w_m2, sun[i].zenith_rad, aoi,
+                                          plant.tilt_rad, plant.ground_albedo})
+                       .global_w_m2();
+    if (pair && sun[i].elevation_rad >= DegToRad(15.0)) {
+      transposed[i] =
+          TransposeIsotropicSky({s[Channel::kGhiWM2][i], s[Channel::kDhiWM2][i], sun[i].zenith_rad,
+                                 aoi, plant.tilt_rad, plant.ground_albedo})
+              .global_w_m2();
+    }
+  }
+  const double f = o.clear_sky_factor;
+  char factor[16];
+  std::snprintf(factor, sizeof factor, "%.2f", f);
+  const std::string above =
+      std::string("above ") + factor + " × the clear sky of a clean atmosphere + 50 W/m²";
+  if (poa) {
+    const std::vector<double>& g = s[Channel::kGPoaWM2];
+    AddRuns(
+        s, "g_poa_w_m2", "above_clear_sky", o.min_run_minutes,
+        [&](std::size_t i) { return g[i] > f * clear_poa[i] + 50.0; }, above, faults);
+  }
+  if (s.Has(Channel::kGhiWM2)) {
+    const std::vector<double>& g = s[Channel::kGhiWM2];
+    AddRuns(
+        s, "ghi_w_m2", "above_clear_sky", o.min_run_minutes,
+        [&](std::size_t i) { return g[i] > f * clear_ghi[i] + 50.0; }, above, faults);
+  }
+  if (poa && pair) {
+    const std::vector<double>& g = s[Channel::kGPoaWM2];
+    AddRuns(
+        s, "g_poa_w_m2", "poa_disagrees_with_ghi_dhi", o.min_disagree_minutes,
+        [&](std::size_t i) {
+          return std::isfinite(transposed[i]) && std::isfinite(g[i]) &&
+                 std::fabs(g[i] - transposed[i]) > o.poa_disagreement * transposed[i] + 50.0;
+        },
+        "differs from GHI/DHI transposed to the plane by more than " +
+            std::to_string(static_cast<int>(100 * o.poa_disagreement)) + " % + 50 W/m²",
+        faults);
+  }
+}
+
 }  // namespace
 
-std::vector<SensorFault> FindSensorFaults(const Series& s, const SensorFaultOptions& o) {
+std::vector<SensorFault> FindSensorFaults(const Series& s, const Plant& plant,
+                                          const SensorFaultOptions& o) {
   std::vector<SensorFault> faults;
+  FindIrradianceFaults(s, plant, o, &faults);
   // Missing: a channel the plant has (some value in the rows) without a
   // value for a while.
   for (const ChannelInfo& info : kChannels) {

@@ -146,7 +146,9 @@ PowerCheckResult CheckPowerAgainstDatasheet(const Series& minutes, const Plant& 
 struct SensorFault {
   std::string channel;  // canonical name (core/channels.h)
   std::int64_t start_s = 0, end_s = 0;
-  std::string kind;  // missing | frozen | heat_without_flow | sky_warmer_than_air
+  // missing | frozen | heat_without_flow | sky_warmer_than_air |
+  // above_clear_sky | poa_disagrees_with_ghi_dhi
+  std::string kind;
   std::string detail;
 };
 
@@ -157,10 +159,21 @@ struct SensorFaultOptions {
   double heat_without_flow_w = 50.0;
   double sky_warmer_k = 2.0;    // sky temperature above air by more than this ...
   double sunny_g_w_m2 = 600.0;  // ... while the sun shines (no overcast explains it)
+  // Irradiance above the clear sky of a very clean atmosphere (Ineichen–
+  // Perez, Linke turbidity 2) by this factor plus 50 W/m² for
+  // min_run_minutes: cloud enhancement lasts seconds to minutes, a wrong
+  // calibration factor or a tilted sensor hours.
+  double clear_sky_factor = 1.25;
+  // In-plane irradiance against GHI/DHI transposed to the plane (isotropic
+  // sky, paper 2.5), with the sun at least 15° high: a relative difference
+  // above this (plus 50 W/m²) for min_disagree_minutes.
+  double poa_disagreement = 0.25;
+  int min_disagree_minutes = 30;
 };
 
 // The faults in rows (step 60 s, increasing times).
-std::vector<SensorFault> FindSensorFaults(const Series& minutes,
+// The plant gives the site and plane of the irradiance checks.
+std::vector<SensorFault> FindSensorFaults(const Series& minutes, const Plant& plant,
                                           const SensorFaultOptions& options = {});
 
 }  // namespace pvtwin

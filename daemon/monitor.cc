@@ -110,7 +110,7 @@ void CheckSensors(Store& store, const DailyCheckInputs& in, LogLines* log) {
     log->push_back({kErr, "daily checks: " + error});
     return;
   }
-  const std::vector<SensorFault> faults = FindSensorFaults(minutes);
+  const std::vector<SensorFault> faults = FindSensorFaults(minutes, in.config->plant);
   if (!store.RecordSensorFaults(faults, &error)) {
     log->push_back({kErr, "daily checks: " + error});
     return;

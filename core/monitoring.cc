@@ -242,6 +242,66 @@ void AddRuns(const Series& s, const std::string& channel, const std::string& kin
   }
 }
 
+// A logger clock that is off: on a clear day the in-plane irradiance follows
+// the clear-sky model of the plane, shifted by the clock's error; the lag
+// (within ±90 min) that best lines the two up is that error, and one beyond
+// max_clock_offset_min is a fault. A day counts as clear when its energy is
+// 80–110 % of the clean clear sky's and 90 % of its daylight rows reach 60 %
+// of it.
+void FindClockShift(const Series& s, const std::vector<double>& clear_poa,
+                    const std::vector<SolarPosition>& sun, const SensorFaultOptions& o,
+                    std::vector<SensorFault>* faults) {
+  const std::vector<double>& g = s[Channel::kGPoaWM2];
+  const double rows_per_min = 60.0 / s.step_s;
+  const int max_lag = static_cast<int>(std::lround(90.0 * rows_per_min));
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const std::int64_t day = s.time_s[i] / kDayS;
+    std::size_t j = i;
+    while (j < s.size() && s.time_s[j] / kDayS == day) ++j;
+    const std::size_t first = i, end = j;
+    i = j;
+    double sum_g = 0, sum_c = 0;
+    int daylight = 0, bright = 0;
+    for (std::size_t k = first; k < end; ++k) {
+      if (sun[k].elevation_rad < DegToRad(5.0) || !std::isfinite(g[k])) continue;
+      sum_g += g[k];
+      sum_c += clear_poa[k];
+      ++daylight;
+      bright += g[k] >= 0.6 * clear_poa[k];
+    }
+    if (daylight < 4 * 60 * rows_per_min || sum_c <= 0.0) continue;
+    if (sum_g < 0.8 * sum_c || sum_g > 1.1 * sum_c || bright < 0.9 * daylight) continue;
+    int best_lag = 0;
+    double best = -1.0;
+    for (int lag = -max_lag; lag <= max_lag; ++lag) {
+      double dot = 0.0;
+      for (std::size_t k = first; k < end; ++k) {
+        const auto shifted = static_cast<std::ptrdiff_t>(k) - lag;
+        if (shifted < 0 || shifted >= static_cast<std::ptrdiff_t>(s.size()) ||
+            !std::isfinite(g[k])) {
+          continue;
+        }
+        dot += g[k] * clear_poa[static_cast<std::size_t>(shifted)];
+      }
+      if (dot > best) {
+        best = dot;
+        best_lag = lag;
+      }
+    }
+    const double offset_min = best_lag / rows_per_min;
+    if (std::fabs(offset_min) <= o.max_clock_offset_min) continue;
+    char detail[160];
+    std::snprintf(detail, sizeof detail,
+                  "on a clear day the irradiance peaks %.0f min %s than the sun: the logger clock "
+                  "is off by about that much",
+                  std::fabs(offset_min), offset_min > 0 ? "later" : "earlier");
+    faults->push_back({"time", s.time_s[first],
+                       s.time_s[end - 1] + static_cast<std::int64_t>(s.step_s), "clock_shift",
+                       detail});
+  }
+}
+
 // The irradiance checks: above the clear sky, and the plane's sensor against
 // the horizontal pair.
 void FindIrradianceFaults(const Series& s, const Plant& plant, const SensorFaultOptions& o,
@@ -296,6 +356,7 @@ void FindIrradianceFaults(const Series& s, const Plant& plant, const SensorFault
         s, "ghi_w_m2", "above_clear_sky", o.min_run_minutes,
         [&](std::size_t i) { return g[i] > f * clear_ghi[i] + 50.0; }, above, faults);
   }
+  if (poa) FindClockShift(s, clear_poa, sun, o, faults);
   if (poa && pair) {
     const std::vector<double>& g = s[Channel::kGPoaWM2];
     AddRuns(

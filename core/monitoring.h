@@ -147,7 +147,7 @@ struct SensorFault {
   std::string channel;  // canonical name (core/channels.h)
   std::int64_t start_s = 0, end_s = 0;
   // missing | frozen | heat_without_flow | sky_warmer_than_air |
-  // above_clear_sky | poa_disagrees_with_ghi_dhi
+  // above_clear_sky | poa_disagrees_with_ghi_dhi | clock_shift (channel "time")
   std::string kind;
   std::string detail;
 };
@@ -169,6 +169,9 @@ struct SensorFaultOptions {
   // above this (plus 50 W/m²) for min_disagree_minutes.
   double poa_disagreement = 0.25;
   int min_disagree_minutes = 30;
+  // A clear day whose irradiance peaks this much earlier or later than the
+  // clear sky of the plane (a logger clock that is off, or on local time).
+  double max_clock_offset_min = 10.0;
 };
 
 // The faults in rows (step 60 s, increasing times).

@@ -525,6 +525,13 @@ TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
             1)
       << "no forecast after the 600-minute outage";
   EXPECT_GT(db.Number("SELECT count(DISTINCT issued_at) FROM forecast"), 24);
+  // The nightly checks recorded the weather station's gap as missing values
+  // (from 100 simulated minutes after the start, still going at 02:00).
+  EXPECT_GE(db.Number("SELECT count(*) FROM qc_event WHERE channel = 't_amb_c' AND kind = "
+                      "'missing' AND start_ts BETWEEN " +
+                      std::to_string(t0 + 95 * 60) + " AND " + std::to_string(t0 + 105 * 60)),
+            1)
+      << Log();
   // The operator's event list has the weather station going down and back.
   EXPECT_GE(db.Number("SELECT count(*) FROM event WHERE kind = 'device' AND severity IN "
                       "('warning', 'error') AND message LIKE '%weather%'"),

@@ -28,15 +28,6 @@ std::string LineAfter(const fs::path& path, const std::string& prefix) {
   return "";
 }
 
-std::string LastLine(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line, last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  return last;
-}
-
 // Keeps the newest `keep` diagnosis-<date>.html (names sort by date).
 void PruneReports(const fs::path& dir, int keep) {
   std::vector<fs::path> reports;
@@ -131,7 +122,7 @@ void NightlyDiagnosis::Finish(int exit_code, const DiagnosisConfig& config, Stor
           "diagnosis " +
               (exit_code < 0 ? "ended by signal " + std::to_string(-exit_code)
                              : "exited with " + std::to_string(exit_code)) +
-              ": " + LastLine(work / "diagnose.log"),
+              ": " + LastOutputLine((work / "diagnose.log").string()),
           log);
     return;
   }

@@ -73,16 +73,6 @@ void RemoveOldRunDirectories(const fs::path& dir, std::size_t keep) {
   }
 }
 
-// The last line of the child's output: why it failed, in its own words.
-std::string LastLine(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line, last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  return last;
-}
-
 std::string Format(const char* fmt, double a) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), fmt, a);
@@ -505,11 +495,12 @@ void Service::FinishRefit(int exit_code) {
   ParamsFile file;
   Diagnostics errors;
   if (exit_code != 0 || !ParseParamsJson(text, new_json.string(), config_.plant, &file, &errors)) {
-    LogToStderr(kWarning, "the refit of calibration " + std::to_string(params_id_) +
-                              " on the whole window failed (" +
-                              (exit_code != 0 ? LastLine(job_dir_ / "calibrate.log")
-                                              : std::string("unreadable parameters")) +
-                              "); the held-out-checked parameters stay");
+    LogToStderr(kWarning,
+                "the refit of calibration " + std::to_string(params_id_) +
+                    " on the whole window failed (" +
+                    (exit_code != 0 ? LastOutputLine((job_dir_ / "calibrate.log").string())
+                                    : std::string("unreadable parameters")) +
+                    "); the held-out-checked parameters stay");
     return;
   }
   const nlohmann::json fit =
@@ -563,7 +554,7 @@ void Service::FinishCalibration(int exit_code) {
     row.status = exit_code < 0 ? "crashed" : "failed";
     row.reason = (exit_code < 0 ? "calibrate ended by signal " + std::to_string(-exit_code)
                                 : "calibrate exited with " + std::to_string(exit_code)) +
-                 ": " + LastLine(job_dir_ / "calibrate.log");
+                 ": " + LastOutputLine((job_dir_ / "calibrate.log").string());
     RecordCalibration(row);
     return;
   }

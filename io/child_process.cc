@@ -9,6 +9,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <fstream>
 
 #include "core/clock.h"
 
@@ -170,6 +171,15 @@ std::string SelfExecutable() {
   if (n <= 0) return "pvtwin";
   buf[n] = '\0';
   return buf;
+}
+
+std::string LastOutputLine(const std::string& output_path) {
+  std::ifstream in(output_path);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
 }
 
 }  // namespace pvtwin

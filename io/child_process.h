@@ -57,4 +57,8 @@ class ChildProcess {
 // Path of the running executable (/proc/self/exe).
 std::string SelfExecutable();
 
+// The last non-empty line of a child's output file (Start's output_path):
+// why it failed, in its own words. Empty when the file is empty or missing.
+std::string LastOutputLine(const std::string& output_path);
+
 }  // namespace pvtwin

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "core/effects.h"
-#include "core/identification.h"
-#include "core/qc.h"
-#include "core/synthetic_plant.h"
+#include "core/data/qc.h"
+#include "core/effects/effects.h"
+#include "core/fit/identification.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 
 namespace pvtwin::cli {

@@ -11,9 +11,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/diagnosis.h"
-#include "core/diagnosis_selftest.h"
-#include "core/synthetic_plant.h"
+#include "core/diagnosis/diagnosis.h"
+#include "core/diagnosis/diagnosis_selftest.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/diagnosis_report.h"

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <iostream>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/csv.h"
 #include "io/time_format.h"
 

@@ -10,7 +10,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 
 extern char** environ;
 

@@ -12,9 +12,9 @@
 #include <bitset>
 #include <string>
 
-#include "core/diagnostic.h"
-#include "core/params.h"
-#include "core/plant.h"
+#include "core/common/diagnostic.h"
+#include "core/common/params.h"
+#include "core/common/plant.h"
 
 namespace pvtwin {
 

@@ -87,9 +87,9 @@
 #include <string>
 #include <vector>
 
-#include "core/aggregate.h"
-#include "core/sample.h"
-#include "core/series.h"
+#include "core/common/sample.h"
+#include "core/common/series.h"
+#include "core/data/aggregate.h"
 
 namespace pvtwin {
 

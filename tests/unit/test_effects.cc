@@ -1,12 +1,12 @@
 // The effect library's catalogue: names, variant grammar, WithEffect and
-// CanAddEffect (core/effects.h).
+// CanAddEffect (core/effects/effects.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <set>
 
-#include "core/effects.h"
-#include "core/synthetic_plant.h"
+#include "core/effects/effects.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

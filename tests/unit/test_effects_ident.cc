@@ -10,10 +10,10 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/effects.h"
-#include "core/identification.h"
-#include "core/qc.h"
-#include "core/synthetic_plant.h"
+#include "core/data/qc.h"
+#include "core/effects/effects.h"
+#include "core/fit/identification.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

@@ -1,15 +1,15 @@
 // Each effect of the library on an analytic case: the effect moves the
 // outputs in the predicted direction by the predicted amount
-// (core/effects.h, thermal_model.cc, drivers.cc).
+// (core/effects/effects.h, thermal_model.cc, drivers.cc).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/effects.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/units.h"
-#include "core/weather_generator.h"
+#include "core/common/units.h"
+#include "core/effects/effects.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
+#include "core/synth/weather_generator.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

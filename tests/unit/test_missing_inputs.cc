@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "core/effects.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/variant.h"
+#include "core/effects/effects.h"
+#include "core/model/thermal_model.h"
+#include "core/model/variant.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/synthetic_series.h"
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/units.h"
+#include "core/common/units.h"
 #include "io/csv.h"
 #include "io/time_format.h"
 #include "tests/support/run_pvtwin.h"
@@ -131,9 +131,10 @@ TEST_F(StoreCli, OneMinuteImportExportsBackToTheSameCsvValues) {
 TEST_F(StoreCli, ExportToAFullDiskLeavesNoPartialFile) {
   WriteRows("m.csv", Rows(kMinute0, 5000, 60.0));  // about 400 kB as CSV
   ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
-  const ProcessResult run = testing::RunCommand(
-      dir_, "trap '' XFSZ; ulimit -f 128; '" + std::string(PVTWIN_BINARY) +
-                "' export --db t.db --out e.csv --from 2024-01-01T00:00:00Z --to 2025-01-01T00:00:00Z --config pvtwin.toml");
+  const ProcessResult run =
+      testing::RunCommand(dir_, "trap '' XFSZ; ulimit -f 128; '" + std::string(PVTWIN_BINARY) +
+                                    "' export --db t.db --out e.csv --from 2024-01-01T00:00:00Z "
+                                    "--to 2025-01-01T00:00:00Z --config pvtwin.toml");
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find("cannot write"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "e.csv"));

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "core/variant.h"
+#include "core/model/variant.h"
 
 namespace pvtwin {
 namespace {

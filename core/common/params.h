@@ -86,6 +86,11 @@ struct ParamInfo {
 // value (Table 3's "±50 %"); use ResolvedInfo() to get absolute numbers.
 extern const std::array<ParamInfo, kNumParams> kParamTable;
 
+// The value of parameter `name` in p.
+inline double ParamOf(const ParamVector& p, Param name) {
+  return p[static_cast<std::size_t>(name)];
+}
+
 inline const ParamInfo& Info(Param p) { return kParamTable[static_cast<std::size_t>(p)]; }
 
 // Start value and bounds for parameter p at this plant (absolute values).

@@ -24,9 +24,6 @@ namespace {
 
 const double kNaN = std::nan("");
 
-// Fewest training days on which soiling (a loss growing over days) is tried.
-constexpr int kMinSoilingTrainDays = 3;
-
 std::string PValue(double p) {
   std::ostringstream s;
   s.precision(2);
@@ -137,46 +134,10 @@ std::vector<double> Residual(const Measurements& m, const std::vector<double>& p
   return r;
 }
 
-// A start for the shading parameters from where the base model over-predicts
-// P_el under beam light: cells of sun azimuth (10°) × elevation (5°) whose
-// mean relative P_el residual (predicted − measured)/predicted exceeds 15 %
-// on rows with at least 200 W/m² in the plane. The obstacle's azimuth window
-// spans those cells, its edge is the highest of them. A local fit started at
-// the default (a shade due south) does not find an obstacle elsewhere.
-// Returns false when no cell qualifies.
-bool ShadingStartFromResiduals(const Series& s, const Drivers& d, const SimOutputs& sim,
-                               const Measurements& m, const Plant& plant, ParamVector* start) {
-  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
-  constexpr int kAz = 36, kEl = 18;
-  std::vector<double> sum(kAz * kEl, 0.0), count(kAz * kEl, 0.0);
-  for (std::uint32_t i : m.rows) {
-    if (sun[i].elevation_rad <= 0.0 || d.g_poa_w_m2[i] < 200.0 || !(sim.p_el_w[i] > 0.0)) continue;
-    const int a = std::clamp(static_cast<int>(RadToDeg(sun[i].azimuth_rad) / 10.0), 0, kAz - 1);
-    const int e = std::clamp(static_cast<int>(RadToDeg(sun[i].elevation_rad) / 5.0), 0, kEl - 1);
-    sum[a * kEl + e] += (sim.p_el_w[i] - m.p_el_w[i]) / sim.p_el_w[i];
-    count[a * kEl + e] += 1.0;
-  }
-  int az_lo = kAz, az_hi = -1, el_hi = -1;
-  for (int a = 0; a < kAz; ++a) {
-    for (int e = 0; e < kEl; ++e) {
-      const int k = a * kEl + e;
-      if (count[k] < 5 || sum[k] / count[k] < 0.15) continue;
-      az_lo = std::min(az_lo, a);
-      az_hi = std::max(az_hi, a);
-      el_hi = std::max(el_hi, e);
-    }
-  }
-  if (az_hi < 0) return false;
-  auto set = [start](Param p, double v) { (*start)[static_cast<std::size_t>(p)] = v; };
-  set(Param::kShadeAzimuthRad, DegToRad(5.0 * (az_lo + az_hi + 1)));
-  set(Param::kShadeWidthRad, DegToRad(10.0 * (az_hi - az_lo + 1)));
-  set(Param::kShadeElevationRad, DegToRad(5.0 * (el_hi + 1)));
-  return true;
-}
-
-// The sensor test of irradiance_bias (see EffectTrial): k per day of data.
-void IrradianceBiasTest(const Series& data, const std::vector<std::int64_t>& day_starts,
-                        const Plant& plant, const ModelSpec& spec, EffectTrial* t) {
+// The sensor test of a sensor fault (EffectModule::sensor_estimate, see
+// EffectTrial): its size estimated on each day of data.
+void SensorTest(const Series& data, const std::vector<std::int64_t>& day_starts, const Plant& plant,
+                const ModelSpec& spec, const EffectModule& effect, EffectTrial* t) {
   std::vector<double> k;
   for (std::int64_t day : day_starts) {
     const std::size_t lo = data.RowAtOrAfter(day);
@@ -184,7 +145,7 @@ void IrradianceBiasTest(const Series& data, const std::vector<std::int64_t>& day
     Drivers d;
     std::string why;
     if (hi <= lo || !PrepareDrivers(data.Slice(lo, hi), plant, spec, &d, &why)) continue;
-    const double kd = EstimateIrradianceBias(d);
+    const double kd = effect.sensor_estimate(d);
     if (std::isfinite(kd)) k.push_back(kd);
   }
   if (k.size() < 3) return;
@@ -405,15 +366,14 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
                options.effects.end();
       });
     }
-    // A drift over days is not seen within fewer than three training days.
-    if (train_days < kMinSoilingTrainDays) {
-      std::erase_if(candidates, [&skipped](const EffectCandidate& c) {
-        if (c.name != "soiling") return false;
-        skipped.push_back({c.name, "needs at least " + std::to_string(kMinSoilingTrainDays) +
-                                       " training days to see a drift over days"});
-        return true;
-      });
-    }
+    // An effect that needs more training days than there are (a drift over days).
+    std::erase_if(candidates, [&skipped, train_days](const EffectCandidate& c) {
+      if (train_days >= c.module->min_train_days) return false;
+      skipped.push_back({c.name, "needs at least " + std::to_string(c.module->min_train_days) +
+                                     " training days " +
+                                     std::string(c.module->min_train_days_why)});
+      return true;
+    });
     if (step == 1) r.skipped = skipped;
     if (candidates.empty()) break;
     std::vector<EffectTrial> trials(candidates.size());
@@ -429,6 +389,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
         t.tested_against = current_spec.Name();
         t.explanation = c.explanation;
         t.signature = c.signature;
+        t.advice = std::string(c.module->advice);
         t.heldout_mae_before_w = MaeSumW(current_score.errors);
         Part tr, ho;
         std::string why;
@@ -438,7 +399,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
         } else {
           // Evidence on the base model's residuals (the gap being explained).
           if (step == 1) {
-            const std::vector<double> sig = CandidateSignature(c.name, ho.drivers, base_score.sim);
+            const std::vector<double> sig = CandidateSignature(c, ho.drivers, base_score.sim);
             std::vector<std::vector<double>> ctl = controls;
             const PartialCorrelation cp = [&] {
               ctl.push_back(base_score.sim.p_el_w);
@@ -451,9 +412,13 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
             t.evidence_output = use_q ? "q_th" : "p_el";
           }
           ParamVector start = MergedStart(plant, current_spec, current_params);
-          if (c.name == "shading") {
-            ShadingStartFromResiduals(train_series, base_train.drivers, base_train_sim,
-                                      base_train.meas, plant, &start);
+          if (c.module->start_from_residuals != nullptr) {
+            EffectResiduals res;
+            res.drivers = &base_train.drivers;
+            res.base = &base_train_sim;
+            res.rows = &base_train.meas.rows;
+            res.p_el_meas_w = &base_train.meas.p_el_w;
+            c.module->start_from_residuals(res, &start);
           }
           const IdentSummary fit = Identify(tr.drivers, tr.meas, start, options.ident);
           t.fit_runtime_s = fit.runtime_s;
@@ -472,10 +437,10 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
               t.test = CompareUnits(current_score, scores[k]);
               t.significant =
                   t.test.wilcoxon_p <= options.alpha && t.shrink_pct >= options.min_shrink_pct;
-              if (c.name == "irradiance_bias") {
-                IrradianceBiasTest(data, day_starts, plant, c.spec, &t);
+              if (c.module->sensor_estimate != nullptr) {
+                SensorTest(data, day_starts, plant, c.spec, *c.module, &t);
                 t.significant = t.irradiance_bias_p <= options.alpha &&
-                                std::fabs(t.irradiance_bias) >= options.min_irradiance_bias;
+                                std::fabs(t.irradiance_bias) >= options.min_sensor_error;
               }
             }
           }
@@ -500,7 +465,9 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
     }
     r.identifications += static_cast<int>(candidates.size());
     // Evidence sentences.
-    for (EffectTrial& t : trials) {
+    for (std::size_t k = 0; k < trials.size(); ++k) {
+      EffectTrial& t = trials[k];
+      const EffectModule& effect = *candidates[k].module;
       std::ostringstream ev;
       if (step == 1 && t.evidence_corr.rows > 0) {
         ev << "partial correlation of the " << (t.evidence_output == "q_th" ? "Q_u" : "P_el")
@@ -508,13 +475,9 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
            << " (z = " << FixedDecimals(t.evidence_corr.z, 1)
            << ", n_eff = " << FixedDecimals(t.evidence_corr.n_eff, 0) << "); ";
       }
-      if (std::isfinite(t.irradiance_bias)) {
-        ev << "against GHI/DHI transposed to the plane, the plane-of-array pyranometer reads "
-           << FixedDecimals(100.0 * std::fabs(t.irradiance_bias), 1) << " % "
-           << (t.irradiance_bias > 0 ? "low" : "high") << " (median over " << t.irradiance_bias_days
-           << " days, two-sided Wilcoxon p = " << PValue(t.irradiance_bias_p)
-           << "); η_PV and F_th absorb such a scale error, so "
-           << "the held-out error barely moves; ";
+      if (effect.sensor_evidence != nullptr && std::isfinite(t.irradiance_bias)) {
+        ev << effect.sensor_evidence(t.irradiance_bias, t.irradiance_bias_p,
+                                     t.irradiance_bias_days);
       }
       if (t.fit_ok) {
         ev << "re-identified " << t.variant << " lowers the held-out MAE on " << t.test.positives

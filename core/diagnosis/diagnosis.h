@@ -24,7 +24,7 @@
 //     Wilcoxon signed-rank test over units (core/diagnosis/diagnosis_stats.h) gives
 //     p ≤ alpha AND the pooled held-out objective shrinks by at least
 //     min_shrink_pct: consistency across days and a size that matters.
-//     irradiance_bias is judged by its sensor test instead (EffectTrial).
+//     A sensor fault is judged by its sensor test instead (EffectTrial).
 //  5. Ladder (forward selection): the significant effect with the largest
 //     shrink is accepted, and step 4 is repeated from the extended model,
 //     until nothing is significant or max_ladder_steps are accepted.
@@ -79,8 +79,9 @@ struct DiagnosisOptions {
   double min_shrink_pct = 1.0;
   // Fewer held-out days than this: test over one-hour blocks instead.
   int min_test_units = 5;
-  // Smallest pyranometer scale error |k| that counts (irradiance_bias).
-  double min_irradiance_bias = 0.02;
+  // Smallest size |estimate| of a sensor fault that counts
+  // (EffectModule::sensor_estimate, e.g. a pyranometer scale error k).
+  double min_sensor_error = 0.02;
   // Most effects accepted on the ladder.
   int max_ladder_steps = 3;
   // "unknown" when nothing is significant and the held-out objective is
@@ -104,6 +105,7 @@ struct EffectTrial {
   std::string tested_against;  // the model it was added to
   std::string explanation;
   std::string signature;
+  std::string advice;  // one sentence for the site (EffectModule::advice)
   bool fit_ok = false;
   std::string failure;  // when !fit_ok
   bool significant = false;
@@ -117,11 +119,11 @@ struct EffectTrial {
   std::string evidence;               // one sentence
   double fit_runtime_s = 0.0;
   ParamVector params{};
-  // irradiance_bias only: the pyranometer scale error is a sensor fault, not
-  // a prediction error (η_PV·F_th absorb it, so the held-out MAE does not
-  // move). It is significant when the per-day estimates of k
-  // (EstimateIrradianceBias on each day of data) have one sign consistently
-  // (two-sided Wilcoxon p ≤ alpha) and |median k| ≥ min_irradiance_bias.
+  // A sensor fault (an effect with EffectModule::sensor_estimate, the
+  // pyranometer scale error k) is not a prediction error: the fit absorbs it
+  // and the held-out MAE does not move. It is significant when its per-day
+  // estimates have one sign consistently (two-sided Wilcoxon p ≤ alpha) and
+  // |median| ≥ min_sensor_error. The fields keep their report.json names.
   double irradiance_bias = std::nan("");    // median of the per-day k
   double irradiance_bias_p = std::nan("");  // two-sided p of k ≠ 0 over days
   int irradiance_bias_days = 0;             // days with an estimate

@@ -62,14 +62,14 @@ std::vector<SelftestCase> SelftestCases(const Plant& plant) {
   probe_options.num_days = 1;
   probe_options.step_s = 3600.0;
   const Series probe = GenerateWeather(plant, probe_options);
-  for (const EffectInfo& info : EffectTable()) {
+  for (const EffectModule* effect : EffectRegistry()) {
     for (const std::string& base_name : bases) {
       const ModelSpec base = Parse(base_name);
-      if (!CanAddEffect(base, info.effect, probe, nullptr)) continue;
-      const ModelSpec truth = WithEffect(base, info.effect);
+      if (!CanAddEffect(base, *effect, probe, nullptr)) continue;
+      const ModelSpec truth = WithEffect(base, *effect);
       const ParamVector params = TruthParamsFor(plant, truth);
-      cases.push_back(
-          {std::string(info.name), std::string(info.name), base, truth, params, std::nullopt, 0.0});
+      cases.push_back({std::string(effect->name), std::string(effect->name), base, truth, params,
+                       std::nullopt, 0.0});
       break;
     }
   }

@@ -6,32 +6,24 @@
 
 namespace pvtwin {
 
-std::vector<std::string> EffectNames() {
-  std::vector<std::string> names;
-  for (const EffectInfo& info : EffectTable()) names.emplace_back(info.name);
-  return names;
-}
-
 std::vector<EffectCandidate> CandidateEffects(const ModelSpec& base, const Series& series,
                                               std::vector<SkippedEffect>* skipped) {
   std::vector<EffectCandidate> out;
-  for (const EffectInfo& info : EffectTable()) {
+  for (const EffectModule* m : EffectRegistry()) {
     std::string why;
-    if (!CanAddEffect(base, info.effect, series, &why)) {
-      if (skipped != nullptr) skipped->push_back({std::string(info.name), why});
+    if (!CanAddEffect(base, *m, series, &why)) {
+      if (skipped != nullptr) skipped->push_back({std::string(m->name), why});
       continue;
     }
-    out.push_back({std::string(info.name), WithEffect(base, info.effect),
-                   std::string(info.explanation), std::string(info.signature)});
+    out.push_back({std::string(m->name), WithEffect(base, *m), std::string(m->physics),
+                   std::string(m->signature), m});
   }
   return out;
 }
 
-std::vector<double> CandidateSignature(const std::string& name, const Drivers& drivers,
+std::vector<double> CandidateSignature(const EffectCandidate& c, const Drivers& drivers,
                                        const SimOutputs& base_outputs) {
-  const std::optional<Effect> effect = EffectFromName(name);
-  if (!effect) return std::vector<double>(drivers.size(), std::nan(""));
-  return EffectSignature(*effect, drivers, base_outputs);
+  return EffectSignature(*c.module, drivers, base_outputs);
 }
 
 }  // namespace pvtwin

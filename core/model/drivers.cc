@@ -4,7 +4,6 @@
 #include <limits>
 
 #include "core/common/units.h"
-#include "core/effects/effects.h"
 #include "core/model/irradiance_drivers.h"
 #include "core/model/thermal_model.h"
 #include "core/physics/iam.h"
@@ -26,7 +25,7 @@ std::string ChannelList(const std::vector<Channel>& channels) {
   return out;
 }
 
-// The raw drivers of the effect library (thermal_model.h, Drivers): sun
+// The raw drivers of the effect modules (core/common/model_data.h, Drivers): sun
 // geometry at the row middles, measured wind and sky temperature, the beam
 // part of the absorbed irradiance, the transposed GHI/DHI and the soiling
 // clock.
@@ -181,25 +180,12 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
 
   ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2);
   FillEffectDrivers(s, plant, spec, &out);
-  if (spec.Has(Extension::kIrradianceBias)) {
-    const double k = EstimateIrradianceBias(out);
-    if (std::isnan(k)) {
-      *error = "variant " + spec.Name() +
-               ": irradiance_bias needs at least 30 rows where g_poa_w_m2 and the transposed "
-               "ghi_w_m2 + dhi_w_m2 both exceed 300 W/m² at an angle of incidence below 60°";
-      return false;
-    }
-    out.irradiance_bias = k;
-    const bool beam_from_poa = s.Has(Channel::kGPoaDiffuseWM2);
-    for (std::size_t i = 0; i < n; ++i) {
-      out.g_poa_w_m2[i] *= 1.0 + k;
-      out.g_abs_w_m2[i] *= 1.0 + k;
-      if (beam_from_poa) out.g_beam_w_m2[i] *= 1.0 + k;
-    }
+  for (const ModelExtension* e : spec.extensions) {
+    if (e->prepare_drivers != nullptr && !e->prepare_drivers(s, &out, error)) return false;
   }
 
   out.ln_wind.assign(n, 0.0);
-  if (spec.wind_paper || spec.Has(Extension::kWind)) {
+  if (spec.ReadsWind()) {
     const auto& wind = s[Channel::kWindMS];
     for (std::size_t i = 0; i < n; ++i) {
       out.ln_wind[i] = wind[i] > 0.0 ? std::log(wind[i])

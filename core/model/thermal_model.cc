@@ -33,23 +33,14 @@ struct RunConstants {
   double g_coll_w_k;
   double u_front_w_m2k;
   double r_refwind;
-  double u_wind_w_m2k;
   double n_wind;
   double eps_pvt;
   double r0_fluid_per_area;  // r0_fluid / A_PVT
   double r_front_m2k_w;      // 1 / U_front
   double r1_fluid;
-  double fluid_cp_j_kgk;
   bool wind_paper;
-  bool wind_convective;
   bool sky;
   PvEfficiencyParams pv;
-  // Effect library (core/effects/effects.h).
-  bool flow_dependent;  // flow_dependent_u
-  double n_flow;
-  double mdot_ref_kg_s;   // kFlowReferenceKgSM2 · A_PVT
-  bool electric_effects;  // P_el is not η·A·I_at: clipping or shading mismatch
-  double p_limit_w;       // pv_clipping: P_limit·A_PVT (+inf without)
 };
 
 RunConstants MakeConstants(const Drivers& d, const ParamVector& p) {
@@ -65,143 +56,38 @@ RunConstants MakeConstants(const Drivers& d, const ParamVector& p) {
   k.g_coll_w_k = spec.nodes == 2 ? P(p, Param::kUCollWM2K) * k.area_m2 : 0.0;
   k.u_front_w_m2k = P(p, Param::kUFrontWM2K);
   k.r_refwind = P(p, Param::kRRefWind);
-  k.u_wind_w_m2k = P(p, Param::kUWindWM2K);
   k.n_wind = P(p, Param::kNWind);
   k.eps_pvt = spec.sky ? P(p, Param::kEpsPvt) : 0.0;
   k.r0_fluid_per_area = P(p, Param::kR0FluidM2KW) / k.area_m2;
   k.r_front_m2k_w = 1.0 / k.u_front_w_m2k;
   k.r1_fluid = P(p, Param::kR1Fluid);
-  k.fluid_cp_j_kgk = d.plant.fluid_cp_j_kgk;
   k.wind_paper = spec.wind_paper;
-  k.wind_convective = spec.Has(Extension::kWind);
   k.sky = spec.sky;
   k.pv = {P(p, Param::kEtaPvRef), P(p, Param::kPvTempCoeffPerK), P(p, Param::kPvIrrCoeffM2W),
           d.plant.pv_t_ref_c, d.plant.pv_g_ref_w_m2};
-  k.flow_dependent = spec.Has(Extension::kFlowDependentU);
-  k.n_flow = P(p, Param::kNFlow);
-  k.mdot_ref_kg_s = kFlowReferenceKgSM2 * k.area_m2;
-  k.electric_effects = spec.Has(Extension::kPvClipping) || spec.Has(Extension::kShading);
-  k.p_limit_w = spec.Has(Extension::kPvClipping) ? P(p, Param::kPLimitWM2) * k.area_m2
-                                                 : std::numeric_limits<double>::infinity();
   return k;
 }
 
-// The weather-side drivers of one run: the Drivers' own vectors, or copies
-// modified by the effects shading, soiling and clock_offset.
-struct WeatherView {
-  const double* g_poa_w_m2;
-  const double* g_abs_w_m2;
-  const double* t_amb_c;
-  const double* t_back_c;
-  const double* ln_wind;
-  const double* t_sky_k4;
-  const double* pv_factor;     // shading: P_el factor 1 − f_mismatch·s; null = 1
-  std::vector<double>* store;  // SimOutputs::effect_work
-};
-
-// Effect shading: fraction of the beam blocked by the obstacle,
-//   s = σ((Δγ/2 − |γ_sun − γ_shade|)/e) · σ((α_shade − α_sun)/e),  α_sun > 0,
-// σ the logistic function, e = 2° edge width, |·| the azimuth difference
-// wrapped to [0, π].
-double ShadedFraction(double sun_azimuth_rad, double sun_elevation_rad, double centre_rad,
-                      double width_rad, double edge_elevation_rad) {
-  if (!(sun_elevation_rad > 0.0)) return 0.0;
-  constexpr double kEdgeRad = 2.0 * kPi / 180.0;
-  double diff = std::fabs(std::remainder(sun_azimuth_rad - centre_rad, 2.0 * kPi));
-  auto logistic = [](double x) { return 1.0 / (1.0 + std::exp(-x)); };
-  return logistic((0.5 * width_rad - diff) / kEdgeRad) *
-         logistic((edge_elevation_rad - sun_elevation_rad) / kEdgeRad);
-}
-
-// Effect clock_offset: v at time t + offset_s by linear interpolation between
-// rows (held at the ends); out[i] for every row i.
-void ShiftInTime(const Drivers& d, const std::vector<double>& v, double offset_s,
-                 std::vector<double>* out) {
-  const std::size_t n = d.size();
-  out->resize(n);
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = static_cast<double>(d.time_s[i]) + offset_s;
-    while (j + 1 < n && static_cast<double>(d.time_s[j + 1]) <= t) ++j;
-    while (j > 0 && static_cast<double>(d.time_s[j]) > t) --j;
-    const double tj = static_cast<double>(d.time_s[j]);
-    if (t <= tj || j + 1 >= n) {
-      (*out)[i] = v[j];
-      continue;
-    }
-    const double w = (t - tj) / static_cast<double>(d.time_s[j + 1] - d.time_s[j]);
-    (*out)[i] = v[j] + w * (v[j + 1] - v[j]);
-  }
-}
-
-void MakeWeatherView(const Drivers& d, const ParamVector& p, SimOutputs* out, WeatherView* w) {
-  const ModelSpec& spec = d.spec;
-  w->store = out->effect_work.data();
-  w->g_poa_w_m2 = d.g_poa_w_m2.data();
-  w->g_abs_w_m2 = d.g_abs_w_m2.data();
-  w->t_amb_c = d.t_amb_c.data();
-  w->t_back_c = d.t_back_c.data();
-  w->ln_wind = d.ln_wind.data();
-  w->t_sky_k4 = d.t_sky_k4.data();
-  w->pv_factor = nullptr;
-  const bool shading = spec.Has(Extension::kShading);
-  const bool soiling = spec.Has(Extension::kSoiling);
-  const bool clock = spec.Has(Extension::kClockOffset);
-  if (!shading && !soiling && !clock) return;
-  const std::size_t n = d.size();
-  std::vector<double>& g_abs = w->store[0];
-  std::vector<double>& g_beam = w->store[1];
-  g_abs = d.g_abs_w_m2;
-  g_beam = d.g_beam_w_m2;
-  if (clock) {
-    const double offset_s = P(p, Param::kClockOffsetS);
-    std::vector<double>& shifted = w->store[7];
-    ShiftInTime(d, d.g_abs_w_m2, offset_s, &g_abs);
-    ShiftInTime(d, d.g_beam_w_m2, offset_s, &g_beam);
-    ShiftInTime(d, d.g_poa_w_m2, offset_s, &w->store[2]);
-    ShiftInTime(d, d.t_amb_c, offset_s, &w->store[3]);
-    ShiftInTime(d, d.t_back_c, offset_s, &w->store[4]);
-    ShiftInTime(d, d.t_sky_k4, offset_s, &w->store[5]);
-    // ln v is −inf in calm: interpolate v itself.
-    std::vector<double>& v = w->store[6];
-    v.resize(n);
-    for (std::size_t i = 0; i < n; ++i) v[i] = std::exp(d.ln_wind[i]);
-    ShiftInTime(d, v, offset_s, &shifted);
-    for (std::size_t i = 0; i < n; ++i) {
-      v[i] = d.ln_wind[i] == 0.0 && !(spec.wind_paper || spec.Has(Extension::kWind))
-                 ? 0.0
-                 : (shifted[i] > 0.0 ? std::log(shifted[i])
-                                     : -std::numeric_limits<double>::infinity());
-    }
-    w->g_poa_w_m2 = w->store[2].data();
-    w->t_amb_c = w->store[3].data();
-    w->t_back_c = w->store[4].data();
-    w->t_sky_k4 = w->store[5].data();
-    w->ln_wind = w->store[6].data();
-  }
-  if (shading) {
-    const double centre = P(p, Param::kShadeAzimuthRad);
-    const double width = P(p, Param::kShadeWidthRad);
-    const double edge = P(p, Param::kShadeElevationRad);
-    const double mismatch = P(p, Param::kShadeMismatch);
-    std::vector<double>& factor = w->store[1];  // the beam is not needed afterwards
-    for (std::size_t i = 0; i < n; ++i) {
-      const double s =
-          ShadedFraction(d.sun_azimuth_rad[i], d.sun_elevation_rad[i], centre, width, edge);
-      const double beam = std::isfinite(g_beam[i]) ? g_beam[i] : 0.0;
-      g_abs[i] -= s * beam;
-      factor[i] = 1.0 - mismatch * s;
-    }
-    w->pv_factor = factor.data();
-  }
-  if (soiling) {
-    // τ_soil = max(0, 1 − r_soil·d), d = days since the last cleaning.
-    const double rate_per_day = P(p, Param::kSoilingPerDay);
-    for (std::size_t i = 0; i < n; ++i) {
-      g_abs[i] *= std::max(0.0, 1.0 - rate_per_day * d.days_since_clean[i]);
+// The run's per-row inputs: the Drivers' arrays, then the hooks of the
+// spec's extensions (ModelExtension::transform_drivers), weather timing
+// (stage 0) before values (stage 1), each stage in variant order.
+void MakeRunInputs(const Drivers& d, const ParamVector& p, SimOutputs* out, RunInputs* run) {
+  run->n = d.size();
+  run->g_poa_w_m2 = d.g_poa_w_m2.data();
+  run->g_abs_w_m2 = d.g_abs_w_m2.data();
+  run->g_beam_w_m2 = d.g_beam_w_m2.data();
+  run->t_amb_c = d.t_amb_c.data();
+  run->t_back_c = d.t_back_c.data();
+  run->ln_wind = d.ln_wind.data();
+  run->t_sky_k4 = d.t_sky_k4.data();
+  run->work = &out->work;
+  for (int stage = 0; stage <= 1; ++stage) {
+    for (const ModelExtension* e : d.spec.extensions) {
+      if (e->transform_drivers != nullptr && e->driver_stage == stage) {
+        e->transform_drivers(d, p, run);
+      }
     }
   }
-  w->g_abs_w_m2 = g_abs.data();
 }
 
 // Everything about one row that does not depend on the node temperatures.
@@ -211,10 +97,11 @@ struct RowTerms {
   double q_sun_w;  // F_th·A·I_at: heat absorbed if no electricity were produced
   PvEfficiencyLinear eta;
   double t_amb_c, t_back_c, t_in_c, t_sky_k4;
-  // P_el = min(η(T)·p_per_eta_w, p_limit_w) when RunConstants::electric_effects.
+  // P_el = min(η(T)·p_per_eta_w, p_limit_w) when `electric`.
   double p_per_eta_w;  // A·I_at·(1 − f_mismatch·s)
   double p_limit_w;
   double f_th;
+  bool electric;  // RunInputs::electric_effects
 
   // Electrical power at T_PV = t_c and its slope (W/K).
   double PElW(double t_c, double* slope_w_k) const {
@@ -228,28 +115,18 @@ struct RowTerms {
   }
 };
 
-// Effect flow_dependent_u: 1/U_fluid = r1/(2w) + r0·(w_ref/w)^n_flow (see
-// effects.cc); the paper's eq. 2.7 for n_flow = 0.
-double GFluidFlowDependentWK(const RunConstants& k, double capacity_flow_w_k, double mdot_kg_s) {
-  if (!(capacity_flow_w_k > 0.0)) return 0.0;
-  const double r0_scaled = k.r0_fluid_per_area * std::pow(k.mdot_ref_kg_s / mdot_kg_s, k.n_flow);
-  return GFluidWK(capacity_flow_w_k, r0_scaled, k.r1_fluid);
-}
-
-RowTerms MakeRowTerms(const RunConstants& k, const Drivers& d, const WeatherView& w,
-                      std::size_t i) {
+RowTerms MakeRowTerms(const RunConstants& k, const Drivers& d, const RunInputs& w, std::size_t i) {
   RowTerms r;
   double u_front = k.u_front_w_m2k;
-  if (k.wind_paper) {
+  if (w.u_front_w_m2k != nullptr) {
+    u_front = w.u_front_w_m2k[i];
+  } else if (k.wind_paper) {
     u_front =
         FrontConductancePaperWM2K(k.r_front_m2k_w, k.r_refwind, WindPower(w.ln_wind[i], k.n_wind));
-  } else if (k.wind_convective) {
-    u_front =
-        FrontConductanceConvectiveWM2K(u_front, k.u_wind_w_m2k, WindPower(w.ln_wind[i], k.n_wind));
   }
   r.g_front_w_k = u_front * k.area_m2;
-  r.g_fluid_w_k = k.flow_dependent
-                      ? GFluidFlowDependentWK(k, d.capacity_flow_w_k[i], d.mdot_kg_s[i])
+  r.g_fluid_w_k = w.g_fluid_w_k != nullptr
+                      ? w.g_fluid_w_k[i]
                       : GFluidWK(d.capacity_flow_w_k[i], k.r0_fluid_per_area, k.r1_fluid);
   r.q_sun_w = k.f_th * k.area_m2 * w.g_abs_w_m2[i];
   r.eta = PvEfficiencyAt(k.pv, w.g_poa_w_m2[i]);
@@ -258,16 +135,17 @@ RowTerms MakeRowTerms(const RunConstants& k, const Drivers& d, const WeatherView
   r.t_in_c = d.t_in_c[i];
   r.t_sky_k4 = w.t_sky_k4[i];
   r.p_per_eta_w = k.area_m2 * w.g_abs_w_m2[i] * (w.pv_factor ? w.pv_factor[i] : 1.0);
-  r.p_limit_w = k.p_limit_w;
+  r.p_limit_w = w.p_limit_w;
   r.f_th = k.f_th;
+  r.electric = w.electric_effects;
   return r;
 }
 
 // Q_abs at T_PV = t_c and its slope dQ_abs/dT (W, W/K). Paper eq. 2.3:
 // Q_abs = (1 − η)·F_th·A·I_at. With clipping or shading mismatch the power
 // that is not converted stays as heat: Q_abs = F_th·(A·I_at − P_el).
-double QAbsW(const RunConstants& k, const RowTerms& r, double t_c, double* slope_w_k) {
-  if (!k.electric_effects) {
+double QAbsW(const RowTerms& r, double t_c, double* slope_w_k) {
+  if (!r.electric) {
     *slope_w_k = -r.q_sun_w * r.eta.SlopeAt(t_c);
     return r.q_sun_w * (1.0 - r.eta.At(t_c));
   }
@@ -321,7 +199,7 @@ void Linearise(const RunConstants& k, const RowTerms& r, double t_lin_c, Lineari
   // −q_sun·dη/dT. The slope enters the conductance only while it leaves at
   // least half of the node's own loss conductance (it is tiny in any
   // physical case); otherwise it stays explicit and the iteration resolves it.
-  l.q_abs_lin_w = QAbsW(k, r, t_lin_c, &l.dq_abs_w_k);
+  l.q_abs_lin_w = QAbsW(r, t_lin_c, &l.dq_abs_w_k);
   if (l.dq_abs_w_k > 0.5 * pv.conductance_w_k) l.dq_abs_w_k = 0.0;
   pv.conductance_w_k -= l.dq_abs_w_k;
   pv.source_w += l.q_abs_lin_w - l.dq_abs_w_k * t_lin_c;
@@ -339,7 +217,7 @@ bool LinearisationConverged(const RunConstants& k, const RowTerms& r, const Line
     flux_error_w += SkyLossW(k, r, t_pv_c, &unused) - (l.q_rad_lin_w + l.dq_rad_w_k * dt);
   }
   double unused_slope;
-  flux_error_w -= QAbsW(k, r, t_pv_c, &unused_slope) - (l.q_abs_lin_w + l.dq_abs_w_k * dt);
+  flux_error_w -= QAbsW(r, t_pv_c, &unused_slope) - (l.q_abs_lin_w + l.dq_abs_w_k * dt);
   return std::fabs(flux_error_w) < kNodeToleranceK * l.g_pv_own_w_k;
 }
 
@@ -366,38 +244,6 @@ void SetRowNaN(SimOutputs* out, std::size_t i, bool energy) {
   }
 }
 
-// Effect transport_delay: the outlet sensor sees the fluid that left the
-// collector τ earlier, T_out(t − τ) (linear interpolation between row
-// means), cooled on the way by the pipe's loss U_pipe·A to ambient (plug flow
-// through a pipe with uniform loss, Duffie & Beckman 10.3):
-//   T_out,sensor = T_amb + (T_out(t − τ) − T_amb)·exp(−U_pipe·A/(ṁ·c_p)),
-// and the measured heat is ṁ·c_p·(T_out,sensor − T_in).
-void ApplyTransportDelay(const Drivers& d, const WeatherView& w, double delay_s, double pipe_w_k,
-                         double cp, SimOutputs* out) {
-  const std::size_t n = d.size();
-  if (n == 0 || !(delay_s > 0.0 || pipe_w_k > 0.0)) return;
-  std::vector<double>& t_out = out->effect_work[8];
-  t_out = out->t_out_c;  // undelayed copy
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!d.usable[i]) continue;
-    const double t_seen = static_cast<double>(d.time_s[i]) - delay_s;
-    std::size_t j = i;
-    while (j > 0 && d.time_s[j] > t_seen && d.usable[j - 1] && !d.restart[j]) --j;
-    double t_sensor = t_out[j];
-    if (j < i && static_cast<double>(d.time_s[j]) < t_seen) {
-      const double w = (t_seen - static_cast<double>(d.time_s[j])) /
-                       static_cast<double>(d.time_s[j + 1] - d.time_s[j]);
-      t_sensor = t_out[j] + w * (t_out[j + 1] - t_out[j]);
-    }
-    if (d.mdot_kg_s[i] > 0.0) {
-      t_sensor =
-          w.t_amb_c[i] + (t_sensor - w.t_amb_c[i]) * std::exp(-pipe_w_k / (d.mdot_kg_s[i] * cp));
-      out->q_th_w[i] = d.mdot_kg_s[i] * cp * (t_sensor - d.t_in_c[i]);
-    }
-    out->t_out_c[i] = t_sensor;
-  }
-}
-
 }  // namespace
 
 void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
@@ -414,8 +260,8 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
     }
   }
   const RunConstants k = MakeConstants(d, params);
-  WeatherView w;
-  MakeWeatherView(d, params, out, &w);
+  RunInputs w;
+  MakeRunInputs(d, params, out, &w);
   double state[2] = {0.0, 0.0};  // node temperatures at the start of the row
   // Step-mean PV temperatures of the last two rows: their linear
   // extrapolation is the first linearisation point, which usually meets the
@@ -462,7 +308,7 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
     out->t_pv_c[i] = t_pv;
     out->t_coll_c[i] = res.t_mean_c[k.nodes == 2 ? 1 : 0];
     out->q_th_w[i] = q_u;
-    if (k.electric_effects) {
+    if (r.electric) {
       double unused_slope;
       out->p_el_w[i] = r.PElW(t_pv, &unused_slope);
     } else {
@@ -481,9 +327,8 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
       out->q_store_w[i] = stored_j / d.dt_s[i];
     }
   }
-  if (d.spec.Has(Extension::kTransportDelay)) {
-    ApplyTransportDelay(d, w, P(params, Param::kTransportDelayS),
-                        P(params, Param::kUPipeWM2K) * k.area_m2, k.fluid_cp_j_kgk, out);
+  for (const ModelExtension* e : d.spec.extensions) {
+    if (e->transform_outputs != nullptr) e->transform_outputs(d, params, &w, out);
   }
 }
 

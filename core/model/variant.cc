@@ -1,27 +1,25 @@
 #include "core/model/variant.h"
 
-#include <array>
+#include <algorithm>
 #include <utility>
+
+#include "core/effects/effects.h"
 
 namespace pvtwin {
 
 namespace {
 
-struct ExtensionName {
-  Extension extension;
-  std::string_view name;
-};
-
-constexpr std::array<ExtensionName, kNumExtensions> kExtensionNames = {{
-    {Extension::kWind, "wind"},
-    {Extension::kTransportDelay, "transport_delay"},
-    {Extension::kFlowDependentU, "flow_dependent_u"},
-    {Extension::kPvClipping, "pv_clipping"},
-    {Extension::kShading, "shading"},
-    {Extension::kSoiling, "soiling"},
-    {Extension::kClockOffset, "clock_offset"},
-    {Extension::kIrradianceBias, "irradiance_bias"},
-}};
+// The modules with a "+name" extension, in variant order.
+std::vector<const EffectModule*> ExtensionsInVariantOrder() {
+  std::vector<const EffectModule*> out;
+  for (const EffectModule* m : EffectRegistry()) {
+    if (m->extension != nullptr) out.push_back(m);
+  }
+  std::stable_sort(out.begin(), out.end(), [](const EffectModule* a, const EffectModule* b) {
+    return a->extension->variant_order < b->extension->variant_order;
+  });
+  return out;
+}
 
 bool ConsumePrefix(std::string_view* s, std::string_view prefix) {
   if (s->substr(0, prefix.size()) != prefix) return false;
@@ -62,40 +60,27 @@ bool ParseBase(std::string_view base, ModelSpec* spec, std::string* error) {
   return true;
 }
 
+// "+effect": an effect with a model extension adds it; an effect that the
+// paper's letters express sets its letters (sky_radiation = r, iam = I,
+// capacitance = the next missing capacitance, second_node = 2N).
 bool ParseEffect(std::string_view effect, ModelSpec* spec, std::string* error) {
-  if (effect == "sky_radiation") {
-    spec->sky = true;
-    return true;
-  }
-  if (effect == "iam") {
-    spec->iam = true;
-    return true;
-  }
-  if (effect == "capacitance") {
-    if (spec->nodes == 1) {
-      spec->c_pv = true;
-    } else if (!spec->c_coll) {
-      spec->c_coll = true;
-    } else {
-      spec->c_pv = true;
+  const EffectModule* m = FindEffect(effect);
+  if (m == nullptr) {
+    std::string known;
+    for (const EffectModule* e : ExtensionsInVariantOrder()) known += std::string(e->name) + ", ";
+    std::string letters;
+    for (const EffectModule* e : EffectRegistry()) {
+      if (e->extension == nullptr) letters += (letters.empty() ? "" : ", ") + std::string(e->name);
     }
-    return true;
+    *error = "unknown effect '" + std::string(effect) + "' (known: " + known + letters + ")";
+    return false;
   }
-  if (effect == "second_node") {
-    spec->nodes = 2;
-    return true;
+  if (m->extension != nullptr) {
+    spec->Add(*m->extension);
+  } else {
+    *spec = WithEffect(*spec, *m);
   }
-  for (const ExtensionName& e : kExtensionNames) {
-    if (e.name == effect) {
-      spec->extensions.set(static_cast<std::size_t>(e.extension));
-      return true;
-    }
-  }
-  std::string known;
-  for (const ExtensionName& e : kExtensionNames) known += std::string(e.name) + ", ";
-  *error = "unknown effect '" + std::string(effect) + "' (known: " + known +
-           "capacitance, second_node, sky_radiation, iam)";
-  return false;
+  return true;
 }
 
 }  // namespace
@@ -116,33 +101,14 @@ bool ParseVariant(std::string_view name, ModelSpec* spec, std::string* error) {
     if (next == std::string_view::npos) break;
     rest.remove_prefix(next + 1);
   }
-  if (out.wind_paper && out.Has(Extension::kWind)) {
+  if (out.wind_paper && std::any_of(out.extensions.begin(), out.extensions.end(),
+                                    [](const ModelExtension* e) { return e->reads_wind; })) {
     *error = "'" + std::string(name) +
              "': 'w' (paper's wind form) and '+wind' (physical form) exclude each other";
     return false;
   }
   *spec = out;
   return true;
-}
-
-std::string ModelSpec::Name() const {
-  std::string name = nodes == 1 ? "1N" : "2N";
-  if (nodes == 1) {
-    if (c_pv) name += "1C";
-  } else if (c_pv && c_coll) {
-    name += "2C";
-  } else if (c_pv) {
-    name += "1Cpv";
-  } else if (c_coll) {
-    name += "1Ccol";
-  }
-  if (wind_paper) name += "w";
-  if (sky) name += "r";
-  if (iam) name += "I";
-  for (const ExtensionName& e : kExtensionNames) {
-    if (Has(e.extension)) name += "+" + std::string(e.name);
-  }
-  return name;
 }
 
 const std::vector<std::string>& PaperVariants() {
@@ -167,27 +133,9 @@ std::bitset<kNumParams> UsedParams(const ModelSpec& spec) {
     use(Param::kRRefWind);
     use(Param::kNWind);
   }
-  if (spec.Has(Extension::kWind)) {
-    use(Param::kUWindWM2K);
-    use(Param::kNWind);
+  for (const ModelExtension* e : spec.extensions) {
+    for (Param p : e->params) use(p);
   }
-  if (spec.Has(Extension::kTransportDelay)) {
-    use(Param::kTransportDelayS);
-    use(Param::kUPipeWM2K);
-  }
-  if (spec.Has(Extension::kFlowDependentU)) use(Param::kNFlow);
-  if (spec.Has(Extension::kPvClipping)) use(Param::kPLimitWM2);
-  if (spec.Has(Extension::kShading)) {
-    for (Param p : {Param::kShadeAzimuthRad, Param::kShadeWidthRad, Param::kShadeElevationRad,
-                    Param::kShadeMismatch}) {
-      use(p);
-    }
-  }
-  if (spec.Has(Extension::kSoiling)) use(Param::kSoilingPerDay);
-  if (spec.Has(Extension::kClockOffset)) use(Param::kClockOffsetS);
-  // irradiance_bias: k is calibrated from the two irradiance sources when the
-  // drivers are prepared (Drivers::irradiance_bias), not by the fit: P_el and
-  // Q_u alone cannot separate it from η_PV·F_th (see effects.cc).
   return used;
 }
 
@@ -212,17 +160,10 @@ std::vector<InputRequirement> RequiredInputs(const ModelSpec& spec) {
   } else {
     req.push_back({"irradiance in the collector plane", {{C::kGPoaWM2}, {C::kGhiWM2, C::kDhiWM2}}});
   }
-  if (spec.wind_paper || spec.Has(Extension::kWind)) {
-    req.push_back({"wind speed (w)", {{C::kWindMS}}});
-  }
+  if (spec.ReadsWind()) req.push_back({"wind speed (w)", {{C::kWindMS}}});
   if (spec.sky) req.push_back({"sky temperature (r)", {{C::kTSkyC}, {C::kLwDownWM2}}});
-  if (spec.Has(Extension::kShading)) {
-    req.push_back({"beam/diffuse irradiance (shading)",
-                   {{C::kGPoaWM2, C::kGPoaDiffuseWM2}, {C::kGhiWM2, C::kDhiWM2}}});
-  }
-  if (spec.Has(Extension::kIrradianceBias)) {
-    req.push_back({"plane-of-array and a second irradiance source (irradiance_bias)",
-                   {{C::kGPoaWM2, C::kGhiWM2, C::kDhiWM2}}});
+  for (const ModelExtension* e : spec.extensions) {
+    req.insert(req.end(), e->inputs.begin(), e->inputs.end());
   }
   return req;
 }

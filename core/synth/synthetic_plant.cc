@@ -57,9 +57,9 @@ ParamVector ReferenceTruthParams(const Plant& plant) {
 
 ParamVector TruthParamsFor(const Plant& plant, const ModelSpec& spec) {
   ParamVector p = ReferenceTruthParams(plant);
-  for (const EffectInfo& info : EffectTable()) {
-    if (!HasEffect(spec, info.effect)) continue;
-    for (const auto& [param, value] : info.typical_truth) {
+  for (const EffectModule* m : EffectRegistry()) {
+    if (!HasEffect(spec, *m)) continue;
+    for (const auto& [param, value] : m->typical_truth) {
       p[static_cast<std::size_t>(param)] = value;
     }
   }
@@ -72,7 +72,10 @@ AbsorberSensorParams SensorParamsFromTruth(const ModelSpec& truth_spec, const Pa
   a.absorbed_fraction = (1.0 - get(Param::kEtaPvRef)) * get(Param::kFTh);
   a.u_front_w_m2k = get(Param::kUFrontWM2K);
   a.u_back_w_m2k = get(Param::kUBackWM2K);
-  a.u_wind_w_m2k = truth_spec.Has(Extension::kWind) ? get(Param::kUWindWM2K) : 0.0;
+  // The physical wind form's coefficient, when the truth uses it.
+  a.u_wind_w_m2k = UsedParams(truth_spec).test(static_cast<std::size_t>(Param::kUWindWM2K))
+                       ? get(Param::kUWindWM2K)
+                       : 0.0;
   a.n_wind = get(Param::kNWind);
   a.eps_lw = truth_spec.sky ? get(Param::kEpsPvt) : 0.0;
   a.r_internal_m2k_w = truth_spec.nodes == 2 ? 1.0 / get(Param::kUCollWM2K) : 0.0;
@@ -184,8 +187,13 @@ Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& option
       }
     }
   }
+  // Sensor errors act on the measurements below, not on the physics.
   ModelSpec physics_spec = options.truth_spec;
-  physics_spec.extensions.reset(static_cast<std::size_t>(Extension::kIrradianceBias));
+  for (const EffectModule* m : EffectRegistry()) {
+    if (m->apply_sensor_error != nullptr && m->extension != nullptr) {
+      physics_spec.Remove(*m->extension);
+    }
+  }
   Drivers drivers;
   std::string error;
   if (!PrepareDrivers(physics, plant, physics_spec, &drivers, &error)) {
@@ -217,11 +225,9 @@ Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& option
                     : 0.0;
     }
   }
-  if (options.truth_spec.Has(Extension::kIrradianceBias)) {
-    const double k = options.truth[static_cast<std::size_t>(Param::kIrradianceBias)];
-    for (Channel c : {Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2}) {
-      if (!s.Has(c)) continue;
-      for (double& g : s[c]) g /= 1.0 + k;
+  for (const EffectModule* m : EffectRegistry()) {
+    if (m->apply_sensor_error != nullptr && HasEffect(options.truth_spec, *m)) {
+      m->apply_sensor_error(options.truth, &s);
     }
   }
   InjectDefects(options.defects, &s);

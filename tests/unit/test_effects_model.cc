@@ -7,9 +7,11 @@
 
 #include "core/common/units.h"
 #include "core/effects/effects.h"
+#include "core/effects/flow_dependent_u.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
 #include "core/synth/weather_generator.h"
+#include "tests/support/effect_named.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
@@ -288,7 +290,8 @@ TEST(EffectModel, IrradianceBiasIsCalibratedAgainstTheSecondSource) {
   }
   // The base model's drivers keep the signature: reference − measured > 0.
   const Drivers base = DriversOf(biased, plant, "1N");
-  const std::vector<double> sig = EffectSignature(Effect::kIrradianceBias, base, SimOutputs{});
+  const std::vector<double> sig =
+      EffectSignature(testing::EffectNamed("irradiance_bias"), base, SimOutputs{});
   double sum = 0.0;
   for (std::size_t i = 0; i < sig.size(); ++i) {
     if (base.g_poa_w_m2[i] > 300.0) sum += sig[i] / base.g_poa_w_m2[i];

@@ -109,31 +109,126 @@ bool LocaliseOptions::IsValid(std::string* why) const {
   return text.empty();
 }
 
+namespace {
+
+// Blocks of block_s from the first counted row: the block of each row (−1
+// for rows without a residual), *blocks their number.
+std::vector<int> AssignBlocks(std::span<const std::int64_t> time_s,
+                              std::span<const double> residual, std::size_t n, double block_s,
+                              int* blocks) {
+  std::vector<int> block(n, -1);
+  std::int64_t first = 0;
+  bool have_first = false;
+  std::map<std::int64_t, int> index;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(residual[i])) continue;
+    if (!have_first) {
+      first = time_s[i];
+      have_first = true;
+    }
+    const auto key =
+        static_cast<std::int64_t>(std::floor(static_cast<double>(time_s[i] - first) / block_s));
+    auto [it, inserted] = index.emplace(key, *blocks);
+    if (inserted) ++*blocks;
+    block[i] = it->second;
+  }
+  return block;
+}
+
+// Names the region: bins k1_lo … k1_hi of the driver (and bin k2 of its
+// second dimension).
+void Describe(const RegimeDriver& d, const std::string& output, std::size_t k1_lo,
+              std::size_t k1_hi, std::size_t k2, GapRegion* g) {
+  g->driver = d.name;
+  g->output = output;
+  g->lower = d.edges[k1_lo];
+  g->upper = d.edges[k1_hi + 1];
+  if (k1_lo == k1_hi && k1_lo < d.labels.size()) g->label = d.labels[k1_lo];
+  if (k1_lo != k1_hi && k1_hi < d.labels.size()) {
+    g->label = d.labels[k1_lo] + " … " + d.labels[k1_hi];
+  }
+  if (!d.name2.empty()) {
+    g->driver2 = d.name2;
+    g->lower2 = d.edges2[k2];
+    g->upper2 = d.edges2[k2 + 1];
+  }
+}
+
+void JudgeDays(const LocaliseOptions& options, std::vector<GapRegion>* evaluated,
+               std::vector<GapRegion>* candidates, std::vector<GapRegion>* bins) {
+  // Days are the blocks themselves: a day's excess is judged against the
+  // other days, by the robust z of its MAE (median, 1.4826·MAD).
+  std::vector<double> maes;
+  for (const GapRegion& g : *evaluated) {
+    if (g.rows > 0) maes.push_back(g.mae_w);
+  }
+  if (maes.size() >= 3) {
+    std::vector<double> sorted = maes;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    for (double& v : sorted) v = std::fabs(v - median);
+    std::sort(sorted.begin(), sorted.end());
+    const double mad = 1.4826 * sorted[sorted.size() / 2];
+    for (GapRegion& g : *evaluated) {
+      if (g.rows == 0) continue;
+      const double excess = g.mae_w - median;
+      g.z = mad > 0.0 ? excess / mad : (excess > 0.0 ? kInf : 0.0);
+      g.flagged = g.z >= options.min_z && g.share_of_rows > 0.0 &&
+                  g.share_of_abs_error / g.share_of_rows >= options.min_ratio &&
+                  g.rows >= options.min_rows;
+      if (g.flagged) candidates->push_back(g);
+    }
+    for (GapRegion& b : *bins) {
+      for (const GapRegion& g : *evaluated) {
+        if (b.driver == g.driver && b.lower == g.lower && b.output == g.output) b = g;
+      }
+    }
+  }
+}
+
+// Merges runs of adjacent flagged bins of a one-dimensional driver into one
+// region when the run as a whole is flagged; else keeps the bins.
+void MergeFlaggedRuns(const RegimeDriver& d, const std::string& output,
+                      const std::vector<BlockSums>& sums, const std::vector<GapRegion>& evaluated,
+                      const Bootstrap& boot, const LocaliseOptions& options,
+                      std::vector<GapRegion>* candidates) {
+  const std::size_t n1 = evaluated.size();
+  // Merge runs of adjacent flagged bins (empty bins between them break a run).
+  for (std::size_t k = 0; k < n1;) {
+    if (!evaluated[k].flagged) {
+      ++k;
+      continue;
+    }
+    std::size_t end = k;
+    BlockSums merged = sums[k];
+    while (end + 1 < n1 && evaluated[end + 1].flagged) {
+      ++end;
+      Add(&merged, sums[end]);
+    }
+    if (end == k) {
+      candidates->push_back(evaluated[k]);
+    } else {
+      GapRegion g = Evaluate(merged, boot, options);
+      Describe(d, output, k, end, 0, &g);
+      if (g.flagged) {
+        candidates->push_back(g);
+      } else {
+        for (std::size_t j = k; j <= end; ++j) candidates->push_back(evaluated[j]);
+      }
+    }
+    k = end + 1;
+  }
+}
+
+}  // namespace
+
 Localisation LocaliseGap(std::span<const std::int64_t> time_s, std::span<const double> residual,
                          const std::string& output, const std::vector<RegimeDriver>& drivers,
                          const LocaliseOptions& options) {
   Localisation result;
   const std::size_t n = std::min(time_s.size(), residual.size());
-  // Blocks of block_s from the first counted row.
-  std::vector<int> block(n, -1);
   int blocks = 0;
-  {
-    std::int64_t first = 0;
-    bool have_first = false;
-    std::map<std::int64_t, int> index;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!std::isfinite(residual[i])) continue;
-      if (!have_first) {
-        first = time_s[i];
-        have_first = true;
-      }
-      const auto key = static_cast<std::int64_t>(
-          std::floor(static_cast<double>(time_s[i] - first) / options.block_s));
-      auto [it, inserted] = index.emplace(key, blocks);
-      if (inserted) ++blocks;
-      block[i] = it->second;
-    }
-  }
+  const std::vector<int> block = AssignBlocks(time_s, residual, n, options.block_s, &blocks);
   if (blocks == 0) return result;
   const auto nb = static_cast<std::size_t>(blocks);
   auto empty_sums = [nb] {
@@ -177,19 +272,7 @@ Localisation LocaliseGap(std::span<const std::int64_t> time_s, std::span<const d
       s.residual[b] += residual[i];
     }
     auto describe = [&](GapRegion* g, std::size_t k1_lo, std::size_t k1_hi, std::size_t k2) {
-      g->driver = d.name;
-      g->output = output;
-      g->lower = d.edges[k1_lo];
-      g->upper = d.edges[k1_hi + 1];
-      if (k1_lo == k1_hi && k1_lo < d.labels.size()) g->label = d.labels[k1_lo];
-      if (k1_lo != k1_hi && k1_hi < d.labels.size()) {
-        g->label = d.labels[k1_lo] + " … " + d.labels[k1_hi];
-      }
-      if (two_d) {
-        g->driver2 = d.name2;
-        g->lower2 = d.edges2[k2];
-        g->upper2 = d.edges2[k2 + 1];
-      }
+      Describe(d, output, k1_lo, k1_hi, k2, g);
     };
     std::vector<GapRegion> evaluated(n1 * n2);
     for (std::size_t k1 = 0; k1 < n1; ++k1) {
@@ -202,34 +285,7 @@ Localisation LocaliseGap(std::span<const std::int64_t> time_s, std::span<const d
       }
     }
     if (d.name == "day") {
-      // Days are the blocks themselves: a day's excess is judged against the
-      // other days, by the robust z of its MAE (median, 1.4826·MAD).
-      std::vector<double> maes;
-      for (const GapRegion& g : evaluated) {
-        if (g.rows > 0) maes.push_back(g.mae_w);
-      }
-      if (maes.size() >= 3) {
-        std::vector<double> sorted = maes;
-        std::sort(sorted.begin(), sorted.end());
-        const double median = sorted[sorted.size() / 2];
-        for (double& v : sorted) v = std::fabs(v - median);
-        std::sort(sorted.begin(), sorted.end());
-        const double mad = 1.4826 * sorted[sorted.size() / 2];
-        for (GapRegion& g : evaluated) {
-          if (g.rows == 0) continue;
-          const double excess = g.mae_w - median;
-          g.z = mad > 0.0 ? excess / mad : (excess > 0.0 ? kInf : 0.0);
-          g.flagged = g.z >= options.min_z && g.share_of_rows > 0.0 &&
-                      g.share_of_abs_error / g.share_of_rows >= options.min_ratio &&
-                      g.rows >= options.min_rows;
-          if (g.flagged) candidates.push_back(g);
-        }
-        for (GapRegion& b : result.bins) {
-          for (const GapRegion& g : evaluated) {
-            if (b.driver == g.driver && b.lower == g.lower && b.output == g.output) b = g;
-          }
-        }
-      }
+      JudgeDays(options, &evaluated, &candidates, &result.bins);
       continue;
     }
     if (two_d) {
@@ -238,31 +294,7 @@ Localisation LocaliseGap(std::span<const std::int64_t> time_s, std::span<const d
       }
       continue;
     }
-    // Merge runs of adjacent flagged bins (empty bins between them break a run).
-    for (std::size_t k = 0; k < n1;) {
-      if (!evaluated[k].flagged) {
-        ++k;
-        continue;
-      }
-      std::size_t end = k;
-      BlockSums merged = sums[k];
-      while (end + 1 < n1 && evaluated[end + 1].flagged) {
-        ++end;
-        Add(&merged, sums[end]);
-      }
-      if (end == k) {
-        candidates.push_back(evaluated[k]);
-      } else {
-        GapRegion g = Evaluate(merged, boot, options);
-        describe(&g, k, end, 0);
-        if (g.flagged) {
-          candidates.push_back(g);
-        } else {
-          for (std::size_t j = k; j <= end; ++j) candidates.push_back(evaluated[j]);
-        }
-      }
-      k = end + 1;
-    }
+    MergeFlaggedRuns(d, output, sums, evaluated, boot, options, &candidates);
   }
   std::stable_sort(
       candidates.begin(), candidates.end(), [](const GapRegion& a, const GapRegion& b) {
@@ -279,6 +311,204 @@ Localisation LocaliseGap(std::span<const std::int64_t> time_s, std::span<const d
   return result;
 }
 
+namespace {
+
+// Hour of local mean solar time.
+void AddHourOfDay(const Series& s, std::int64_t offset_s, std::vector<RegimeDriver>* out_) {
+  const std::size_t n = s.size();
+  RegimeDriver hour{"hour_of_day", std::vector<double>(n), {}, {}, {}, {}, {}};
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int64_t t = s.time_s[i];
+    hour.values[i] = static_cast<double>(t - SolarDayStartS(t, offset_s)) / 3600.0;
+  }
+  for (int h = 0; h <= 24; h += 2) hour.edges.push_back(h);
+  out_->push_back(std::move(hour));
+}
+
+// Local solar day (labelled by its date).
+void AddSolarDay(const Series& s, std::int64_t offset_s, std::vector<RegimeDriver>* out_) {
+  const std::size_t n = s.size();
+  RegimeDriver day{"day", std::vector<double>(n), {}, {}, {}, {}, {}};
+  std::int64_t last = std::numeric_limits<std::int64_t>::min();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int64_t start = SolarDayStartS(s.time_s[i], offset_s);
+    day.values[i] = static_cast<double>(start);
+    if (start != last) {
+      day.edges.push_back(static_cast<double>(start));
+      day.labels.push_back(SolarDate(start, offset_s));
+      last = start;
+    }
+  }
+  day.edges.push_back(day.edges.back() + kSecondsPerDay);
+  out_->push_back(std::move(day));
+}
+
+// Angle of incidence, measured when logged.
+void AddAngleOfIncidence(const Series& s, const std::vector<SolarPosition>& sun, const Plant& plant,
+                         std::vector<RegimeDriver>* out_) {
+  const std::size_t n = s.size();
+  RegimeDriver aoi{"aoi_deg", std::vector<double>(n, kNaN), {0, 15, 30, 45, 60, 75, 90}, {}, {}, {},
+                   {}};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (sun[i].elevation_rad <= 0.0) continue;
+    const double measured = s.At(Channel::kAoiRad, i);
+    aoi.values[i] = RadToDeg(std::isfinite(measured)
+                                 ? measured
+                                 : AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad,
+                                                       plant.tilt_rad, plant.azimuth_rad));
+  }
+  out_->push_back(std::move(aoi));
+}
+
+// Rate of change of the in-plane irradiance, W/m² per minute.
+void AddIrradianceRate(const Series& s, const std::vector<double>& g,
+                       std::vector<RegimeDriver>* out_) {
+  const std::size_t n = s.size();
+  RegimeDriver rate{"g_poa_rate_w_m2_min",
+                    std::vector<double>(n, kNaN),
+                    {0, 5, 20, 50, 100, 200, kInf},
+                    {},
+                    {},
+                    {},
+                    {}};
+  for (std::size_t i = 1; i < n; ++i) {
+    const double dt_s = static_cast<double>(s.time_s[i] - s.time_s[i - 1]);
+    if (dt_s > 0.0 && dt_s <= 2.0 * s.step_s) {
+      rate.values[i] = std::fabs(g[i] - g[i - 1]) / (dt_s / 60.0);
+    }
+  }
+  out_->push_back(std::move(rate));
+}
+
+// Beam fraction of the in-plane (or horizontal) irradiance.
+void AddBeamFraction(const Series& s, std::vector<RegimeDriver>* out_) {
+  const std::size_t n = s.size();
+  RegimeDriver beam{"beam_fraction",
+                    std::vector<double>(n, kNaN),
+                    {0, 0.2, 0.4, 0.6, 0.8, 1.0001},
+                    {},
+                    {},
+                    {},
+                    {}};
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    double total = kNaN, diffuse = kNaN;
+    if (s.Has(Channel::kGPoaDiffuseWM2) && s.Has(Channel::kGPoaWM2)) {
+      total = s[Channel::kGPoaWM2][i];
+      diffuse = s[Channel::kGPoaDiffuseWM2][i];
+    } else if (s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2)) {
+      total = s[Channel::kGhiWM2][i];
+      diffuse = s[Channel::kDhiWM2][i];
+    }
+    if (std::isfinite(total) && std::isfinite(diffuse) && total > 50.0) {
+      beam.values[i] = std::clamp(1.0 - diffuse / total, 0.0, 1.0);
+      any = true;
+    }
+  }
+  if (any) out_->push_back(std::move(beam));
+}
+
+// Sky temperature deficit T_amb − T_sky, K (when the sky is measured).
+void AddSkyDeficit(const Series& s, const Drivers& d, std::vector<RegimeDriver>* out_) {
+  if (!(s.Has(Channel::kTSkyC) || s.Has(Channel::kLwDownWM2))) return;
+  const std::size_t n = s.size();
+  RegimeDriver sky{"sky_deficit_k",
+                   std::vector<double>(n, kNaN),
+                   {-kInf, 5, 10, 15, 20, 25, kInf},
+                   {},
+                   {},
+                   {},
+                   {}};
+  for (std::size_t i = 0; i < n; ++i) {
+    double t_sky_c = s.At(Channel::kTSkyC, i);
+    const double lw = s.At(Channel::kLwDownWM2, i);
+    if (!std::isfinite(t_sky_c) && std::isfinite(lw) && lw > 0.0) {
+      t_sky_c = KToC(SkyTemperatureK(lw));
+    }
+    sky.values[i] = d.t_amb_c[i] - t_sky_c;
+  }
+  out_->push_back(std::move(sky));
+}
+
+// T_in − T_amb, K.
+void AddInletMinusAmbient(const Drivers& d, std::vector<RegimeDriver>* out_) {
+  const std::size_t n = d.size();
+  RegimeDriver dt{"t_in_minus_t_amb_k",
+                  std::vector<double>(n, kNaN),
+                  {-kInf, -5, 0, 5, 10, 20, kInf},
+                  {},
+                  {},
+                  {},
+                  {}};
+  for (std::size_t i = 0; i < n; ++i) dt.values[i] = d.t_in_c[i] - d.t_amb_c[i];
+  out_->push_back(std::move(dt));
+}
+
+// Pump on/off, the flow level when running, and the minutes since the pump
+// last switched.
+void AddFlowDrivers(const Series& s, const Drivers& d, std::vector<RegimeDriver>* out_) {
+  const std::size_t n = s.size();
+  RegimeDriver on{"flow_on", std::vector<double>(n, kNaN), {0, 0.5, 1.5}, {"off", "on"}, {}, {},
+                  {}};
+  std::vector<double> running;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = d.mdot_kg_s[i];
+    if (!std::isfinite(m)) continue;
+    on.values[i] = m > 0.0 ? 1.0 : 0.0;
+    if (m > 0.0) running.push_back(m);
+  }
+  out_->push_back(std::move(on));
+  if (running.size() >= 50) {
+    std::sort(running.begin(), running.end());
+    RegimeDriver level{"flow_kg_s", std::vector<double>(n, kNaN), {}, {}, {}, {}, {}};
+    level.edges.push_back(running.front());
+    for (int q = 1; q < 5; ++q) {
+      const double v = running[running.size() * static_cast<std::size_t>(q) / 5];
+      if (v > level.edges.back()) level.edges.push_back(v);
+    }
+    level.edges.push_back(std::nextafter(running.back(), kInf));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (d.mdot_kg_s[i] > 0.0) level.values[i] = d.mdot_kg_s[i];
+    }
+    if (level.edges.size() >= 3) out_->push_back(std::move(level));
+  }
+  RegimeDriver since{
+      "min_since_pump_switch", std::vector<double>(n, kNaN), {0, 5, 15, 60, kInf}, {}, {}, {}, {}};
+  double last_switch_s = kNaN;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = d.mdot_kg_s[i];
+    if (i > 0 && std::isfinite(m) && std::isfinite(d.mdot_kg_s[i - 1]) &&
+        (m > 0.0) != (d.mdot_kg_s[i - 1] > 0.0)) {
+      last_switch_s = static_cast<double>(s.time_s[i]);
+    }
+    if (std::isfinite(last_switch_s)) {
+      since.values[i] = (static_cast<double>(s.time_s[i]) - last_switch_s) / 60.0;
+    }
+  }
+  out_->push_back(std::move(since));
+}
+
+// Sun azimuth × elevation cells (sun up).
+void AddSunCells(const std::vector<SolarPosition>& sun, std::vector<RegimeDriver>* out_) {
+  const std::size_t n = sun.size();
+  RegimeDriver cells{"sun_azimuth_deg",
+                     std::vector<double>(n, kNaN),
+                     {},
+                     {},
+                     "sun_elevation_deg",
+                     std::vector<double>(n, kNaN),
+                     {0, 10, 20, 30, 45, 60, 90}};
+  for (int a = 0; a <= 360; a += 30) cells.edges.push_back(a);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (sun[i].elevation_rad <= 0.0) continue;
+    cells.values[i] = RadToDeg(sun[i].azimuth_rad);
+    cells.values2[i] = RadToDeg(sun[i].elevation_rad);
+  }
+  out_->push_back(std::move(cells));
+}
+
+}  // namespace
+
 std::vector<RegimeDriver> StandardRegimeDrivers(const Series& s, const Drivers& d,
                                                 const Plant& plant) {
   std::vector<RegimeDriver> out;
@@ -286,183 +516,24 @@ std::vector<RegimeDriver> StandardRegimeDrivers(const Series& s, const Drivers& 
   if (n == 0) return out;
   const std::int64_t offset_s = SolarDayOffsetS(plant);
 
-  {  // hour of local mean solar time
-    RegimeDriver hour{"hour_of_day", std::vector<double>(n), {}, {}, {}, {}, {}};
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::int64_t t = s.time_s[i];
-      hour.values[i] = static_cast<double>(t - SolarDayStartS(t, offset_s)) / 3600.0;
-    }
-    for (int h = 0; h <= 24; h += 2) hour.edges.push_back(h);
-    out.push_back(std::move(hour));
-  }
-  {  // local solar day
-    RegimeDriver day{"day", std::vector<double>(n), {}, {}, {}, {}, {}};
-    std::int64_t last = std::numeric_limits<std::int64_t>::min();
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::int64_t start = SolarDayStartS(s.time_s[i], offset_s);
-      day.values[i] = static_cast<double>(start);
-      if (start != last) {
-        day.edges.push_back(static_cast<double>(start));
-        day.labels.push_back(SolarDate(start, offset_s));
-        last = start;
-      }
-    }
-    day.edges.push_back(day.edges.back() + kSecondsPerDay);
-    out.push_back(std::move(day));
-  }
+  AddHourOfDay(s, offset_s, &out);
+  AddSolarDay(s, offset_s, &out);
 
   // Sun position at the middle of each row.
   const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
 
-  {  // angle of incidence, measured when logged
-    RegimeDriver aoi{
-        "aoi_deg", std::vector<double>(n, kNaN), {0, 15, 30, 45, 60, 75, 90}, {}, {}, {}, {}};
-    for (std::size_t i = 0; i < n; ++i) {
-      if (sun[i].elevation_rad <= 0.0) continue;
-      const double measured = s.At(Channel::kAoiRad, i);
-      aoi.values[i] = RadToDeg(std::isfinite(measured)
-                                   ? measured
-                                   : AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad,
-                                                         plant.tilt_rad, plant.azimuth_rad));
-    }
-    out.push_back(std::move(aoi));
-  }
+  AddAngleOfIncidence(s, sun, plant, &out);
   const std::vector<double>& g = d.g_poa_w_m2;
   out.push_back({"g_poa_w_m2", g, {0, 50, 200, 400, 600, 800, 1000, 1500}, {}, {}, {}, {}});
-  {
-    RegimeDriver rate{"g_poa_rate_w_m2_min",
-                      std::vector<double>(n, kNaN),
-                      {0, 5, 20, 50, 100, 200, kInf},
-                      {},
-                      {},
-                      {},
-                      {}};
-    for (std::size_t i = 1; i < n; ++i) {
-      const double dt_s = static_cast<double>(s.time_s[i] - s.time_s[i - 1]);
-      if (dt_s > 0.0 && dt_s <= 2.0 * s.step_s) {
-        rate.values[i] = std::fabs(g[i] - g[i - 1]) / (dt_s / 60.0);
-      }
-    }
-    out.push_back(std::move(rate));
-  }
-  {  // beam fraction of the in-plane (or horizontal) irradiance
-    RegimeDriver beam{"beam_fraction",
-                      std::vector<double>(n, kNaN),
-                      {0, 0.2, 0.4, 0.6, 0.8, 1.0001},
-                      {},
-                      {},
-                      {},
-                      {}};
-    bool any = false;
-    for (std::size_t i = 0; i < n; ++i) {
-      double total = kNaN, diffuse = kNaN;
-      if (s.Has(Channel::kGPoaDiffuseWM2) && s.Has(Channel::kGPoaWM2)) {
-        total = s[Channel::kGPoaWM2][i];
-        diffuse = s[Channel::kGPoaDiffuseWM2][i];
-      } else if (s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2)) {
-        total = s[Channel::kGhiWM2][i];
-        diffuse = s[Channel::kDhiWM2][i];
-      }
-      if (std::isfinite(total) && std::isfinite(diffuse) && total > 50.0) {
-        beam.values[i] = std::clamp(1.0 - diffuse / total, 0.0, 1.0);
-        any = true;
-      }
-    }
-    if (any) out.push_back(std::move(beam));
-  }
+  AddIrradianceRate(s, g, &out);
+  AddBeamFraction(s, &out);
   if (s.Has(Channel::kWindMS)) {
     out.push_back({"wind_m_s", s[Channel::kWindMS], {0, 1, 2, 3, 4, 6, 10, kInf}, {}, {}, {}, {}});
   }
-  if (s.Has(Channel::kTSkyC) || s.Has(Channel::kLwDownWM2)) {
-    RegimeDriver sky{"sky_deficit_k",
-                     std::vector<double>(n, kNaN),
-                     {-kInf, 5, 10, 15, 20, 25, kInf},
-                     {},
-                     {},
-                     {},
-                     {}};
-    for (std::size_t i = 0; i < n; ++i) {
-      double t_sky_c = s.At(Channel::kTSkyC, i);
-      const double lw = s.At(Channel::kLwDownWM2, i);
-      if (!std::isfinite(t_sky_c) && std::isfinite(lw) && lw > 0.0) {
-        t_sky_c = KToC(SkyTemperatureK(lw));
-      }
-      sky.values[i] = d.t_amb_c[i] - t_sky_c;
-    }
-    out.push_back(std::move(sky));
-  }
-  {
-    RegimeDriver dt{"t_in_minus_t_amb_k",
-                    std::vector<double>(n, kNaN),
-                    {-kInf, -5, 0, 5, 10, 20, kInf},
-                    {},
-                    {},
-                    {},
-                    {}};
-    for (std::size_t i = 0; i < n; ++i) dt.values[i] = d.t_in_c[i] - d.t_amb_c[i];
-    out.push_back(std::move(dt));
-  }
-  {
-    RegimeDriver on{"flow_on", std::vector<double>(n, kNaN), {0, 0.5, 1.5}, {"off", "on"}, {}, {},
-                    {}};
-    std::vector<double> running;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double m = d.mdot_kg_s[i];
-      if (!std::isfinite(m)) continue;
-      on.values[i] = m > 0.0 ? 1.0 : 0.0;
-      if (m > 0.0) running.push_back(m);
-    }
-    out.push_back(std::move(on));
-    if (running.size() >= 50) {
-      std::sort(running.begin(), running.end());
-      RegimeDriver level{"flow_kg_s", std::vector<double>(n, kNaN), {}, {}, {}, {}, {}};
-      level.edges.push_back(running.front());
-      for (int q = 1; q < 5; ++q) {
-        const double v = running[running.size() * static_cast<std::size_t>(q) / 5];
-        if (v > level.edges.back()) level.edges.push_back(v);
-      }
-      level.edges.push_back(std::nextafter(running.back(), kInf));
-      for (std::size_t i = 0; i < n; ++i) {
-        if (d.mdot_kg_s[i] > 0.0) level.values[i] = d.mdot_kg_s[i];
-      }
-      if (level.edges.size() >= 3) out.push_back(std::move(level));
-    }
-    RegimeDriver since{"min_since_pump_switch",
-                       std::vector<double>(n, kNaN),
-                       {0, 5, 15, 60, kInf},
-                       {},
-                       {},
-                       {},
-                       {}};
-    double last_switch_s = kNaN;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double m = d.mdot_kg_s[i];
-      if (i > 0 && std::isfinite(m) && std::isfinite(d.mdot_kg_s[i - 1]) &&
-          (m > 0.0) != (d.mdot_kg_s[i - 1] > 0.0)) {
-        last_switch_s = static_cast<double>(s.time_s[i]);
-      }
-      if (std::isfinite(last_switch_s)) {
-        since.values[i] = (static_cast<double>(s.time_s[i]) - last_switch_s) / 60.0;
-      }
-    }
-    out.push_back(std::move(since));
-  }
-  {  // sun azimuth × elevation cells (sun up)
-    RegimeDriver cells{"sun_azimuth_deg",
-                       std::vector<double>(n, kNaN),
-                       {},
-                       {},
-                       "sun_elevation_deg",
-                       std::vector<double>(n, kNaN),
-                       {0, 10, 20, 30, 45, 60, 90}};
-    for (int a = 0; a <= 360; a += 30) cells.edges.push_back(a);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (sun[i].elevation_rad <= 0.0) continue;
-      cells.values[i] = RadToDeg(sun[i].azimuth_rad);
-      cells.values2[i] = RadToDeg(sun[i].elevation_rad);
-    }
-    out.push_back(std::move(cells));
-  }
+  AddSkyDeficit(s, d, &out);
+  AddInletMinusAmbient(d, &out);
+  AddFlowDrivers(s, d, &out);
+  AddSunCells(sun, &out);
   return out;
 }
 

@@ -463,6 +463,386 @@ void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, M
   }
 }
 
+// The parameters a fit frees: used by the variant, requested (or free by
+// default), with a non-empty range; `base` is the start clamped into the
+// bounds.
+struct FreeSet {
+  ParamVector base{};
+  std::vector<Param> free;
+  std::vector<ParamInfo> infos;  // resolved, per free parameter
+};
+
+FreeSet SelectFree(const Drivers& drivers, const ParamVector& start, const IdentOptions& options) {
+  const auto used = UsedParams(drivers.spec);
+  const auto requested = options.free.any() ? options.free : DefaultFreeParams(drivers.spec);
+  FreeSet fs;
+  fs.base = start;
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), drivers.plant);
+    fs.base[i] = std::clamp(fs.base[i], info.lower, info.upper);
+    if (used.test(i) && requested.test(i) && info.upper > info.lower) {
+      fs.free.push_back(static_cast<Param>(i));
+      fs.infos.push_back(info);
+    }
+  }
+  return fs;
+}
+
+// Coarse stage: the same fit on the data averaged to about 5 min gets close
+// to the optimum at a fraction of the cost; the fine stage starts from there.
+// (The model at 5 min is the same model: its exact step makes the coarse
+// optimum close to the fine one.) Replaces *best when the coarse optimum
+// also beats the start on the data as given; returns its simulations.
+int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOptions& options,
+                const FreeSet& fs, Objective& obj, double initial_cost, ParamVector* best) {
+  const double data_step_s = drivers.dt_s.empty() ? 0.0 : drivers.dt_s[0];
+  const double coarse_step_s =
+      data_step_s < 30.0 && options.coarse_step_s > 60.0 ? 60.0 : options.coarse_step_s;
+  const int coarse_factor = coarse_step_s > 0.0 && data_step_s > 0.0
+                                ? static_cast<int>(coarse_step_s / data_step_s + 0.5)
+                                : 1;
+  if (coarse_factor < 2 || fs.free.empty() || options.optimizer.max_evaluations < 200) return 0;
+  Drivers cd;
+  Measurements cm;
+  Coarsen(drivers, meas, coarse_factor, &cd, &cm);
+  if (static_cast<int>(cm.rows.size()) < options.min_rows) return 0;
+  IdentOptions coarse = options;
+  // From data finer than 30 s the ladder has two rungs: 1 min, then the
+  // configured coarse step.
+  coarse.coarse_step_s =
+      options.coarse_step_s > 60.0 && drivers.dt_s[0] < 30.0 ? options.coarse_step_s : 0.0;
+  coarse.fix_unidentifiable = false;
+  coarse.optimizer.ftol_rel = std::max(options.optimizer.ftol_rel, 1e-3);
+  coarse.optimizer.max_evaluations = options.optimizer.max_evaluations / 4;
+  const IdentSummary cs = Identify(cd, cm, fs.base, coarse);
+  // A misspecified model can have its coarse optimum far from the fine one:
+  // keep it only if it also beats the start on the data as given.
+  if (cs.ok && obj.DataCost(cs.params) < initial_cost) *best = cs.params;
+  return cs.evaluations;
+}
+
+// The fine stage: the fit of the active parameters, then identifiability
+// (standard errors of the free parameters at the fit; a parameter whose
+// standard error exceeds undetermined_se of its range is fixed at its
+// reference value, worst first, provided that costs at most
+// fix_cost_tolerance more: a parameter the data really do not determine
+// costs nothing to fix), then a polish of the rest.
+class FineFit {
+ public:
+  FineFit(Objective& obj, const FreeSet& fs, const Measurements& meas, const IdentOptions& options,
+          const Plant& plant, int coarse_simulations, const ParamVector& best)
+      : obj_(obj),
+        fs_(fs),
+        options_(options),
+        area_m2_(plant.area_m2),
+        coarse_simulations_(coarse_simulations),
+        n_rows_(static_cast<double>(meas.rows.size())),
+        active_(fs.free.size(), true),
+        se_(fs.free.size(), 0.0),
+        rejected_(fs.free.size(), false),
+        best_(best) {
+    // Floor of the residual spread for the standard errors: 0.1 % of the
+    // mean measured power per m², so that noise-free data still expose
+    // exactly flat directions and nothing else.
+    double mean_abs = 0.0;
+    for (std::uint32_t i : meas.rows)
+      mean_abs += std::fabs(meas.p_el_w[i]) + std::fabs(meas.q_th_w[i]);
+    sigma_floor_ = 1e-3 * mean_abs / (2.0 * n_rows_ * area_m2_);
+  }
+
+  // The fit from the best point so far (coarse stage or start).
+  void FitAll() {
+    fit_ = FitActive(active_, best_, &best_cost_);
+    if (fit_.termination == Termination::kMaxEvaluations && fit_.message == "no evaluations left") {
+      fit_.ok = true;  // nothing could be tried; the start stands (and is reported)
+    }
+    best_ = fit_.params;
+  }
+
+  void FixUnidentifiable(std::vector<std::string>* notes) {
+    for (int round = 0; fit_.ok && options_.fix_unidentifiable && round < 8; ++round) {
+      if (!FixRound(notes)) break;
+    }
+  }
+
+  // Polish the remaining parameters once with the fixed ones in place.
+  void Polish() {
+    if (!any_fixed_ || Remaining() <= 20) return;
+    double polished_cost = 0.0;
+    const FitOutcome polished = FitActive(active_, best_, &polished_cost);
+    if (polished.ok && polished_cost <= best_cost_) {
+      best_ = polished.params;
+      best_cost_ = polished_cost;
+      fit_.termination = polished.termination;
+    }
+  }
+
+  int Remaining() const {
+    return options_.optimizer.max_evaluations - obj_.simulations() - coarse_simulations_;
+  }
+  const FitOutcome& fit() const { return fit_; }
+  const ParamVector& best() const { return best_; }
+  const std::vector<bool>& active() const { return active_; }
+  const std::vector<double>& se() const { return se_; }
+
+ private:
+  // Fits the parameters marked in `act_mask` from `from_point` (the others
+  // held at their reference values); returns the outcome and the data cost.
+  FitOutcome FitActive(const std::vector<bool>& act_mask, const ParamVector& from_point,
+                       double* data_cost, int max_budget = std::numeric_limits<int>::max()) {
+    std::vector<Param> act;
+    std::vector<ParamInfo> act_infos;
+    std::vector<double> z_ref;
+    ParamVector from = from_point;
+    for (std::size_t j = 0; j < fs_.free.size(); ++j) {
+      const auto idx = static_cast<std::size_t>(fs_.free[j]);
+      if (!act_mask[j]) {
+        from[idx] = fs_.base[idx];
+        continue;
+      }
+      act.push_back(fs_.free[j]);
+      act_infos.push_back(fs_.infos[j]);
+      z_ref.push_back(ToUnit(fs_.infos[j], fs_.base[idx]));
+    }
+    obj_.SetBase(from);
+    obj_.SetFree(act, act_infos, z_ref);
+    FitOutcome out;
+    if (act.empty()) {
+      out.params = from;
+      out.ok = true;
+      out.termination = Termination::kConverged;
+    } else {
+      // One simulation stays reserved for the final check of the result.
+      const int budget = std::min(Remaining() - 1, max_budget);
+      if (budget >= 2) {
+        out = RunFit(obj_, act_infos, z_ref, from, options_, budget, n_rows_, area_m2_);
+      } else {
+        out.params = from;
+        out.ok = true;
+        out.termination = Termination::kMaxEvaluations;
+        out.message = "no evaluations left";
+      }
+    }
+    *data_cost = obj_.DataCost(out.params);
+    return out;
+  }
+
+  std::vector<ParamInfo> ActiveInfos() const {
+    std::vector<ParamInfo> v;
+    for (std::size_t j = 0; j < fs_.free.size(); ++j) {
+      if (active_[j]) v.push_back(fs_.infos[j]);
+    }
+    return v;
+  }
+
+  // One round of fixing: the standard errors of the active parameters, the
+  // worst undetermined one fixed if that is cheap enough. False when no
+  // round is left to do.
+  bool FixRound(std::vector<std::string>* notes) {
+    std::vector<std::size_t> act_index;  // positions in `free` of the active ones
+    for (std::size_t j = 0; j < fs_.free.size(); ++j) {
+      if (active_[j]) act_index.push_back(j);
+    }
+    const auto m = static_cast<Eigen::Index>(act_index.size());
+    if (m <= 1 || Remaining() < static_cast<int>(m) + 10) return false;
+    if (jac_.cols() != m) {
+      jac_ = fit_.jacobian.cols() == m ? fit_.jacobian : Eigen::MatrixXd();
+      if (jac_.cols() == m) {
+        obj_.Residuals(best_, &r_);
+      } else {
+        std::vector<Param> act;
+        for (std::size_t j : act_index) act.push_back(fs_.free[j]);
+        obj_.SetFree(act, ActiveInfos(), std::vector<double>(act.size(), 0.0));
+        jac_ = SensitivityMatrix(obj_, ActiveInfos(), best_, &r_);
+      }
+    }
+    const Eigen::VectorXd act_se =
+        StandardErrors(jac_, r_, std::vector<bool>(act_index.size(), true), sigma_floor_);
+    Eigen::Index worst = -1;
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const std::size_t j = act_index[static_cast<std::size_t>(a)];
+      se_[j] = act_se(a);
+      if (rejected_[j] || !(act_se(a) > options_.undetermined_se)) continue;
+      if (worst < 0 || act_se(a) > act_se(worst)) worst = a;
+    }
+    if (worst < 0) return false;
+    ParamVector predicted;
+    Eigen::VectorXd r_pred;
+    double cost = PredictCostOfFixing(act_index, worst, &predicted, &r_pred);
+    const std::size_t j = act_index[static_cast<std::size_t>(worst)];
+    ParamVector point = predicted;
+    // Relative tolerance, with an absolute floor (the 0.1 % of the measured
+    // power used for sigma_floor) so that noise-free fits can fix too.
+    const double limit = best_cost_ * (1.0 + options_.fix_cost_tolerance) + 2.0 * sigma_floor_;
+    // The linear prediction is poor for large moves on a log scale: when it
+    // is inconclusive (close to the limit, or the parameter is not bounded
+    // by the data at all, se > 1) a short re-fit decides.
+    if (std::isfinite(cost) && cost > limit &&
+        (cost <= 10.0 * limit - 9.0 * best_cost_ || se_[j] > 1.0)) {
+      std::vector<bool> trial_mask = active_;
+      trial_mask[j] = false;
+      const FitOutcome trial =
+          FitActive(trial_mask, predicted, &cost, 8 * (static_cast<int>(m) + 2));
+      point = trial.params;
+      if (!trial.ok) cost = kNaN;
+    }
+    if (std::isfinite(cost) && cost <= limit) {
+      Fix(worst, j, point, cost, point == predicted ? &r_pred : nullptr);
+    } else {
+      rejected_[j] = true;
+    }
+    notes->push_back(FixNote(j, cost, !rejected_[j]));
+    return true;
+  }
+
+  // The cost of fixing the active parameter `worst` (position j in `free`)
+  // at its reference value, predicted with one simulation per candidate
+  // point: the others unchanged, and the others following the damped
+  // (Levenberg) weighted least-squares response of the linearised
+  // residuals for two dampings, each step limited to the size of the move of
+  // parameter j (the linearisation holds only that far). The cheapest
+  // predicts the cost; *predicted and *r_pred are its point and residuals.
+  double PredictCostOfFixing(const std::vector<std::size_t>& act_index, Eigen::Index worst,
+                             ParamVector* predicted, Eigen::VectorXd* r_pred) {
+    const auto m = static_cast<Eigen::Index>(act_index.size());
+    const std::size_t j = act_index[static_cast<std::size_t>(worst)];
+    const auto idx = static_cast<std::size_t>(fs_.free[j]);
+    Eigen::VectorXd z(m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const std::size_t k = act_index[static_cast<std::size_t>(a)];
+      z(a) = ToUnit(fs_.infos[k], best_[static_cast<std::size_t>(fs_.free[k])]);
+    }
+    const double dz_j = ToUnit(fs_.infos[j], fs_.base[idx]) - z(worst);
+    Eigen::MatrixXd j_others(jac_.rows(), m - 1);
+    for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+      if (a != worst) j_others.col(c++) = jac_.col(a);
+    }
+    const double delta = std::max(0.3 * r_.cwiseAbs().mean(), sigma_floor_);
+    const Eigen::VectorXd w = r_.cwiseAbs().cwiseMax(delta).cwiseInverse();
+    const Eigen::VectorXd b = r_ + jac_.col(worst) * dz_j;
+    const Eigen::MatrixXd wj = j_others.array().colwise() * w.array();
+    const Eigen::MatrixXd h = j_others.transpose() * wj;
+    const Eigen::VectorXd g = wj.transpose() * b;
+    const double mean_diag = std::max(h.diagonal().mean(), 1e-300);
+    const double limit_dz = std::max(std::fabs(dz_j), 0.02);
+    double cost = kNaN;
+    *predicted = best_;
+    for (double damping : {-1.0, 1e-4, 1e-2}) {
+      Eigen::VectorXd dz_o = Eigen::VectorXd::Zero(m - 1);
+      if (damping > 0.0) {
+        Eigen::MatrixXd hd = h;
+        hd.diagonal().array() += damping * mean_diag;
+        dz_o = -hd.ldlt().solve(g);
+        const double norm = dz_o.cwiseAbs().maxCoeff();
+        if (norm > limit_dz) dz_o *= limit_dz / norm;
+      }
+      ParamVector candidate = best_;
+      candidate[idx] = fs_.base[idx];
+      for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+        if (a == worst) continue;
+        const std::size_t k = act_index[static_cast<std::size_t>(a)];
+        candidate[static_cast<std::size_t>(fs_.free[k])] =
+            FromUnit(fs_.infos[k], std::clamp(z(a) + dz_o(c++), 0.0, 1.0));
+      }
+      Eigen::VectorXd r_cand;
+      obj_.Residuals(candidate, &r_cand);
+      const double c_cost = r_cand.cwiseAbs().sum() / n_rows_;
+      if (std::isfinite(c_cost) && !(c_cost >= cost)) {
+        cost = c_cost;
+        *predicted = candidate;
+        *r_pred = r_cand;
+      }
+    }
+    return cost;
+  }
+
+  // Fixes the active parameter `worst` (position j in `free`) at `point`;
+  // the old Jacobian without its column serves the next round.
+  void Fix(Eigen::Index worst, std::size_t j, const ParamVector& point, double cost,
+           const Eigen::VectorXd* r_at_point) {
+    const auto m = jac_.cols();
+    active_[j] = false;
+    best_ = point;
+    best_cost_ = cost;
+    any_fixed_ = true;
+    Eigen::MatrixXd reduced(jac_.rows(), m - 1);
+    for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+      if (a != worst) reduced.col(c++) = jac_.col(a);
+    }
+    jac_ = reduced;
+    if (r_at_point != nullptr)
+      r_ = *r_at_point;
+    else
+      obj_.Residuals(best_, &r_);
+  }
+
+  std::string FixNote(std::size_t j, double cost, bool fixed) const {
+    const auto idx = static_cast<std::size_t>(fs_.free[j]);
+    const char* range = fs_.infos[j].scale == ParamScale::kLog ? "log" : "search";
+    char note[240];
+    if (fixed) {
+      std::snprintf(note, sizeof(note),
+                    "%s is not determined by these data (standard error %.2g of its %s range); "
+                    "fixed at its reference value %.4g",
+                    Name(fs_.free[j]).c_str(), se_[j], range, fs_.base[idx]);
+    } else {
+      std::snprintf(note, sizeof(note),
+                    "%s is only weakly determined (standard error %.2g of its %s range); kept "
+                    "free because fixing it at %.4g raises the MAE by %.1f %%",
+                    Name(fs_.free[j]).c_str(), se_[j], range, fs_.base[idx],
+                    100.0 * (cost / best_cost_ - 1.0));
+    }
+    return note;
+  }
+
+  Objective& obj_;
+  const FreeSet& fs_;
+  const IdentOptions& options_;
+  double area_m2_;
+  int coarse_simulations_;
+  double n_rows_;
+  double sigma_floor_ = 0.0;
+  std::vector<bool> active_;
+  std::vector<double> se_;
+  std::vector<bool> rejected_;
+  ParamVector best_;
+  double best_cost_ = 0.0;
+  bool any_fixed_ = false;
+  FitOutcome fit_;
+  Eigen::MatrixXd jac_;  // columns: active parameters, in `free` order
+  Eigen::VectorXd r_;
+};
+
+// One estimate per parameter the variant uses.
+std::vector<ParamEstimate> Estimates(const Drivers& drivers, const FreeSet& fs, const FineFit& fine,
+                                     const IdentOptions& options) {
+  std::vector<ParamEstimate> out;
+  const auto used = UsedParams(drivers.spec);
+  const ParamVector& best = fine.best();
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    if (!used.test(i)) continue;
+    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), drivers.plant);
+    ParamEstimate e;
+    e.param = info.param;
+    e.value = best[i];
+    e.start = fs.base[i];
+    e.lower = info.lower;
+    e.upper = info.upper;
+    const auto it = std::find(fs.free.begin(), fs.free.end(), info.param);
+    e.free = it != fs.free.end();
+    if (e.free) {
+      const auto j = static_cast<std::size_t>(it - fs.free.begin());
+      e.undetermined = !fine.active()[j];
+      e.se_unit = fine.se()[j];
+      e.weak = fine.active()[j] && fine.se()[j] > options.undetermined_se;
+      const double z = ToUnit(fs.infos[j], e.value);
+      e.at_bound = fine.active()[j] && (z < 1e-3 || z > 1.0 - 1e-3);
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
 }  // namespace
 
 IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const ParamVector& start,
@@ -487,310 +867,27 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
                              std::to_string(options.min_rows) + " needed");
   }
 
-  const Plant& plant = drivers.plant;
-  const auto used = UsedParams(drivers.spec);
-  const auto requested = options.free.any() ? options.free : DefaultFreeParams(drivers.spec);
-  ParamVector base = start;
-  std::vector<Param> free;
-  std::vector<ParamInfo> infos;
-  for (std::size_t i = 0; i < kNumParams; ++i) {
-    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), plant);
-    base[i] = std::clamp(base[i], info.lower, info.upper);
-    if (used.test(i) && requested.test(i) && info.upper > info.lower) {
-      free.push_back(static_cast<Param>(i));
-      infos.push_back(info);
-    }
-  }
-  Objective obj(drivers, meas, options, base);
-  int coarse_simulations = 0;
-  const double initial_cost = obj.DataCost(base);
+  const FreeSet fs = SelectFree(drivers, start, options);
+  Objective obj(drivers, meas, options, fs.base);
+  const double initial_cost = obj.DataCost(fs.base);
   summary.initial_cost_w_m2 = initial_cost;
   if (!std::isfinite(initial_cost)) {
     return finish(false, "the model gives non-finite outputs at the start values");
   }
-
-  std::vector<bool> active(free.size(), true);
-  std::vector<double> se(free.size(), 0.0);
-  ParamVector best = base;
-  // Coarse stage: the same fit on the data averaged to about 5 min gets
-  // close to the optimum at a fraction of the cost; the fine stage below
-  // starts from there. (The model at 5 min is the same model: its exact
-  // step makes the coarse optimum close to the fine one.)
-  const double data_step_s = drivers.dt_s.empty() ? 0.0 : drivers.dt_s[0];
-  const double coarse_step_s =
-      data_step_s < 30.0 && options.coarse_step_s > 60.0 ? 60.0 : options.coarse_step_s;
-  const int coarse_factor = coarse_step_s > 0.0 && data_step_s > 0.0
-                                ? static_cast<int>(coarse_step_s / data_step_s + 0.5)
-                                : 1;
-  if (coarse_factor >= 2 && !free.empty() && options.optimizer.max_evaluations >= 200) {
-    Drivers cd;
-    Measurements cm;
-    Coarsen(drivers, meas, coarse_factor, &cd, &cm);
-    if (static_cast<int>(cm.rows.size()) >= options.min_rows) {
-      IdentOptions coarse = options;
-      // From data finer than 30 s the ladder has two rungs: 1 min, then
-      // the configured coarse step.
-      coarse.coarse_step_s =
-          options.coarse_step_s > 60.0 && drivers.dt_s[0] < 30.0 ? options.coarse_step_s : 0.0;
-      coarse.fix_unidentifiable = false;
-      coarse.optimizer.ftol_rel = std::max(options.optimizer.ftol_rel, 1e-3);
-      coarse.optimizer.max_evaluations = options.optimizer.max_evaluations / 4;
-      const IdentSummary cs = Identify(cd, cm, base, coarse);
-      coarse_simulations = cs.evaluations;
-      // A misspecified model can have its coarse optimum far from the fine
-      // one: keep it only if it also beats the start on the data as given.
-      if (cs.ok && obj.DataCost(cs.params) < initial_cost) best = cs.params;
-    }
-  }
-  FitOutcome fit;
-  fit.ok = true;
-  fit.termination = Termination::kConverged;
-  const double n_rows = static_cast<double>(meas.rows.size());
-  // Floor of the residual spread for the standard errors: 0.1 % of the mean
-  // measured power per m², so that noise-free data still expose exactly
-  // flat directions and nothing else.
-  double mean_abs = 0.0;
-  for (std::uint32_t i : meas.rows)
-    mean_abs += std::fabs(meas.p_el_w[i]) + std::fabs(meas.q_th_w[i]);
-  const double sigma_floor = 1e-3 * mean_abs / (2.0 * n_rows * plant.area_m2);
-  auto remaining = [&] {
-    return options.optimizer.max_evaluations - obj.simulations() - coarse_simulations;
-  };
-  // Fits the parameters marked in `act_mask` from `from` (the others held at
-  // their reference values); returns the outcome and the data cost.
-  auto fit_active = [&](const std::vector<bool>& act_mask, const ParamVector& from_point,
-                        double* data_cost, int max_budget = std::numeric_limits<int>::max()) {
-    std::vector<Param> act;
-    std::vector<ParamInfo> act_infos;
-    std::vector<double> z_ref;
-    ParamVector from = from_point;
-    for (std::size_t j = 0; j < free.size(); ++j) {
-      const auto idx = static_cast<std::size_t>(free[j]);
-      if (!act_mask[j]) {
-        from[idx] = base[idx];
-        continue;
-      }
-      act.push_back(free[j]);
-      act_infos.push_back(infos[j]);
-      z_ref.push_back(ToUnit(infos[j], base[idx]));
-    }
-    obj.SetBase(from);
-    obj.SetFree(act, act_infos, z_ref);
-    FitOutcome out;
-    if (act.empty()) {
-      out.params = from;
-      out.ok = true;
-      out.termination = Termination::kConverged;
-    } else {
-      // One simulation stays reserved for the final check of the result.
-      const int budget = std::min(remaining() - 1, max_budget);
-      if (budget >= 2) {
-        out = RunFit(obj, act_infos, z_ref, from, options, budget, n_rows, plant.area_m2);
-      } else {
-        out.params = from;
-        out.ok = true;
-        out.termination = Termination::kMaxEvaluations;
-        out.message = "no evaluations left";
-      }
-    }
-    *data_cost = obj.DataCost(out.params);
-    return out;
-  };
-
-  double best_cost = 0.0;
-  fit = fit_active(active, best, &best_cost);
-  if (fit.termination == Termination::kMaxEvaluations && fit.message == "no evaluations left") {
-    fit.ok = true;  // nothing could be tried; the start stands (and is reported)
-  }
-  best = fit.params;
-  // Identifiability: standard errors of the free parameters at the fit. A
-  // parameter whose standard error exceeds undetermined_se of its range is
-  // fixed at its reference value, worst first, provided that costs at most
-  // fix_cost_tolerance more: a parameter the data really do not determine
-  // costs nothing to fix. The cost of fixing is first predicted with one
-  // simulation (the other parameters follow the weighted least-squares
-  // response of the linearised residuals); only a borderline prediction
-  // pays for a full re-fit.
-  std::vector<bool> rejected(free.size(), false);
-  bool any_fixed = false;
-  Eigen::MatrixXd jac;  // columns: active parameters, in `free` order
-  Eigen::VectorXd r;
-  auto active_infos = [&] {
-    std::vector<ParamInfo> v;
-    for (std::size_t j = 0; j < free.size(); ++j) {
-      if (active[j]) v.push_back(infos[j]);
-    }
-    return v;
-  };
-  for (int round = 0; fit.ok && options.fix_unidentifiable && round < 8; ++round) {
-    std::vector<std::size_t> act_index;  // positions in `free` of the active ones
-    for (std::size_t j = 0; j < free.size(); ++j) {
-      if (active[j]) act_index.push_back(j);
-    }
-    const auto m = static_cast<Eigen::Index>(act_index.size());
-    if (m <= 1 || remaining() < static_cast<int>(m) + 10) break;
-    if (jac.cols() != m) {
-      jac = fit.jacobian.cols() == m ? fit.jacobian : Eigen::MatrixXd();
-      if (jac.cols() == m) {
-        obj.Residuals(best, &r);
-      } else {
-        std::vector<Param> act;
-        for (std::size_t j : act_index) act.push_back(free[j]);
-        obj.SetFree(act, active_infos(), std::vector<double>(act.size(), 0.0));
-        jac = SensitivityMatrix(obj, active_infos(), best, &r);
-      }
-    }
-    const Eigen::VectorXd act_se =
-        StandardErrors(jac, r, std::vector<bool>(act_index.size(), true), sigma_floor);
-    Eigen::Index worst = -1;
-    for (Eigen::Index a = 0; a < m; ++a) {
-      const std::size_t j = act_index[static_cast<std::size_t>(a)];
-      se[j] = act_se(a);
-      if (rejected[j] || !(act_se(a) > options.undetermined_se)) continue;
-      if (worst < 0 || act_se(a) > act_se(worst)) worst = a;
-    }
-    if (worst < 0) break;
-    const std::size_t j = act_index[static_cast<std::size_t>(worst)];
-    const auto idx = static_cast<std::size_t>(free[j]);
-
-    // Predicted point: parameter j at its reference, the others following.
-    Eigen::VectorXd z(m);
-    for (Eigen::Index a = 0; a < m; ++a) {
-      const std::size_t k = act_index[static_cast<std::size_t>(a)];
-      z(a) = ToUnit(infos[k], best[static_cast<std::size_t>(free[k])]);
-    }
-    const double dz_j = ToUnit(infos[j], base[idx]) - z(worst);
-    Eigen::MatrixXd j_others(jac.rows(), m - 1);
-    for (Eigen::Index a = 0, c = 0; a < m; ++a) {
-      if (a != worst) j_others.col(c++) = jac.col(a);
-    }
-    const double delta = std::max(0.3 * r.cwiseAbs().mean(), sigma_floor);
-    const Eigen::VectorXd w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
-    const Eigen::VectorXd b = r + jac.col(worst) * dz_j;
-    // Candidate points, one simulation each: the others unchanged, and the
-    // others following the damped (Levenberg) weighted least-squares
-    // response of the linearised residuals for two dampings, each step
-    // limited to the size of the move of parameter j (the linearisation holds
-    // only that far). The cheapest predicts the cost of fixing j.
-    const Eigen::MatrixXd wj = j_others.array().colwise() * w.array();
-    const Eigen::MatrixXd h = j_others.transpose() * wj;
-    const Eigen::VectorXd g = wj.transpose() * b;
-    const double mean_diag = std::max(h.diagonal().mean(), 1e-300);
-    const double limit_dz = std::max(std::fabs(dz_j), 0.02);
-    double cost = kNaN;
-    ParamVector predicted = best;
-    Eigen::VectorXd r_pred;
-    for (double damping : {-1.0, 1e-4, 1e-2}) {
-      Eigen::VectorXd dz_o = Eigen::VectorXd::Zero(m - 1);
-      if (damping > 0.0) {
-        Eigen::MatrixXd hd = h;
-        hd.diagonal().array() += damping * mean_diag;
-        dz_o = -hd.ldlt().solve(g);
-        const double norm = dz_o.cwiseAbs().maxCoeff();
-        if (norm > limit_dz) dz_o *= limit_dz / norm;
-      }
-      ParamVector candidate = best;
-      candidate[idx] = base[idx];
-      for (Eigen::Index a = 0, c = 0; a < m; ++a) {
-        if (a == worst) continue;
-        const std::size_t k = act_index[static_cast<std::size_t>(a)];
-        candidate[static_cast<std::size_t>(free[k])] =
-            FromUnit(infos[k], std::clamp(z(a) + dz_o(c++), 0.0, 1.0));
-      }
-      Eigen::VectorXd r_cand;
-      obj.Residuals(candidate, &r_cand);
-      const double c_cost = r_cand.cwiseAbs().sum() / n_rows;
-      if (std::isfinite(c_cost) && !(c_cost >= cost)) {
-        cost = c_cost;
-        predicted = candidate;
-        r_pred = r_cand;
-      }
-    }
-    ParamVector point = predicted;
-    // Relative tolerance, with an absolute floor (the 0.1 % of the measured
-    // power used for sigma_floor) so that noise-free fits can fix too.
-    const double limit = best_cost * (1.0 + options.fix_cost_tolerance) + 2.0 * sigma_floor;
-    // The linear prediction is poor for large moves on a log scale: when it
-    // is inconclusive (close to the limit, or the parameter is not bounded
-    // by the data at all, se > 1) a short re-fit decides.
-    if (std::isfinite(cost) && cost > limit &&
-        (cost <= 10.0 * limit - 9.0 * best_cost || se[j] > 1.0)) {
-      std::vector<bool> trial_mask = active;
-      trial_mask[j] = false;
-      const FitOutcome trial =
-          fit_active(trial_mask, predicted, &cost, 8 * (static_cast<int>(m) + 2));
-      point = trial.params;
-      if (!trial.ok) cost = kNaN;
-    }
-    char note[240];
-    if (std::isfinite(cost) && cost <= limit) {
-      active[j] = false;
-      best = point;
-      best_cost = cost;
-      any_fixed = true;
-      // The old Jacobian without the fixed column serves the next round.
-      Eigen::MatrixXd reduced(jac.rows(), m - 1);
-      for (Eigen::Index a = 0, c = 0; a < m; ++a) {
-        if (a != worst) reduced.col(c++) = jac.col(a);
-      }
-      jac = reduced;
-      if (point == predicted)
-        r = r_pred;
-      else
-        obj.Residuals(best, &r);
-      std::snprintf(note, sizeof(note),
-                    "%s is not determined by these data (standard error %.2g of its %s range); "
-                    "fixed at its reference value %.4g",
-                    Name(free[j]).c_str(), se[j],
-                    infos[j].scale == ParamScale::kLog ? "log" : "search", base[idx]);
-    } else {
-      rejected[j] = true;
-      std::snprintf(note, sizeof(note),
-                    "%s is only weakly determined (standard error %.2g of its %s range); kept "
-                    "free because fixing it at %.4g raises the MAE by %.1f %%",
-                    Name(free[j]).c_str(), se[j],
-                    infos[j].scale == ParamScale::kLog ? "log" : "search", base[idx],
-                    100.0 * (cost / best_cost - 1.0));
-    }
-    summary.notes.push_back(note);
-  }
-  if (any_fixed && remaining() > 20) {
-    // Polish the remaining parameters once with the fixed ones in place.
-    double polished_cost = 0.0;
-    const FitOutcome polished = fit_active(active, best, &polished_cost);
-    if (polished.ok && polished_cost <= best_cost) {
-      best = polished.params;
-      best_cost = polished_cost;
-      fit.termination = polished.termination;
-    }
-  }
+  ParamVector best = fs.base;
+  const int coarse_simulations = CoarseStart(drivers, meas, options, fs, obj, initial_cost, &best);
+  FineFit fine(obj, fs, meas, options, drivers.plant, coarse_simulations, best);
+  fine.FitAll();
+  fine.FixUnidentifiable(&summary.notes);
+  fine.Polish();
+  const FitOutcome& fit = fine.fit();
   summary.termination = fit.termination;
-  summary.params = best;
-  const double final_cost = obj.DataCost(best);
+  summary.params = fine.best();
+  const double final_cost = obj.DataCost(fine.best());
   summary.final_cost_w_m2 = final_cost;
-  summary.train = ComputeErrors(meas, obj.last(), plant.area_m2);
+  summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
   summary.evaluations = obj.simulations() + coarse_simulations;
-  for (std::size_t i = 0; i < kNumParams; ++i) {
-    if (!used.test(i)) continue;
-    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), plant);
-    ParamEstimate e;
-    e.param = info.param;
-    e.value = best[i];
-    e.start = base[i];
-    e.lower = info.lower;
-    e.upper = info.upper;
-    const auto it = std::find(free.begin(), free.end(), info.param);
-    e.free = it != free.end();
-    if (e.free) {
-      const auto j = static_cast<std::size_t>(it - free.begin());
-      e.undetermined = !active[j];
-      e.se_unit = se[j];
-      e.weak = active[j] && se[j] > options.undetermined_se;
-      const double z = ToUnit(infos[j], e.value);
-      e.at_bound = active[j] && (z < 1e-3 || z > 1.0 - 1e-3);
-    }
-    summary.estimates.push_back(e);
-  }
+  summary.estimates = Estimates(drivers, fs, fine, options);
   if (!fit.ok) {
     return finish(false, "optimiser stopped with " + std::string(ToString(fit.termination)) +
                              (fit.message.empty() ? "" : ": " + fit.message));

@@ -497,6 +497,108 @@ std::vector<DayType> DayTypesFor(const WeatherOptions& options) {
   return types;
 }
 
+namespace {
+
+// The generated series' rows (every step_s from start_time_s over num_days)
+// with every generated channel at 0; *times_s the row times as doubles.
+Series EmptyWeatherSeries(const WeatherOptions& options, std::vector<double>* times_s) {
+  const auto step = static_cast<std::int64_t>(options.step_s);
+  const auto rows = static_cast<std::size_t>(options.num_days * 86400LL / step);
+  Series series;
+  series.step_s = options.step_s;
+  series.time_s.resize(rows);
+  times_s->resize(rows);
+  for (std::size_t i = 0; i < rows; ++i) {
+    series.time_s[i] = options.start_time_s + static_cast<std::int64_t>(i) * step;
+    (*times_s)[i] = static_cast<double>(series.time_s[i]);
+  }
+  for (Channel c : {Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2,
+                    Channel::kAoiRad, Channel::kTAmbC, Channel::kWindMS, Channel::kLwDownWM2,
+                    Channel::kMdotKgS, Channel::kTInC, Channel::kValid}) {
+    series[c].assign(rows, 0.0);
+  }
+  return series;
+}
+
+// Target of the clear-sky index k_c for the day type: clear days vary with
+// the haze, broken clouds switch between cloud shadow and edge brightening,
+// overcast days follow the deck's thickness (unit-variance processes x).
+double ClearSkyIndexTarget(const DayParameters& day, bool sun_hidden, double haze_x, double depth_x,
+                           double edge_x, double overcast_x) {
+  double k_target = 1.0;
+  switch (day.type) {
+    case DayType::kClear:
+      k_target = std::clamp(day.clear_factor + 0.012 * haze_x, 0.93, 1.03);
+      break;
+    case DayType::kBrokenClouds:
+      k_target = sun_hidden ? std::clamp(0.35 + 0.1 * depth_x, 0.1, 0.6)
+                            : std::clamp(1.03 + 0.03 * edge_x, 0.97, 1.1);
+      break;
+    case DayType::kOvercast:
+      k_target = std::clamp(day.overcast_k + 0.07 * overcast_x, 0.05, 0.55);
+      break;
+  }
+  return k_target;
+}
+
+// Row i's irradiance: horizontal global (clear sky × k_c, Ineichen–Perez)
+// and diffuse (Erbs), and the collector plane's global, diffuse and angle of
+// incidence (isotropic sky).
+void IrradianceRow(const Plant& plant, const WeatherOptions& options, const SolarPosition& s,
+                   double doy, double k_clear_sky, std::size_t i, Series* series) {
+  auto& ghi = (*series)[Channel::kGhiWM2];
+  auto& dhi = (*series)[Channel::kDhiWM2];
+  auto& g_poa = (*series)[Channel::kGPoaWM2];
+  auto& g_poa_diffuse = (*series)[Channel::kGPoaDiffuseWM2];
+  auto& aoi = (*series)[Channel::kAoiRad];
+  const double cos_zenith = std::cos(s.zenith_rad);
+  ClearSkyInput cs_in;
+  cs_in.zenith_rad = s.zenith_rad;
+  cs_in.day_of_year = doy;
+  cs_in.elevation_m = plant.elevation_m;
+  cs_in.linke_turbidity = options.linke_turbidity;
+  const ClearSkyIrradiance clear = ClearSkyIneichenPerez(cs_in);
+  const double ghi_w_m2 = k_clear_sky * clear.ghi_w_m2;
+  double dhi_w_m2 = ghi_w_m2;
+  if (cos_zenith >= 0.05) {
+    const double kt = ghi_w_m2 / (ExtraterrestrialNormalWM2(doy) * cos_zenith);
+    dhi_w_m2 = ErbsDiffuseFraction(kt) * ghi_w_m2;
+  }
+  ghi[i] = ghi_w_m2;
+  dhi[i] = std::min(dhi_w_m2, ghi_w_m2);
+
+  // Collector plane.
+  const double aoi_rad =
+      AngleOfIncidenceRad(s.zenith_rad, s.azimuth_rad, plant.tilt_rad, plant.azimuth_rad);
+  IsotropicSkyInput poa_in;
+  poa_in.ghi_w_m2 = ghi[i];
+  poa_in.dhi_w_m2 = dhi[i];
+  poa_in.zenith_rad = s.zenith_rad;
+  poa_in.aoi_rad = aoi_rad;
+  poa_in.tilt_rad = plant.tilt_rad;
+  poa_in.ground_albedo = plant.ground_albedo;
+  const PoaComponents poa = TransposeIsotropicSky(poa_in);
+  g_poa[i] = poa.global_w_m2();
+  g_poa_diffuse[i] = poa.sky_diffuse_w_m2 + poa.ground_diffuse_w_m2;
+  aoi[i] = aoi_rad;
+}
+
+// Long-wave irradiance on the plane, W/m²: Brunt clear-sky emissivity with a
+// cloud-cover increase for the sky part, ground at air temperature, each
+// weighted by its view factor from the tilted plane.
+double LongWaveDownWM2(double relative_humidity, double cover, double t_amb_c, double tilt_rad) {
+  const double cos_tilt = std::cos(tilt_rad);
+  const double sky_view = 0.5 * (1.0 + cos_tilt);
+  const double ground_view = 0.5 * (1.0 - cos_tilt);
+  const double vapour_hpa = relative_humidity * SaturationVapourPressureHpa(t_amb_c);
+  const double eps_clear = 0.52 + 0.065 * std::sqrt(vapour_hpa);
+  const double eps_sky = cover + (1.0 - cover) * eps_clear;
+  const double black_body_w_m2 = kStefanBoltzmannW_m2k4 * std::pow(CToK(t_amb_c), 4);
+  return sky_view * eps_sky * black_body_w_m2 + ground_view * black_body_w_m2;
+}
+
+}  // namespace
+
 Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) {
@@ -504,17 +606,9 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
     std::abort();
   }
   const double dt_s = options.step_s;
-  const auto step = static_cast<std::int64_t>(dt_s);
-  const auto rows = static_cast<std::size_t>(options.num_days * 86400LL / step);
-
-  Series series;
-  series.step_s = dt_s;
-  series.time_s.resize(rows);
-  std::vector<double> times_s(rows);
-  for (std::size_t i = 0; i < rows; ++i) {
-    series.time_s[i] = options.start_time_s + static_cast<std::int64_t>(i) * step;
-    times_s[i] = static_cast<double>(series.time_s[i]);
-  }
+  std::vector<double> times_s;
+  Series series = EmptyWeatherSeries(options, &times_s);
+  const std::size_t rows = series.size();
 
   // Sun positions for all rows at once.
   SolarPositionInput site;
@@ -529,16 +623,7 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
   const double first_day =
       LocalSolarDayNumber(times_s.empty() ? 0.0 : times_s[0], plant.longitude_rad);
 
-  for (Channel c : {Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2,
-                    Channel::kAoiRad, Channel::kTAmbC, Channel::kWindMS, Channel::kLwDownWM2,
-                    Channel::kMdotKgS, Channel::kTInC, Channel::kValid}) {
-    series[c].assign(rows, 0.0);
-  }
-  auto& ghi = series[Channel::kGhiWM2];
-  auto& dhi = series[Channel::kDhiWM2];
   auto& g_poa = series[Channel::kGPoaWM2];
-  auto& g_poa_diffuse = series[Channel::kGPoaDiffuseWM2];
-  auto& aoi = series[Channel::kAoiRad];
   auto& t_amb = series[Channel::kTAmbC];
   auto& wind = series[Channel::kWindMS];
   auto& lw_down = series[Channel::kLwDownWM2];
@@ -578,9 +663,6 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
   const double abs_lat_deg = std::abs(RadToDeg(plant.latitude_rad));
   const double t_annual_c = 28.0 - 0.38 * abs_lat_deg;
   const double t_season_k = 0.22 * abs_lat_deg * (plant.latitude_rad >= 0.0 ? 1.0 : -1.0);
-  const double cos_tilt = std::cos(plant.tilt_rad);
-  const double sky_view = 0.5 * (1.0 + cos_tilt);
-  const double ground_view = 0.5 * (1.0 - cos_tilt);
 
   double current_day = std::nan("");
   DayParameters day;
@@ -620,54 +702,12 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
     } else {
       if (u_switch < 1.0 - std::exp(-dt_s / tau_visible_s)) sun_hidden = true;
     }
-    double k_target = 1.0;
-    switch (day.type) {
-      case DayType::kClear:
-        k_target = std::clamp(day.clear_factor + 0.012 * haze_x, 0.93, 1.03);
-        break;
-      case DayType::kBrokenClouds:
-        k_target = sun_hidden ? std::clamp(0.35 + 0.1 * depth_x, 0.1, 0.6)
-                              : std::clamp(1.03 + 0.03 * edge_x, 0.97, 1.1);
-        break;
-      case DayType::kOvercast:
-        k_target = std::clamp(day.overcast_k + 0.07 * overcast_x, 0.05, 0.55);
-        break;
-    }
+    const double k_target =
+        ClearSkyIndexTarget(day, sun_hidden, haze_x, depth_x, edge_x, overcast_x);
     const double k_clear_sky = std::clamp(k_smooth.Update(k_target), 0.0, 1.1);
 
-    // Horizontal irradiance.
     const double doy = DayOfYear(time_s);
-    const double cos_zenith = std::cos(s.zenith_rad);
-    ClearSkyInput cs_in;
-    cs_in.zenith_rad = s.zenith_rad;
-    cs_in.day_of_year = doy;
-    cs_in.elevation_m = plant.elevation_m;
-    cs_in.linke_turbidity = options.linke_turbidity;
-    const ClearSkyIrradiance clear = ClearSkyIneichenPerez(cs_in);
-    const double ghi_w_m2 = k_clear_sky * clear.ghi_w_m2;
-    double dhi_w_m2 = ghi_w_m2;
-    if (cos_zenith >= 0.05) {
-      const double kt = ghi_w_m2 / (ExtraterrestrialNormalWM2(doy) * cos_zenith);
-      dhi_w_m2 = ErbsDiffuseFraction(kt) * ghi_w_m2;
-    }
-    ghi[i] = ghi_w_m2;
-    dhi[i] = std::min(dhi_w_m2, ghi_w_m2);
-
-    // Collector plane.
-    const double aoi_rad =
-        AngleOfIncidenceRad(s.zenith_rad, s.azimuth_rad, plant.tilt_rad, plant.azimuth_rad);
-    IsotropicSkyInput poa_in;
-    poa_in.ghi_w_m2 = ghi[i];
-    poa_in.dhi_w_m2 = dhi[i];
-    poa_in.zenith_rad = s.zenith_rad;
-    poa_in.aoi_rad = aoi_rad;
-    poa_in.tilt_rad = plant.tilt_rad;
-    poa_in.ground_albedo = plant.ground_albedo;
-    const PoaComponents poa = TransposeIsotropicSky(poa_in);
-    g_poa[i] = poa.global_w_m2();
-    g_poa_diffuse[i] = poa.sky_diffuse_w_m2 + poa.ground_diffuse_w_m2;
-    aoi[i] = aoi_rad;
-
+    IrradianceRow(plant, options, s, doy, k_clear_sky, i, &series);
     // Ambient temperature: season + offset + anomaly + diurnal wave + noise.
     const double season_c = t_annual_c + t_season_k * std::cos(kTwoPi * (doy - 201.0) / 365.2425);
     const double half_range_k = half_range_smooth.Update(day.t_amb_half_range_k);
@@ -684,13 +724,9 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
 
     // Long-wave irradiance on the plane: Brunt clear-sky emissivity with a
     // cloud-cover increase for the sky part, ground at air temperature.
-    const double vapour_hpa =
-        humidity_smooth.Update(day.relative_humidity) * SaturationVapourPressureHpa(t_amb_c);
-    const double eps_clear = 0.52 + 0.065 * std::sqrt(vapour_hpa);
+    const double relative_humidity = humidity_smooth.Update(day.relative_humidity);
     const double cover = cover_smooth.Update(day.sky_cloud_cover);
-    const double eps_sky = cover + (1.0 - cover) * eps_clear;
-    const double black_body_w_m2 = kStefanBoltzmannW_m2k4 * std::pow(CToK(t_amb_c), 4);
-    lw_down[i] = sky_view * eps_sky * black_body_w_m2 + ground_view * black_body_w_m2;
+    lw_down[i] = LongWaveDownWM2(relative_humidity, cover, t_amb_c, plant.tilt_rad);
 
     // Pump and inlet.
     RowWeather row_weather;

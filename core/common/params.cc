@@ -32,7 +32,7 @@ const std::array<ParamInfo, kNumParams> kParamTable = {{
     {Param::kPvIrrCoeffM2W, "pv_irr_coeff_m2_w", "m²/W", "f_corr_I", 1.0, 0.5, 1.5, kLin, true},
     {Param::kTransportDelayS, "transport_delay_s", "s", "τ_transport", 30.0, 0.0, 900.0, kLin,
      false},
-    // Effect library (core/effects/effects.h). Bounds: the physically plausible range
+    // Effect modules (core/effects/). Bounds: the physically plausible range
     // of each effect; starts: inside the range where the effect acts on
     // typical data, so that identification sees a gradient.
     // UA of the collector loop's piping per m² of collector: insulated pipes

@@ -49,8 +49,11 @@ enum class Param : std::size_t {
   kPvTempCoeffPerK,  // f_corr_T (fixed by default, from the plant config)
   kPvIrrCoeffM2W,    // f_corr_I (fixed by default, from the plant config)
   kTransportDelayS,  // effect transport_delay: inlet-to-outlet dead time
-  // Parameters of the effect library (core/effects/effects.h); appended so that the
-  // indices above keep their meaning.
+  // Parameters of the effect modules (core/effects/<effect>.h, which list
+  // them in EffectModule::params); appended so that the indices above keep
+  // their meaning. Each is a slot of the fixed-size ParamVector, so that the
+  // simulation loop never allocates: a new effect's parameter adds a slot
+  // here and a row in params.cc.
   kUPipeWM2K,          // transport_delay: pipe loss to ambient, W/(m²K) of collector
   kNFlow,              // flow_dependent_u: exponent of the fluid-side resistance on flow
   kPLimitWM2,          // pv_clipping: inverter AC limit per m² of collector, W/m²

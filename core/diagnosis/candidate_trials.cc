@@ -40,12 +40,12 @@ void SensorTest(const Series& data, const std::vector<std::int64_t>& day_starts,
   if (k.size() < 3) return;
   std::vector<double> sorted = k;
   std::sort(sorted.begin(), sorted.end());
-  t->irradiance_bias = sorted[sorted.size() / 2];
+  t->sensor_estimate = sorted[sorted.size() / 2];
   const std::vector<double> zeros(k.size(), 0.0);
   const PairedTest up = OneSidedPairedTest(k, zeros);
   const PairedTest down = OneSidedPairedTest(zeros, k);
-  t->irradiance_bias_p = std::min(1.0, 2.0 * std::min(up.wilcoxon_p, down.wilcoxon_p));
-  t->irradiance_bias_days = static_cast<int>(k.size());
+  t->sensor_p = std::min(1.0, 2.0 * std::min(up.wilcoxon_p, down.wilcoxon_p));
+  t->sensor_days = static_cast<int>(k.size());
 }
 
 // The candidates of this step: every effect the current model can take with
@@ -143,8 +143,8 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
             t.test.wilcoxon_p <= options.alpha && t.shrink_pct >= options.min_shrink_pct;
         if (c.module->sensor_estimate != nullptr) {
           SensorTest(*in.data, in.split->day_starts, plant, c.spec, *c.module, &t);
-          t.significant = t.irradiance_bias_p <= options.alpha &&
-                          std::fabs(t.irradiance_bias) >= options.min_sensor_error;
+          t.significant = t.sensor_p <= options.alpha &&
+                          std::fabs(t.sensor_estimate) >= options.min_sensor_error;
         }
       }
     }
@@ -174,8 +174,8 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
        << " (z = " << FixedDecimals(t.evidence_corr.z, 1)
        << ", n_eff = " << FixedDecimals(t.evidence_corr.n_eff, 0) << "); ";
   }
-  if (effect.sensor_evidence != nullptr && std::isfinite(t.irradiance_bias)) {
-    ev << effect.sensor_evidence(t.irradiance_bias, t.irradiance_bias_p, t.irradiance_bias_days);
+  if (effect.sensor_evidence != nullptr && std::isfinite(t.sensor_estimate)) {
+    ev << effect.sensor_evidence(t.sensor_estimate, t.sensor_p, t.sensor_days);
   }
   if (t.fit_ok) {
     ev << "re-identified " << t.variant << " lowers the held-out MAE on " << t.test.positives

@@ -123,10 +123,11 @@ struct EffectTrial {
   // pyranometer scale error k) is not a prediction error: the fit absorbs it
   // and the held-out MAE does not move. It is significant when its per-day
   // estimates have one sign consistently (two-sided Wilcoxon p ≤ alpha) and
-  // |median| ≥ min_sensor_error. The fields keep their report.json names.
-  double irradiance_bias = std::nan("");    // median of the per-day k
-  double irradiance_bias_p = std::nan("");  // two-sided p of k ≠ 0 over days
-  int irradiance_bias_days = 0;             // days with an estimate
+  // |median| ≥ min_sensor_error. report.json writes them as
+  // irradiance_bias_k and irradiance_bias_p (the one sensor effect so far).
+  double sensor_estimate = std::nan("");  // median of the per-day estimates
+  double sensor_p = std::nan("");         // two-sided p of estimate ≠ 0 over days
+  int sensor_days = 0;                    // days with an estimate
 };
 
 struct LadderStep {

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "core/synth/synthetic_plant.h"
 #include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
 #include "core/synth/weather_generator.h"
 
 namespace pvtwin {
@@ -44,9 +44,9 @@ std::string HashOfRun(const Series& s, const Plant& plant, const std::string& va
   Simulate(d, TruthParamsFor(plant, spec), &out, options);
   Simulate(d, TruthParamsFor(plant, spec), &out, options);
   std::uint64_t h = 1469598103934665603ull;
-  for (const auto* v : {&out.p_el_w, &out.q_th_w, &out.t_pv_c, &out.t_coll_c, &out.t_out_c,
-                        &out.q_abs_w, &out.q_front_w, &out.q_back_w, &out.q_rad_w,
-                        &out.q_store_w}) {
+  for (const auto* v :
+       {&out.p_el_w, &out.q_th_w, &out.t_pv_c, &out.t_coll_c, &out.t_out_c, &out.q_abs_w,
+        &out.q_front_w, &out.q_back_w, &out.q_rad_w, &out.q_store_w}) {
     Hash(*v, &h);
   }
   char buf[32];
@@ -72,8 +72,9 @@ TEST(ModelGolden, OutputsOfTable6VariantsAndEffectsAreBitIdentical) {
                         "clock_offset", "irradiance_bias"}) {
     variants.push_back(std::string("1Nr+") + e);
   }
-  variants.push_back("2N2Cr+wind+transport_delay+flow_dependent_u+pv_clipping+shading+soiling+"
-                     "clock_offset+irradiance_bias");
+  variants.push_back(
+      "2N2Cr+wind+transport_delay+flow_dependent_u+pv_clipping+shading+soiling+"
+      "clock_offset+irradiance_bias");
   variants.push_back("2N1CcolwrI+shading+clock_offset+soiling");
   for (const std::string& v : variants) {
     const std::string got = HashOfRun(s, plant, v);

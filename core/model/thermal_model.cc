@@ -98,7 +98,7 @@ struct RowTerms {
   PvEfficiencyLinear eta;
   double t_amb_c, t_back_c, t_in_c, t_sky_k4;
   // P_el = min(η(T)·p_per_eta_w, p_limit_w) when `electric`.
-  double p_per_eta_w;  // A·I_at·(1 − f_mismatch·s)
+  double p_per_eta_w;  // A·I_at·pv_factor
   double p_limit_w;
   double f_th;
   bool electric;  // RunInputs::electric_effects
@@ -142,8 +142,9 @@ RowTerms MakeRowTerms(const RunConstants& k, const Drivers& d, const RunInputs& 
 }
 
 // Q_abs at T_PV = t_c and its slope dQ_abs/dT (W, W/K). Paper eq. 2.3:
-// Q_abs = (1 − η)·F_th·A·I_at. With clipping or shading mismatch the power
-// that is not converted stays as heat: Q_abs = F_th·(A·I_at − P_el).
+// Q_abs = (1 − η)·F_th·A·I_at. When an effect limits or reduces P_el
+// (RunInputs::electric_effects) the power that is not converted stays as
+// heat: Q_abs = F_th·(A·I_at − P_el).
 double QAbsW(const RowTerms& r, double t_c, double* slope_w_k) {
   if (!r.electric) {
     *slope_w_k = -r.q_sun_w * r.eta.SlopeAt(t_c);
@@ -276,7 +277,7 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
       continue;
     }
     const RowTerms r = MakeRowTerms(k, d, w, i);
-    // clock_offset: a shifted weather value may come from a row with a gap.
+    // A weather value moved by an effect's hook may come from a row with a gap.
     if (!std::isfinite(r.q_sun_w) || !std::isfinite(r.t_amb_c) || !std::isfinite(r.t_back_c) ||
         !std::isfinite(r.t_sky_k4) || !std::isfinite(r.eta.eta_at_ref_temp) ||
         std::isnan(r.g_front_w_k)) {

@@ -33,7 +33,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/channels.h"
+#include "core/common/channels.h"
 
 namespace pvtwin {
 

@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "config/toml_reader.h"
-#include "core/units.h"
-#include "core/variant.h"
+#include "core/common/units.h"
+#include "core/model/variant.h"
 
 namespace pvtwin {
 namespace {

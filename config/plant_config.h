@@ -31,8 +31,8 @@
 #include <string_view>
 
 #include "config/modbus_config.h"
-#include "core/diagnostic.h"
-#include "core/plant.h"
+#include "core/common/diagnostic.h"
+#include "core/common/plant.h"
 
 namespace pvtwin {
 

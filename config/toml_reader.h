@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/diagnostic.h"
+#include "core/common/diagnostic.h"
 
 namespace pvtwin::config_detail {
 

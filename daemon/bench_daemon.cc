@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "config/config_edit.h"
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "daemon/bench.h"
 #include "daemon/demo_config.h"
 #include "io/child_process.h"

@@ -5,9 +5,9 @@
 #include <string>
 #include <thread>
 
-#include "core/diagnosis.h"
-#include "core/qc.h"
-#include "core/synthetic_plant.h"
+#include "core/data/qc.h"
+#include "core/diagnosis/diagnosis.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 
 namespace pvtwin::cli {

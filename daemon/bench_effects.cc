@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "core/effects.h"
-#include "core/identification.h"
-#include "core/qc.h"
-#include "core/synthetic_plant.h"
+#include "core/data/qc.h"
+#include "core/effects/effects.h"
+#include "core/fit/identification.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 
 namespace pvtwin::cli {
@@ -27,17 +27,11 @@ constexpr int kHeldOutDays = 7;
 
 // The base model each effect is added to: 1N1Cwr, or the variant just
 // without the effect's letter.
-const char* BaseFor(Effect e) {
-  switch (e) {
-    case Effect::kCapacitance:
-      return "1Nwr";
-    case Effect::kWind:
-      return "1N1Cr";
-    case Effect::kSkyRadiation:
-      return "1N1Cw";
-    default:
-      return "1N1Cwr";
-  }
+const char* BaseFor(const EffectModule& e) {
+  if (e.name == "capacitance") return "1Nwr";
+  if (e.name == "wind") return "1N1Cr";
+  if (e.name == "sky_radiation") return "1N1Cw";
+  return "1N1Cwr";
 }
 
 struct Scored {
@@ -101,14 +95,15 @@ void BenchEffects(int repeats, std::uint64_t seed) {
   std::printf("  %-17s %-26s %8s %6s %28s  %s\n", "effect", "truth", "fit (s)", "sims",
               "held-out MAE W/m2 truth/with/base", "parameter: fit (truth)");
   double total_s = 0.0;
-  for (const EffectInfo& info : EffectTable()) {
+  for (const EffectModule* effect : EffectRegistry()) {
+    const EffectModule& info = *effect;
     const ModelSpec base = [&] {
       ModelSpec spec;
       std::string error;
-      ParseVariant(BaseFor(info.effect), &spec, &error);
+      ParseVariant(BaseFor(info), &spec, &error);
       return spec;
     }();
-    const ModelSpec with = WithEffect(base, info.effect);
+    const ModelSpec with = WithEffect(base, info);
     SyntheticOptions options;
     std::string error;
     if (!DefaultSyntheticOptions(plant, with.Name(), kTrainDays + kHeldOutDays, seed, &options,
@@ -131,8 +126,8 @@ void BenchEffects(int repeats, std::uint64_t seed) {
     // irradiance_bias, which the drivers estimate from GHI/DHI.
     std::string param = "-";
     if (!info.params.empty()) {
-      const Param p = info.effect == Effect::kShading ? Param::kShadeMismatch : info.params.front();
-      const double value = info.effect == Effect::kIrradianceBias
+      const Param p = info.name == "shading" ? Param::kShadeMismatch : info.params.front();
+      const double value = info.sensor_estimate != nullptr
                                ? fit.irradiance_bias
                                : fit.params[static_cast<std::size_t>(p)];
       char buf[96];

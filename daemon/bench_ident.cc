@@ -22,9 +22,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/identification.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
+#include "core/fit/identification.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 
 namespace pvtwin::cli {

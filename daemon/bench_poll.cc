@@ -24,7 +24,7 @@
 #include <mutex>
 #include <vector>
 
-#include "core/synthetic_plant.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 #include "io/modbus_poller.h"
 #include "io/modbus_sim_server.h"

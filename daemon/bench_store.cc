@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "core/aggregate.h"
-#include "core/synthetic_plant.h"
+#include "core/data/aggregate.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 #include "io/store.h"
 

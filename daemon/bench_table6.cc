@@ -8,8 +8,8 @@
 #include <string>
 #include <thread>
 
-#include "core/backtest.h"
-#include "core/synthetic_plant.h"
+#include "core/forecast/backtest.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 
 namespace pvtwin::cli {

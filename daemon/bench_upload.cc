@@ -16,7 +16,7 @@
 #include <fstream>
 #include <string>
 
-#include "core/synthetic_plant.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 #include "io/pg_scratch_server.h"
 #include "io/store.h"

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <map>
 
-#include "core/identification.h"
-#include "core/thermal_model.h"
+#include "core/fit/identification.h"
+#include "core/model/thermal_model.h"
 
 namespace pvtwin::cli {
 

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "core/params.h"
-#include "core/plant.h"
-#include "core/series.h"
-#include "core/variant.h"
+#include "core/common/params.h"
+#include "core/common/plant.h"
+#include "core/common/series.h"
+#include "core/model/variant.h"
 
 namespace pvtwin::cli {
 

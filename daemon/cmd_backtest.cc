@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "core/backtest.h"
-#include "core/variant.h"
+#include "core/forecast/backtest.h"
+#include "core/model/variant.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/backtest_report.h"

@@ -6,9 +6,9 @@
 #include <iostream>
 #include <vector>
 
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 #include "daemon/commands.h"
 

@@ -8,9 +8,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "core/identification.h"
-#include "core/iso9806.h"
-#include "core/resample.h"
+#include "core/data/resample.h"
+#include "core/fit/identification.h"
+#include "core/fit/iso9806.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/params_json.h"

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "config/plant_config.h"
-#include "core/units.h"
+#include "core/common/units.h"
 #include "daemon/commands.h"
 
 namespace pvtwin::cli {

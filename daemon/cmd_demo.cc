@@ -25,8 +25,8 @@
 #include <sstream>
 
 #include "config/config_edit.h"
-#include "core/clock.h"
-#include "core/units.h"
+#include "core/common/clock.h"
+#include "core/common/units.h"
 #include "daemon/commands.h"
 #include "daemon/demo_config.h"
 #include "daemon/inputs.h"

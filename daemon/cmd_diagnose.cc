@@ -13,10 +13,10 @@
 #include <thread>
 #include <vector>
 
-#include "core/clock.h"
-#include "core/diagnosis.h"
-#include "core/diagnosis_selftest.h"
-#include "core/synthetic_plant.h"
+#include "core/common/clock.h"
+#include "core/diagnosis/diagnosis.h"
+#include "core/diagnosis/diagnosis_selftest.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"

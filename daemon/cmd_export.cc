@@ -4,7 +4,7 @@
 #include <iostream>
 #include <vector>
 
-#include "core/aggregate.h"
+#include "core/data/aggregate.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"

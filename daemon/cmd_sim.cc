@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/resample.h"
+#include "core/data/resample.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/csv.h"

@@ -4,8 +4,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/effect_candidates.h"
-#include "core/variant.h"
+#include "core/diagnosis/effect_candidates.h"
+#include "core/model/variant.h"
 
 namespace pvtwin::cli {
 

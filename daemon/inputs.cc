@@ -7,7 +7,7 @@
 #include <csignal>
 #include <iostream>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/csv.h"
 #include "io/time_format.h"
 

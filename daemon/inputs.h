@@ -8,9 +8,9 @@
 #include <string>
 
 #include "config/plant_config.h"
-#include "core/series.h"
-#include "core/thermal_model.h"
-#include "core/variant.h"
+#include "core/common/series.h"
+#include "core/model/thermal_model.h"
+#include "core/model/variant.h"
 #include "io/local_time.h"
 
 namespace pvtwin::cli {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/monitoring.h"
+#include "core/monitor/monitoring.h"
 #include "io/log.h"
 #include "io/params_json.h"
 #include "io/time_format.h"

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "config/plant_config.h"
-#include "core/variant.h"
+#include "core/model/variant.h"
 #include "io/store.h"
 
 namespace pvtwin::cli {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <vector>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/log.h"
 #include "io/time_format.h"
 

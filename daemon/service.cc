@@ -17,12 +17,12 @@
 #include <vector>
 
 #include "config/plant_config.h"
-#include "core/clock.h"
-#include "core/forecast.h"
-#include "core/identification.h"
-#include "core/sample.h"
-#include "core/thermal_model.h"
-#include "core/variant.h"
+#include "core/common/clock.h"
+#include "core/common/sample.h"
+#include "core/fit/identification.h"
+#include "core/forecast/forecast.h"
+#include "core/model/thermal_model.h"
+#include "core/model/variant.h"
 #include "daemon/calibration_acceptance.h"
 #include "daemon/monitor.h"
 #include "daemon/nightly_diagnosis.h"

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <cstdio>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 
 namespace pvtwin {
 

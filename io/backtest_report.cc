@@ -3,7 +3,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "core/variant.h"
+#include "core/model/variant.h"
 #include "io/time_format.h"
 
 namespace pvtwin {

@@ -27,7 +27,7 @@
 #include <span>
 #include <string>
 
-#include "core/backtest.h"
+#include "core/forecast/backtest.h"
 
 namespace pvtwin {
 

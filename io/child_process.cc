@@ -11,7 +11,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 
 extern char** environ;
 

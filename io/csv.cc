@@ -17,9 +17,9 @@
 #include <string_view>
 #include <vector>
 
-#include "core/physical_limits.h"
-#include "core/qc.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/data/physical_limits.h"
+#include "core/data/qc.h"
 #include "io/time_format.h"
 
 namespace pvtwin {

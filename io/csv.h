@@ -30,9 +30,9 @@
 #include <span>
 #include <string>
 
-#include "core/channels.h"
-#include "core/diagnostic.h"
-#include "core/series.h"
+#include "core/common/channels.h"
+#include "core/common/diagnostic.h"
+#include "core/common/series.h"
 
 namespace pvtwin {
 

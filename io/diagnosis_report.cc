@@ -133,9 +133,9 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
     e["evidence_r"] = Number(t.evidence_corr.r);
     e["evidence_z"] = Number(t.evidence_corr.z);
     e["evidence_output"] = t.evidence_output;
-    if (std::isfinite(t.irradiance_bias)) {
-      e["irradiance_bias_k"] = Number(t.irradiance_bias);
-      e["irradiance_bias_p"] = Number(t.irradiance_bias_p);
+    if (std::isfinite(t.sensor_estimate)) {
+      e["irradiance_bias_k"] = Number(t.sensor_estimate);
+      e["irradiance_bias_p"] = Number(t.sensor_p);
     }
     e["explanation"] = t.explanation;
     e["fit_ok"] = t.fit_ok;

@@ -42,7 +42,7 @@
 
 #include <string>
 
-#include "core/diagnosis.h"
+#include "core/diagnosis/diagnosis.h"
 
 namespace pvtwin {
 

@@ -8,7 +8,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/physical_limits.h"
+#include "core/data/physical_limits.h"
 #include "io/modbus_tcp_read.h"
 #include "io/register_codec.h"
 

@@ -49,8 +49,8 @@
 #include <vector>
 
 #include "config/modbus_config.h"
-#include "core/clock.h"
-#include "core/sample.h"
+#include "core/common/clock.h"
+#include "core/common/sample.h"
 #include "io/log.h"
 #include "io/read_plan.h"
 

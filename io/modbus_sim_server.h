@@ -33,7 +33,7 @@
 #include <vector>
 
 #include "config/modbus_config.h"
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/log.h"
 #include "io/plant_source.h"
 

@@ -12,9 +12,9 @@
 #include <bitset>
 #include <string>
 
-#include "core/diagnostic.h"
-#include "core/params.h"
-#include "core/plant.h"
+#include "core/common/diagnostic.h"
+#include "core/common/params.h"
+#include "core/common/plant.h"
 
 namespace pvtwin {
 
@@ -38,7 +38,6 @@ std::string FormatParamsJson(const std::string& variant, const ParamVector& valu
                              const std::bitset<kNumParams>& only, const std::string& fit_json);
 
 // Writes the text atomically (temporary file, then rename).
-bool WriteTextFileAtomically(const std::string& path, const std::string& text,
-                             std::string* error);
+bool WriteTextFileAtomically(const std::string& path, const std::string& text, std::string* error);
 
 }  // namespace pvtwin

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/synthetic_plant.h"
+#include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 
 namespace pvtwin {

@@ -34,13 +34,13 @@
 #include <string_view>
 #include <vector>
 
-#include "core/diagnostic.h"
-#include "core/params.h"
-#include "core/plant.h"
-#include "core/sample.h"
-#include "core/series.h"
-#include "core/variant.h"
-#include "core/weather_generator.h"
+#include "core/common/diagnostic.h"
+#include "core/common/params.h"
+#include "core/common/plant.h"
+#include "core/common/sample.h"
+#include "core/common/series.h"
+#include "core/model/variant.h"
+#include "core/synth/weather_generator.h"
 
 namespace pvtwin {
 

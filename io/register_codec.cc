@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "core/units.h"
+#include "core/common/units.h"
 
 namespace pvtwin {
 

@@ -23,7 +23,7 @@
 #include <span>
 
 #include "config/modbus_config.h"
-#include "core/channels.h"
+#include "core/common/channels.h"
 
 namespace pvtwin {
 

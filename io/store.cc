@@ -19,8 +19,8 @@
 #include <thread>
 #include <unordered_map>
 
-#include "core/physical_limits.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/data/physical_limits.h"
 
 namespace pvtwin {
 

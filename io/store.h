@@ -131,10 +131,10 @@
 #include <string>
 #include <vector>
 
-#include "core/aggregate.h"
-#include "core/monitoring.h"
-#include "core/sample.h"
-#include "core/series.h"
+#include "core/common/sample.h"
+#include "core/common/series.h"
+#include "core/data/aggregate.h"
+#include "core/monitor/monitoring.h"
 
 namespace pvtwin {
 

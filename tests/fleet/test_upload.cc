@@ -14,7 +14,7 @@
 #include <sstream>
 
 #include "config/config_edit.h"
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/child_process.h"
 #include "io/pg_scratch_server.h"
 #include "tests/support/files.h"

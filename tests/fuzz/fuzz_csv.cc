@@ -3,7 +3,7 @@
 // backtest and diagnose. It must never crash, and what it accepts must hold
 // the reader's promises: strictly increasing times, one value per row in
 // every present channel, every value finite or missing and within its
-// channel's physical limits (core/physical_limits.h), every diagnostic
+// channel's physical limits (core/data/physical_limits.h), every diagnostic
 // printable (no control bytes, cut cells). Seeds: tests/fuzz/corpus/csv/.
 #include <cmath>
 #include <cstddef>
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "core/physical_limits.h"
+#include "core/data/physical_limits.h"
 #include "io/csv.h"
 
 namespace {

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "core/effects.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/variant.h"
+#include "core/effects/effects.h"
+#include "core/model/thermal_model.h"
+#include "core/model/variant.h"
+#include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 
 namespace {
@@ -32,8 +32,8 @@ std::vector<pvtwin::ModelSpec> Variants() {
   }
   pvtwin::ModelSpec base;
   pvtwin::ParseVariant("2N1CcolwrI", &base, &error);
-  for (std::size_t e = 0; e < pvtwin::kNumEffects; ++e) {
-    specs.push_back(pvtwin::WithEffect(base, static_cast<pvtwin::Effect>(e)));
+  for (const pvtwin::EffectModule* e : pvtwin::EffectRegistry()) {
+    specs.push_back(pvtwin::WithEffect(base, *e));
   }
   return specs;
 }
@@ -63,8 +63,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Require(out.p_el_w.size() == series.size() && out.q_th_w.size() == series.size());
   // transport_delay and clock_offset read neighbouring rows, which may be
   // missing; every other variant gives a usable row finite outputs.
-  const bool reads_neighbours =
-      spec.Has(pvtwin::Extension::kTransportDelay) || spec.Has(pvtwin::Extension::kClockOffset);
+  const bool reads_neighbours = pvtwin::HasEffect(spec, *pvtwin::FindEffect("transport_delay")) ||
+                                pvtwin::HasEffect(spec, *pvtwin::FindEffect("clock_offset"));
   for (std::size_t i = 0; i < series.size(); ++i) {
     Require(!std::isinf(out.p_el_w[i]) && !std::isinf(out.q_th_w[i]));
     if (drivers.usable[i] && !reads_neighbours) {

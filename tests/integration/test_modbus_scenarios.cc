@@ -45,7 +45,7 @@
 #include <vector>
 
 #include "config/plant_config.h"
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/modbus_poller.h"
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"

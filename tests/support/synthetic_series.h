@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "core/series.h"
-#include "core/variant.h"
+#include "core/common/series.h"
+#include "core/model/variant.h"
 
 namespace pvtwin::testing {
 
@@ -49,7 +49,7 @@ inline Series MakeConstantSeries(std::size_t rows, double step_s, const Constant
 inline constexpr std::int64_t kJune1_2024UtcS = 1717200000;
 
 // Adds the in-plane diffuse irradiance that the 'I' variants need to split
-// g_poa_w_m2 into beam and diffuse parts (core/irradiance.h,
+// g_poa_w_m2 into beam and diffuse parts (core/physics/irradiance.h,
 // SplitMeasuredPoa): `fraction` of g_poa_w_m2 on every row.
 inline void AddPoaDiffuse(Series* s, double fraction) {
   const std::vector<double>& g_poa = (*s)[Channel::kGPoaWM2];

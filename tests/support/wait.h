@@ -6,7 +6,7 @@
 #include <functional>
 #include <thread>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 
 namespace pvtwin::testing {
 

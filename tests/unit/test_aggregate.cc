@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/aggregate.h"
+#include "core/data/aggregate.h"
 
 namespace pvtwin {
 namespace {

@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "core/backtest.h"
-#include "core/synthetic_plant.h"
-#include "core/units.h"
-#include "core/variant.h"
+#include "core/common/units.h"
+#include "core/forecast/backtest.h"
+#include "core/model/variant.h"
+#include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/synthetic_series.h"

@@ -1,7 +1,7 @@
 // The daemon's rule for taking a new calibration (daemon/calibration_acceptance.h).
 #include <gtest/gtest.h>
 
-#include "core/synthetic_plant.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/calibration_acceptance.h"
 #include "tests/support/synthetic_series.h"
 

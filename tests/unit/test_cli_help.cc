@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "core/effect_candidates.h"
+#include "core/diagnosis/effect_candidates.h"
 #include "tests/support/run_pvtwin.h"
 
 namespace pvtwin {

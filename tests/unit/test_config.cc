@@ -5,7 +5,7 @@
 #include <string>
 
 #include "config/plant_config.h"
-#include "core/units.h"
+#include "core/common/units.h"
 
 namespace pvtwin {
 namespace {
@@ -59,7 +59,7 @@ TEST(ConfigLoad, OmittedKeysTakeTheDocumentedDefaults) {
   EXPECT_DOUBLE_EQ(p.latitude_rad, 47.358 * kPi / 180);
   EXPECT_DOUBLE_EQ(p.azimuth_rad, kPi);
   EXPECT_EQ(p.elevation_m, 0.0);
-  // DESIGN.md's [plant] example values, which core/plant.h also uses.
+  // DESIGN.md's [plant] example values, which core/common/plant.h also uses.
   EXPECT_EQ(p.fluid_cp_j_kgk, 3650);
   EXPECT_EQ(p.fluid_density_kg_m3, 1040);
   EXPECT_EQ(p.ground_albedo, 0.2);

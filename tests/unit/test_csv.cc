@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "config/plant_config.h"
-#include "core/units.h"
+#include "core/common/units.h"
 #include "io/csv.h"
 #include "io/local_time.h"
 #include "io/time_format.h"

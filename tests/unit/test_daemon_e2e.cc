@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "config/config_edit.h"
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/child_process.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"

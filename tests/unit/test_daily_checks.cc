@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-#include "core/synthetic_plant.h"
+#include "core/synth/synthetic_plant.h"
 #include "daemon/monitor.h"
 #include "io/log.h"
 #include "io/params_json.h"

@@ -9,12 +9,12 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "core/diagnosis.h"
-#include "core/diagnosis_stats.h"
-#include "core/gap_localisation.h"
-#include "core/qc.h"
-#include "core/synthetic_plant.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/data/qc.h"
+#include "core/diagnosis/diagnosis.h"
+#include "core/diagnosis/diagnosis_stats.h"
+#include "core/diagnosis/gap_localisation.h"
+#include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 #include "io/diagnosis_report.h"
 #include "tests/support/run_pvtwin.h"

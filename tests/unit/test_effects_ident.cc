@@ -1,5 +1,5 @@
 // Identification of every effect on synthetic data with a known answer:
-// truth = base + effect at its typical magnitude (EffectInfo::typical_truth),
+// truth = base + effect at its typical magnitude (EffectModule::typical_truth),
 // realistic noise and the paper's data defects (seeds recorded); fitting
 // base + effect recovers the effect's parameter and reaches the held-out
 // noise floor, while the base model alone leaves a gap.
@@ -10,10 +10,11 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/effects.h"
-#include "core/identification.h"
-#include "core/qc.h"
-#include "core/synthetic_plant.h"
+#include "core/data/qc.h"
+#include "core/effects/effects.h"
+#include "core/fit/identification.h"
+#include "core/synth/synthetic_plant.h"
+#include "tests/support/effect_named.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
@@ -27,10 +28,10 @@ constexpr int kTrainDays = 7;
 // (the PV-to-absorber temperature difference shows only through η_PV's
 // temperature coefficient), hence its wide tolerance.
 struct IdentCase {
-  Effect effect;
-  const char* base;  // the model without the effect
-  Param checked;     // parameter whose truth must come back
-  double tolerance;  // absolute, in the parameter's unit
+  const char* effect;  // vocabulary name
+  const char* base;    // the model without the effect
+  Param checked;       // parameter whose truth must come back
+  double tolerance;    // absolute, in the parameter's unit
   std::uint64_t seed;
   // Start value of `checked` for the fit; NaN: the reference start value
   // (params.h). Either way the start must be more than `tolerance` from the
@@ -114,7 +115,7 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
   const IdentCase c = GetParam();
   const Plant plant = DesignExamplePlant();
   const ModelSpec base = testing::SpecOf(c.base);
-  const ModelSpec with = WithEffect(base, c.effect);
+  const ModelSpec with = WithEffect(base, testing::EffectNamed(c.effect));
   SyntheticOptions options;
   std::string error;
   ASSERT_TRUE(DefaultSyntheticOptions(plant, with.Name(), kDays, c.seed, &options, &error))
@@ -139,11 +140,11 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
   std::printf(
       "%-16s truth %-28s held-out MAE: truth %.3f (se %.4f), with %.3f, base %.3f W/m2; %s = "
       "%.4g (truth %.4g, start %.4g); %.1f s\n",
-      std::string(Info(c.effect).name).c_str(), with.Name().c_str(), truth.heldout_w_m2,
-      truth.heldout_se_w_m2, fit_with.heldout_w_m2, fit_base.heldout_w_m2,
-      std::string(Info(c.checked).name).c_str(), value, truth_value, start[checked], runtime_s);
+      c.effect, with.Name().c_str(), truth.heldout_w_m2, truth.heldout_se_w_m2,
+      fit_with.heldout_w_m2, fit_base.heldout_w_m2, std::string(Info(c.checked).name).c_str(),
+      value, truth_value, start[checked], runtime_s);
   EXPECT_NEAR(value, truth_value, c.tolerance) << fit_with.summary.BriefReport();
-  if (c.effect == Effect::kShading) {
+  if (std::string_view(c.effect) == "shading") {
     // Identifiable is what the sun path crosses: the obstacle's edge
     // elevation and the window's west edge (June afternoons). The east edge
     // is not determined by summer data (the morning sun passes it above the
@@ -156,11 +157,11 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
                 at(truth_p, Param::kShadeAzimuthRad) + 0.5 * at(truth_p, Param::kShadeWidthRad),
                 0.03);
   }
-  if (c.effect == Effect::kTransportDelay) {
+  if (std::string_view(c.effect) == "transport_delay") {
     const std::size_t pipe = static_cast<std::size_t>(Param::kUPipeWM2K);
     EXPECT_NEAR(fit_with.summary.params[pipe], options.truth[pipe], 0.3);
   }
-  if (c.effect == Effect::kIrradianceBias) {
+  if (std::string_view(c.effect) == "irradiance_bias") {
     // Without the second source the fit absorbs the pyranometer's 6 % low
     // reading into η_PV; with it, η_PV comes back unbiased.
     const std::size_t eta = static_cast<std::size_t>(Param::kEtaPvRef);
@@ -175,7 +176,7 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
 
 INSTANTIATE_TEST_SUITE_P(
     AllEffects, EffectIdentification,
-    ::testing::Values(IdentCase{Effect::kCapacitance, "1Nwr", Param::kCPvJM2K, 5e3, 101},
+    ::testing::Values(IdentCase{"capacitance", "1Nwr", Param::kCPvJM2K, 5e3, 101},
                       // U_coll: started 8× above the truth; the fit returns 17.1
                       // (truth 12) with a standard error of 29 % (0.021 of the
                       // log range): tolerance 9 ≈ 2 standard errors. With the
@@ -183,27 +184,24 @@ INSTANTIATE_TEST_SUITE_P(
                       // converge_fully. The base model's gap is 0.058 W/m²
                       // (2.3 noise standard errors): not well above the noise
                       // at U_coll = 12.
-                      IdentCase{Effect::kSecondNode, "1N1Cwr", Param::kUCollWM2K, 9.0, 102, 100.0,
+                      IdentCase{"second_node", "1N1Cwr", Param::kUCollWM2K, 9.0, 102, 100.0,
                                 /*converge_fully=*/true, /*gap_visible=*/false},
-                      IdentCase{Effect::kWind, "1N1Cr", Param::kRRefWind, 0.01, 103},
-                      IdentCase{Effect::kSkyRadiation, "1N1Cw", Param::kEpsPvt, 0.02, 104},
-                      IdentCase{Effect::kIam, "1N1Cwr", Param::kEtaPvRef, 0.005, 105},
+                      IdentCase{"wind", "1N1Cr", Param::kRRefWind, 0.01, 103},
+                      IdentCase{"sky_radiation", "1N1Cw", Param::kEpsPvt, 0.02, 104},
+                      IdentCase{"iam", "1N1Cwr", Param::kEtaPvRef, 0.005, 105},
                       // The base model absorbs this effect into r0/r1: its
                       // held-out MAE is 1.325 against a floor of 1.300 W/m²
                       // (1 noise standard error); no gap is required.
-                      IdentCase{Effect::kFlowDependentU, "1N1Cwr", Param::kNFlow, 0.2, 106,
+                      IdentCase{"flow_dependent_u", "1N1Cwr", Param::kNFlow, 0.2, 106,
                                 std::numeric_limits<double>::quiet_NaN(),
                                 /*converge_fully=*/false, /*gap_visible=*/false},
-                      IdentCase{Effect::kTransportDelay, "1N1Cwr", Param::kTransportDelayS, 30.0,
-                                107},
-                      IdentCase{Effect::kPvClipping, "1N1Cwr", Param::kPLimitWM2, 2.0, 108},
-                      IdentCase{Effect::kShading, "1N1Cwr", Param::kShadeMismatch, 0.05, 109},
-                      IdentCase{Effect::kSoiling, "1N1Cwr", Param::kSoilingPerDay, 0.001, 110},
-                      IdentCase{Effect::kClockOffset, "1N1Cwr", Param::kClockOffsetS, 60.0, 111},
-                      IdentCase{Effect::kIrradianceBias, "1N1Cwr", Param::kEtaPvRef, 0.005, 112}),
-    [](const ::testing::TestParamInfo<IdentCase>& info) {
-      return std::string(Info(info.param.effect).name);
-    });
+                      IdentCase{"transport_delay", "1N1Cwr", Param::kTransportDelayS, 30.0, 107},
+                      IdentCase{"pv_clipping", "1N1Cwr", Param::kPLimitWM2, 2.0, 108},
+                      IdentCase{"shading", "1N1Cwr", Param::kShadeMismatch, 0.05, 109},
+                      IdentCase{"soiling", "1N1Cwr", Param::kSoilingPerDay, 0.001, 110},
+                      IdentCase{"clock_offset", "1N1Cwr", Param::kClockOffsetS, 60.0, 111},
+                      IdentCase{"irradiance_bias", "1N1Cwr", Param::kEtaPvRef, 0.005, 112}),
+    [](const ::testing::TestParamInfo<IdentCase>& info) { return std::string(info.param.effect); });
 
 }  // namespace
 }  // namespace pvtwin

@@ -1,15 +1,17 @@
 // Each effect of the library on an analytic case: the effect moves the
 // outputs in the predicted direction by the predicted amount
-// (core/effects.h, thermal_model.cc, drivers.cc).
+// (core/effects/effects.h, thermal_model.cc, drivers.cc).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/effects.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/units.h"
-#include "core/weather_generator.h"
+#include "core/common/units.h"
+#include "core/effects/effects.h"
+#include "core/effects/flow_dependent_u.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
+#include "core/synth/weather_generator.h"
+#include "tests/support/effect_named.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
@@ -288,7 +290,8 @@ TEST(EffectModel, IrradianceBiasIsCalibratedAgainstTheSecondSource) {
   }
   // The base model's drivers keep the signature: reference − measured > 0.
   const Drivers base = DriversOf(biased, plant, "1N");
-  const std::vector<double> sig = EffectSignature(Effect::kIrradianceBias, base, SimOutputs{});
+  const std::vector<double> sig =
+      EffectSignature(testing::EffectNamed("irradiance_bias"), base, SimOutputs{});
   double sum = 0.0;
   for (std::size_t i = 0; i < sig.size(); ++i) {
     if (base.g_poa_w_m2[i] > 300.0) sum += sig[i] / base.g_poa_w_m2[i];

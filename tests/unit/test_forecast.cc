@@ -1,13 +1,13 @@
-// Forecasts (core/forecast.h): with perfect inputs a forecast of the true
+// Forecasts (core/forecast/forecast.h): with perfect inputs a forecast of the true
 // model reproduces the truth; without a weather forecast it persists the last
 // measured day; without a plan it runs the window's typical day.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/forecast.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
+#include "core/forecast/forecast.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "core/iam.h"
-#include "core/irradiance.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/physics/iam.h"
+#include "core/physics/irradiance.h"
 
 namespace pvtwin {
 namespace {

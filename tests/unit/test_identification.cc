@@ -6,10 +6,10 @@
 #include <set>
 
 #include "config/plant_config.h"
-#include "core/identification.h"
-#include "core/iso9806.h"
-#include "core/synthetic_plant.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/fit/identification.h"
+#include "core/fit/iso9806.h"
+#include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 #include "tests/support/synthetic_series.h"
 

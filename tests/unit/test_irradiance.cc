@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "core/irradiance.h"
-#include "core/solar_position.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/physics/irradiance.h"
+#include "core/physics/solar_position.h"
 
 namespace pvtwin {
 namespace {

@@ -1,13 +1,13 @@
-// ISO 9806 equivalents of the grey-box model (core/iso9806.h), checked
+// ISO 9806 equivalents of the grey-box model (core/fit/iso9806.h), checked
 // against the model itself at operating points the read-off did not use, and
 // against the structure of each variant.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/iso9806.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
+#include "core/fit/iso9806.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <random>
 
-#include "core/lad_fit.h"
+#include "core/fit/lad_fit.h"
 
 namespace pvtwin {
 namespace {

@@ -11,10 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "core/effects.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/variant.h"
+#include "core/effects/effects.h"
+#include "core/model/thermal_model.h"
+#include "core/model/variant.h"
+#include "core/synth/synthetic_plant.h"
+#include "tests/support/effect_named.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/synthetic_series.h"
 
@@ -74,8 +75,7 @@ std::vector<ModelSpec> VariantsUnderTest() {
   std::vector<ModelSpec> v;
   for (const std::string& name : PaperVariants()) v.push_back(testing::SpecOf(name));
   const ModelSpec base = testing::SpecOf("1N1Cr");
-  for (std::size_t e = 0; e < kNumEffects; ++e)
-    v.push_back(WithEffect(base, static_cast<Effect>(e)));
+  for (const EffectModule* e : EffectRegistry()) v.push_back(WithEffect(base, *e));
   return v;
 }
 
@@ -100,7 +100,8 @@ TEST(MissingInputs, EveryVariantEffectAndChannelSimulatesAroundTheGap) {
         if (!PrepareDrivers(s, plant, spec, &d, &error)) {
           // Only irradiance_bias may refuse: it needs enough rows where both
           // irradiance sources are high, and the gap may take them away.
-          EXPECT_TRUE(spec.Has(Extension::kIrradianceBias)) << name << ": " << error;
+          EXPECT_TRUE(HasEffect(spec, testing::EffectNamed("irradiance_bias")))
+              << name << ": " << error;
           EXPECT_NE(error.find("irradiance_bias needs"), std::string::npos) << error;
           continue;
         }
@@ -111,8 +112,8 @@ TEST(MissingInputs, EveryVariantEffectAndChannelSimulatesAroundTheGap) {
           const bool has_output = std::isfinite(out.p_el_w[i]) && std::isfinite(out.q_th_w[i]);
           // transport_delay and clock_offset read neighbouring rows: a row
           // next to a gap may lack its delayed or shifted input.
-          const bool reads_neighbours =
-              spec.Has(Extension::kTransportDelay) || spec.Has(Extension::kClockOffset);
+          const bool reads_neighbours = HasEffect(spec, testing::EffectNamed("transport_delay")) ||
+                                        HasEffect(spec, testing::EffectNamed("clock_offset"));
           const bool near_gap = i + 3 >= gap.first && i < gap.first + gap.count + 3;
           if (!in_gap && !(reads_neighbours && near_gap)) {
             ASSERT_TRUE(has_output) << name << ", " << ChannelName(c) << " missing on " << gap.what

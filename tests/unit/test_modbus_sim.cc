@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "core/synthetic_plant.h"
+#include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <random>
 
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

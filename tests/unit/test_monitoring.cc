@@ -9,11 +9,11 @@
 #include <regex>
 
 #include "config/plant_config.h"
-#include "core/iam.h"
-#include "core/monitoring.h"
-#include "core/solar_position.h"
-#include "core/synthetic_plant.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/monitor/monitoring.h"
+#include "core/physics/iam.h"
+#include "core/physics/solar_position.h"
+#include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 #include "tests/support/synthetic_series.h"
 

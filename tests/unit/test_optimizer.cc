@@ -1,4 +1,4 @@
-// Analytic cases for the bounded minimiser (core/optimizer.h).
+// Analytic cases for the bounded minimiser (core/fit/optimizer.h).
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/optimizer.h"
+#include "core/fit/optimizer.h"
 
 // Counts operator new calls so that a test can check that the optimiser
 // does not allocate between two cost evaluations. Counting only; the

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "core/params.h"
+#include "core/common/params.h"
 
 namespace pvtwin {
 namespace {

@@ -1,4 +1,4 @@
-// The physical limits of the canonical channels (core/physical_limits.h) and
+// The physical limits of the canonical channels (core/data/physical_limits.h) and
 // the paths that apply them: the CSV reader, the 1-min aggregation, the
 // store's reads; and messages that never echo binary bytes or a 1 MB cell.
 #include <gtest/gtest.h>
@@ -6,10 +6,10 @@
 #include <cmath>
 #include <sstream>
 
-#include "core/aggregate.h"
-#include "core/diagnostic.h"
-#include "core/physical_limits.h"
-#include "core/units.h"
+#include "core/common/diagnostic.h"
+#include "core/common/units.h"
+#include "core/data/aggregate.h"
+#include "core/data/physical_limits.h"
 #include "io/csv.h"
 #include "io/store.h"
 #include "tests/support/files.h"

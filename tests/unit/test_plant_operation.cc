@@ -1,5 +1,5 @@
-// The simulated plant's operation (core/pump_controller.h,
-// core/absorber_sensor.h, PumpControl in core/weather_generator.h,
+// The simulated plant's operation (core/synth/pump_controller.h,
+// core/synth/absorber_sensor.h, PumpControl in core/synth/weather_generator.h,
 // io/plant_source.h): the ΔT thermostat on hand-checkable cases, the absorber
 // sensor against its analytic steady state and step response, heat from the
 // heat-pump source in November and June at the example plant through
@@ -15,11 +15,11 @@
 #include <string>
 
 #include "config/plant_config.h"
-#include "core/absorber_sensor.h"
-#include "core/pump_controller.h"
-#include "core/synthetic_plant.h"
-#include "core/units.h"
-#include "core/weather_generator.h"
+#include "core/common/units.h"
+#include "core/synth/absorber_sensor.h"
+#include "core/synth/pump_controller.h"
+#include "core/synth/synthetic_plant.h"
+#include "core/synth/weather_generator.h"
 #include "io/csv.h"
 #include "io/plant_source.h"
 #include "tests/support/run_pvtwin.h"

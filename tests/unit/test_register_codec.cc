@@ -10,7 +10,7 @@
 #include <limits>
 #include <vector>
 
-#include "core/units.h"
+#include "core/common/units.h"
 #include "io/register_codec.h"
 
 namespace pvtwin {

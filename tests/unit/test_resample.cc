@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "core/qc.h"
-#include "core/resample.h"
+#include "core/data/qc.h"
+#include "core/data/resample.h"
 
 namespace pvtwin {
 namespace {

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <vector>
 
-#include "core/solar_position.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/physics/solar_position.h"
 
 namespace pvtwin {
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/units.h"
+#include "core/common/units.h"
 #include "io/store.h"
 #include "tests/support/sqlite_db.h"
 
@@ -66,7 +66,7 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   EXPECT_EQ(db.Number("PRAGMA user_version"), static_cast<double>(kStoreSchemaVersion));
   EXPECT_EQ(db.Rows("PRAGMA journal_mode")[0][0], "wal");
   // sample_5s and measurement_1min: every canonical channel, named as in
-  // core/channels.h (DESIGN.md "SQLite").
+  // core/common/channels.h (DESIGN.md "SQLite").
   EXPECT_EQ(db.Columns("sample_5s"), WithChannels({"ts"}, {"rejected_mask"}));
   EXPECT_EQ(db.Columns("measurement_1min"), WithChannels({"ts"}, {"n_samples", "qc_flags"}));
   EXPECT_EQ(db.Columns("sample_5s")[8], "aoi_deg");

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/units.h"
+#include "core/common/units.h"
 #include "io/csv.h"
 #include "io/time_format.h"
 #include "tests/support/run_pvtwin.h"

@@ -15,7 +15,7 @@
 #include <functional>
 #include <thread>
 
-#include "core/clock.h"
+#include "core/common/clock.h"
 #include "io/child_process.h"
 #include "io/store.h"
 #include "tests/support/files.h"

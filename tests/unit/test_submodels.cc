@@ -1,18 +1,18 @@
 // The small physical sub-models of the thermal model against values worked
 // out by hand from the equations in their headers (the arithmetic is in the
-// comments): sky radiation (core/sky_radiation.h), PV efficiency
-// (core/pv_efficiency.h), fluid coupling (core/fluid_coupling.h) and both
-// wind forms (core/wind.h). Every expected number is a literal, never a call
+// comments): sky radiation (core/physics/sky_radiation.h), PV efficiency
+// (core/physics/pv_efficiency.h), fluid coupling (core/physics/fluid_coupling.h) and both
+// wind forms (core/physics/wind.h). Every expected number is a literal, never a call
 // of the function under test, so a changed formula fails here.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "core/fluid_coupling.h"
-#include "core/pv_efficiency.h"
-#include "core/sky_radiation.h"
-#include "core/wind.h"
+#include "core/physics/fluid_coupling.h"
+#include "core/physics/pv_efficiency.h"
+#include "core/physics/sky_radiation.h"
+#include "core/physics/wind.h"
 
 namespace pvtwin {
 namespace {
@@ -24,7 +24,7 @@ void ExpectRel(double actual, double expected, const char* what) {
   EXPECT_NEAR(actual, expected, kRel * std::fabs(expected)) << what;
 }
 
-// σ = 5.670374419e-8 W/(m²K⁴) (CODATA 2018, core/units.h).
+// σ = 5.670374419e-8 W/(m²K⁴) (CODATA 2018, core/common/units.h).
 // A sky at 280 K sends L↓ = σ·280⁴ = 5.670374419e-8 · 6 146 560 000
 //   = 348.5329658885 W/m²; the inverse must give back 280 K.
 TEST(SkyRadiation, SkyTemperatureFromLongWaveIrradiance) {

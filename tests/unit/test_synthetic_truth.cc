@@ -1,13 +1,13 @@
-// The synthetic truth model of the gap diagnosis (core/synthetic_plant.h):
+// The synthetic truth model of the gap diagnosis (core/synth/synthetic_plant.h):
 // effects switched on by variant name, the paper's data defects and the
 // uncatalogued disturbances, each checked for what it must do to the data.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/effects.h"
-#include "core/qc.h"
-#include "core/synthetic_plant.h"
+#include "core/data/qc.h"
+#include "core/effects/effects.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

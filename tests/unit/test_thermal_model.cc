@@ -5,10 +5,12 @@
 #include <cmath>
 #include <random>
 
-#include "core/rc_network.h"
-#include "core/synthetic_plant.h"
-#include "core/thermal_model.h"
-#include "core/units.h"
+#include "core/common/units.h"
+#include "core/effects/effects.h"
+#include "core/model/thermal_model.h"
+#include "core/physics/rc_network.h"
+#include "core/synth/synthetic_plant.h"
+#include "tests/support/effect_named.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
@@ -243,7 +245,7 @@ TEST(ThermalModel, SteadyStateMatchesAnIndependentEnergyBalance) {
     const double v_pow = std::pow(in.wind_m_s, at(Param::kNWind));
     if (spec.wind_paper) {
       u_front_w_m2k = 1.0 / (1.0 / u_front_w_m2k + at(Param::kRRefWind) * v_pow);
-    } else if (spec.Has(Extension::kWind)) {
+    } else if (HasEffect(spec, testing::EffectNamed("wind"))) {
       u_front_w_m2k += at(Param::kUWindWM2K) * v_pow;
     }
     const double q_front_w = u_front_w_m2k * a_m2 * (t_pv_c - in.t_amb_c);

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
-#include "core/variant.h"
+#include "core/effects/effects.h"
+#include "core/model/variant.h"
+#include "tests/support/effect_named.h"
 
 namespace pvtwin {
 namespace {
@@ -39,7 +41,7 @@ TEST(Variant, GrammarCoversCombinationsBeyondTheTable) {
   EXPECT_FALSE(s.wind_paper);
   EXPECT_TRUE(s.sky);
   ASSERT_TRUE(ParseVariant("1N1Cwr+transport_delay", &s, &e)) << e;
-  EXPECT_TRUE(s.Has(Extension::kTransportDelay));
+  EXPECT_TRUE(HasEffect(s, testing::EffectNamed("transport_delay")));
   EXPECT_EQ(s.Name(), "1N1Cwr+transport_delay");
   ASSERT_TRUE(ParseVariant("1N1C+sky_radiation+wind", &s, &e)) << e;
   EXPECT_EQ(s.Name(), "1N1Cr+wind");

@@ -5,10 +5,10 @@
 #include <cstring>
 #include <string>
 
-#include "core/irradiance.h"
-#include "core/solar_position.h"
-#include "core/units.h"
-#include "core/weather_generator.h"
+#include "core/common/units.h"
+#include "core/physics/irradiance.h"
+#include "core/physics/solar_position.h"
+#include "core/synth/weather_generator.h"
 
 namespace pvtwin {
 namespace {

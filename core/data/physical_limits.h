@@ -1,0 +1,71 @@
+// Physical limits of the canonical channels: one table, used by every path
+// data enter pvtwin through (the CSV reader, the Modbus poller's QC, the
+// store's reads of 1-min rows and forecast inputs), so that the fits never
+// see a value no sensor can deliver (−300 °C, 1e308 W, negative wind, an
+// angle of incidence of 500°). A value outside its channel's limits is
+// treated as missing, and the reader that can name file, line and column
+// says so.
+//
+// The limits are wide on purpose: they catch broken readings, not unusual
+// weather. Sources:
+//  * short-wave irradiance: BSRN "physically possible" upper limit
+//    (Long & Dutton, BSRN Global Network recommended QC tests, V2.0):
+//    1.5·S_a·cos(θz)^1.2 + 100 W/m² ≤ 2150 W/m² for GHI; 2000 W/m² in the
+//    collector plane with cloud enhancement is already rare, 2500 W/m² is
+//    not reached. The lower limit −50 W/m² is far below the night-time
+//    thermal offset of a thermopile pyranometer (ISO 9060:2018 allows
+//    ±7 W/m² zero offset for class A, a few tens for unventilated class C),
+//    so night rows keep their small negative readings as logged.
+//  * long-wave irradiance: BSRN physically possible limits 40–700 W/m².
+//  * air temperature: −90 … 60 °C (the recorded extremes are −89.2 °C and
+//    56.7 °C); sky temperature −120 … 60 °C.
+//  * fluid and collector temperatures: −60 … 250 °C (brine of a heat-pump
+//    source down to about −25 °C; stagnation of a glazed collector about
+//    200 °C).
+//  * wind speed 0 … 100 m/s; angle of incidence 0 … 180°.
+//  * specific quantities scale with the collector area A: flow |ṁ| ≤
+//    1 kg/(s·m²) (50× the nominal 0.02 kg/(s·m²)); P_el −50 … 600 W/m²;
+//    Q_u −5000 … 2500 W/m² (night losses of a hot collector reach a few
+//    kW/m² only at stagnation temperatures).
+// Small negative flows (a stopped pump's meter) are the paper's correction
+// (core/data/qc.h), applied after these limits.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+
+#include "core/common/channels.h"
+#include "core/common/series.h"
+
+namespace pvtwin {
+
+struct PhysicalLimit {
+  double lo = 0.0;  // in the channel's unit as core holds it (aoi in rad)
+  double hi = 0.0;
+  bool Contains(double x) const { return x >= lo && x <= hi; }
+};
+
+// Area used for the area-scaled limits when the plant's is unknown (the
+// config's upper bound of area_m2).
+inline constexpr double kMaxAreaM2 = 1e6;
+
+// The limits of channel c for a field of area_m2 (≤ 0: unknown, kMaxAreaM2).
+PhysicalLimit PhysicalLimitOf(Channel c, double area_m2);
+
+// "[lo, hi] unit" in the unit of the CSV column (aoi in degrees).
+std::string DescribeLimit(Channel c, double area_m2);
+
+// What ApplyPhysicalLimits changed, per channel.
+struct LimitViolations {
+  std::array<std::size_t, kNumChannels> count{};
+  std::array<std::size_t, kNumChannels> first_row{};
+  std::array<double, kNumChannels> first_value{};
+
+  std::size_t Total() const;
+};
+
+// Sets every finite cell outside its channel's limits to NaN (missing).
+LimitViolations ApplyPhysicalLimits(Series* series, double area_m2);
+
+}  // namespace pvtwin

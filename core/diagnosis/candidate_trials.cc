@@ -1,0 +1,233 @@
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <sstream>
+#include <thread>
+
+#include "core/common/calendar.h"
+#include "core/diagnosis/stages.h"
+
+namespace pvtwin::diagnosis_stages {
+
+namespace {
+
+// Start values for `spec`: the reference values, overwritten by `fitted`
+// for every parameter the fitted model used.
+ParamVector MergedStart(const Plant& plant, const ModelSpec& fitted_spec,
+                        const ParamVector& fitted) {
+  ParamVector start = StartParams(plant);
+  const std::bitset<kNumParams> used = UsedParams(fitted_spec);
+  for (std::size_t p = 0; p < kNumParams; ++p) {
+    if (used.test(p)) start[p] = fitted[p];
+  }
+  return start;
+}
+
+// The sensor test of a sensor fault (EffectModule::sensor_estimate, see
+// EffectTrial): its size estimated on each day of data.
+void SensorTest(const Series& data, const std::vector<std::int64_t>& day_starts, const Plant& plant,
+                const ModelSpec& spec, const EffectModule& effect, EffectTrial* t) {
+  std::vector<double> k;
+  for (std::int64_t day : day_starts) {
+    const std::size_t lo = data.RowAtOrAfter(day);
+    const std::size_t hi = data.RowAtOrAfter(day + kSecondsPerDay);
+    Drivers d;
+    std::string why;
+    if (hi <= lo || !PrepareDrivers(data.Slice(lo, hi), plant, spec, &d, &why)) continue;
+    const double kd = effect.sensor_estimate(d);
+    if (std::isfinite(kd)) k.push_back(kd);
+  }
+  if (k.size() < 3) return;
+  std::vector<double> sorted = k;
+  std::sort(sorted.begin(), sorted.end());
+  t->sensor_estimate = sorted[sorted.size() / 2];
+  const std::vector<double> zeros(k.size(), 0.0);
+  const PairedTest up = OneSidedPairedTest(k, zeros);
+  const PairedTest down = OneSidedPairedTest(zeros, k);
+  t->sensor_p = std::min(1.0, 2.0 * std::min(up.wilcoxon_p, down.wilcoxon_p));
+  t->sensor_days = static_cast<int>(k.size());
+}
+
+// The candidates of this step: every effect the current model can take with
+// the data's channels, those the options select, given enough training days.
+std::vector<EffectCandidate> SelectCandidates(const TrialInputs& in, const ModelSpec& current_spec,
+                                              std::vector<SkippedEffect>* skipped_out) {
+  const DiagnosisOptions& options = *in.options;
+  const Series& data = *in.data;
+  const int train_days = in.split->train_days;
+  std::vector<SkippedEffect>& skipped = *skipped_out;
+  std::vector<EffectCandidate> candidates = CandidateEffects(current_spec, data, &skipped);
+  if (!options.effects.empty()) {
+    std::erase_if(candidates, [&options](const EffectCandidate& c) {
+      return std::find(options.effects.begin(), options.effects.end(), c.name) ==
+             options.effects.end();
+    });
+  }
+  // An effect that needs more training days than there are (a drift over days).
+  std::erase_if(candidates, [&skipped, train_days](const EffectCandidate& c) {
+    if (train_days >= c.module->min_train_days) return false;
+    skipped.push_back({c.name, "needs at least " + std::to_string(c.module->min_train_days) +
+                                   " training days " + std::string(c.module->min_train_days_why)});
+    return true;
+  });
+  return candidates;
+}
+
+// The decisive test of one candidate: evidence on the base model's residuals
+// (step 1), re-identification from the current model's parameters (and the
+// module's start from the residuals), the held-out score and its tests.
+void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
+                  const EffectCandidate& c, EffectTrial* trial, Score* score) {
+  EffectTrial& t = *trial;
+  const Plant& plant = *in.plant;
+  const DiagnosisOptions& options = *in.options;
+  const Series& train_series = in.split->train_series;
+  const Series& heldout_series = in.split->heldout_series;
+  const std::int64_t data_start_s = in.split->data_start_s;
+  const ModelSpec& current_spec = current.spec;
+  const Score& current_score = current.score;
+  const Score& base_score = in.base->score;
+  const Part& base_train = in.base->train;
+  t.name = c.name;
+  t.variant = c.spec.Name();
+  t.tested_against = current_spec.Name();
+  t.explanation = c.explanation;
+  t.signature = c.signature;
+  t.advice = std::string(c.module->advice);
+  t.heldout_mae_before_w = MaeSumW(current_score.errors);
+  Part tr, ho;
+  std::string why;
+  if (!PreparePart(train_series, plant, c.spec, data_start_s, &tr, &why) ||
+      !PreparePart(heldout_series, plant, c.spec, data_start_s, &ho, &why)) {
+    t.failure = why;
+  } else {
+    // Evidence on the base model's residuals (the gap being explained).
+    if (step == 1) {
+      const std::vector<double> sig = CandidateSignature(c, ho.drivers, base_score.sim);
+      std::vector<std::vector<double>> ctl = in.controls;
+      const PartialCorrelation cp = [&] {
+        ctl.push_back(base_score.sim.p_el_w);
+        return PartialCorrelate(in.residuals->p_el_w, sig, ctl);
+      }();
+      ctl.back() = base_score.sim.q_th_w;
+      const PartialCorrelation cq = PartialCorrelate(in.residuals->q_th_w, sig, ctl);
+      const bool use_q = std::fabs(cq.z) >= std::fabs(cp.z);
+      t.evidence_corr = use_q ? cq : cp;
+      t.evidence_output = use_q ? "q_th" : "p_el";
+    }
+    ParamVector start = MergedStart(plant, current_spec, current.params);
+    if (c.module->start_from_residuals != nullptr) {
+      EffectResiduals res;
+      res.drivers = &base_train.drivers;
+      res.base = &in.base->train_sim;
+      res.rows = &base_train.meas.rows;
+      res.p_el_meas_w = &base_train.meas.p_el_w;
+      c.module->start_from_residuals(res, &start);
+    }
+    const IdentSummary fit = Identify(tr.drivers, tr.meas, start, options.ident);
+    t.fit_runtime_s = fit.runtime_s;
+    t.params = fit.params;
+    if (!fit.ok) {
+      t.failure = "identification failed: " + fit.failure_reason;
+    } else {
+      *score = ScoreHeldout(ho, fit.params, in.base->units, plant.area_m2);
+      if (!std::isfinite((*score).errors.objective_w_m2())) {
+        t.failure = "non-finite held-out outputs";
+      } else {
+        t.fit_ok = true;
+        t.heldout_mae_after_w = MaeSumW((*score).errors);
+        t.shrink_pct = 100.0 * (1.0 - (*score).errors.objective_w_m2() /
+                                          current_score.errors.objective_w_m2());
+        t.test = CompareUnits(current_score, (*score));
+        t.significant =
+            t.test.wilcoxon_p <= options.alpha && t.shrink_pct >= options.min_shrink_pct;
+        if (c.module->sensor_estimate != nullptr) {
+          SensorTest(*in.data, in.split->day_starts, plant, c.spec, *c.module, &t);
+          t.significant = t.sensor_p <= options.alpha &&
+                          std::fabs(t.sensor_estimate) >= options.min_sensor_error;
+        }
+      }
+    }
+  }
+}
+
+std::string ProgressLine(int step, int finished, std::size_t candidates, const EffectTrial& t,
+                         const std::string& test_unit) {
+  return "[step " + std::to_string(step) + ", " + std::to_string(finished) + "/" +
+         std::to_string(candidates) + "] +" + t.name + ": " +
+         (t.fit_ok ? "shrink " + FixedDecimals(t.shrink_pct, 1) + " %, better on " +
+                         std::to_string(t.test.positives) + " of " + std::to_string(t.test.pairs) +
+                         " " + test_unit + "s, p = " + PValue(t.test.wilcoxon_p) +
+                         (t.significant ? " (significant)" : "")
+                   : "FAILED: " + t.failure) +
+         " (" + FixedDecimals(t.fit_runtime_s, 2) + " s)";
+}
+
+// The trial's evidence in one sentence: residual correlation (step 1), the
+// module's sensor evidence, the held-out test.
+std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, int step,
+                             const std::string& test_unit) {
+  std::ostringstream ev;
+  if (step == 1 && t.evidence_corr.rows > 0) {
+    ev << "partial correlation of the " << (t.evidence_output == "q_th" ? "Q_u" : "P_el")
+       << " residual with " << t.signature << " r = " << FixedDecimals(t.evidence_corr.r, 2)
+       << " (z = " << FixedDecimals(t.evidence_corr.z, 1)
+       << ", n_eff = " << FixedDecimals(t.evidence_corr.n_eff, 0) << "); ";
+  }
+  if (effect.sensor_evidence != nullptr && std::isfinite(t.sensor_estimate)) {
+    ev << effect.sensor_evidence(t.sensor_estimate, t.sensor_p, t.sensor_days);
+  }
+  if (t.fit_ok) {
+    ev << "re-identified " << t.variant << " lowers the held-out MAE on " << t.test.positives
+       << " of " << t.test.pairs << " " << test_unit
+       << "s (one-sided Wilcoxon p = " << PValue(t.test.wilcoxon_p)
+       << ", sign test p = " << PValue(t.test.sign_p) << ")";
+  } else {
+    ev << "not tested: " << t.failure;
+  }
+  return ev.str();
+}
+
+}  // namespace
+
+// Controls of the evidence regression, per held-out row.
+std::vector<std::vector<double>> EvidenceControls(const Drivers& d) {
+  const std::size_t n = d.size();
+  std::vector<double> g(n), dt(n), flow(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    g[i] = d.g_poa_w_m2[i];
+    dt[i] = d.t_in_c[i] - d.t_amb_c[i];
+    flow[i] = d.mdot_kg_s[i];
+  }
+  return {g, dt, flow};
+}
+
+StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& current) {
+  StepTrials out;
+  out.candidates = SelectCandidates(in, current.spec, &out.skipped);
+  const std::vector<EffectCandidate>& candidates = out.candidates;
+  if (candidates.empty()) return out;
+  out.trials.resize(candidates.size());
+  out.scores.resize(candidates.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<int> done{0};
+  auto worker = [&] {
+    for (std::size_t k = next++; k < candidates.size(); k = next++) {
+      TryCandidate(in, step, current, candidates[k], &out.trials[k], &out.scores[k]);
+      const int finished = ++done;
+      in.progress(ProgressLine(step, finished, candidates.size(), out.trials[k], in.test_unit));
+    }
+  };
+  std::vector<std::thread> pool;
+  const int n_threads = std::min<int>(in.threads, static_cast<int>(candidates.size()));
+  for (int w = 1; w < n_threads; ++w) pool.emplace_back(worker);
+  worker();
+  for (std::thread& th : pool) th.join();
+  for (std::size_t k = 0; k < out.trials.size(); ++k) {
+    out.trials[k].evidence =
+        EvidenceSentence(out.trials[k], *candidates[k].module, step, in.test_unit);
+  }
+  return out;
+}
+
+}  // namespace pvtwin::diagnosis_stages

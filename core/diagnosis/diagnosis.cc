@@ -1,0 +1,118 @@
+#include "core/diagnosis/diagnosis.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "core/data/resample.h"
+#include "core/diagnosis/stages.h"
+
+namespace pvtwin {
+
+std::string FixedDecimals(double x, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << x;
+  return s.str();
+}
+
+IdentOptions DiagnosisIdentOptions() {
+  IdentOptions o;
+  o.optimizer.ftol_rel = 1e-4;
+  return o;
+}
+
+bool DiagnosisOptions::IsValid(std::string* why) const {
+  std::ostringstream out;
+  if (train_days < 0) out << "train_days = " << train_days << ": must be ≥ 0 (0 = automatic); ";
+  if (heldout_days < 0)
+    out << "heldout_days = " << heldout_days << ": must be ≥ 0 (0 = the rest); ";
+  if (step_s != 0.0 &&
+      !(step_s >= 1.0 && step_s == std::floor(step_s) && std::fmod(86400.0, step_s) == 0.0)) {
+    out << "step_s = " << step_s << ": must be 0 or whole seconds dividing 86400; ";
+  }
+  std::string ident_why;
+  if (!ident.IsValid(&ident_why)) out << "ident: " << ident_why << "; ";
+  if (!(alpha > 0.0 && alpha < 1.0)) out << "alpha = " << alpha << ": must be in (0, 1); ";
+  if (!(min_shrink_pct >= 0.0 && min_shrink_pct < 100.0)) {
+    out << "min_shrink_pct = " << min_shrink_pct << ": must be in [0, 100); ";
+  }
+  if (min_test_units < 2) out << "min_test_units = " << min_test_units << ": must be ≥ 2; ";
+  if (max_ladder_steps < 1) out << "max_ladder_steps = " << max_ladder_steps << ": must be ≥ 1; ";
+  if (!(unknown_noise_ratio > 1.0)) {
+    out << "unknown_noise_ratio = " << unknown_noise_ratio << ": must be > 1; ";
+  }
+  const std::vector<std::string> names = EffectNames();
+  for (const std::string& e : effects) {
+    if (std::find(names.begin(), names.end(), e) == names.end()) {
+      out << "effects = " << e << ": not an effect of the vocabulary; ";
+    }
+  }
+  std::string where_why;
+  if (!where.IsValid(&where_why)) out << "where: " << where_why << "; ";
+  if (threads < 0) out << "threads = " << threads << ": must be ≥ 0; ";
+  const std::string text = out.str();
+  if (why != nullptr) *why = text.empty() ? "" : text.substr(0, text.size() - 2);
+  return text.empty();
+}
+
+bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
+              const DiagnosisOptions& options, DiagnosisResult* result, std::string* error,
+              const std::function<void(const std::string&)>& progress_in) {
+  namespace st = diagnosis_stages;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::mutex progress_mutex;
+  auto progress = [&](const std::string& line) {
+    if (!progress_in) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    progress_in(line);
+  };
+  if (!options.IsValid(error)) return false;
+  if (data_in.size() < 2) {
+    *error = "the data have fewer than 2 rows";
+    return false;
+  }
+  Series data;
+  if (options.step_s > 0.0 && options.step_s != data_in.step_s) {
+    if (!Resample(data_in, options.step_s, &data, error)) return false;
+  } else {
+    data = data_in;
+  }
+  DiagnosisResult r;
+  r.base_variant = base.Name();
+  r.step_s = data.step_s;
+
+  st::Split split;
+  if (!st::SplitDays(data, plant, options, &split, error)) return false;
+  st::BaseFit base_fit;
+  if (!st::FitBase(split, plant, base, options, progress, &base_fit, &r, error)) return false;
+  const st::BaseResiduals residuals = st::LocaliseBaseGap(split, base_fit, plant, options, &r);
+
+  st::TrialInputs trials;
+  trials.data = &data;
+  trials.split = &split;
+  trials.plant = &plant;
+  trials.options = &options;
+  trials.base = &base_fit;
+  trials.residuals = &residuals;
+  trials.controls = st::EvidenceControls(base_fit.heldout.drivers);
+  trials.threads = options.threads > 0
+                       ? options.threads
+                       : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  trials.test_unit = r.test_unit;
+  trials.progress = progress;
+  const st::LadderModel final_model = st::RunLadder(trials, base, &r);
+
+  if (!st::EstimateNoiseFloor(split, plant, final_model, &r, error)) return false;
+  st::BuildReportModel(split, base_fit, residuals, final_model, plant.area_m2, &r);
+  st::DecideVerdict(options, &r);
+  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  *result = std::move(r);
+  return true;
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,243 @@
+#include "core/diagnosis/diagnosis_selftest.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "core/common/calendar.h"
+#include "core/data/qc.h"
+#include "core/effects/effects.h"
+#include "core/fit/identification.h"
+#include "core/model/thermal_model.h"
+#include "core/synth/synthetic_plant.h"
+
+namespace pvtwin {
+
+namespace {
+
+const double kNaN = std::nan("");
+
+ModelSpec Parse(const std::string& name) {
+  ModelSpec spec;
+  std::string error;
+  if (!ParseVariant(name, &spec, &error)) {
+    std::cerr << "diagnosis self-test: bad built-in variant " << name << ": " << error << "\n";
+    std::abort();
+  }
+  return spec;
+}
+
+// Held-out objective of the truth model with its true parameters, simulated
+// over the whole data (soiling counts from the first row) and scored on the
+// held-out days.
+double TruthHeldoutObjective(const Series& data, const Plant& plant, const SelftestCase& c,
+                             int train_days) {
+  const std::int64_t offset_s = SolarDayOffsetS(plant);
+  const std::int64_t start = SolarDayStartS(data.time_s.front(), offset_s) +
+                             static_cast<std::int64_t>(train_days) * kSecondsPerDay;
+  Drivers d;
+  std::string error;
+  if (!PrepareDrivers(data, plant, c.truth, &d, &error)) return kNaN;
+  Measurements m = MakeMeasurements(data, d);
+  std::erase_if(m.rows, [&](std::uint32_t i) { return data.time_s[i] < start; });
+  SimOutputs out;
+  Simulate(d, c.truth_params, &out);
+  return ComputeErrors(m, out, plant.area_m2).objective_w_m2();
+}
+
+}  // namespace
+
+std::vector<SelftestCase> SelftestCases(const Plant& plant) {
+  std::vector<SelftestCase> cases;
+  // Bases to withhold an effect from, in order of preference.
+  const std::vector<std::string> bases = {"1N1Cwr", "1Nwr", "1N1Cr", "1N1Cw", "2N1Ccolwr"};
+  // Data with every channel, to ask which effects can be added.
+  WeatherOptions probe_options;
+  probe_options.num_days = 1;
+  probe_options.step_s = 3600.0;
+  const Series probe = GenerateWeather(plant, probe_options);
+  for (const EffectModule* effect : EffectRegistry()) {
+    for (const std::string& base_name : bases) {
+      const ModelSpec base = Parse(base_name);
+      if (!CanAddEffect(base, *effect, probe, nullptr)) continue;
+      const ModelSpec truth = WithEffect(base, *effect);
+      const ParamVector params = TruthParamsFor(plant, truth);
+      cases.push_back({std::string(effect->name), std::string(effect->name), base, truth, params,
+                       std::nullopt, 0.0});
+      break;
+    }
+  }
+  const ModelSpec plain = Parse("1N1Cwr");
+  const ParamVector truth = TruthParamsFor(plant, plain);
+  cases.push_back({"null", "none", plain, plain, truth, std::nullopt, 0.0});
+  cases.push_back(
+      {"failing_pump", "unknown", plain, plain, truth, DisturbanceKind::kFailingPump, 0.3});
+  cases.push_back({"stuck_flow_reading", "unknown", plain, plain, truth,
+                   DisturbanceKind::kStuckFlowReading, 0.0});
+  cases.push_back({"snow_cover", "unknown", plain, plain, truth, DisturbanceKind::kSnowCover, 0.0});
+  return cases;
+}
+
+Series SelftestData(const Plant& plant, const SelftestCase& c, std::uint64_t seed,
+                    const SelftestOptions& options, std::vector<std::int64_t>* disturbed_days) {
+  SyntheticOptions synth;
+  std::string error;
+  if (!DefaultSyntheticOptions(plant, c.truth.Name(), options.train_days + options.heldout_days,
+                               seed, &synth, &error)) {
+    std::cerr << "diagnosis self-test: " << error << "\n";
+    std::abort();  // the case's variant comes from the library: a bug
+  }
+  synth.truth_spec = c.truth;
+  synth.truth = c.truth_params;
+  synth.weather.step_s = options.step_s;
+  // Start at local solar midnight so that the data are whole solar days.
+  const std::int64_t offset_s = SolarDayOffsetS(plant);
+  const std::int64_t first = SolarDayStartS(synth.weather.start_time_s, offset_s) + kSecondsPerDay;
+  synth.weather.start_time_s = first;
+  std::vector<std::int64_t> days;
+  if (c.disturbance) {
+    for (int k : {1, 4}) {
+      if (k >= options.heldout_days) continue;
+      const std::int64_t day =
+          first + static_cast<std::int64_t>(options.train_days + k) * kSecondsPerDay;
+      days.push_back(day);
+      synth.disturbances.push_back({*c.disturbance, day, day + kSecondsPerDay, c.severity});
+    }
+  }
+  if (disturbed_days != nullptr) *disturbed_days = days;
+  Series s = MakeSyntheticPlantData(plant, synth);
+  ApplyPaperCorrections(&s);
+  return s;
+}
+
+SelftestOutcome RunSelftestCase(const Plant& plant, const SelftestCase& c, std::uint64_t seed,
+                                const SelftestOptions& options,
+                                const std::function<void(const std::string&)>& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SelftestOutcome o;
+  o.case_name = c.name;
+  o.seed = seed;
+  o.expected = c.expected;
+  std::vector<std::int64_t> disturbed_days;
+  const Series data = SelftestData(plant, c, seed, options, &disturbed_days);
+  DiagnosisOptions dopt = options.diagnosis;
+  dopt.train_days = options.train_days;
+  dopt.heldout_days = options.heldout_days;
+  dopt.step_s = 0.0;
+  std::string error;
+  if (!Diagnose(data, plant, c.base, dopt, &o.result, &error, progress)) {
+    o.verdict = "error";
+    o.why = error;
+    return o;
+  }
+  const DiagnosisResult& r = o.result;
+  o.verdict = r.verdict;
+  o.first_step = r.ladder.size() > 1 ? r.ladder[1].added : "";
+  o.heldout_before_w_m2 = r.ladder.front().objective_w_m2;
+  o.heldout_after_w_m2 = r.ladder.back().objective_w_m2;
+  o.heldout_truth_w_m2 = TruthHeldoutObjective(data, plant, c, options.train_days);
+  for (const EffectTrial& t : r.effects) {
+    if (c.expected == "none" && t.significant) o.false_significant = true;
+  }
+  std::ostringstream why;
+  if (o.verdict != c.expected)
+    why << "verdict " << o.verdict << ", expected " << c.expected << "; ";
+  if (c.expected != "none" && c.expected != "unknown") {
+    if (o.first_step != c.expected) why << "first ladder step '" << o.first_step << "'; ";
+    // After the ladder, the held-out error is near the truth model's.
+    if (!(o.heldout_after_w_m2 <= (1.0 + options.after_tolerance) * o.heldout_truth_w_m2)) {
+      why << "held-out after " << FixedDecimals(o.heldout_after_w_m2, 3) << " W/m² > (1 + "
+          << options.after_tolerance << ") × truth " << FixedDecimals(o.heldout_truth_w_m2, 3)
+          << "; ";
+    }
+  }
+  if (c.expected == "unknown") {
+    const GapRegion* day_region = nullptr;
+    for (const GapRegion& w : r.where) {
+      if (w.driver == "day") {
+        day_region = &w;
+        break;
+      }
+    }
+    bool hit = false;
+    if (day_region != nullptr) {
+      for (std::int64_t d : disturbed_days) {
+        hit = hit || (static_cast<double>(d) >= day_region->lower &&
+                      static_cast<double>(d) < day_region->upper);
+      }
+    }
+    if (!hit) why << "where does not point at a disturbed day first; ";
+  }
+  o.why = why.str();
+  o.correct = o.why.empty();
+  o.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return o;
+}
+
+std::string FormatSelftestReport(const std::vector<SelftestOutcome>& outcomes) {
+  std::ostringstream out;
+  out << "case              seed  verdict            1st step           before  after  truth "
+         " W/m²   s    ok\n";
+  for (const SelftestOutcome& o : outcomes) {
+    char line[256];
+    std::snprintf(line, sizeof line, "%-17s %4llu  %-18s %-18s %6.3f %6.3f %6.3f %6.1f  %s",
+                  o.case_name.c_str(), static_cast<unsigned long long>(o.seed), o.verdict.c_str(),
+                  o.first_step.empty() ? "-" : o.first_step.c_str(), o.heldout_before_w_m2,
+                  o.heldout_after_w_m2, o.heldout_truth_w_m2, o.wall_time_s,
+                  o.correct ? "yes" : "NO");
+    out << line;
+    if (!o.correct) out << "  (" << o.why << ")";
+    out << "\n";
+  }
+  // Confusion table: rows expected, columns verdict.
+  std::vector<std::string> labels;
+  for (const SelftestOutcome& o : outcomes) {
+    for (const std::string& l : {o.expected, o.verdict}) {
+      if (std::find(labels.begin(), labels.end(), l) == labels.end()) labels.push_back(l);
+    }
+  }
+  std::map<std::pair<std::string, std::string>, int> counts;
+  for (const SelftestOutcome& o : outcomes) ++counts[{o.expected, o.verdict}];
+  out << "\nconfusion (rows: expected, columns: verdict)\n" << std::string(17, ' ');
+  for (const std::string& l : labels) {
+    char cell[32];
+    std::snprintf(cell, sizeof cell, " %6.6s", l.c_str());
+    out << cell;
+  }
+  out << "\n";
+  for (const std::string& e : labels) {
+    bool any = false;
+    for (const SelftestOutcome& o : outcomes) any = any || o.expected == e;
+    if (!any) continue;
+    char head[32];
+    std::snprintf(head, sizeof head, "%-17s", e.c_str());
+    out << head;
+    for (const std::string& v : labels) {
+      const auto it = counts.find({e, v});
+      char cell[32];
+      std::snprintf(cell, sizeof cell, " %6d", it == counts.end() ? 0 : it->second);
+      out << cell;
+    }
+    out << "\n";
+  }
+  int correct = 0, false_significant = 0, null_cases = 0;
+  for (const SelftestOutcome& o : outcomes) {
+    correct += o.correct;
+    false_significant += o.false_significant;
+    null_cases += o.expected == "none";
+  }
+  out << "\nhit rate: " << correct << " / " << outcomes.size() << " = "
+      << FixedDecimals(
+             outcomes.empty() ? 0.0 : 100.0 * correct / static_cast<double>(outcomes.size()), 1)
+      << " %; false significant effects on null cases: " << false_significant << " of "
+      << null_cases << "\n";
+  return out.str();
+}
+
+}  // namespace pvtwin

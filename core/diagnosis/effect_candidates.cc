@@ -1,0 +1,29 @@
+#include "core/diagnosis/effect_candidates.h"
+
+#include <cmath>
+
+#include "core/effects/effects.h"
+
+namespace pvtwin {
+
+std::vector<EffectCandidate> CandidateEffects(const ModelSpec& base, const Series& series,
+                                              std::vector<SkippedEffect>* skipped) {
+  std::vector<EffectCandidate> out;
+  for (const EffectModule* m : EffectRegistry()) {
+    std::string why;
+    if (!CanAddEffect(base, *m, series, &why)) {
+      if (skipped != nullptr) skipped->push_back({std::string(m->name), why});
+      continue;
+    }
+    out.push_back({std::string(m->name), WithEffect(base, *m), std::string(m->physics),
+                   std::string(m->signature), m});
+  }
+  return out;
+}
+
+std::vector<double> CandidateSignature(const EffectCandidate& c, const Drivers& drivers,
+                                       const SimOutputs& base_outputs) {
+  return EffectSignature(*c.module, drivers, base_outputs);
+}
+
+}  // namespace pvtwin

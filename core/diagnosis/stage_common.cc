@@ -1,0 +1,70 @@
+#include <sstream>
+
+#include "core/diagnosis/stages.h"
+
+namespace pvtwin::diagnosis_stages {
+
+std::string PValue(double p) {
+  std::ostringstream s;
+  s.precision(2);
+  s << p;
+  return s.str();
+}
+
+bool PreparePart(const Series& s, const Plant& plant, const ModelSpec& spec,
+                 std::int64_t data_start_s, Part* part, std::string* error) {
+  if (!PrepareDrivers(s, plant, spec, &part->drivers, error)) return false;
+  Drivers& d = part->drivers;
+  if (d.days_since_clean.size() == d.size()) {
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      d.days_since_clean[i] = static_cast<double>(d.time_s[i] - data_start_s) / 86400.0;
+    }
+  }
+  part->meas = MakeMeasurements(s, part->drivers);
+  return true;
+}
+
+Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& units,
+                   double area_m2) {
+  Score score;
+  Simulate(heldout.drivers, params, &score.sim);
+  score.errors = ComputeErrors(heldout.meas, score.sim, area_m2);
+  std::vector<double> sum(static_cast<std::size_t>(units.count), 0.0);
+  std::vector<double> rows(static_cast<std::size_t>(units.count), 0.0);
+  for (std::uint32_t i : heldout.meas.rows) {
+    const int u = units.unit_of_row[i];
+    if (u < 0) continue;
+    const auto k = static_cast<std::size_t>(u);
+    sum[k] += std::fabs(score.sim.p_el_w[i] - heldout.meas.p_el_w[i]) +
+              std::fabs(score.sim.q_th_w[i] - heldout.meas.q_th_w[i]);
+    rows[k] += 1.0;
+  }
+  score.unit_objective_w_m2.assign(static_cast<std::size_t>(units.count), kNaN);
+  for (std::size_t k = 0; k < sum.size(); ++k) {
+    if (rows[k] > 0.0) score.unit_objective_w_m2[k] = sum[k] / rows[k] / area_m2;
+  }
+  return score;
+}
+
+double MaeSumW(const ErrorMetrics& e) { return e.mae_p_el_w + e.mae_q_th_w; }
+
+PairedTest CompareUnits(const Score& before, const Score& after) {
+  std::vector<double> b, a;
+  for (std::size_t k = 0; k < before.unit_objective_w_m2.size(); ++k) {
+    const double x = before.unit_objective_w_m2[k], y = after.unit_objective_w_m2[k];
+    if (std::isfinite(x) && std::isfinite(y)) {
+      b.push_back(x);
+      a.push_back(y);
+    }
+  }
+  return OneSidedPairedTest(b, a);
+}
+
+std::vector<double> Residual(const Measurements& m, const std::vector<double>& pred,
+                             const std::vector<double>& meas) {
+  std::vector<double> r(m.size(), kNaN);
+  for (std::uint32_t i : m.rows) r[i] = pred[i] - meas[i];
+  return r;
+}
+
+}  // namespace pvtwin::diagnosis_stages

@@ -1,0 +1,161 @@
+// The stages of the gap diagnosis (Diagnose, diagnosis.h), each a function
+// in its own file with its own inputs and outputs:
+//   1. split.cc             days and the training / held-out split
+//   2. base_fit.cc          the base model's fit, its held-out score, test units
+//   3. localisation.cc      where the base model's held-out error lies
+//   4. candidate_trials.cc  every candidate effect added, re-identified, scored
+//   5. ladder.cc            forward selection over the candidate trials
+//   6. noise_floor.cc       the MAE that sensor noise alone gives
+//   7. verdict.cc           the verdict and its sentence
+//   8. report_model.cc      the days table and the trace the report plots
+// Helpers shared by the stages are in stage_common.cc. No stage knows an
+// effect by name: what differs between effects is asked of the candidate's
+// module (EffectCandidate::module).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/diagnosis/diagnosis.h"
+#include "core/model/thermal_model.h"
+
+namespace pvtwin::diagnosis_stages {
+
+using Progress = std::function<void(const std::string&)>;
+
+inline const double kNaN = std::nan("");
+
+// --- Shared helpers (stage_common.cc) ---
+
+// p with two significant digits, as the sentences print p-values.
+std::string PValue(double p);
+
+// MAE P_el + MAE Q_u, W.
+double MaeSumW(const ErrorMetrics& e);
+
+// One part of the data (training or held-out) prepared for one model.
+struct Part {
+  Drivers drivers;
+  Measurements meas;
+};
+
+// data_start_s: the first row of the whole data set. The days-since-cleaning
+// clock counts, with no cleaning known, from the start of the data, not from
+// the start of each part (SetCleaningTimes ignores cleanings before a part's
+// first row, so the count is set here).
+bool PreparePart(const Series& s, const Plant& plant, const ModelSpec& spec,
+                 std::int64_t data_start_s, Part* part, std::string* error);
+
+// The test units (held-out days, or hours) of the held-out rows.
+struct Units {
+  std::vector<int> unit_of_row;  // per held-out row, −1 = none
+  int count = 0;
+};
+
+// Held-out scores of one model.
+struct Score {
+  SimOutputs sim;
+  ErrorMetrics errors;
+  std::vector<double> unit_objective_w_m2;  // per test unit, NaN if the unit has no rows
+};
+
+Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& units,
+                   double area_m2);
+
+// One-sided paired test of the per-unit objectives: is `after` lower?
+PairedTest CompareUnits(const Score& before, const Score& after);
+
+// Residual (predicted − measured) of one output over the objective rows, NaN elsewhere.
+std::vector<double> Residual(const Measurements& m, const std::vector<double>& pred,
+                             const std::vector<double>& meas);
+
+// --- 1. Split ---
+struct Split {
+  std::int64_t offset_s = 0;             // SolarDayOffsetS of the plant
+  std::vector<std::int64_t> day_starts;  // every local solar day with data
+  int train_days = 0;
+  int heldout_days = 0;
+  std::int64_t data_start_s = 0;  // first row of the data
+  Series train_series, heldout_series;
+};
+bool SplitDays(const Series& data, const Plant& plant, const DiagnosisOptions& options,
+               Split* split, std::string* error);
+
+// --- 2. Base fit ---
+struct BaseFit {
+  Part train, heldout;
+  Units units;
+  ParamVector params{};
+  SimOutputs train_sim;  // on the training days
+  Score score;           // on the held-out days
+};
+// Also fills r's gap, test unit, low-confidence note and the ladder's base step.
+bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
+             const DiagnosisOptions& options, const Progress& progress, BaseFit* fit,
+             DiagnosisResult* r, std::string* error);
+
+// --- 3. Localisation ---
+struct BaseResiduals {
+  std::vector<RegimeDriver> regimes;   // of the held-out rows
+  std::vector<double> p_el_w, q_th_w;  // predicted − measured, NaN off the objective rows
+};
+// Fills r->where and r->where_bins.
+BaseResiduals LocaliseBaseGap(const Split& split, const BaseFit& base, const Plant& plant,
+                              const DiagnosisOptions& options, DiagnosisResult* r);
+
+// --- 4. Candidate trials ---
+// Controls of the evidence regression, per held-out row: in-plane
+// irradiance, T_in − T_amb, flow.
+std::vector<std::vector<double>> EvidenceControls(const Drivers& d);
+
+// What every ladder step's trials read.
+struct TrialInputs {
+  const Series* data = nullptr;
+  const Split* split = nullptr;
+  const Plant* plant = nullptr;
+  const DiagnosisOptions* options = nullptr;
+  const BaseFit* base = nullptr;
+  const BaseResiduals* residuals = nullptr;
+  std::vector<std::vector<double>> controls;  // of the evidence regression, per held-out row
+  int threads = 1;
+  std::string test_unit;  // "day" or "hour"
+  Progress progress;
+};
+// A model on the ladder.
+struct LadderModel {
+  ModelSpec spec;
+  ParamVector params{};
+  Score score;
+};
+struct StepTrials {
+  std::vector<EffectCandidate> candidates;
+  std::vector<SkippedEffect> skipped;
+  std::vector<EffectTrial> trials;  // per candidate
+  std::vector<Score> scores;        // per candidate
+};
+// Step `step` of the ladder: every candidate effect added to `current`,
+// re-identified on the training days and scored on the held-out days, with
+// its residual evidence (step 1) and evidence sentence.
+StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& current);
+
+// --- 5. Ladder ---
+// Forward selection: fills r's effects (ranked), ladder, skipped effects,
+// identifications and final variant; returns the final model.
+LadderModel RunLadder(const TrialInputs& in, const ModelSpec& base, DiagnosisResult* r);
+
+// --- 6. Noise floor ---
+bool EstimateNoiseFloor(const Split& split, const Plant& plant, const LadderModel& final_model,
+                        DiagnosisResult* r, std::string* error);
+
+// --- 7. Verdict ---
+void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* r);
+
+// --- 8. Report model ---
+// The trace of the held-out rows and the days table.
+void BuildReportModel(const Split& split, const BaseFit& base, const BaseResiduals& residuals,
+                      const LadderModel& final_model, double area_m2, DiagnosisResult* r);
+
+}  // namespace pvtwin::diagnosis_stages

@@ -1,0 +1,102 @@
+// core/effects/: one module per effect of DESIGN.md's effect vocabulary
+// (capacitance, second_node, …, irradiance_bias), the registration list
+// (registry.cc) and the generic library functions that ask the modules
+// (effects.h).
+//
+// May depend on core/common/ and core/physics/ only. The model
+// (core/model/), the fit, the synthetic plant and the diagnosis depend on
+// it and ask a module what differs between effects; none of them names an
+// effect. Adding an effect = one new module (a .h/.cc pair here, its tests
+// in tests/unit/) plus one line in registry.cc.
+//
+// An effect module holds everything about its effect: the name and a
+// paragraph of physics with its source; its parameters (rows of the
+// parameter table, core/common/params.h: name, unit, symbol, start, bounds,
+// scale); the channels it needs; its equations as pure functions in its
+// header; how it enters the model (ModelExtension's hooks, or the paper's
+// letters of a variant); its residual signature for evidence; its truth form
+// for synthetic data; and its advice sentence for the report.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/common/channels.h"
+#include "core/common/model_data.h"
+#include "core/common/model_spec.h"
+#include "core/common/params.h"
+#include "core/common/series.h"
+
+namespace pvtwin {
+
+// What start_from_residuals reads: the base model's fit on the training days.
+struct EffectResiduals {
+  const Drivers* drivers = nullptr;                  // base model's training drivers
+  const SimOutputs* base = nullptr;                  // base model's outputs on them
+  const std::vector<std::uint32_t>* rows = nullptr;  // objective rows
+  const std::vector<double>* p_el_meas_w = nullptr;  // measured P_el per row
+};
+
+struct EffectModule {
+  std::string_view name;     // DESIGN.md vocabulary, e.g. "pv_clipping"
+  std::string_view physics;  // one paragraph of physics, for the report
+  std::string_view source;   // where the equations come from (paper section, reference)
+  // Parameters the effect adds (their rows: Info(Param)).
+  std::vector<Param> params;
+  // Extra input channels the effect needs beyond the base variant's.
+  std::vector<Channel> needs;
+  // What the residual evidence correlates with (signature_values' quantity).
+  std::string_view signature;
+  // One sentence for the site when the diagnosis finds the effect.
+  std::string_view advice;
+  // A realistic magnitude for synthetic truth data (applied on top of
+  // ReferenceTruthParams, core/synth/synthetic_plant.h).
+  std::vector<std::pair<Param, double>> typical_truth;
+
+  // --- How it shows in a variant ---
+  // "+name" in the model, with its hooks; null for an effect that the
+  // paper's letters express (nodes, capacitances, w, r, I).
+  const ModelExtension* extension = nullptr;
+  // Whether spec has the effect; null: spec.Has(*extension).
+  bool (*in_spec)(const ModelSpec& spec) = nullptr;
+  // Adds the effect to spec (WithEffect); null: spec->Add(*extension).
+  void (*add_to_spec)(ModelSpec* spec) = nullptr;
+  // Why it cannot be added to spec ("" = it can); null: present = cannot.
+  std::string (*cannot_add)(const ModelSpec& spec) = nullptr;
+  // Why the data cannot show it, e.g. a missing channel ("" = they can).
+  std::string (*data_lacks)(const Series& data) = nullptr;
+
+  // --- Evidence ---
+  // Per-row value of the signature, NaN where undefined. drivers may belong
+  // to a model without the effect; base are the base model's outputs.
+  std::vector<double> (*signature_values)(const Drivers& drivers, const SimOutputs& base) = nullptr;
+
+  // --- Diagnosis ---
+  // Fewest training days on which the effect can be seen, and why.
+  int min_train_days = 0;
+  std::string_view min_train_days_why;
+  // A start for the effect's parameters from the base model's residuals
+  // (false: none found, *start unchanged).
+  bool (*start_from_residuals)(const EffectResiduals& residuals, ParamVector* start) = nullptr;
+  // A sensor fault that the fit absorbs (the held-out error does not move):
+  // judged by its size estimated on each day of data instead. NaN = no
+  // estimate on that day.
+  double (*sensor_estimate)(const Drivers& day) = nullptr;
+  // The evidence sentence of a sensor estimate (median over days, two-sided
+  // p of ≠ 0, days), ending in "; ".
+  std::string (*sensor_evidence)(double median, double p, int days) = nullptr;
+
+  // --- Synthetic truth ---
+  // A sensor error: the truth plant runs without the effect and this turns
+  // the true measurements into what the faulty sensor reads.
+  void (*apply_sensor_error)(const ParamVector& truth, Series* measured) = nullptr;
+};
+
+// Central difference per minute of a per-row value, NaN across restarts and
+// gaps (a signature helper).
+std::vector<double> RatePerMinute(const Drivers& d, const std::vector<double>& v);
+
+}  // namespace pvtwin

@@ -1,0 +1,19 @@
+// The registration list of the effect modules: every effect of DESIGN.md's
+// vocabulary, in the vocabulary's order (the order the diagnosis tries them
+// and reports ties in).
+#pragma once
+
+#include <string_view>
+#include <vector>
+
+#include "core/effects/effect_module.h"
+
+namespace pvtwin {
+
+// Every module, in the vocabulary's order.
+const std::vector<const EffectModule*>& EffectRegistry();
+
+// The module named `name`, or null.
+const EffectModule* FindEffect(std::string_view name);
+
+}  // namespace pvtwin

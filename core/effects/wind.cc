@@ -1,0 +1,79 @@
+#include "core/effects/wind.h"
+
+#include "core/physics/wind.h"
+
+namespace pvtwin {
+
+namespace {
+
+// U_front(v) = U_front + c_wind·v^n_wind per row, W/(m²K)
+// (FrontConductanceConvectiveWM2K; ln v from the run's wind driver).
+void FrontLossPerRow(const Drivers&, const ParamVector& p, RunInputs* run) {
+  std::vector<double>& u = run->Scratch();
+  u.resize(run->n);
+  const double u_front_w_m2k = ParamOf(p, Param::kUFrontWM2K);
+  const double u_wind_w_m2k = ParamOf(p, Param::kUWindWM2K);
+  const double n_wind = ParamOf(p, Param::kNWind);
+  for (std::size_t i = 0; i < run->n; ++i) {
+    u[i] = FrontConductanceConvectiveWM2K(u_front_w_m2k, u_wind_w_m2k,
+                                          WindPower(run->ln_wind[i], n_wind));
+  }
+  run->u_front_w_m2k = u.data();
+}
+
+const ModelExtension& Extension() {
+  static const ModelExtension kExtension = [] {
+    ModelExtension e;
+    e.name = "wind";
+    e.variant_order = 0;
+    e.params = {Param::kUWindWM2K, Param::kNWind};
+    e.reads_wind = true;
+    e.transform_drivers = FrontLossPerRow;
+    return e;
+  }();
+  return kExtension;
+}
+
+bool InSpec(const ModelSpec& spec) { return spec.wind_paper || spec.Has(Extension()); }
+
+// The paper's form 'w', unless the physical form is present.
+void AddToSpec(ModelSpec* spec) {
+  if (!spec->Has(Extension())) spec->wind_paper = true;
+}
+
+std::string DataLacks(const Series& data) {
+  return data.Has(Channel::kWindMS) ? "" : "needs wind_m_s";
+}
+
+std::vector<double> Signature(const Drivers& d, const SimOutputs&) { return d.wind_m_s; }
+
+}  // namespace
+
+const EffectModule& WindEffect() {
+  static const EffectModule kModule = [] {
+    EffectModule m;
+    m.name = "wind";
+    m.physics =
+        "Forced convection on the uncovered front: the front loss conductance grows with "
+        "wind speed, U_front(v) with 1/U = 1/U_front + r_refwind/v^n (paper 2.8, 'w').";
+    m.source =
+        "paper 2.8 ('w'); ISO 9806:2017 quasi-dynamic model, wind term (c6, c3·u) for '+wind'";
+    // The paper's form ('w') first, then the physical form's coefficient.
+    m.params = {Param::kRRefWind, Param::kNWind, Param::kUWindWM2K};
+    m.needs = {Channel::kWindMS};
+    m.typical_truth = {{Param::kRRefWind, 0.02}, {Param::kNWind, 0.8}};
+    m.signature = "wind speed, m/s";
+    m.advice =
+        "Use a variant with wind ('w') and keep the anemometer near the collector plane; "
+        "forecasts then need a wind forecast.";
+    m.extension = &Extension();
+    m.in_spec = InSpec;
+    m.add_to_spec = AddToSpec;
+    m.data_lacks = DataLacks;
+    m.signature_values = Signature;
+    return m;
+  }();
+  return kModule;
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,905 @@
+#include "core/fit/identification.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/fit/lad_fit.h"
+
+namespace pvtwin {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Unit coordinate of value x in [lower, upper] (log where the range spans
+// decades), as the optimiser sees it.
+double ToUnit(const ParamInfo& info, double x) {
+  if (info.upper <= info.lower) return 0.0;
+  if (info.scale == ParamScale::kLog) {
+    return std::log(x / info.lower) / std::log(info.upper / info.lower);
+  }
+  return (x - info.lower) / (info.upper - info.lower);
+}
+
+double FromUnit(const ParamInfo& info, double z) {
+  if (info.scale == ParamScale::kLog) {
+    return info.lower * std::pow(info.upper / info.lower, z);
+  }
+  return info.lower + z * (info.upper - info.lower);
+}
+
+// The objective and its bookkeeping, shared by the optimiser callback and
+// the identifiability analysis. Simulate() reuses `sim`, so an evaluation
+// allocates nothing.
+class Objective {
+ public:
+  Objective(const Drivers& d, const Measurements& m, const IdentOptions& o, ParamVector base)
+      : drivers_(d), meas_(m), options_(o), base_(base) {
+    const double area = d.plant.area_m2;
+    inv_rows_area_ = 1.0 / (static_cast<double>(m.rows.size()) * area);
+    use_t_pv_ = o.use_t_pv && !m.t_pv_c.empty();
+  }
+
+  void SetFree(const std::vector<Param>& free, const std::vector<ParamInfo>& infos,
+               const std::vector<double>& z_ref) {
+    free_ = free;
+    infos_ = infos;
+    z_ref_ = z_ref;
+  }
+  const std::vector<Param>& free() const { return free_; }
+  void SetBase(const ParamVector& base) { base_ = base; }
+
+  ParamVector Params(std::span<const double> x) const {
+    ParamVector p = base_;
+    for (std::size_t j = 0; j < free_.size(); ++j) p[static_cast<std::size_t>(free_[j])] = x[j];
+    return p;
+  }
+
+  // Paper objective at p (W/m²), plus the T_PV term when enabled; NaN if the
+  // model produced a non-finite output in an objective row.
+  double DataCost(const ParamVector& p, double smoothing_w = 0.0) {
+    Simulate(drivers_, p, &sim_);
+    ++simulations_;
+    double sum_p = 0.0, sum_q = 0.0, sum_t = 0.0;
+    const double d2 = smoothing_w * smoothing_w;
+    for (std::uint32_t i : meas_.rows) {
+      const double ep = sim_.p_el_w[i] - meas_.p_el_w[i];
+      const double eq = sim_.q_th_w[i] - meas_.q_th_w[i];
+      if (smoothing_w > 0.0) {
+        sum_p += std::sqrt(ep * ep + d2) - smoothing_w;
+        sum_q += std::sqrt(eq * eq + d2) - smoothing_w;
+      } else {
+        sum_p += std::fabs(ep);
+        sum_q += std::fabs(eq);
+      }
+      if (use_t_pv_) sum_t += std::fabs(sim_.t_pv_c[i] - meas_.t_pv_c[i]);
+    }
+    double cost = (sum_p + sum_q) * inv_rows_area_;
+    if (use_t_pv_) {
+      cost += options_.t_pv_weight_w_m2k * sum_t / static_cast<double>(meas_.rows.size());
+    }
+    return std::isfinite(cost) ? cost : kNaN;
+  }
+
+  double Prior(std::span<const double> x) const {
+    double sum = 0.0;
+    for (std::size_t j = 0; j < free_.size(); ++j) {
+      const double dz = ToUnit(infos_[j], x[j]) - z_ref_[j];
+      sum += dz * dz;
+    }
+    return options_.prior_weight_w_m2 * sum;
+  }
+
+  double Cost(std::span<const double> x, double smoothing_w = 0.0) {
+    return DataCost(Params(x), smoothing_w) + Prior(x);
+  }
+
+  // Residuals at p in blocks over the objective rows: P_el per m², Q_u per
+  // m², and w_T·(T_PV error) when the T_PV term is on. Σ|r|/rows is the
+  // objective.
+  void Residuals(const ParamVector& p, Eigen::VectorXd* r) {
+    Simulate(drivers_, p, &sim_);
+    ++simulations_;
+    const auto m = static_cast<Eigen::Index>(meas_.rows.size());
+    r->resize((use_t_pv_ ? 3 : 2) * m);
+    const double inv_area = 1.0 / drivers_.plant.area_m2;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const std::uint32_t i = meas_.rows[static_cast<std::size_t>(k)];
+      (*r)(k) = (sim_.p_el_w[i] - meas_.p_el_w[i]) * inv_area;
+      (*r)(m + k) = (sim_.q_th_w[i] - meas_.q_th_w[i]) * inv_area;
+      if (use_t_pv_) {
+        (*r)(2 * m + k) = options_.t_pv_weight_w_m2k * (sim_.t_pv_c[i] - meas_.t_pv_c[i]);
+      }
+    }
+  }
+
+  const SimOutputs& last() const { return sim_; }
+  int simulations() const { return simulations_; }
+
+ private:
+  const Drivers& drivers_;
+  const Measurements& meas_;
+  const IdentOptions& options_;
+  ParamVector base_;
+  std::vector<Param> free_;
+  std::vector<ParamInfo> infos_;
+  std::vector<double> z_ref_;
+  SimOutputs sim_;
+  double inv_rows_area_ = 0.0;
+  bool use_t_pv_ = false;
+  int simulations_ = 0;
+};
+
+// Standard errors of the free parameters (unit coordinates) from the
+// sensitivity matrix J (residuals × parameters) and the residuals r at the
+// fit: se_j = σ·√[(JᵀJ)⁻¹]_jj with σ the residual RMS (floored at
+// sigma_floor) inflated by √((1+ρ)/(1−ρ)) for the lag-1 autocorrelation ρ
+// of the residuals, which are far from independent at a 1-min step.
+// `active` marks the parameters still free; the covariance is taken over
+// those only.
+Eigen::VectorXd StandardErrors(const Eigen::MatrixXd& jac, const Eigen::VectorXd& r,
+                               const std::vector<bool>& active, double sigma_floor) {
+  const Eigen::Index n = jac.cols();
+  std::vector<Eigen::Index> idx;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (active[static_cast<std::size_t>(j)]) idx.push_back(j);
+  }
+  const auto m = static_cast<Eigen::Index>(idx.size());
+  Eigen::MatrixXd jtj(m, m);
+  for (Eigen::Index a = 0; a < m; ++a) {
+    for (Eigen::Index b = a; b < m; ++b) {
+      jtj(a, b) = jtj(b, a) =
+          jac.col(idx[static_cast<std::size_t>(a)]).dot(jac.col(idx[static_cast<std::size_t>(b)]));
+    }
+  }
+  const double rms =
+      std::sqrt(r.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(r.size(), 1)));
+  // Lag-1 autocorrelation of the residual sequences (blocks per output).
+  double num = 0.0, den = 0.0;
+  for (Eigen::Index i = 1; i < r.size(); ++i) {
+    num += r(i) * r(i - 1);
+    den += r(i) * r(i);
+  }
+  const double rho = den > 0.0 ? std::clamp(num / den, 0.0, 0.9) : 0.0;
+  const double sigma = std::max(rms, sigma_floor) * std::sqrt((1.0 + rho) / (1.0 - rho));
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jtj);
+  const Eigen::VectorXd lam =
+      eig.eigenvalues().cwiseMax(1e-14 * std::max(eig.eigenvalues().maxCoeff(), 1e-300));
+  const Eigen::MatrixXd cov =
+      eig.eigenvectors() * lam.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+  Eigen::VectorXd se = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index a = 0; a < m; ++a)
+    se(idx[static_cast<std::size_t>(a)]) = sigma * std::sqrt(cov(a, a));
+  return se;
+}
+
+}  // namespace
+
+Measurements MakeMeasurements(const Series& s, const Drivers& d) {
+  Measurements m;
+  const std::size_t n = s.size();
+  m.p_el_w = s.Has(Channel::kPElW) ? s[Channel::kPElW] : std::vector<double>(n, kNaN);
+  if (s.Has(Channel::kQThW)) {
+    m.q_th_w = s[Channel::kQThW];
+  } else {
+    m.q_th_w.assign(n, kNaN);
+  }
+  if (s.Has(Channel::kTOutC) && s.Has(Channel::kTInC)) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (std::isnan(m.q_th_w[i])) {
+        m.q_th_w[i] = d.capacity_flow_w_k[i] * (s[Channel::kTOutC][i] - s[Channel::kTInC][i]);
+      }
+    }
+  }
+  if (s.Has(Channel::kTPvC)) m.t_pv_c = s[Channel::kTPvC];
+  for (std::size_t i = 0; i < n; ++i) {
+    const double valid = s.At(Channel::kValid, i);
+    if (valid == 0.0 || !d.usable[i]) continue;
+    if (!std::isfinite(m.p_el_w[i]) || !std::isfinite(m.q_th_w[i])) continue;
+    m.rows.push_back(static_cast<std::uint32_t>(i));
+  }
+  return m;
+}
+
+ErrorMetrics ComputeErrors(const Measurements& meas, const SimOutputs& sim, double area_m2) {
+  ErrorMetrics e;
+  e.rows = meas.rows.size();
+  if (e.rows == 0) return e;
+  double abs_p = 0.0, abs_q = 0.0, sum_p = 0.0, sum_q = 0.0, sum_t = 0.0;
+  for (std::uint32_t i : meas.rows) {
+    sum_p += std::fabs(sim.p_el_w[i] - meas.p_el_w[i]);
+    sum_q += std::fabs(sim.q_th_w[i] - meas.q_th_w[i]);
+    abs_p += std::fabs(meas.p_el_w[i]);
+    abs_q += std::fabs(meas.q_th_w[i]);
+    if (!meas.t_pv_c.empty()) sum_t += std::fabs(sim.t_pv_c[i] - meas.t_pv_c[i]);
+  }
+  const double n = static_cast<double>(e.rows);
+  e.mae_p_el_w = sum_p / n;
+  e.mae_q_th_w = sum_q / n;
+  e.mae_p_el_w_m2 = e.mae_p_el_w / area_m2;
+  e.mae_q_th_w_m2 = e.mae_q_th_w / area_m2;
+  e.nmae_p_el = abs_p > 0.0 ? sum_p / abs_p : kNaN;
+  e.nmae_q_th = abs_q > 0.0 ? sum_q / abs_q : kNaN;
+  e.mae_t_pv_k = meas.t_pv_c.empty() ? kNaN : sum_t / n;
+  return e;
+}
+
+OptimizerOptions IdentOptions::DefaultOptimizerOptions() {
+  OptimizerOptions o;
+  o.algorithm = OptAlgorithm::kSbplx;
+  o.max_evaluations = 4000;
+  o.ftol_rel = 1e-3;
+  o.xtol_rel = 1e-6;
+  o.initial_step = 0.1;
+  o.max_restarts = 3;
+  return o;
+}
+
+bool IdentOptions::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& field, double value, const std::string& rule) {
+    if (why) {
+      char buf[64];
+      std::snprintf(buf, sizeof(buf), "%g", value);
+      *why = field + " = " + buf + ": " + rule;
+    }
+    return false;
+  };
+  if (!optimizer.IsValid(why)) return false;
+  if (!(t_pv_weight_w_m2k >= 0.0))
+    return fail("t_pv_weight_w_m2k", t_pv_weight_w_m2k, "must be >= 0");
+  if (!(prior_weight_w_m2 >= 0.0))
+    return fail("prior_weight_w_m2", prior_weight_w_m2, "must be >= 0");
+  if (!(undetermined_se > 0.0)) return fail("undetermined_se", undetermined_se, "must be > 0");
+  if (min_rows < 1) return fail("min_rows", min_rows, "must be >= 1");
+  return true;
+}
+
+std::vector<std::string> IdentSummary::AtBounds() const {
+  std::vector<std::string> names;
+  for (const ParamEstimate& e : estimates) {
+    if (e.free && e.at_bound) names.emplace_back(Info(e.param).name);
+  }
+  return names;
+}
+
+std::string IdentSummary::BriefReport() const {
+  char buf[320];
+  std::snprintf(buf, sizeof(buf),
+                "%s: %s, %s (%s), cost %.4g -> %.4g W/m2, %d simulations, %.3f s%s%s",
+                variant.c_str(), ok ? "ok" : "FAILED", algorithm.c_str(),
+                std::string(ToString(termination)).c_str(), initial_cost_w_m2, final_cost_w_m2,
+                evaluations, runtime_s, ok ? "" : ": ", ok ? "" : failure_reason.c_str());
+  std::string report = buf;
+  const std::vector<std::string> bounds = AtBounds();
+  if (ok && !bounds.empty()) {
+    report += "; ok, but " + std::to_string(bounds.size()) +
+              (bounds.size() == 1 ? " parameter" : " parameters") + " at bounds (";
+    for (std::size_t i = 0; i < bounds.size(); ++i) report += (i ? ", " : "") + bounds[i];
+    report += "): the data or the model do not hold them inside their physical range";
+  }
+  return report;
+}
+
+std::string IdentAlgorithmName(const IdentOptions& options) {
+  return options.method == IdentMethod::kLadLm ? "lad_lm"
+                                               : std::string(ToString(options.optimizer.algorithm));
+}
+
+bool SetIdentAlgorithm(std::string_view name, IdentOptions* options) {
+  if (name == "lad_lm") {
+    options->method = IdentMethod::kLadLm;
+    return true;
+  }
+  const std::optional<OptAlgorithm> a = OptAlgorithmFromString(name);
+  if (!a) return false;
+  options->method = IdentMethod::kNlopt;
+  options->optimizer.algorithm = *a;
+  return true;
+}
+
+namespace {
+
+struct FitOutcome {
+  ParamVector params;
+  Termination termination = Termination::kFailure;
+  bool ok = false;
+  std::string message;
+  Eigen::MatrixXd jacobian;  // at params when the method had it, else empty
+};
+
+// One fit of the active parameters from `from`.
+FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
+                  const std::vector<double>& z_ref, const ParamVector& from,
+                  const IdentOptions& options, int budget, double n_rows, double area_m2) {
+  FitOutcome out;
+  out.params = from;
+  const std::vector<Param>& active = obj.free();
+  const std::size_t n = active.size();
+  std::vector<double> x0(n);
+  for (std::size_t j = 0; j < n; ++j) x0[j] = from[static_cast<std::size_t>(active[j])];
+  if (options.method == IdentMethod::kLadLm) {
+    LadFitOptions lo;
+    lo.max_evaluations = budget;
+    lo.ftol_rel = options.optimizer.ftol_rel;
+    lo.xtol = options.optimizer.xtol_rel;
+    lo.prior_weight = options.prior_weight_w_m2;
+    lo.n_scale = n_rows;
+    Eigen::VectorXd z0(static_cast<Eigen::Index>(n)), zr(static_cast<Eigen::Index>(n));
+    for (std::size_t j = 0; j < n; ++j) {
+      z0(static_cast<Eigen::Index>(j)) = ToUnit(infos[j], x0[j]);
+      zr(static_cast<Eigen::Index>(j)) = z_ref[j];
+    }
+    std::vector<double> x(n);
+    ResidualFunction residuals = [&](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
+      for (std::size_t j = 0; j < n; ++j)
+        x[j] = FromUnit(infos[j], z(static_cast<Eigen::Index>(j)));
+      obj.Residuals(obj.Params(x), r);
+      return r->allFinite();
+    };
+    const LadFitResult fit = LadFit(residuals, z0, zr, lo);
+    for (std::size_t j = 0; j < n; ++j)
+      x[j] = FromUnit(infos[j], fit.z(static_cast<Eigen::Index>(j)));
+    out.params = obj.Params(x);
+    out.ok = std::isfinite(fit.final_cost) && fit.final_cost <= fit.initial_cost;
+    out.termination = !std::isfinite(fit.final_cost) ? Termination::kNonFiniteCost
+                      : fit.converged                ? Termination::kConverged
+                                                     : Termination::kMaxEvaluations;
+    out.message = fit.message;
+    out.jacobian = fit.jacobian;
+    return out;
+  }
+  const bool smooth = NeedsGradient(options.optimizer.algorithm);
+  const double smoothing_w = smooth ? 0.5 * area_m2 : 0.0;  // 0.5 W/m² pseudo-Huber width
+  std::vector<double> lower(n), upper(n), xp(n);
+  std::vector<bool> log_scale(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    lower[j] = infos[j].lower;
+    upper[j] = infos[j].upper;
+    log_scale[j] = infos[j].scale == ParamScale::kLog;
+  }
+  CostFunction cost = [&](std::span<const double> x, std::span<double> grad) -> double {
+    const double c = obj.Cost(x, smoothing_w);
+    if (!grad.empty()) {  // forward differences on the smoothed objective
+      std::copy(x.begin(), x.end(), xp.begin());
+      for (std::size_t j = 0; j < n; ++j) {
+        const double h = log_scale[j] ? 1e-5 * xp[j] : 1e-5 * (upper[j] - lower[j]);
+        const double xj = xp[j];
+        xp[j] = xj + h <= upper[j] ? xj + h : xj - h;
+        grad[j] = (obj.Cost(xp, smoothing_w) - c) / (xp[j] - xj);
+        xp[j] = xj;
+      }
+    }
+    return c;
+  };
+  OptimizerOptions opt = options.optimizer;
+  // A gradient method's cost call runs n + 1 simulations.
+  opt.max_evaluations = std::max(smooth ? budget / static_cast<int>(n + 1) : budget, 1);
+  const OptimizerResult result = Minimize(cost, x0, Bounds{lower, upper, log_scale}, opt);
+  if (!result.x.empty()) out.params = obj.Params(result.x);
+  out.ok = result.ok();
+  out.termination = result.termination;
+  out.message = result.message;
+  return out;
+}
+
+// Sensitivity matrix of the residuals to the active parameters (unit
+// coordinates) at p, by forward differences; r0 gets the residuals at p.
+Eigen::MatrixXd SensitivityMatrix(Objective& obj, const std::vector<ParamInfo>& infos,
+                                  const ParamVector& p, Eigen::VectorXd* r0) {
+  const std::vector<Param>& active = obj.free();
+  obj.Residuals(p, r0);
+  Eigen::MatrixXd jac(r0->size(), static_cast<Eigen::Index>(active.size()));
+  Eigen::VectorXd r1;
+  constexpr double kStep = 1e-4;
+  for (std::size_t j = 0; j < active.size(); ++j) {
+    ParamVector q = p;
+    const auto idx = static_cast<std::size_t>(active[j]);
+    const double z = ToUnit(infos[j], p[idx]);
+    const double h = z + kStep <= 1.0 ? kStep : -kStep;
+    q[idx] = FromUnit(infos[j], z + h);
+    obj.Residuals(q, &r1);
+    jac.col(static_cast<Eigen::Index>(j)) = (r1 - *r0) / h;
+  }
+  return jac;
+}
+
+std::string Name(Param p) { return std::string(kParamTable[static_cast<std::size_t>(p)].name); }
+
+// Averages groups of `factor` consecutive rows of drivers and measurements
+// (never across a restart or an unusable row), as resampling the data to a
+// coarser step would. Used for the coarse first stage of identification.
+void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, Measurements* cm) {
+  const std::size_t n = d.size();
+  std::vector<std::uint8_t> in_obj(n, 0);
+  for (std::uint32_t i : m.rows) in_obj[i] = 1;
+  cd->spec = d.spec;
+  cd->plant = d.plant;
+  const bool t_pv = !m.t_pv_c.empty();
+  std::size_t i = 0;
+  while (i < n) {
+    std::size_t end = i + 1;
+    if (d.usable[i]) {
+      while (end < n && end - i < static_cast<std::size_t>(factor) && d.usable[end] &&
+             !d.restart[end]) {
+        ++end;
+      }
+    }
+    double dt = 0.0;
+    for (std::size_t k = i; k < end; ++k) dt += d.dt_s[k];
+    auto mean = [&](const std::vector<double>& v) {
+      double acc = 0.0;
+      for (std::size_t k = i; k < end; ++k) acc += v[k] * d.dt_s[k];
+      return acc / dt;
+    };
+    double wind = 0.0;
+    bool all_obj = true;
+    for (std::size_t k = i; k < end; ++k) {
+      wind += std::exp(d.ln_wind[k]) * d.dt_s[k];
+      all_obj = all_obj && in_obj[k];
+    }
+    cd->time_s.push_back(d.time_s[i]);
+    cd->dt_s.push_back(dt);
+    cd->restart.push_back(d.restart[i]);
+    cd->usable.push_back(d.usable[i]);
+    cd->t_in_c.push_back(mean(d.t_in_c));
+    cd->mdot_kg_s.push_back(mean(d.mdot_kg_s));
+    cd->capacity_flow_w_k.push_back(mean(d.capacity_flow_w_k));
+    cd->g_poa_w_m2.push_back(mean(d.g_poa_w_m2));
+    cd->g_abs_w_m2.push_back(mean(d.g_abs_w_m2));
+    cd->t_amb_c.push_back(mean(d.t_amb_c));
+    cd->t_back_c.push_back(mean(d.t_back_c));
+    cd->ln_wind.push_back(std::log(wind / dt));
+    cd->t_sky_k4.push_back(mean(d.t_sky_k4));
+    AppendCoarseEffectDrivers(d, i, end, cd);
+    if (all_obj) cm->rows.push_back(static_cast<std::uint32_t>(cm->p_el_w.size()));
+    cm->p_el_w.push_back(all_obj ? mean(m.p_el_w) : kNaN);
+    cm->q_th_w.push_back(all_obj ? mean(m.q_th_w) : kNaN);
+    if (t_pv) cm->t_pv_c.push_back(all_obj ? mean(m.t_pv_c) : kNaN);
+    i = end;
+  }
+}
+
+// The parameters a fit frees: used by the variant, requested (or free by
+// default), with a non-empty range; `base` is the start clamped into the
+// bounds.
+struct FreeSet {
+  ParamVector base{};
+  std::vector<Param> free;
+  std::vector<ParamInfo> infos;  // resolved, per free parameter
+};
+
+FreeSet SelectFree(const Drivers& drivers, const ParamVector& start, const IdentOptions& options) {
+  const auto used = UsedParams(drivers.spec);
+  const auto requested = options.free.any() ? options.free : DefaultFreeParams(drivers.spec);
+  FreeSet fs;
+  fs.base = start;
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), drivers.plant);
+    fs.base[i] = std::clamp(fs.base[i], info.lower, info.upper);
+    if (used.test(i) && requested.test(i) && info.upper > info.lower) {
+      fs.free.push_back(static_cast<Param>(i));
+      fs.infos.push_back(info);
+    }
+  }
+  return fs;
+}
+
+// Coarse stage: the same fit on the data averaged to about 5 min gets close
+// to the optimum at a fraction of the cost; the fine stage starts from there.
+// (The model at 5 min is the same model: its exact step makes the coarse
+// optimum close to the fine one.) Replaces *best when the coarse optimum
+// also beats the start on the data as given; returns its simulations.
+int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOptions& options,
+                const FreeSet& fs, Objective& obj, double initial_cost, ParamVector* best) {
+  const double data_step_s = drivers.dt_s.empty() ? 0.0 : drivers.dt_s[0];
+  const double coarse_step_s =
+      data_step_s < 30.0 && options.coarse_step_s > 60.0 ? 60.0 : options.coarse_step_s;
+  const int coarse_factor = coarse_step_s > 0.0 && data_step_s > 0.0
+                                ? static_cast<int>(coarse_step_s / data_step_s + 0.5)
+                                : 1;
+  if (coarse_factor < 2 || fs.free.empty() || options.optimizer.max_evaluations < 200) return 0;
+  Drivers cd;
+  Measurements cm;
+  Coarsen(drivers, meas, coarse_factor, &cd, &cm);
+  if (static_cast<int>(cm.rows.size()) < options.min_rows) return 0;
+  IdentOptions coarse = options;
+  // From data finer than 30 s the ladder has two rungs: 1 min, then the
+  // configured coarse step.
+  coarse.coarse_step_s =
+      options.coarse_step_s > 60.0 && drivers.dt_s[0] < 30.0 ? options.coarse_step_s : 0.0;
+  coarse.fix_unidentifiable = false;
+  coarse.optimizer.ftol_rel = std::max(options.optimizer.ftol_rel, 1e-3);
+  coarse.optimizer.max_evaluations = options.optimizer.max_evaluations / 4;
+  const IdentSummary cs = Identify(cd, cm, fs.base, coarse);
+  // A misspecified model can have its coarse optimum far from the fine one:
+  // keep it only if it also beats the start on the data as given.
+  if (cs.ok && obj.DataCost(cs.params) < initial_cost) *best = cs.params;
+  return cs.evaluations;
+}
+
+// The fine stage: the fit of the active parameters, then identifiability
+// (standard errors of the free parameters at the fit; a parameter whose
+// standard error exceeds undetermined_se of its range is fixed at its
+// reference value, worst first, provided that costs at most
+// fix_cost_tolerance more: a parameter the data really do not determine
+// costs nothing to fix), then a polish of the rest.
+class FineFit {
+ public:
+  FineFit(Objective& obj, const FreeSet& fs, const Measurements& meas, const IdentOptions& options,
+          const Plant& plant, int coarse_simulations, const ParamVector& best)
+      : obj_(obj),
+        fs_(fs),
+        options_(options),
+        area_m2_(plant.area_m2),
+        coarse_simulations_(coarse_simulations),
+        n_rows_(static_cast<double>(meas.rows.size())),
+        active_(fs.free.size(), true),
+        se_(fs.free.size(), 0.0),
+        rejected_(fs.free.size(), false),
+        best_(best) {
+    // Floor of the residual spread for the standard errors: 0.1 % of the
+    // mean measured power per m², so that noise-free data still expose
+    // exactly flat directions and nothing else.
+    double mean_abs = 0.0;
+    for (std::uint32_t i : meas.rows)
+      mean_abs += std::fabs(meas.p_el_w[i]) + std::fabs(meas.q_th_w[i]);
+    sigma_floor_ = 1e-3 * mean_abs / (2.0 * n_rows_ * area_m2_);
+  }
+
+  // The fit from the best point so far (coarse stage or start).
+  void FitAll() {
+    fit_ = FitActive(active_, best_, &best_cost_);
+    if (fit_.termination == Termination::kMaxEvaluations && fit_.message == "no evaluations left") {
+      fit_.ok = true;  // nothing could be tried; the start stands (and is reported)
+    }
+    best_ = fit_.params;
+  }
+
+  void FixUnidentifiable(std::vector<std::string>* notes) {
+    for (int round = 0; fit_.ok && options_.fix_unidentifiable && round < 8; ++round) {
+      if (!FixRound(notes)) break;
+    }
+  }
+
+  // Polish the remaining parameters once with the fixed ones in place.
+  void Polish() {
+    if (!any_fixed_ || Remaining() <= 20) return;
+    double polished_cost = 0.0;
+    const FitOutcome polished = FitActive(active_, best_, &polished_cost);
+    if (polished.ok && polished_cost <= best_cost_) {
+      best_ = polished.params;
+      best_cost_ = polished_cost;
+      fit_.termination = polished.termination;
+    }
+  }
+
+  int Remaining() const {
+    return options_.optimizer.max_evaluations - obj_.simulations() - coarse_simulations_;
+  }
+  const FitOutcome& fit() const { return fit_; }
+  const ParamVector& best() const { return best_; }
+  const std::vector<bool>& active() const { return active_; }
+  const std::vector<double>& se() const { return se_; }
+
+ private:
+  // Fits the parameters marked in `act_mask` from `from_point` (the others
+  // held at their reference values); returns the outcome and the data cost.
+  FitOutcome FitActive(const std::vector<bool>& act_mask, const ParamVector& from_point,
+                       double* data_cost, int max_budget = std::numeric_limits<int>::max()) {
+    std::vector<Param> act;
+    std::vector<ParamInfo> act_infos;
+    std::vector<double> z_ref;
+    ParamVector from = from_point;
+    for (std::size_t j = 0; j < fs_.free.size(); ++j) {
+      const auto idx = static_cast<std::size_t>(fs_.free[j]);
+      if (!act_mask[j]) {
+        from[idx] = fs_.base[idx];
+        continue;
+      }
+      act.push_back(fs_.free[j]);
+      act_infos.push_back(fs_.infos[j]);
+      z_ref.push_back(ToUnit(fs_.infos[j], fs_.base[idx]));
+    }
+    obj_.SetBase(from);
+    obj_.SetFree(act, act_infos, z_ref);
+    FitOutcome out;
+    if (act.empty()) {
+      out.params = from;
+      out.ok = true;
+      out.termination = Termination::kConverged;
+    } else {
+      // One simulation stays reserved for the final check of the result.
+      const int budget = std::min(Remaining() - 1, max_budget);
+      if (budget >= 2) {
+        out = RunFit(obj_, act_infos, z_ref, from, options_, budget, n_rows_, area_m2_);
+      } else {
+        out.params = from;
+        out.ok = true;
+        out.termination = Termination::kMaxEvaluations;
+        out.message = "no evaluations left";
+      }
+    }
+    *data_cost = obj_.DataCost(out.params);
+    return out;
+  }
+
+  std::vector<ParamInfo> ActiveInfos() const {
+    std::vector<ParamInfo> v;
+    for (std::size_t j = 0; j < fs_.free.size(); ++j) {
+      if (active_[j]) v.push_back(fs_.infos[j]);
+    }
+    return v;
+  }
+
+  // One round of fixing: the standard errors of the active parameters, the
+  // worst undetermined one fixed if that is cheap enough. False when no
+  // round is left to do.
+  bool FixRound(std::vector<std::string>* notes) {
+    std::vector<std::size_t> act_index;  // positions in `free` of the active ones
+    for (std::size_t j = 0; j < fs_.free.size(); ++j) {
+      if (active_[j]) act_index.push_back(j);
+    }
+    const auto m = static_cast<Eigen::Index>(act_index.size());
+    if (m <= 1 || Remaining() < static_cast<int>(m) + 10) return false;
+    if (jac_.cols() != m) {
+      jac_ = fit_.jacobian.cols() == m ? fit_.jacobian : Eigen::MatrixXd();
+      if (jac_.cols() == m) {
+        obj_.Residuals(best_, &r_);
+      } else {
+        std::vector<Param> act;
+        for (std::size_t j : act_index) act.push_back(fs_.free[j]);
+        obj_.SetFree(act, ActiveInfos(), std::vector<double>(act.size(), 0.0));
+        jac_ = SensitivityMatrix(obj_, ActiveInfos(), best_, &r_);
+      }
+    }
+    const Eigen::VectorXd act_se =
+        StandardErrors(jac_, r_, std::vector<bool>(act_index.size(), true), sigma_floor_);
+    Eigen::Index worst = -1;
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const std::size_t j = act_index[static_cast<std::size_t>(a)];
+      se_[j] = act_se(a);
+      if (rejected_[j] || !(act_se(a) > options_.undetermined_se)) continue;
+      if (worst < 0 || act_se(a) > act_se(worst)) worst = a;
+    }
+    if (worst < 0) return false;
+    ParamVector predicted;
+    Eigen::VectorXd r_pred;
+    double cost = PredictCostOfFixing(act_index, worst, &predicted, &r_pred);
+    const std::size_t j = act_index[static_cast<std::size_t>(worst)];
+    ParamVector point = predicted;
+    // Relative tolerance, with an absolute floor (the 0.1 % of the measured
+    // power used for sigma_floor) so that noise-free fits can fix too.
+    const double limit = best_cost_ * (1.0 + options_.fix_cost_tolerance) + 2.0 * sigma_floor_;
+    // The linear prediction is poor for large moves on a log scale: when it
+    // is inconclusive (close to the limit, or the parameter is not bounded
+    // by the data at all, se > 1) a short re-fit decides.
+    if (std::isfinite(cost) && cost > limit &&
+        (cost <= 10.0 * limit - 9.0 * best_cost_ || se_[j] > 1.0)) {
+      std::vector<bool> trial_mask = active_;
+      trial_mask[j] = false;
+      const FitOutcome trial =
+          FitActive(trial_mask, predicted, &cost, 8 * (static_cast<int>(m) + 2));
+      point = trial.params;
+      if (!trial.ok) cost = kNaN;
+    }
+    if (std::isfinite(cost) && cost <= limit) {
+      Fix(worst, j, point, cost, point == predicted ? &r_pred : nullptr);
+    } else {
+      rejected_[j] = true;
+    }
+    notes->push_back(FixNote(j, cost, !rejected_[j]));
+    return true;
+  }
+
+  // The cost of fixing the active parameter `worst` (position j in `free`)
+  // at its reference value, predicted with one simulation per candidate
+  // point: the others unchanged, and the others following the damped
+  // (Levenberg) weighted least-squares response of the linearised
+  // residuals for two dampings, each step limited to the size of the move of
+  // parameter j (the linearisation holds only that far). The cheapest
+  // predicts the cost; *predicted and *r_pred are its point and residuals.
+  double PredictCostOfFixing(const std::vector<std::size_t>& act_index, Eigen::Index worst,
+                             ParamVector* predicted, Eigen::VectorXd* r_pred) {
+    const auto m = static_cast<Eigen::Index>(act_index.size());
+    const std::size_t j = act_index[static_cast<std::size_t>(worst)];
+    const auto idx = static_cast<std::size_t>(fs_.free[j]);
+    Eigen::VectorXd z(m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const std::size_t k = act_index[static_cast<std::size_t>(a)];
+      z(a) = ToUnit(fs_.infos[k], best_[static_cast<std::size_t>(fs_.free[k])]);
+    }
+    const double dz_j = ToUnit(fs_.infos[j], fs_.base[idx]) - z(worst);
+    Eigen::MatrixXd j_others(jac_.rows(), m - 1);
+    for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+      if (a != worst) j_others.col(c++) = jac_.col(a);
+    }
+    const double delta = std::max(0.3 * r_.cwiseAbs().mean(), sigma_floor_);
+    const Eigen::VectorXd w = r_.cwiseAbs().cwiseMax(delta).cwiseInverse();
+    const Eigen::VectorXd b = r_ + jac_.col(worst) * dz_j;
+    const Eigen::MatrixXd wj = j_others.array().colwise() * w.array();
+    const Eigen::MatrixXd h = j_others.transpose() * wj;
+    const Eigen::VectorXd g = wj.transpose() * b;
+    const double mean_diag = std::max(h.diagonal().mean(), 1e-300);
+    const double limit_dz = std::max(std::fabs(dz_j), 0.02);
+    double cost = kNaN;
+    *predicted = best_;
+    for (double damping : {-1.0, 1e-4, 1e-2}) {
+      Eigen::VectorXd dz_o = Eigen::VectorXd::Zero(m - 1);
+      if (damping > 0.0) {
+        Eigen::MatrixXd hd = h;
+        hd.diagonal().array() += damping * mean_diag;
+        dz_o = -hd.ldlt().solve(g);
+        const double norm = dz_o.cwiseAbs().maxCoeff();
+        if (norm > limit_dz) dz_o *= limit_dz / norm;
+      }
+      ParamVector candidate = best_;
+      candidate[idx] = fs_.base[idx];
+      for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+        if (a == worst) continue;
+        const std::size_t k = act_index[static_cast<std::size_t>(a)];
+        candidate[static_cast<std::size_t>(fs_.free[k])] =
+            FromUnit(fs_.infos[k], std::clamp(z(a) + dz_o(c++), 0.0, 1.0));
+      }
+      Eigen::VectorXd r_cand;
+      obj_.Residuals(candidate, &r_cand);
+      const double c_cost = r_cand.cwiseAbs().sum() / n_rows_;
+      if (std::isfinite(c_cost) && !(c_cost >= cost)) {
+        cost = c_cost;
+        *predicted = candidate;
+        *r_pred = r_cand;
+      }
+    }
+    return cost;
+  }
+
+  // Fixes the active parameter `worst` (position j in `free`) at `point`;
+  // the old Jacobian without its column serves the next round.
+  void Fix(Eigen::Index worst, std::size_t j, const ParamVector& point, double cost,
+           const Eigen::VectorXd* r_at_point) {
+    const auto m = jac_.cols();
+    active_[j] = false;
+    best_ = point;
+    best_cost_ = cost;
+    any_fixed_ = true;
+    Eigen::MatrixXd reduced(jac_.rows(), m - 1);
+    for (Eigen::Index a = 0, c = 0; a < m; ++a) {
+      if (a != worst) reduced.col(c++) = jac_.col(a);
+    }
+    jac_ = reduced;
+    if (r_at_point != nullptr)
+      r_ = *r_at_point;
+    else
+      obj_.Residuals(best_, &r_);
+  }
+
+  std::string FixNote(std::size_t j, double cost, bool fixed) const {
+    const auto idx = static_cast<std::size_t>(fs_.free[j]);
+    const char* range = fs_.infos[j].scale == ParamScale::kLog ? "log" : "search";
+    char note[240];
+    if (fixed) {
+      std::snprintf(note, sizeof(note),
+                    "%s is not determined by these data (standard error %.2g of its %s range); "
+                    "fixed at its reference value %.4g",
+                    Name(fs_.free[j]).c_str(), se_[j], range, fs_.base[idx]);
+    } else {
+      std::snprintf(note, sizeof(note),
+                    "%s is only weakly determined (standard error %.2g of its %s range); kept "
+                    "free because fixing it at %.4g raises the MAE by %.1f %%",
+                    Name(fs_.free[j]).c_str(), se_[j], range, fs_.base[idx],
+                    100.0 * (cost / best_cost_ - 1.0));
+    }
+    return note;
+  }
+
+  Objective& obj_;
+  const FreeSet& fs_;
+  const IdentOptions& options_;
+  double area_m2_;
+  int coarse_simulations_;
+  double n_rows_;
+  double sigma_floor_ = 0.0;
+  std::vector<bool> active_;
+  std::vector<double> se_;
+  std::vector<bool> rejected_;
+  ParamVector best_;
+  double best_cost_ = 0.0;
+  bool any_fixed_ = false;
+  FitOutcome fit_;
+  Eigen::MatrixXd jac_;  // columns: active parameters, in `free` order
+  Eigen::VectorXd r_;
+};
+
+// One estimate per parameter the variant uses.
+std::vector<ParamEstimate> Estimates(const Drivers& drivers, const FreeSet& fs, const FineFit& fine,
+                                     const IdentOptions& options) {
+  std::vector<ParamEstimate> out;
+  const auto used = UsedParams(drivers.spec);
+  const ParamVector& best = fine.best();
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    if (!used.test(i)) continue;
+    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), drivers.plant);
+    ParamEstimate e;
+    e.param = info.param;
+    e.value = best[i];
+    e.start = fs.base[i];
+    e.lower = info.lower;
+    e.upper = info.upper;
+    const auto it = std::find(fs.free.begin(), fs.free.end(), info.param);
+    e.free = it != fs.free.end();
+    if (e.free) {
+      const auto j = static_cast<std::size_t>(it - fs.free.begin());
+      e.undetermined = !fine.active()[j];
+      e.se_unit = fine.se()[j];
+      e.weak = fine.active()[j] && fine.se()[j] > options.undetermined_se;
+      const double z = ToUnit(fs.infos[j], e.value);
+      e.at_bound = fine.active()[j] && (z < 1e-3 || z > 1.0 - 1e-3);
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace
+
+IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const ParamVector& start,
+                      const IdentOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  IdentSummary summary;
+  summary.variant = drivers.spec.Name();
+  summary.algorithm = IdentAlgorithmName(options);
+  summary.params = start;
+  auto finish = [&](bool ok, const std::string& reason) {
+    summary.ok = ok;
+    summary.failure_reason = reason;
+    summary.runtime_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return summary;
+  };
+  std::string why;
+  if (!options.IsValid(&why)) return finish(false, "invalid options: " + why);
+  if (static_cast<int>(meas.rows.size()) < options.min_rows) {
+    return finish(false, "too little data: " + std::to_string(meas.rows.size()) +
+                             " rows in the objective, at least " +
+                             std::to_string(options.min_rows) + " needed");
+  }
+
+  const FreeSet fs = SelectFree(drivers, start, options);
+  Objective obj(drivers, meas, options, fs.base);
+  const double initial_cost = obj.DataCost(fs.base);
+  summary.initial_cost_w_m2 = initial_cost;
+  if (!std::isfinite(initial_cost)) {
+    return finish(false, "the model gives non-finite outputs at the start values");
+  }
+  ParamVector best = fs.base;
+  const int coarse_simulations = CoarseStart(drivers, meas, options, fs, obj, initial_cost, &best);
+  FineFit fine(obj, fs, meas, options, drivers.plant, coarse_simulations, best);
+  fine.FitAll();
+  fine.FixUnidentifiable(&summary.notes);
+  fine.Polish();
+  const FitOutcome& fit = fine.fit();
+  summary.termination = fit.termination;
+  summary.params = fine.best();
+  const double final_cost = obj.DataCost(fine.best());
+  summary.final_cost_w_m2 = final_cost;
+  summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
+  summary.evaluations = obj.simulations() + coarse_simulations;
+  summary.estimates = Estimates(drivers, fs, fine, options);
+  if (!fit.ok) {
+    return finish(false, "optimiser stopped with " + std::string(ToString(fit.termination)) +
+                             (fit.message.empty() ? "" : ": " + fit.message));
+  }
+  if (!std::isfinite(final_cost)) return finish(false, "the fitted model gives non-finite outputs");
+  if (final_cost > initial_cost) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "the fit is worse than the start values (%.4g > %.4g W/m2)",
+                  final_cost, initial_cost);
+    return finish(false, buf);
+  }
+  return finish(true, "");
+}
+
+}  // namespace pvtwin

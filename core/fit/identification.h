@@ -1,0 +1,154 @@
+// Parameter identification (paper 3.2): fit the free parameters of a variant
+// to measured electrical and thermal power by minimising the paper's mean
+// absolute error, with NLopt behind core/fit/optimizer.h.
+//
+// Objective (paper 3.2.2), per m² of nameplate area A:
+//   MAE = mean_i |P_el,calc − P_el,meas| / A + mean_i |Q_u,calc − Q_u,meas| / A
+// over the rows i that are in the objective (see Measurements). Optionally
+// (IdentOptions::use_t_pv) + w_T · mean_i |T_PV,calc − T_PV,meas|.
+// A weak quadratic prior in the optimiser's unit coordinates pulls
+// directions the data do not determine towards the reference values (see
+// IdentOptions::prior_weight_w_m2). Its default weight, 0.01 W/m² per unit²,
+// is small against the MAE that moving any determined parameter across its
+// range costs, so it decides only where the data are indifferent.
+#pragma once
+
+#include <bitset>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/common/params.h"
+#include "core/common/series.h"
+#include "core/fit/optimizer.h"
+#include "core/model/thermal_model.h"
+
+namespace pvtwin {
+
+// Calibration targets of each row, aligned with the drivers built from the
+// same series.
+struct Measurements {
+  std::vector<double> p_el_w;
+  std::vector<double> q_th_w;  // q_th_w column, else ṁ·c_p·(T_out − T_in)
+  std::vector<double> t_pv_c;  // empty when not measured
+  // Rows in the objective and the error metrics: valid ≠ 0, model inputs
+  // usable (flow, irradiance, temperatures present) and P_el, Q_u present.
+  std::vector<std::uint32_t> rows;
+  std::size_t size() const { return p_el_w.size(); }
+};
+
+Measurements MakeMeasurements(const Series& series, const Drivers& drivers);
+
+// Errors of a simulation against measurements (paper 3.2.2).
+struct ErrorMetrics {
+  std::size_t rows = 0;
+  double mae_p_el_w = 0.0;  // whole field, W
+  double mae_q_th_w = 0.0;
+  double mae_p_el_w_m2 = 0.0;  // per m² of nameplate area
+  double mae_q_th_w_m2 = 0.0;
+  double nmae_p_el = 0.0;  // MAE / mean |measured|
+  double nmae_q_th = 0.0;
+  double mae_t_pv_k = 0.0;  // NaN unless T_PV is measured
+  double objective_w_m2() const { return mae_p_el_w_m2 + mae_q_th_w_m2; }
+};
+
+// Errors over the objective rows. area_m2 is the nameplate area used for the
+// per-m² figures. NaN predictions in objective rows make the metrics NaN.
+ErrorMetrics ComputeErrors(const Measurements& meas, const SimOutputs& sim, double area_m2);
+
+enum class IdentMethod {
+  // Levenberg–Marquardt on IRLS for the MAE (core/fit/lad_fit.h): uses the
+  // residual structure, a forward-difference Jacobian per iteration.
+  kLadLm,
+  // A method of NLopt (core/fit/optimizer.h), IdentOptions::optimizer.algorithm.
+  kNlopt,
+};
+
+struct IdentOptions {
+  // Search method. The default is the one that reached the lowest held-out
+  // MAE for the least time in `pvtwin bench ident` (see README).
+  IdentMethod method = IdentMethod::kLadLm;
+  // Budget and tolerances (both methods: max_evaluations, ftol_rel,
+  // xtol_rel); algorithm and its settings for kNlopt.
+  OptimizerOptions optimizer = DefaultOptimizerOptions();
+  // Parameters to identify; empty = DefaultFreeParams(variant). Parameters
+  // the variant does not use are never freed.
+  std::bitset<kNumParams> free;
+  // Add mean |T_PV,calc − T_PV,meas| (weighted) to the objective when the
+  // data has t_pv_c.
+  bool use_t_pv = false;
+  // Weight of the T_PV term, W/(m²K): a temperature error of 1 K costs as
+  // much as this flux error.
+  double t_pv_weight_w_m2k = 5.0;
+  // Prior: prior_weight_w_m2 · Σ (z_j − z_ref,j)² in unit coordinates. 0 = off.
+  double prior_weight_w_m2 = 0.01;
+  // Fix parameters the data do not determine at their start values (see
+  // IdentSummary::estimates) and re-fit.
+  bool fix_unidentifiable = true;
+  // A free parameter counts as not determined by the data when its standard
+  // error (from the sensitivity matrix at the fit, the residual spread and
+  // the residuals' autocorrelation) exceeds this fraction of its search range
+  // in unit coordinates (log range for log-scaled parameters).
+  double undetermined_se = 0.25;
+  // Such a parameter is fixed only if the re-fit without it raises the data
+  // objective by at most this fraction; otherwise it stays free and is
+  // reported as weakly determined.
+  double fix_cost_tolerance = 0.01;
+  // Fit first on the data averaged to this step (s), then on the data as
+  // given from that result; 0 or a step not at least twice the data step
+  // disables the coarse stage.
+  double coarse_step_s = 300.0;
+  // Fewest objective rows accepted.
+  int min_rows = 30;
+
+  static OptimizerOptions DefaultOptimizerOptions();
+  // False if a field is out of range; *why names field, value and rule.
+  bool IsValid(std::string* why) const;
+};
+
+struct ParamEstimate {
+  Param param;
+  double value = 0.0;
+  double start = 0.0;
+  double lower = 0.0;
+  double upper = 0.0;
+  bool free = false;          // identified (false: fixed by the caller or the variant)
+  bool at_bound = false;      // within 0.1 % of the search range from a bound
+  bool undetermined = false;  // the data do not determine it (fixed at start when asked)
+  bool weak = false;          // free, but its standard error exceeds undetermined_se
+  double se_unit = 0.0;       // standard error in unit coordinates (0 when not free)
+};
+
+// Name used on the command line: "lad_lm" or an NLopt algorithm name.
+std::string IdentAlgorithmName(const IdentOptions& options);
+// Sets method (and optimizer.algorithm) from such a name; false if unknown.
+bool SetIdentAlgorithm(std::string_view name, IdentOptions* options);
+
+struct IdentSummary {
+  bool ok = false;
+  std::string failure_reason;  // why the fit is rejected, when !ok
+  std::string variant;
+  std::string algorithm;  // "lad_lm" or the NLopt algorithm's name
+  Termination termination = Termination::kFailure;
+  double initial_cost_w_m2 = 0.0;  // objective at the start values
+  double final_cost_w_m2 = 0.0;    // objective at the result (without the prior)
+  int evaluations = 0;             // model simulations, all stages
+  double runtime_s = 0.0;
+  ParamVector params{};
+  std::vector<ParamEstimate> estimates;  // the parameters the variant uses
+  std::vector<std::string> notes;        // identifiability findings, in words
+  ErrorMetrics train;                    // errors on the training data
+
+  // Names of the free parameters that ended at a bound of their search range.
+  std::vector<std::string> AtBounds() const;
+  // One line: variant, ok/FAILED, termination, cost start → end, evaluations,
+  // runtime; "ok, but N parameters at bounds (names)" when any are.
+  std::string BriefReport() const;
+};
+
+// Identifies the parameters of drivers.spec from the measurements, starting
+// at `start` (typically StartParams(plant), or yesterday's parameters).
+IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const ParamVector& start,
+                      const IdentOptions& options);
+
+}  // namespace pvtwin

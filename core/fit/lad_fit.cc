@@ -1,0 +1,127 @@
+#include "core/fit/lad_fit.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pvtwin {
+
+namespace {
+
+double Objective(const Eigen::VectorXd& r, const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref,
+                 const LadFitOptions& o) {
+  return r.cwiseAbs().sum() / o.n_scale + o.prior_weight * (z - z_ref).squaredNorm();
+}
+
+}  // namespace
+
+LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0,
+                    const Eigen::VectorXd& z_ref, const LadFitOptions& o) {
+  LadFitResult res;
+  const Eigen::Index n = z0.size();
+  Eigen::VectorXd z = z0.cwiseMax(0.0).cwiseMin(1.0);
+  Eigen::VectorXd r, r_trial, r_step;
+  auto eval = [&](const Eigen::VectorXd& at, Eigen::VectorXd* out) {
+    ++res.evaluations;
+    return residuals(at, out);
+  };
+  if (!eval(z, &r)) {
+    res.z = z;
+    res.initial_cost = res.final_cost = std::nan("");
+    res.message = "non-finite residuals at the start point";
+    return res;
+  }
+  double cost = Objective(r, z, z_ref, o);
+  res.initial_cost = cost;
+  double lambda = 1e-3;
+  Eigen::MatrixXd jac(r.size(), n);
+  Eigen::VectorXd w;
+  bool jac_at_z = false;  // jac was computed at the current z
+  double floor_rel = o.weight_floor_rel;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    if (res.evaluations + n + 1 > o.max_evaluations) {
+      res.message = "evaluation budget reached";
+      break;
+    }
+    ++res.iterations;
+    // IRLS weights at the current residuals.
+    const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
+    w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
+    // Forward-difference Jacobian, stepping inwards at the upper bound.
+    for (Eigen::Index j = 0; j < n; ++j) {
+      Eigen::VectorXd zp = z;
+      const double h = z(j) + o.jacobian_step <= 1.0 ? o.jacobian_step : -o.jacobian_step;
+      zp(j) += h;
+      if (!eval(zp, &r_step)) r_step = r;  // a non-finite column gives no direction
+      jac.col(j) = (r_step - r) / h;
+    }
+    jac_at_z = true;
+    // Majoriser: H = JᵀWJ / N + 2p·I, g = JᵀW r / N + 2p (z − z_ref).
+    const Eigen::MatrixXd wj = jac.array().colwise() * w.array();
+    Eigen::MatrixXd h = (jac.transpose() * wj) / o.n_scale;
+    Eigen::VectorXd g = (wj.transpose() * r) / o.n_scale;
+    h.diagonal().array() += 2.0 * o.prior_weight;
+    g += 2.0 * o.prior_weight * (z - z_ref);
+    bool accepted = false;
+    double step_norm = 0.0;
+    double new_cost = cost;
+    for (int tries = 0; tries < 12 && res.evaluations < o.max_evaluations; ++tries) {
+      Eigen::MatrixXd damped = h;
+      damped.diagonal() +=
+          lambda * (h.diagonal().cwiseMax(1e-12 * h.diagonal().maxCoeff() + 1e-300));
+      const Eigen::VectorXd step = -damped.ldlt().solve(g);
+      const Eigen::VectorXd z_new = (z + step).cwiseMax(0.0).cwiseMin(1.0);
+      step_norm = (z_new - z).cwiseAbs().maxCoeff();
+      if (!(step_norm > 0.0) || !eval(z_new, &r_trial)) {
+        lambda *= 4.0;
+        continue;
+      }
+      new_cost = Objective(r_trial, z_new, z_ref, o);
+      if (new_cost < cost) {
+        z = z_new;
+        r.swap(r_trial);
+        accepted = true;
+        // Trust the Gauss–Newton model quickly again after a success: near
+        // the optimum its steps are the fast ones.
+        lambda = std::max(lambda / 10.0, 1e-9);
+        break;
+      }
+      lambda *= 4.0;
+    }
+    if (!accepted) {
+      // The smoothed model found no descent of the true objective: sharpen
+      // it (continuation on the weight floor) before giving up.
+      if (floor_rel > 1e-6) {
+        floor_rel *= 0.1;
+        lambda = 1e-3;
+        continue;
+      }
+      res.converged = true;
+      res.message = "no further descent (damping " + std::to_string(lambda) + ")";
+      break;
+    }
+    jac_at_z = false;
+    const double decrease = cost - new_cost;
+    cost = new_cost;
+    if (step_norm <= o.xtol && floor_rel > 1e-6) {  // stalled on the smoothing
+      floor_rel *= 0.1;
+      lambda = 1e-3;
+      continue;
+    }
+    if (decrease <= o.ftol_rel * cost || step_norm <= o.xtol) {
+      res.converged = true;
+      res.message =
+          decrease <= o.ftol_rel * cost ? "relative decrease below ftol" : "step below xtol";
+      break;
+    }
+  }
+  if (res.message.empty()) res.message = "iteration limit reached";
+  res.z = z;
+  res.final_cost = cost;
+  if (jac_at_z) {
+    res.jacobian = jac;
+    res.weights = w;
+  }
+  return res;
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,73 @@
+// 24 h forecasts of a calibrated model (issue 5, DESIGN.md table `forecast`).
+//
+// A forecast runs the calibrated variant over the horizon on the best inputs
+// available for each row, after a warm-up on measured data so that the
+// thermal states start where the plant is:
+//
+//   rows        [issued_at − warmup_s, issued_at)   measured 1-min history
+//               [issued_at, issued_at + horizon_s)  forecast inputs, per channel:
+//   weather     1. the weather forecast (table weather_forecast), where it has
+//                  the channel at that minute (linear interpolation across gaps
+//                  up to max_interp_gap_s);
+//               2. persistence: the measured value 24 h earlier (48 h, … up to
+//                  the window), the usual baseline of day-ahead PV forecasting;
+//   operation   1. the operation plan (table operation_plan: t_in_c, flow_kg_s);
+//   (t_in_c,    2. the typical day of the window: the median, over the window's
+//    flow_kg_s)    days, of the value at the same minute of the (UTC) day.
+//
+// Timestamp convention as everywhere: a row's time is the start of its
+// interval; outputs are interval means (core/model/thermal_model.h). Forecast rows
+// are whole minutes when issued_at is.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/common/params.h"
+#include "core/common/plant.h"
+#include "core/common/series.h"
+#include "core/model/variant.h"
+
+namespace pvtwin {
+
+struct ForecastRequest {
+  std::int64_t issued_at_s = 0;      // first forecast row (unix s UTC)
+  double horizon_s = 86400.0;        // forecast length
+  double step_s = 60.0;              // row spacing of the forecast and of the inputs
+  double warmup_s = 86400.0;         // measured history simulated before the horizon
+  double max_interp_gap_s = 3600.0;  // longest gap in a forecast input bridged linearly
+};
+
+// Where each forecast row's inputs came from, counted over the horizon rows.
+struct ForecastInputUse {
+  std::size_t rows = 0;
+  std::size_t weather_forecast = 0;     // rows whose weather came (fully) from the forecast table
+  std::size_t weather_persistence = 0;  // rows with at least one persisted weather value
+  std::size_t weather_missing = 0;      // rows without a value for a needed weather channel
+  std::size_t operation_plan = 0;       // rows whose t_in_c and flow came from the plan
+  std::size_t operation_typical = 0;    // rows with a typical-day operation value
+  // One line for the forecast row's `inputs` column, e.g.
+  // "weather: forecast 1440/1440; operation: plan 0/1440, typical day 1440/1440".
+  std::string Describe() const;
+};
+
+struct Forecast {
+  // time_s and the output channels p_el_w, q_th_w, t_pv_c, t_out_c (NaN
+  // where an input was missing); the horizon rows only.
+  Series rows;
+  ForecastInputUse inputs;
+  // The model inputs of the horizon rows as used (weather and operation
+  // channels), for inspection.
+  Series inputs_used;
+};
+
+// history: measured 1-min rows up to issued_at (the calibration window or at
+// least the last day plus the warm-up); weather_forecast and operation_plan:
+// rows covering (part of) the horizon, possibly empty. Returns false with
+// *error when the history is too short to persist a day or warm up.
+bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                  const Series& history, const Series& weather_forecast,
+                  const Series& operation_plan, const ForecastRequest& request, Forecast* out,
+                  std::string* error);
+
+}  // namespace pvtwin

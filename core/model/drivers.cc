@@ -1,0 +1,225 @@
+// PrepareDrivers: measured series → per-row model inputs (thermal_model.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/common/units.h"
+#include "core/model/irradiance_drivers.h"
+#include "core/model/thermal_model.h"
+#include "core/physics/iam.h"
+#include "core/physics/irradiance.h"
+#include "core/physics/sky_radiation.h"
+#include "core/physics/solar_position.h"
+
+namespace pvtwin {
+
+namespace {
+
+bool AllPresent(const Series& s, const std::vector<Channel>& channels) {
+  return std::all_of(channels.begin(), channels.end(), [&s](Channel c) { return s.Has(c); });
+}
+
+std::string ChannelList(const std::vector<Channel>& channels) {
+  std::string out;
+  for (Channel c : channels) out += (out.empty() ? "" : " + ") + std::string(ChannelName(c));
+  return out;
+}
+
+// The raw drivers of the effect modules (core/common/model_data.h, Drivers): sun
+// geometry at the row middles, measured wind and sky temperature, the beam
+// part of the absorbed irradiance, the transposed GHI/DHI and the soiling
+// clock.
+void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d) {
+  const std::size_t n = s.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  d->wind_m_s = s.Has(Channel::kWindMS) ? s[Channel::kWindMS] : std::vector<double>(n, nan);
+  d->t_sky_c.assign(n, nan);
+  for (std::size_t i = 0; i < n; ++i) {
+    double t_sky_c = s.At(Channel::kTSkyC, i);
+    if (std::isnan(t_sky_c) && s.Has(Channel::kLwDownWM2)) {
+      t_sky_c = KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
+    }
+    d->t_sky_c[i] = t_sky_c;
+  }
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
+  d->sun_azimuth_rad.resize(n);
+  d->sun_elevation_rad.resize(n);
+  d->aoi_rad.resize(n);
+  d->g_beam_w_m2.assign(n, nan);
+  d->g_ref_w_m2.assign(n, nan);
+  const bool have_horizontal = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
+  for (std::size_t i = 0; i < n; ++i) {
+    d->sun_azimuth_rad[i] = sun[i].azimuth_rad;
+    d->sun_elevation_rad[i] = sun[i].elevation_rad;
+    double aoi_rad = s.At(Channel::kAoiRad, i);
+    if (std::isnan(aoi_rad)) {
+      aoi_rad = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
+                                    plant.azimuth_rad);
+    }
+    d->aoi_rad[i] = aoi_rad;
+    double beam_w_m2 = nan;
+    if (have_horizontal) {
+      IsotropicSkyInput h;
+      h.ghi_w_m2 = s[Channel::kGhiWM2][i];
+      h.dhi_w_m2 = s[Channel::kDhiWM2][i];
+      h.zenith_rad = sun[i].zenith_rad;
+      h.aoi_rad = aoi_rad;
+      h.tilt_rad = plant.tilt_rad;
+      h.ground_albedo = plant.ground_albedo;
+      const PoaComponents poa = TransposeIsotropicSky(h);
+      d->g_ref_w_m2[i] = poa.global_w_m2();
+      beam_w_m2 = poa.beam_w_m2;
+    }
+    const double g_poa = s.At(Channel::kGPoaWM2, i);
+    const double diffuse = s.At(Channel::kGPoaDiffuseWM2, i);
+    if (!std::isnan(g_poa) && !std::isnan(diffuse)) beam_w_m2 = std::max(0.0, g_poa - diffuse);
+    if (spec.iam) beam_w_m2 *= IamSoukaSafwat(aoi_rad, plant.iam_b0);
+    d->g_beam_w_m2[i] = beam_w_m2;
+  }
+  SetCleaningTimes({}, d);
+}
+
+}  // namespace
+
+void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t end,
+                               Drivers* coarse) {
+  double dt_s = 0.0;
+  for (std::size_t k = begin; k < end; ++k) dt_s += d.dt_s[k];
+  auto mean = [&](const std::vector<double>& v) {
+    double acc = 0.0;
+    for (std::size_t k = begin; k < end; ++k) acc += v[k] * d.dt_s[k];
+    return acc / dt_s;
+  };
+  const std::size_t mid = begin + (end - begin) / 2;
+  coarse->wind_m_s.push_back(mean(d.wind_m_s));
+  coarse->t_sky_c.push_back(mean(d.t_sky_c));
+  coarse->sun_azimuth_rad.push_back(d.sun_azimuth_rad[mid]);
+  coarse->sun_elevation_rad.push_back(d.sun_elevation_rad[mid]);
+  coarse->aoi_rad.push_back(d.aoi_rad[mid]);
+  coarse->g_beam_w_m2.push_back(mean(d.g_beam_w_m2));
+  coarse->g_ref_w_m2.push_back(mean(d.g_ref_w_m2));
+  coarse->days_since_clean.push_back(mean(d.days_since_clean));
+  coarse->irradiance_bias = d.irradiance_bias;
+}
+
+void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers* d) {
+  std::vector<std::int64_t> cleanings = cleaning_times_s;
+  std::sort(cleanings.begin(), cleanings.end());
+  const std::size_t n = d->size();
+  d->days_since_clean.resize(n);
+  if (n == 0) return;
+  std::int64_t last_clean_s = d->time_s[0];
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (next < cleanings.size() && cleanings[next] <= d->time_s[i]) {
+      last_clean_s = std::max(last_clean_s, cleanings[next]);
+      ++next;
+    }
+    d->days_since_clean[i] = static_cast<double>(d->time_s[i] - last_clean_s) / 86400.0;
+  }
+}
+
+bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d,
+                    std::string* error) {
+  std::string missing;
+  for (const InputRequirement& req : RequiredInputs(spec)) {
+    const bool ok = std::any_of(req.alternatives.begin(), req.alternatives.end(),
+                                [&s](const auto& set) { return AllPresent(s, set); });
+    if (ok) continue;
+    std::string options;
+    for (const auto& set : req.alternatives) {
+      options += (options.empty() ? "" : " or ") + ChannelList(set);
+    }
+    missing += (missing.empty() ? "" : "; ") + req.what + " (" + options + ")";
+  }
+  if (!missing.empty()) {
+    *error = "variant " + spec.Name() + " needs columns the data lacks: " + missing;
+    return false;
+  }
+  const std::size_t n = s.size();
+  if (n == 0) {
+    *error = "no data rows";
+    return false;
+  }
+  Drivers out;
+  out.spec = spec;
+  out.plant = plant;
+  out.time_s = s.time_s;
+  const double step_s = s.step_s > 0.0 ? s.step_s : 60.0;
+  // A gap longer than this restarts the states (paper 2.2 initialisation).
+  const double max_gap_s = std::max(3.0 * step_s, 600.0);
+  out.dt_s.resize(n);
+  out.restart.assign(n, 0);
+  out.usable.assign(n, 1);
+  out.restart[0] = 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double to_next = i + 1 < n ? static_cast<double>(s.time_s[i + 1] - s.time_s[i]) : step_s;
+    if (to_next > max_gap_s) {
+      out.dt_s[i] = step_s;
+      if (i + 1 < n) out.restart[i + 1] = 1;
+    } else {
+      out.dt_s[i] = to_next;
+    }
+  }
+
+  out.t_in_c = s[Channel::kTInC];
+  out.mdot_kg_s = s[Channel::kMdotKgS];
+  out.t_amb_c = s[Channel::kTAmbC];
+  out.t_back_c = s.Has(Channel::kTBackC) ? s[Channel::kTBackC] : s[Channel::kTAmbC];
+  for (std::size_t i = 0; i < n; ++i) {
+    // T_back = T_amb where the back temperature is not measured (free-standing field).
+    if (std::isnan(out.t_back_c[i])) out.t_back_c[i] = out.t_amb_c[i];
+    // Paper Table 1: small negative flows mean no flow.
+    if (out.mdot_kg_s[i] < 0.0) out.mdot_kg_s[i] = 0.0;
+  }
+
+  out.capacity_flow_w_k.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.capacity_flow_w_k[i] = out.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
+  }
+
+  ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2);
+  FillEffectDrivers(s, plant, spec, &out);
+  for (const ModelExtension* e : spec.extensions) {
+    if (e->prepare_drivers != nullptr && !e->prepare_drivers(s, &out, error)) return false;
+  }
+
+  out.ln_wind.assign(n, 0.0);
+  if (spec.ReadsWind()) {
+    const auto& wind = s[Channel::kWindMS];
+    for (std::size_t i = 0; i < n; ++i) {
+      out.ln_wind[i] = wind[i] > 0.0 ? std::log(wind[i])
+                                     : (wind[i] == 0.0 || wind[i] < 0.0
+                                            ? -std::numeric_limits<double>::infinity()
+                                            : wind[i]);  // NaN stays NaN
+    }
+  }
+  out.t_sky_k4.assign(n, 0.0);
+  if (spec.sky) {
+    const bool have_t_sky = s.Has(Channel::kTSkyC);
+    for (std::size_t i = 0; i < n; ++i) {
+      double t_sky_k = have_t_sky ? CToK(s[Channel::kTSkyC][i]) : std::nan("");
+      if (std::isnan(t_sky_k) && s.Has(Channel::kLwDownWM2)) {
+        t_sky_k = SkyTemperatureK(s[Channel::kLwDownWM2][i]);
+      }
+      out.t_sky_k4[i] = t_sky_k * t_sky_k * t_sky_k * t_sky_k;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const double inputs[] = {
+        out.t_in_c[i],
+        out.mdot_kg_s[i],
+        out.t_amb_c[i],
+        out.t_back_c[i],
+        out.g_poa_w_m2[i],
+        out.g_abs_w_m2[i],
+        out.ln_wind[i] == -std::numeric_limits<double>::infinity() ? 0.0 : out.ln_wind[i],
+        out.t_sky_k4[i]};
+    out.usable[i] = std::all_of(std::begin(inputs), std::end(inputs),
+                                [](double v) { return std::isfinite(v); });
+  }
+  *d = std::move(out);
+  return true;
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,74 @@
+#include "core/model/irradiance_drivers.h"
+
+#include <cmath>
+
+#include "core/physics/iam.h"
+#include "core/physics/irradiance.h"
+#include "core/physics/solar_position.h"
+
+namespace pvtwin {
+
+std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) {
+  std::vector<double> mid_s(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    mid_s[i] = static_cast<double>(s.time_s[i]) + 0.5 * s.step_s;
+  }
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  site.elevation_m = plant.elevation_m;
+  std::vector<SolarPosition> sun;
+  ComputeSolarPositions(mid_s, site, &sun);
+  return sun;
+}
+
+void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
+                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2) {
+  const std::size_t n = s.size();
+  const bool measured_poa = s.Has(Channel::kGPoaWM2);
+  const bool measured_aoi = s.Has(Channel::kAoiRad);
+  const bool have_horizontal = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
+  // A row whose measured g_poa is missing falls back to the transposition, so
+  // the sun is needed wherever GHI and DHI are, measured POA or not.
+  const bool need_sun = have_horizontal || (spec.iam && !measured_aoi);
+  const std::vector<SolarPosition> sun =
+      need_sun ? SunAtRowMiddles(s, plant) : std::vector<SolarPosition>{};
+  const EffectiveDiffuseAngles diffuse_angles = BrandemuehlBeckmanAngles(plant.tilt_rad);
+  g_poa_w_m2->assign(n, std::nan(""));
+  g_abs_w_m2->assign(n, std::nan(""));
+  for (std::size_t i = 0; i < n; ++i) {
+    double aoi_rad = measured_aoi ? s[Channel::kAoiRad][i] : std::nan("");
+    if (std::isnan(aoi_rad) && !sun.empty()) {
+      aoi_rad = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
+                                    plant.azimuth_rad);
+    }
+    PoaComponents poa;
+    const double measured = measured_poa ? s[Channel::kGPoaWM2][i] : std::nan("");
+    if (!std::isnan(measured)) {
+      MeasuredPoaInput m;
+      m.g_poa_w_m2 = measured;
+      m.g_poa_diffuse_w_m2 = s.At(Channel::kGPoaDiffuseWM2, i);
+      m.ghi_w_m2 = s.At(Channel::kGhiWM2, i);
+      m.tilt_rad = plant.tilt_rad;
+      m.ground_albedo = plant.ground_albedo;
+      poa = SplitMeasuredPoa(m);
+      (*g_poa_w_m2)[i] = measured;
+    } else if (have_horizontal) {
+      IsotropicSkyInput h;
+      h.ghi_w_m2 = s[Channel::kGhiWM2][i];
+      h.dhi_w_m2 = s[Channel::kDhiWM2][i];
+      h.zenith_rad = sun[i].zenith_rad;
+      h.aoi_rad = aoi_rad;
+      h.tilt_rad = plant.tilt_rad;
+      h.ground_albedo = plant.ground_albedo;
+      poa = TransposeIsotropicSky(h);
+      (*g_poa_w_m2)[i] = poa.global_w_m2();
+    } else {
+      continue;  // no irradiance for this row
+    }
+    (*g_abs_w_m2)[i] = spec.iam ? AbsorbedIrradianceWM2(poa, aoi_rad, diffuse_angles, plant.iam_b0)
+                                : (*g_poa_w_m2)[i];
+  }
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,30 @@
+// Irradiance inputs of the model for each row: the global irradiance in the
+// collector plane I_gt (used by the PV efficiency correction) and the
+// absorbed irradiance I_at (paper 2.5; equal to I_gt without the 'I' option).
+#pragma once
+
+#include <vector>
+
+#include "core/common/plant.h"
+#include "core/common/series.h"
+#include "core/model/variant.h"
+#include "core/physics/solar_position.h"
+
+namespace pvtwin {
+
+// Sun position at the middle of each row (a row is the mean over
+// [t_k, t_k + step)), at the plant's site.
+std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant);
+
+// Sources, in order of preference:
+//  * I_gt: measured g_poa_w_m2; else transposed from ghi_w_m2 + dhi_w_m2
+//    (isotropic sky, paper 2.5) with the sun at the middle of the row.
+//  * I_at ('I' variants): beam and diffuse parts from g_poa_diffuse_w_m2
+//    when measured, else from the transposition; each part weighted with the
+//    Souka & Safwat IAM at its angle (aoi_deg when measured, else computed;
+//    Brandemuehl & Beckman angles for sky and ground diffuse).
+// Rows whose inputs are missing get NaN.
+void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
+                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2);
+
+}  // namespace pvtwin

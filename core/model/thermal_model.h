@@ -1,0 +1,69 @@
+// The PVT grey-box model of the paper (sections 2.1–2.10): one or two
+// temperature nodes, optional capacitances, wind and sky long-wave losses,
+// beam/diffuse split with an IAM, PV efficiency with temperature and
+// irradiance correction; plus the hooks of the effects beyond the paper's
+// letters (ModelExtension, core/common/model_spec.h), which the model runs
+// without knowing them by name.
+//
+// Network (Fig. 1 of the paper; per m² values × A_PVT):
+//   PV node T_PV:   Q_abs(T_PV) + U_front,w·(T_amb − T_PV) + U_rad·(T_sky − T_PV)
+//                   [+ U_coll·(T_coll − T_PV)]                = C_PV·dT_PV/dt
+//   collector node T_coll (2N):
+//                   U_back·(T_back − T_coll) + U_fluid·(T_in − T_coll)
+//                   + U_coll·(T_PV − T_coll)                  = C_coll·dT_coll/dt
+//   In the one-node model the back and fluid links attach to T_PV (paper 2.10).
+//   Q_abs = (1 − η_PV)·F_th·A_PVT·I_at (eq. 2.3), P_el = η_PV·A_PVT·I_at,
+//   Q_u = U_fluid·(T_fluid-node − T_in).
+//
+// Time convention: row k of the input is the mean over [t_k, t_k + dt_k); the
+// model holds row k's inputs constant over that interval, advances the
+// capacitive nodes exactly (rc_network.h) and reports interval means, so an
+// output row is comparable with a logged average. The states start (first
+// row, after a gap or a row with missing inputs) at the steady state of that
+// row's inputs (paper 2.2).
+//
+// Non-linear terms: η_PV is linear in T_PV and sky radiation ε·σ·(T_PV⁴ −
+// T_sky⁴) is linearised about the step-mean T_PV (Newton); the linearisation
+// point is updated until the remaining linearisation error moves T_PV by less
+// than kNodeToleranceK (at most kMaxNodeIterations passes). The step is exact
+// for the linear part at any step length, so every variant is stable for any
+// parameter within Table 3's bounds and any step from 5 s to 15 min.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/common/model_data.h"
+#include "core/common/params.h"
+#include "core/common/plant.h"
+#include "core/common/series.h"
+#include "core/model/variant.h"
+
+namespace pvtwin {
+
+inline constexpr double kNodeToleranceK = 1e-4;
+inline constexpr int kMaxNodeIterations = 8;
+
+// Builds the drivers of `spec` from measured data. Fails (false, *error says
+// which inputs are missing) when the series lacks a channel the variant needs.
+// Gaps longer than max_gap_s restart the states.
+bool PrepareDrivers(const Series& series, const Plant& plant, const ModelSpec& spec,
+                    Drivers* drivers, std::string* error);
+
+// soiling: cleanings (rain or washing) at these unix times reset the soiling
+// loss; recomputes drivers->days_since_clean. Times need not be sorted.
+void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers* drivers);
+
+// Appends to *coarse the effect modules' raw drivers of rows [begin, end) of d
+// averaged to one row (time-weighted means; sun angles of the middle row),
+// for a coarsened copy of d such as identification's coarse stage builds.
+void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t end,
+                               Drivers* coarse);
+
+// Runs the model. `out` is resized to the drivers' length; reusing it between
+// calls avoids any allocation.
+void Simulate(const Drivers& drivers, const ParamVector& params, SimOutputs* out,
+              const SimOptions& options = {});
+
+}  // namespace pvtwin

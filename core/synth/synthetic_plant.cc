@@ -1,0 +1,248 @@
+#include "core/synth/synthetic_plant.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <random>
+
+#include "core/common/units.h"
+#include "core/effects/effects.h"
+#include "core/model/thermal_model.h"
+
+namespace pvtwin {
+
+namespace {
+
+// Standard normal deviate (Box–Muller), independent of the standard
+// library's distribution implementations.
+double Normal(std::mt19937_64& rng) {
+  constexpr double kScale = 1.0 / 18446744073709551616.0;  // 2^-64
+  const double u1 = (static_cast<double>(rng()) + 0.5) * kScale;
+  const double u2 = (static_cast<double>(rng()) + 0.5) * kScale;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.14159265358979323846 * u2);
+}
+
+}  // namespace
+
+Plant DesignExamplePlant() {
+  Plant plant;  // fluid and PV defaults are the example's values
+  plant.latitude_rad = DegToRad(47.358);
+  plant.longitude_rad = DegToRad(16.128);
+  plant.tilt_rad = DegToRad(20.0);
+  plant.azimuth_rad = DegToRad(180.0);
+  plant.area_m2 = 1.8;
+  return plant;
+}
+
+ParamVector ReferenceTruthParams(const Plant& plant) {
+  ParamVector p = StartParams(plant);
+  auto set = [&p](Param name, double v) { p[static_cast<std::size_t>(name)] = v; };
+  set(Param::kEtaPvRef, 0.17);
+  set(Param::kFTh, 0.92);
+  set(Param::kEpsPvt, 0.12);
+  set(Param::kUFrontWM2K, 14.0);
+  set(Param::kUBackWM2K, 1.5);
+  set(Param::kUCollWM2K, 45.0);
+  set(Param::kR0FluidM2KW, 0.01);
+  set(Param::kR1Fluid, 1.2);
+  set(Param::kCPvJM2K, 1.2e4);
+  set(Param::kCCollJM2K, 3.5e4);
+  set(Param::kRRefWind, 0.02);
+  set(Param::kNWind, 0.8);
+  set(Param::kUWindWM2K, 3.0);
+  set(Param::kTransportDelayS, 45.0);
+  return p;
+}
+
+ParamVector TruthParamsFor(const Plant& plant, const ModelSpec& spec) {
+  ParamVector p = ReferenceTruthParams(plant);
+  for (const EffectModule* m : EffectRegistry()) {
+    if (!HasEffect(spec, *m)) continue;
+    for (const auto& [param, value] : m->typical_truth) {
+      p[static_cast<std::size_t>(param)] = value;
+    }
+  }
+  return p;
+}
+
+AbsorberSensorParams SensorParamsFromTruth(const ModelSpec& truth_spec, const ParamVector& truth) {
+  auto get = [&truth](Param name) { return truth[static_cast<std::size_t>(name)]; };
+  AbsorberSensorParams a;
+  a.absorbed_fraction = (1.0 - get(Param::kEtaPvRef)) * get(Param::kFTh);
+  a.u_front_w_m2k = get(Param::kUFrontWM2K);
+  a.u_back_w_m2k = get(Param::kUBackWM2K);
+  // The physical wind form's coefficient, when the truth uses it.
+  a.u_wind_w_m2k = UsedParams(truth_spec).test(static_cast<std::size_t>(Param::kUWindWM2K))
+                       ? get(Param::kUWindWM2K)
+                       : 0.0;
+  a.n_wind = get(Param::kNWind);
+  a.eps_lw = truth_spec.sky ? get(Param::kEpsPvt) : 0.0;
+  a.r_internal_m2k_w = truth_spec.nodes == 2 ? 1.0 / get(Param::kUCollWM2K) : 0.0;
+  a.r0_fluid_m2k_w = get(Param::kR0FluidM2KW);
+  a.r1_fluid = get(Param::kR1Fluid);
+  a.c_j_m2k = (truth_spec.c_pv ? get(Param::kCPvJM2K) : 0.0) +
+              (truth_spec.c_coll ? get(Param::kCCollJM2K) : 0.0);
+  if (a.c_j_m2k <= 0.0) a.c_j_m2k = get(Param::kCCollJM2K);  // a static truth: the sensor's own lag
+  return a;
+}
+
+std::string_view DisturbanceName(DisturbanceKind kind) {
+  switch (kind) {
+    case DisturbanceKind::kFailingPump:
+      return "failing_pump";
+    case DisturbanceKind::kStuckFlowReading:
+      return "stuck_flow_reading";
+    case DisturbanceKind::kSnowCover:
+      return "snow_cover";
+  }
+  return "?";
+}
+
+bool DefaultSyntheticOptions(const Plant& plant, std::string_view truth_variant, int days,
+                             std::uint64_t seed, SyntheticOptions* options, std::string* error) {
+  SyntheticOptions o;
+  if (!ParseVariant(truth_variant, &o.truth_spec, error)) return false;
+  o.weather.num_days = days;
+  o.weather.step_s = 60.0;
+  o.weather.seed = seed;
+  o.weather.flow_mode = FlowMode::kVariable;
+  o.truth = TruthParamsFor(plant, o.truth_spec);
+  o.noise = RealisticSensorNoise(seed + 1000);
+  o.defects = PaperDataDefects(seed + 2000);
+  *options = o;
+  return true;
+}
+
+namespace {
+
+bool InWindow(const Disturbance& d, std::int64_t t_s) { return t_s >= d.start_s && t_s < d.end_s; }
+
+// Applies the data defects in place (own random stream: the outputs' noise
+// does not depend on them).
+void InjectDefects(const DataDefects& defects, Series* s) {
+  std::mt19937_64 rng(defects.seed);
+  const std::size_t n = s->size();
+  if (n == 0) return;
+  auto uniform = [&rng](double a, double b) {
+    return a + (b - a) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
+  };
+  auto row = [&rng, n]() { return static_cast<std::size_t>(rng() % n); };
+  auto& g_poa = (*s)[Channel::kGPoaWM2];
+  for (int k = 0, tries = 0; k < defects.irradiance_glitches && tries < 10000; ++tries) {
+    const std::size_t i = row();
+    if (g_poa[i] != 0.0) continue;  // only at night, as in the paper
+    g_poa[i] = uniform(5001.0, 9999.0);
+    ++k;
+  }
+  if (defects.negative_flow_at_rest) {
+    auto& flow = (*s)[Channel::kMdotKgS];
+    for (double& f : flow) {
+      if (f == 0.0) f = -uniform(0.0, 0.8e-3);
+    }
+  }
+  auto block = [&](std::size_t len, auto&& apply) {
+    const std::size_t i0 = row();
+    for (std::size_t i = i0; i < std::min(n, i0 + len); ++i) apply(i);
+  };
+  auto& valid = s->Ensure(Channel::kValid);
+  for (int k = 0; k < defects.invalid_blocks; ++k) {
+    block(30, [&valid](std::size_t i) { valid[i] = 0.0; });
+  }
+  const double nan = std::nan("");
+  for (int k = 0; k < defects.dropout_blocks; ++k) {
+    block(10, [s, nan](std::size_t i) {
+      (*s)[Channel::kTOutC][i] = nan;
+      (*s)[Channel::kQThW][i] = nan;
+    });
+  }
+}
+
+}  // namespace
+
+Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options) {
+  WeatherOptions weather = options.weather;
+  weather.absorber = SensorParamsFromTruth(options.truth_spec, options.truth);
+  Series s = GenerateWeather(plant, weather);
+  const std::size_t n = s.size();
+  // The plant's physics: the real flow and irradiance under disturbances, the
+  // true irradiance (irradiance_bias is a sensor error, applied below).
+  Series physics = s;
+  for (const Disturbance& d : options.disturbances) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!InWindow(d, s.time_s[i])) continue;
+      switch (d.kind) {
+        case DisturbanceKind::kFailingPump:
+          physics[Channel::kMdotKgS][i] *= d.severity;
+          break;
+        case DisturbanceKind::kStuckFlowReading:
+          physics[Channel::kMdotKgS][i] = 0.0;
+          break;
+        case DisturbanceKind::kSnowCover:
+          for (Channel c :
+               {Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2, Channel::kGhiWM2, Channel::kDhiWM2}) {
+            if (physics.Has(c)) physics[c][i] *= d.severity;
+          }
+          break;
+      }
+    }
+  }
+  // Sensor errors act on the measurements below, not on the physics.
+  ModelSpec physics_spec = options.truth_spec;
+  for (const EffectModule* m : EffectRegistry()) {
+    if (m->apply_sensor_error != nullptr && m->extension != nullptr) {
+      physics_spec.Remove(*m->extension);
+    }
+  }
+  Drivers drivers;
+  std::string error;
+  if (!PrepareDrivers(physics, plant, physics_spec, &drivers, &error)) {
+    std::cerr << "MakeSyntheticPlantData: " << error << "\n";
+    std::abort();  // the generator provides every channel: a bug
+  }
+  if (!options.cleaning_times_s.empty()) SetCleaningTimes(options.cleaning_times_s, &drivers);
+  SimOutputs out;
+  Simulate(drivers, options.truth, &out);
+  const SensorNoise& noise = options.noise;
+  std::mt19937_64 rng(noise.seed);
+  auto& p_el = s.Ensure(Channel::kPElW);
+  auto& q_th = s.Ensure(Channel::kQThW);
+  auto& t_out = s.Ensure(Channel::kTOutC);
+  auto& t_pv = s.Ensure(Channel::kTPvC);
+  const auto& flow_read = s[Channel::kMdotKgS];
+  for (std::size_t i = 0; i < n; ++i) {
+    p_el[i] = out.p_el_w[i] * (1.0 + noise.p_el_rel * Normal(rng));
+    // A heat meter reads zero without flow.
+    const double q_noise = noise.q_th_w * Normal(rng);
+    q_th[i] = out.q_th_w[i] + (drivers.mdot_kg_s[i] > 0.0 ? q_noise : 0.0);
+    t_out[i] = out.t_out_c[i] + noise.t_out_c * Normal(rng);
+    t_pv[i] = out.t_pv_c[i];
+    if (flow_read[i] != drivers.mdot_kg_s[i]) {
+      // Disturbed flow: the heat meter multiplies its flow reading by the
+      // real temperature rise.
+      q_th[i] = flow_read[i] > 0.0
+                    ? flow_read[i] * plant.fluid_cp_j_kgk * (t_out[i] - s[Channel::kTInC][i])
+                    : 0.0;
+    }
+  }
+  for (const EffectModule* m : EffectRegistry()) {
+    if (m->apply_sensor_error != nullptr && HasEffect(options.truth_spec, *m)) {
+      m->apply_sensor_error(options.truth, &s);
+    }
+  }
+  InjectDefects(options.defects, &s);
+  return s;
+}
+
+Series MakeSyntheticPlantData(const Plant& plant, const WeatherOptions& weather,
+                              const ModelSpec& truth_spec, const ParamVector& truth,
+                              const SensorNoise& noise) {
+  SyntheticOptions options;
+  options.weather = weather;
+  options.truth_spec = truth_spec;
+  options.truth = truth;
+  options.noise = noise;
+  return MakeSyntheticPlantData(plant, options);
+}
+
+}  // namespace pvtwin

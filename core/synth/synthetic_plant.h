@@ -1,0 +1,132 @@
+// Synthetic operation data of a PVT field: generated weather and operation
+// (weather_generator.h) run through a "truth" model variant with known
+// parameters, with optional sensor noise. The basis of identification tests
+// on data with a known answer, of benchmarks and of the demo.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/common/params.h"
+#include "core/common/series.h"
+#include "core/model/variant.h"
+#include "core/synth/weather_generator.h"
+
+namespace pvtwin {
+
+// Sensor noise (1 σ, Gaussian, independent per row), as data-sheet classes of
+// typical monitoring sensors: a class-A Pt100 pair on the fluid, a power
+// meter on the PV, a heat meter on the fluid.
+struct SensorNoise {
+  double t_out_c = 0.0;   // K
+  double p_el_rel = 0.0;  // fraction of the reading
+  double q_th_w = 0.0;    // W
+  std::uint64_t seed = 1;
+};
+
+inline SensorNoise RealisticSensorNoise(std::uint64_t seed) { return {0.05, 0.005, 5.0, seed}; }
+
+// The plant of DESIGN.md's example [plant] section: 47.358° N, 16.128° E,
+// 20° tilt facing south, 1.8 m², the paper's fluid and PV reference data.
+Plant DesignExamplePlant();
+
+// A plausible uncovered PVT collector, inside Table 3's bounds, used as the
+// known answer of synthetic tests.
+ParamVector ReferenceTruthParams(const Plant& plant);
+
+// The absorber sensor of the plant's controller (absorber_sensor.h) with the
+// truth's parameters: (1 − η_PV,ref)·F_th, U_front, U_back, the physical wind
+// form if the truth has it (the paper's 'w' form is left out: the sensor is
+// a close estimate, not the truth), ε if it has sky radiation, the fluid
+// coupling r0/r1 with 1/U_coll in series for two nodes, C_PV + C_coll.
+AbsorberSensorParams SensorParamsFromTruth(const ModelSpec& truth_spec, const ParamVector& truth);
+
+// Weather and operation from `weather`, outputs p_el_w, q_th_w, t_out_c and
+// t_pv_c from `truth_spec` with `truth`, then noise on p_el_w, q_th_w and
+// t_out_c (q_th_w stays consistent with flow and the noisy outlet: the heat
+// meter's noise is applied on q_th_w itself).
+Series MakeSyntheticPlantData(const Plant& plant, const WeatherOptions& weather,
+                              const ModelSpec& truth_spec, const ParamVector& truth,
+                              const SensorNoise& noise);
+
+// ---------------------------------------------------------------------------
+// The truth model for the gap diagnosis: any variant with effects
+// ("1N1Cwr+pv_clipping+shading") at a chosen magnitude, realistic operation,
+// noise, the paper's data defects and uncatalogued disturbances.
+
+// ReferenceTruthParams with EffectInfo::typical_truth of every effect that
+// spec has (HasEffect), letters included.
+ParamVector TruthParamsFor(const Plant& plant, const ModelSpec& spec);
+
+// Plant faults that no catalogued effect explains (the diagnosis's
+// `unknown` cases). Each acts on rows with start_s ≤ time < end_s.
+enum class DisturbanceKind {
+  // The pump fails: the real flow is `severity` × the reading (a clogged
+  // strainer, a dying pump). The heat meter multiplies the (normal) flow
+  // reading by the real temperature rise, so q_th_w and t_out_c run high.
+  kFailingPump,
+  // The pump stands still while the flow meter keeps its last reading (a
+  // stuck sensor): the collector stagnates; t_out_c is the stagnant fluid.
+  kStuckFlowReading,
+  // Snow (or a tarpaulin) covers the field: the pyranometers, mounted apart,
+  // still see the sun, the collector absorbs `severity` × the irradiance
+  // (0 = total cover), so P_el and Q_u are near zero.
+  kSnowCover,
+};
+
+std::string_view DisturbanceName(DisturbanceKind kind);
+
+struct Disturbance {
+  DisturbanceKind kind = DisturbanceKind::kFailingPump;
+  std::int64_t start_s = 0;  // unix s UTC
+  std::int64_t end_s = 0;
+  double severity = 0.0;  // kFailingPump: real/read flow; kSnowCover: transmitted fraction
+};
+
+// The paper's data defects (Tables 1 and 2, core/data/qc.h), injected so that the
+// data path's corrections are exercised: consumers run ApplyPaperCorrections
+// (qc.h) as the CSV import and the poller do.
+struct DataDefects {
+  // Night rows whose short-wave irradiance reads above 5000 W/m² (Table 2).
+  int irradiance_glitches = 0;
+  // While the pump stands, the magnetic-inductive meter reads small negative
+  // flows in [−0.8e-3, 0) kg/s (Table 1; corrected to 0).
+  bool negative_flow_at_rest = false;
+  // Blocks of 30 rows marked valid = 0 (maintenance, logger restarts).
+  int invalid_blocks = 0;
+  // Blocks of 10 rows where t_out_c and q_th_w are missing (sensor dropout).
+  int dropout_blocks = 0;
+  std::uint64_t seed = 7;
+};
+
+inline DataDefects PaperDataDefects(std::uint64_t seed) { return {6, true, 4, 4, seed}; }
+
+struct SyntheticOptions {
+  WeatherOptions weather;
+  ModelSpec truth_spec;
+  ParamVector truth{};
+  SensorNoise noise;
+  std::vector<Disturbance> disturbances;
+  DataDefects defects;
+  // soiling: cleanings (rain) that reset the loss; none = soiling from the
+  // first row (SetCleaningTimes).
+  std::vector<std::int64_t> cleaning_times_s;
+};
+
+// Multi-week data as a real plant delivers it: `days` days of 1-min rows
+// from 2024-06-01 with drawn clear/broken/overcast days, variable flow with
+// pump starts and stops, the inlet drifting with the tank, realistic sensor
+// noise and the paper's data defects, truth = TruthParamsFor(variant). False
+// (with *error) when the variant does not parse.
+bool DefaultSyntheticOptions(const Plant& plant, std::string_view truth_variant, int days,
+                             std::uint64_t seed, SyntheticOptions* options, std::string* error);
+
+// The data of SyntheticOptions. The truth model is options.truth_spec with
+// options.truth; irradiance_bias is a sensor error: the physics sees the true
+// irradiance and g_poa_w_m2 (and g_poa_diffuse_w_m2) are written divided by
+// (1 + k). Aborts on a bad weather option (a caller bug, as GenerateWeather).
+Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options);
+
+}  // namespace pvtwin

@@ -49,6 +49,7 @@ void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSp
       m.g_poa_w_m2 = measured;
       m.g_poa_diffuse_w_m2 = s.At(Channel::kGPoaDiffuseWM2, i);
       m.ghi_w_m2 = s.At(Channel::kGhiWM2, i);
+      m.dhi_w_m2 = s.At(Channel::kDhiWM2, i);
       m.tilt_rad = plant.tilt_rad;
       m.ground_albedo = plant.ground_albedo;
       poa = SplitMeasuredPoa(m);

@@ -38,6 +38,21 @@ PoaComponents SplitMeasuredPoa(const MeasuredPoaInput& in) {
   }
   const double global_w_m2 = std::max(0.0, in.g_poa_w_m2);
   if (!std::isfinite(in.g_poa_diffuse_w_m2)) {
+    if (std::isfinite(in.ghi_w_m2) && std::isfinite(in.dhi_w_m2)) {
+      // Paper 2.5 with the measured horizontal global and diffuse.
+      PoaComponents poa;
+      poa.sky_diffuse_w_m2 = 0.5 * (1.0 + std::cos(in.tilt_rad)) * std::max(0.0, in.dhi_w_m2);
+      poa.ground_diffuse_w_m2 =
+          in.ground_albedo * 0.5 * (1.0 - std::cos(in.tilt_rad)) * std::max(0.0, in.ghi_w_m2);
+      const double diffuse_w_m2 = poa.sky_diffuse_w_m2 + poa.ground_diffuse_w_m2;
+      if (diffuse_w_m2 > global_w_m2) {
+        const double scale = diffuse_w_m2 > 0.0 ? global_w_m2 / diffuse_w_m2 : 0.0;
+        poa.sky_diffuse_w_m2 *= scale;
+        poa.ground_diffuse_w_m2 *= scale;
+      }
+      poa.beam_w_m2 = std::max(0.0, global_w_m2 - diffuse_w_m2);
+      return poa;
+    }
     // Not observable without an in-plane diffuse: everything is beam.
     return {global_w_m2, 0.0, 0.0};
   }

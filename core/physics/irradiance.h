@@ -58,6 +58,7 @@ struct MeasuredPoaInput {
   // when not measured.
   double g_poa_diffuse_w_m2 = std::numeric_limits<double>::quiet_NaN();
   double ghi_w_m2 = std::numeric_limits<double>::quiet_NaN();  // I_gh; NaN when not measured
+  double dhi_w_m2 = std::numeric_limits<double>::quiet_NaN();  // I_dh; NaN when not measured
   double tilt_rad = 0.0;                                       // β
   double ground_albedo = 0.2;                                  // ρ_gnd
 };
@@ -75,10 +76,20 @@ struct MeasuredPoaInput {
 //   beam   = I_gt − D.
 // The parts are ≥ 0 and sum to max(0, I_gt) (up to rounding).
 //
-// Without a measured in-plane diffuse (NaN), the split is not observable:
-// the whole of max(0, I_gt) is returned as beam, and the caller applies the
-// beam IAM at the measured or computed angle of incidence to all of it
-// (the documented fallback). NaN I_gt gives NaN parts.
+// Without a measured in-plane diffuse but with I_gh and I_dh measured (the
+// paper's own set-up, Table 2: I_gt_m, I_gh_m, I_dh_m), the diffuse parts are
+// paper 2.5's:
+//   I_dsky = (1 + cos β)/2 · I_dh,   I_dgd = ρ_gnd · (1 − cos β)/2 · I_gh,
+//   beam   = I_gt − I_dsky − I_dgd.
+// A row whose diffuse parts exceed the measured I_gt (an overcast sky that
+// is not isotropic, or the sensors disagree) would get a negative beam; there
+// the beam is 0 and the two diffuse parts are scaled down to sum to I_gt, so
+// that no row absorbs more than its measured global irradiance.
+//
+// With neither, the split is not observable: the whole of max(0, I_gt) is
+// returned as beam, and the caller applies the beam IAM at the measured or
+// computed angle of incidence to all of it (the documented fallback). NaN
+// I_gt gives NaN parts.
 PoaComponents SplitMeasuredPoa(const MeasuredPoaInput& in);
 
 // Effective incidence angles of isotropic sky-diffuse and ground-reflected

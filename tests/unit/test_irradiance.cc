@@ -1,10 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/common/units.h"
+#include "core/model/thermal_model.h"
 #include "core/physics/irradiance.h"
 #include "core/physics/solar_position.h"
+#include "core/synth/synthetic_plant.h"
+#include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
@@ -129,7 +134,7 @@ TEST(Irradiance, SplitMeasuredPoaWithInPlaneDiffuse) {
 TEST(Irradiance, SplitMeasuredPoaFallsBackToAllBeamWithoutDiffuse) {
   MeasuredPoaInput in;
   in.g_poa_w_m2 = 640.0;
-  in.ghi_w_m2 = 600.0;
+  in.ghi_w_m2 = 600.0;  // without I_dh the split is not observable
   in.tilt_rad = DegToRad(20.0);
   const PoaComponents poa = SplitMeasuredPoa(in);
   EXPECT_EQ(poa.beam_w_m2, 640.0);
@@ -179,6 +184,94 @@ TEST(Irradiance, SplitInvertsTransposition) {
   EXPECT_NEAR(back.beam_w_m2, forward.beam_w_m2, 1e-9);
   EXPECT_NEAR(back.sky_diffuse_w_m2, forward.sky_diffuse_w_m2, 1e-9);
   EXPECT_NEAR(back.ground_diffuse_w_m2, forward.ground_diffuse_w_m2, 1e-9);
+}
+
+// Paper 2.5 with the measured I_gt, I_gh and I_dh (the paper's set-up, Table
+// 2) and no in-plane diffuse: β = 30°, ρ = 0.2, I_gt = 800, I_gh = 700,
+// I_dh = 150 W/m²:
+//   I_dsky = (1 + cos 30°)/2 · 150 = 0.9330127 · 150      = 139.951905 W/m²
+//   I_dgd  = 0.2 · (1 − cos 30°)/2 · 700 = 0.2·0.0669873·700 = 9.378222 W/m²
+//   beam   = 800 − 139.951905 − 9.378222                  = 650.669873 W/m²
+// (the old fallback took all 800 W/m² as beam, giving the diffuse light the
+// beam's incidence angle modifier).
+TEST(Irradiance, SplitMeasuredPoaWithGhiAndDhiIsThePapersEquation) {
+  MeasuredPoaInput in;
+  in.g_poa_w_m2 = 800.0;
+  in.ghi_w_m2 = 700.0;
+  in.dhi_w_m2 = 150.0;
+  in.tilt_rad = DegToRad(30.0);
+  in.ground_albedo = 0.2;
+  PoaComponents poa = SplitMeasuredPoa(in);
+  EXPECT_NEAR(poa.sky_diffuse_w_m2, 139.951905, 1e-6);
+  EXPECT_NEAR(poa.ground_diffuse_w_m2, 9.378222, 1e-6);
+  EXPECT_NEAR(poa.beam_w_m2, 650.669873, 1e-6);
+  // An overcast row whose diffuse parts exceed the measured global: no beam,
+  // the diffuse parts scaled to the global (120 → 111.96 + 1.61 = 113.57 W/m²
+  // of diffuse against 100 W/m² measured).
+  in.g_poa_w_m2 = 100.0;
+  in.ghi_w_m2 = 120.0;
+  in.dhi_w_m2 = 120.0;
+  poa = SplitMeasuredPoa(in);
+  EXPECT_EQ(poa.beam_w_m2, 0.0);
+  EXPECT_NEAR(poa.global_w_m2(), 100.0, 1e-9);
+  EXPECT_NEAR(poa.ground_diffuse_w_m2 / poa.sky_diffuse_w_m2,
+              0.2 * (1 - std::cos(DegToRad(30.0))) * 120 / ((1 + std::cos(DegToRad(30.0))) * 120),
+              1e-12);
+  // A measured in-plane diffuse still takes precedence.
+  in.g_poa_w_m2 = 800.0;
+  in.g_poa_diffuse_w_m2 = 200.0;
+  EXPECT_NEAR(SplitMeasuredPoa(in).beam_w_m2, 600.0, 1e-9);
+}
+
+// Transposing GHI/DHI and splitting the in-plane global with only GHI and DHI
+// beside it gives the same parts back.
+TEST(Irradiance, SplitWithGhiAndDhiInvertsTransposition) {
+  IsotropicSkyInput sky = ClearNoon();
+  sky.tilt_rad = DegToRad(35.0);
+  sky.aoi_rad = DegToRad(12.0);
+  const PoaComponents forward = TransposeIsotropicSky(sky);
+  MeasuredPoaInput measured;
+  measured.g_poa_w_m2 = forward.global_w_m2();
+  measured.ghi_w_m2 = sky.ghi_w_m2;
+  measured.dhi_w_m2 = sky.dhi_w_m2;
+  measured.tilt_rad = sky.tilt_rad;
+  measured.ground_albedo = sky.ground_albedo;
+  const PoaComponents back = SplitMeasuredPoa(measured);
+  EXPECT_NEAR(back.beam_w_m2, forward.beam_w_m2, 1e-9);
+  EXPECT_NEAR(back.sky_diffuse_w_m2, forward.sky_diffuse_w_m2, 1e-9);
+  EXPECT_NEAR(back.ground_diffuse_w_m2, forward.ground_diffuse_w_m2, 1e-9);
+}
+
+// The model end to end: noise-free data of a truth with the beam/diffuse
+// split (2N1CcolwrI) whose logger kept the in-plane global, GHI and DHI but
+// no in-plane diffuse are simulated by the truth's own parameters as well as
+// with the in-plane diffuse (the paper's set-up; before paper 2.5 was used
+// here, the diffuse light got the beam IAM and the heat was off).
+TEST(Irradiance, AnIVariantWithoutInPlaneDiffuseReproducesItsTruthFromGhiAndDhi) {
+  const Plant plant = DesignExamplePlant();
+  WeatherOptions weather;
+  weather.num_days = 2;
+  weather.step_s = 60.0;
+  weather.seed = 5;
+  const ModelSpec spec = testing::SpecOf("2N1CcolwrI");
+  const ParamVector truth = ReferenceTruthParams(plant);
+  Series s = MakeSyntheticPlantData(plant, weather, spec, truth, SensorNoise{});
+  ASSERT_TRUE(s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2) && s.Has(Channel::kGPoaWM2));
+  s.columns[static_cast<std::size_t>(Channel::kGPoaDiffuseWM2)].clear();
+  Drivers drivers;
+  std::string error;
+  ASSERT_TRUE(PrepareDrivers(s, plant, spec, &drivers, &error)) << error;
+  SimOutputs sim;
+  Simulate(drivers, truth, &sim);
+  double worst_q = 0.0, worst_p = 0.0, max_q = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    worst_q = std::max(worst_q, std::fabs(sim.q_th_w[i] - s[Channel::kQThW][i]));
+    worst_p = std::max(worst_p, std::fabs(sim.p_el_w[i] - s[Channel::kPElW][i]));
+    max_q = std::max(max_q, std::fabs(s[Channel::kQThW][i]));
+  }
+  EXPECT_GT(max_q, 100.0) << "no heat to compare";
+  EXPECT_LT(worst_q, 1e-6 * max_q + 1e-6);
+  EXPECT_LT(worst_p, 1e-6);
 }
 
 }  // namespace

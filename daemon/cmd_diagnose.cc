@@ -64,7 +64,12 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
     // Bad data (too little, missing columns) is bad input; a failed base fit is a runtime failure.
     return error.find("identification") != std::string::npos ? kExitRuntime : kExitBadInput;
   }
-  std::printf("verdict: %s\n%s\n\n", result.verdict.c_str(), result.verdict_sentence.c_str());
+  std::printf("verdict: %s\n%s\n", result.verdict.c_str(), result.verdict_sentence.c_str());
+  const GapBias bias = BaseModelBias(result);
+  std::printf(
+      "bias of the base model on the held-out days (predicted − measured): P_el %+.2f W "
+      "(%.0f %% of its MAE), Q_u %+.2f W (%.0f %% of its MAE)\n\n",
+      bias.p_el_w, 100 * bias.share_p_el, bias.q_th_w, 100 * bias.share_q_th);
   const double area_m2 = plant.area_m2;
   std::printf("ladder (held-out, MAE P_el + Q_u):\n");
   for (std::size_t k = 0; k < result.ladder.size(); ++k) {
@@ -111,20 +116,6 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
   return kExitOk;
 }
 
-// Mean predicted − measured of the base model over the held-out rows of the
-// trace; NaN without rows.
-double MeanBias(const std::vector<double>& predicted, const std::vector<double>& measured) {
-  double sum = 0.0;
-  int n = 0;
-  for (std::size_t i = 0; i < predicted.size() && i < measured.size(); ++i) {
-    if (std::isfinite(predicted[i]) && std::isfinite(measured[i])) {
-      sum += predicted[i] - measured[i];
-      ++n;
-    }
-  }
-  return n > 0 ? sum / n : std::nan("");
-}
-
 // The diagnosis row of the store (Store::DiagnosisRow, DESIGN.md).
 bool RecordDiagnosis(Store& store, const DiagnosisResult& r, std::int64_t from_ts,
                      std::int64_t to_ts, const DiagnoseArgs& a) {
@@ -140,8 +131,9 @@ bool RecordDiagnosis(Store& store, const DiagnosisResult& r, std::int64_t from_t
       r.ladder.size() > 1 && r.ladder.front().heldout_mae_w > 0.0
           ? 100.0 * (1.0 - r.ladder.back().heldout_mae_w / r.ladder.front().heldout_mae_w)
           : 0.0;
-  row.bias_p_el_w = MeanBias(r.trace.p_el_base_w, r.trace.p_el_meas_w);
-  row.bias_q_th_w = MeanBias(r.trace.q_th_base_w, r.trace.q_th_meas_w);
+  const GapBias bias = BaseModelBias(r);
+  row.bias_p_el_w = bias.p_el_w;
+  row.bias_q_th_w = bias.q_th_w;
   row.report_json = DiagnosisReportJson(r);
   std::string error;
   if (!store.InsertDiagnosis(&row, &error)) {

@@ -104,12 +104,17 @@ std::vector<double> Edges(double lo, double hi, double step) {
 std::string DiagnosisReportJson(const DiagnosisResult& r) {
   Json j;
   j["base_variant"] = r.base_variant;
+  const GapBias bias = BaseModelBias(r);
   j["gap"] = Json{{"mae_p_el_w", Number(r.gap.mae_p_el_w)},
                   {"mae_q_th_w", Number(r.gap.mae_q_th_w)},
                   {"nmae_p_el", Number(r.gap.nmae_p_el)},
                   {"nmae_q_th", Number(r.gap.nmae_q_th)},
                   {"rows", r.gap.rows},
-                  {"objective_w_m2", Number(r.gap.objective_w_m2())}};
+                  {"objective_w_m2", Number(r.gap.objective_w_m2())},
+                  {"bias_p_el_w", Number(bias.p_el_w)},
+                  {"bias_q_th_w", Number(bias.q_th_w)},
+                  {"bias_share_p_el", Number(bias.share_p_el)},
+                  {"bias_share_q_th", Number(bias.share_q_th)}};
   Json where = Json::array();
   for (const GapRegion& g : r.where) where.push_back(RegionJson(g));
   j["where"] = where;

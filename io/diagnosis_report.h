@@ -4,7 +4,9 @@
 // more fields, never renamed:
 //   { "base_variant": "1N1Cwr",
 //     "gap": {"mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th",     held-out, base model
-//             "rows", "objective_w_m2"},
+//             "rows", "objective_w_m2",
+//             "bias_p_el_w", "bias_q_th_w",          mean predicted − measured, W
+//             "bias_share_p_el", "bias_share_q_th"},  |bias| / MAE
 //     "where": [{"driver": "aoi_deg", "range": [60, 90],
 //                "share_of_abs_error": 0.4, "output": "q_th",             "p_el" | "q_th"
 //                "share_of_rows", "bias_w", "mae_w", "rows",

@@ -115,4 +115,25 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   return true;
 }
 
+GapBias BaseModelBias(const DiagnosisResult& r) {
+  const double nan = std::nan("");
+  auto mean_and_share = [nan](const std::vector<double>& predicted,
+                              const std::vector<double>& measured, double* bias, double* share) {
+    double sum = 0.0, sum_abs = 0.0;
+    int n = 0;
+    for (std::size_t i = 0; i < predicted.size() && i < measured.size(); ++i) {
+      if (!std::isfinite(predicted[i]) || !std::isfinite(measured[i])) continue;
+      sum += predicted[i] - measured[i];
+      sum_abs += std::fabs(predicted[i] - measured[i]);
+      ++n;
+    }
+    *bias = n > 0 ? sum / n : nan;
+    *share = sum_abs > 0.0 ? std::fabs(sum) / sum_abs : nan;
+  };
+  GapBias b;
+  mean_and_share(r.trace.p_el_base_w, r.trace.p_el_meas_w, &b.p_el_w, &b.share_p_el);
+  mean_and_share(r.trace.q_th_base_w, r.trace.q_th_meas_w, &b.q_th_w, &b.share_q_th);
+  return b;
+}
+
 }  // namespace pvtwin

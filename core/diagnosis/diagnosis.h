@@ -188,6 +188,16 @@ struct DiagnosisResult {
   double wall_time_s = 0.0;
 };
 
+// The base model's bias on the held-out rows (the trace): mean predicted −
+// measured, and the share of the MAE it explains (|bias| / MAE: 1 when every
+// error has the same sign, as when a loss coefficient sits at its bound and
+// the held-out days run at another temperature). NaN without rows.
+struct GapBias {
+  double p_el_w = 0.0, q_th_w = 0.0;
+  double share_p_el = 0.0, share_q_th = 0.0;
+};
+GapBias BaseModelBias(const DiagnosisResult& result);
+
 // x with `digits` decimals ("12.35"), as the verdict sentence prints numbers.
 std::string FixedDecimals(double x, int digits);
 

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -348,6 +349,32 @@ TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
                                      " --csv no_wind.csv --variant 1N --train-days 5");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("train_days = 5"), std::string::npos) << run.err;
+}
+
+// Real data: the htw saar collector trained on day 3 (inlet 7 K above
+// ambient) and predicting day 1 (inlet 4 K below) with 2N1CcolwrI. The held-
+// out heat error is a bias: the model predicts more heat on every scored
+// row (+72 W against a 72 W MAE), which the report now states beside the MAE
+// (gap.bias_q_th_w, gap.bias_share_q_th) and the summary prints.
+TEST_F(DiagnoseCli, TheReportStatesTheBiasOfTheHeldOutErrorOnRealData) {
+  const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+  std::ofstream out(dir_ / "htw.csv");
+  out << testing::ReadFile(data / "day3_clear_medium_dT.csv");
+  const std::string day1 = testing::ReadFile(data / "day1_clear_low_dT.csv");
+  out << day1.substr(day1.find('\n') + 1);
+  out.close();
+  const testing::ProcessResult run = testing::RunPvtwin(
+      dir_,
+      "diagnose --config '" + (data / "plant.toml").string() +
+          "' --csv htw.csv --variant 2N1CcolwrI --train-days 1 --heldout-days 1 --report out");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json gap =
+      nlohmann::json::parse(testing::ReadFile(dir_ / "out" / "report.json")).at("gap");
+  EXPECT_GT(gap.at("bias_q_th_w").get<double>(), 0.9 * gap.at("mae_q_th_w").get<double>());
+  EXPECT_GT(gap.at("bias_share_q_th").get<double>(), 0.95);
+  EXPECT_LE(gap.at("bias_share_q_th").get<double>(), 1.0);
+  EXPECT_NE(run.out.find("bias of the base model on the held-out days"), std::string::npos)
+      << run.out;
 }
 
 }  // namespace

@@ -143,6 +143,7 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
       e["irradiance_bias_p"] = Number(t.sensor_p);
     }
     e["explanation"] = t.explanation;
+    if (!t.advice.empty()) e["advice"] = t.advice;
     e["fit_ok"] = t.fit_ok;
     if (!t.fit_ok) e["failure"] = t.failure;
     effects.push_back(e);
@@ -203,6 +204,11 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
   h << "<h1>Gap diagnosis of " << XmlEscape(r.base_variant) << "</h1>\n";
   h << "<p class='verdict'><b>Verdict: " << XmlEscape(r.verdict) << ".</b> "
     << XmlEscape(r.verdict_sentence) << "</p>\n";
+  for (const EffectTrial& t : r.effects) {
+    if (t.name == r.verdict && !t.advice.empty()) {
+      h << "<p><b>For the site:</b> " << XmlEscape(t.advice) << "</p>\n";
+    }
+  }
   for (const std::string& n : r.notes) h << "<p class='note'>" << XmlEscape(n) << "</p>\n";
   std::size_t train = 0, heldout = 0;
   for (const DiagnosisDay& d : r.days) (d.heldout ? heldout : train)++;

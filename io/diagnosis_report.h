@@ -20,7 +20,8 @@
 //                  "variant", "tested_against", "accepted_at_step",
 //                  "p_value" (one-sided Wilcoxon), "sign_test_p", "t_stat",
 //                  "units_better", "units", "evidence_r", "evidence_z",
-//                  "evidence_output", "explanation", "fit_ok", "failure",
+//                  "evidence_output", "explanation", "advice" (one sentence for
+//                  the site, from the effect's module), "fit_ok", "failure",
 //                  "irradiance_bias_k", "irradiance_bias_p" (irradiance_bias only)}],   ranked
 //     "verdict": "wind",                       an effect, "none" or "unknown"
 //     "verdict_sentence": "...",

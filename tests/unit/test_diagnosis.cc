@@ -304,6 +304,8 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesTheReports) {
   EXPECT_EQ(j["effects"][0].at("significant"), true);
   EXPECT_GT(j["effects"][0].at("shrink_pct").get<double>(), 10.0);
   EXPECT_EQ(j.at("ladder").at(1).at("added"), "wind");
+  // Each tried effect carries its module's advice for the site.
+  EXPECT_FALSE(j["effects"][0].at("advice").get<std::string>().empty());
   // No other effect is significant at the first step.
   for (std::size_t k = 1; k < j["effects"].size(); ++k) {
     if (j["effects"][k].at("accepted_at_step").get<int>() == 0) {
@@ -312,6 +314,7 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesTheReports) {
   }
   const std::string html = testing::ReadFile(dir_ / "out" / "report.html");
   EXPECT_NE(html.find("Verdict: wind"), std::string::npos);
+  EXPECT_NE(html.find("For the site:"), std::string::npos);
   EXPECT_NE(html.find("<svg"), std::string::npos);
 }
 

@@ -12,14 +12,6 @@
 
 namespace pvtwin {
 
-std::string FixedDecimals(double x, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << x;
-  return s.str();
-}
-
 IdentOptions DiagnosisIdentOptions() {
   IdentOptions o;
   o.optimizer.ftol_rel = 1e-4;

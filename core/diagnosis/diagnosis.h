@@ -44,6 +44,7 @@
 
 #include "core/common/plant.h"
 #include "core/common/series.h"
+#include "core/common/text.h"
 #include "core/diagnosis/diagnosis_stats.h"
 #include "core/diagnosis/effect_candidates.h"
 #include "core/diagnosis/gap_localisation.h"
@@ -197,9 +198,6 @@ struct GapBias {
   double share_p_el = 0.0, share_q_th = 0.0;
 };
 GapBias BaseModelBias(const DiagnosisResult& result);
-
-// x with `digits` decimals ("12.35"), as the verdict sentence prints numbers.
-std::string FixedDecimals(double x, int digits);
 
 // Runs the diagnosis of `base` on `data`. Returns false with *error when it
 // cannot run: invalid options, a step the data cannot be averaged to, missing

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/common/text.h"
 #include "core/common/units.h"
 
 namespace pvtwin {
@@ -83,14 +84,6 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) {
     out[i] = d.g_ref_w_m2[i] - d.g_poa_w_m2[i] / (1.0 + d.irradiance_bias);
   }
   return out;
-}
-
-std::string FixedDecimals(double x, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << x;
-  return s.str();
 }
 
 std::string SensorEvidence(double k, double p, int days) {

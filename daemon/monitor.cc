@@ -1,5 +1,6 @@
 #include "daemon/monitor.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -27,7 +28,7 @@ std::string Day(std::int64_t t) { return FormatIsoUtc(t).substr(0, 10); }
 // performance_daily for every whole UTC day of the calibration window that
 // has no row yet, with the accepted parameters. Returns the newest day it
 // scored (-1: none).
-std::int64_t ScoreNewDays(Store& store, const DailyCheckInputs& in,
+std::int64_t ScoreNewDays(Store& store, const DailyCheckInputs& in, const Series& minutes,
                           const Store::CalibrationRow& cal, const ParamVector& params,
                           LogLines* log) {
   std::int64_t newest = -1;
@@ -35,9 +36,7 @@ std::int64_t ScoreNewDays(Store& store, const DailyCheckInputs& in,
   const std::int64_t first = today - in.config->calibration.window_days * kDayS;
   std::string error;
   std::vector<DayPerformance> done;
-  Series minutes;
-  if (!store.ReadPerformanceDays(first, today, &done, &error) ||
-      !store.ReadMinutes(first, today, &minutes, &error)) {
+  if (!store.ReadPerformanceDays(first, today, &done, &error)) {
     log->push_back({kErr, "daily checks: " + error});
     return newest;
   }
@@ -103,14 +102,16 @@ void CheckPerformanceAlarm(Store& store, const DailyCheckInputs& in, std::int64_
 
 // Sensor faults of the last two days (a fault that goes on is recorded again
 // with its later end).
-void CheckSensors(Store& store, const DailyCheckInputs& in, LogLines* log) {
-  Series minutes;
+void CheckSensors(Store& store, const DailyCheckInputs& in, const Series& window, LogLines* log) {
   std::string error;
-  if (!store.ReadMinutes(in.now_s - 2 * kDayS, in.now_s, &minutes, &error)) {
-    log->push_back({kErr, "daily checks: " + error});
-    return;
+  Series recent = window.Between(in.now_s - 2 * kDayS, in.now_s);
+  // A channel without a value in these days is absent, as the store reads it.
+  for (std::vector<double>& column : recent.columns) {
+    if (std::all_of(column.begin(), column.end(), [](double v) { return std::isnan(v); })) {
+      column.clear();
+    }
   }
-  const std::vector<SensorFault> faults = FindSensorFaults(minutes, in.config->plant);
+  const std::vector<SensorFault> faults = FindSensorFaults(recent, in.config->plant);
   if (!store.RecordSensorFaults(faults, &error)) {
     log->push_back({kErr, "daily checks: " + error});
     return;
@@ -149,16 +150,13 @@ void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::Calibrati
 
 // The datasheet's power check over the calibration window; an event when
 // its outcome differs from the last one recorded (pass: info, fail: warning).
-void CheckDatasheetPower(Store& store, const DailyCheckInputs& in, LogLines* log) {
+void CheckDatasheetPower(Store& store, const DailyCheckInputs& in, const Series& window,
+                         LogLines* log) {
   const MonitorConfig& m = in.config->monitor;
   if (!(m.datasheet_eta0 > 0.0)) return;
-  Series minutes;
   std::string error;
-  const std::int64_t from = in.now_s - in.config->calibration.window_days * kDayS;
-  if (!store.ReadMinutes(from, in.now_s, &minutes, &error)) {
-    log->push_back({kErr, "daily checks: " + error});
-    return;
-  }
+  const Series minutes =
+      window.Between(in.now_s - in.config->calibration.window_days * kDayS, in.now_s);
   CollectorDatasheet d;
   d.eta0 = m.datasheet_eta0;
   d.c1_w_m2k = m.datasheet_c1_w_m2k;
@@ -200,8 +198,17 @@ void CheckDatasheetPower(Store& store, const DailyCheckInputs& in, LogLines* log
 
 std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const DailyCheckInputs& in) {
   LogLines log;
-  CheckSensors(store, in, &log);
-  CheckDatasheetPower(store, in, &log);
+  // One read of the 1-min rows for every check: from the first day of the
+  // calibration window up to now.
+  Series window;
+  std::string read_error;
+  const std::int64_t first = in.now_s / kDayS * kDayS - in.config->calibration.window_days * kDayS;
+  if (!store.ReadMinutes(first, in.now_s, &window, &read_error)) {
+    log.push_back({kErr, "daily checks: " + read_error});
+    return log;
+  }
+  CheckSensors(store, in, window, &log);
+  CheckDatasheetPower(store, in, window, &log);
   Store::CalibrationRow cal;
   bool found = false;
   std::string error;
@@ -223,7 +230,7 @@ std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const Dail
   ParseVariant(cal.variant, &spec, &variant_error);  // the calibration's own variant
   DailyCheckInputs with_variant = in;
   with_variant.spec = spec;
-  const std::int64_t newest = ScoreNewDays(store, with_variant, cal, file.values, &log);
+  const std::int64_t newest = ScoreNewDays(store, with_variant, window, cal, file.values, &log);
   CheckPerformanceAlarm(store, in, newest, &log);
   if (in.accepted_now) CheckDrift(store, in, cal, &log);
   return log;

@@ -8,6 +8,7 @@
 
 #include "core/common/units.h"
 #include "core/fit/identification.h"
+#include "core/model/irradiance_drivers.h"
 #include "core/model/thermal_model.h"
 #include "core/physics/iam.h"
 #include "core/physics/irradiance.h"
@@ -139,14 +140,7 @@ PowerCheckResult CheckPowerAgainstDatasheet(const Series& s, const Plant& plant,
       !s.Has(Channel::kTInC) || !s.Has(Channel::kTOutC) || !s.Has(Channel::kMdotKgS)) {
     return r;
   }
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  std::vector<double> times(s.time_s.begin(), s.time_s.end());
-  for (double& t : times) t += 0.5 * s.step_s;  // the middle of each row's interval
-  std::vector<SolarPosition> sun;
-  ComputeSolarPositions(times, site, &sun);
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   const bool has_q = s.Has(Channel::kQThW);
   const bool has_wind = s.Has(Channel::kWindMS);
   const bool has_lw = s.Has(Channel::kLwDownWM2);
@@ -309,14 +303,7 @@ void FindIrradianceFaults(const Series& s, const Plant& plant, const SensorFault
   const bool poa = s.Has(Channel::kGPoaWM2);
   const bool pair = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
   if (!poa && !s.Has(Channel::kGhiWM2)) return;
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  std::vector<double> times(s.time_s.begin(), s.time_s.end());
-  for (double& t : times) t += 0.5 * s.step_s;
-  std::vector<SolarPosition> sun;
-  ComputeSolarPositions(times, site, &sun);
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   const std::size_t n = s.size();
   std::vector<double> clear_poa(n, 0.0), clear_ghi(n, 0.0), transposed(n, kNaN);
   for (std::size_t i = 0; i < n; ++i) {

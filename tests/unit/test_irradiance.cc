@@ -167,23 +167,30 @@ TEST(Irradiance, SplitMeasuredPoaKeepsPartsNonNegativeAndSummingToGlobal) {
   EXPECT_TRUE(std::isnan(SplitMeasuredPoa(in).beam_w_m2));
 }
 
-// Transposing GHI/DHI and splitting the resulting in-plane global with its
-// in-plane diffuse gives the same parts back.
+// Transposing GHI/DHI and splitting the resulting in-plane global gives the
+// same parts back, whether the in-plane diffuse or GHI and DHI stand beside it.
 TEST(Irradiance, SplitInvertsTransposition) {
   IsotropicSkyInput sky = ClearNoon();
   sky.tilt_rad = DegToRad(35.0);
   sky.aoi_rad = DegToRad(12.0);
   const PoaComponents forward = TransposeIsotropicSky(sky);
-  MeasuredPoaInput measured;
-  measured.g_poa_w_m2 = forward.global_w_m2();
-  measured.g_poa_diffuse_w_m2 = forward.sky_diffuse_w_m2 + forward.ground_diffuse_w_m2;
-  measured.ghi_w_m2 = sky.ghi_w_m2;
-  measured.tilt_rad = sky.tilt_rad;
-  measured.ground_albedo = sky.ground_albedo;
-  const PoaComponents back = SplitMeasuredPoa(measured);
-  EXPECT_NEAR(back.beam_w_m2, forward.beam_w_m2, 1e-9);
-  EXPECT_NEAR(back.sky_diffuse_w_m2, forward.sky_diffuse_w_m2, 1e-9);
-  EXPECT_NEAR(back.ground_diffuse_w_m2, forward.ground_diffuse_w_m2, 1e-9);
+  for (const bool in_plane_diffuse : {true, false}) {
+    SCOPED_TRACE(in_plane_diffuse ? "in-plane diffuse" : "GHI and DHI");
+    MeasuredPoaInput measured;
+    measured.g_poa_w_m2 = forward.global_w_m2();
+    if (in_plane_diffuse) {
+      measured.g_poa_diffuse_w_m2 = forward.sky_diffuse_w_m2 + forward.ground_diffuse_w_m2;
+    } else {
+      measured.dhi_w_m2 = sky.dhi_w_m2;
+    }
+    measured.ghi_w_m2 = sky.ghi_w_m2;
+    measured.tilt_rad = sky.tilt_rad;
+    measured.ground_albedo = sky.ground_albedo;
+    const PoaComponents back = SplitMeasuredPoa(measured);
+    EXPECT_NEAR(back.beam_w_m2, forward.beam_w_m2, 1e-9);
+    EXPECT_NEAR(back.sky_diffuse_w_m2, forward.sky_diffuse_w_m2, 1e-9);
+    EXPECT_NEAR(back.ground_diffuse_w_m2, forward.ground_diffuse_w_m2, 1e-9);
+  }
 }
 
 // Paper 2.5 with the measured I_gt, I_gh and I_dh (the paper's set-up, Table
@@ -221,25 +228,6 @@ TEST(Irradiance, SplitMeasuredPoaWithGhiAndDhiIsThePapersEquation) {
   in.g_poa_w_m2 = 800.0;
   in.g_poa_diffuse_w_m2 = 200.0;
   EXPECT_NEAR(SplitMeasuredPoa(in).beam_w_m2, 600.0, 1e-9);
-}
-
-// Transposing GHI/DHI and splitting the in-plane global with only GHI and DHI
-// beside it gives the same parts back.
-TEST(Irradiance, SplitWithGhiAndDhiInvertsTransposition) {
-  IsotropicSkyInput sky = ClearNoon();
-  sky.tilt_rad = DegToRad(35.0);
-  sky.aoi_rad = DegToRad(12.0);
-  const PoaComponents forward = TransposeIsotropicSky(sky);
-  MeasuredPoaInput measured;
-  measured.g_poa_w_m2 = forward.global_w_m2();
-  measured.ghi_w_m2 = sky.ghi_w_m2;
-  measured.dhi_w_m2 = sky.dhi_w_m2;
-  measured.tilt_rad = sky.tilt_rad;
-  measured.ground_albedo = sky.ground_albedo;
-  const PoaComponents back = SplitMeasuredPoa(measured);
-  EXPECT_NEAR(back.beam_w_m2, forward.beam_w_m2, 1e-9);
-  EXPECT_NEAR(back.sky_diffuse_w_m2, forward.sky_diffuse_w_m2, 1e-9);
-  EXPECT_NEAR(back.ground_diffuse_w_m2, forward.ground_diffuse_w_m2, 1e-9);
 }
 
 // The model end to end: noise-free data of a truth with the beam/diffuse

@@ -269,9 +269,10 @@ void RegisterSim(CLI::App& app) {
   cmd->add_flag("--stepped", args->stepped,
                 "simulated time stands still at --start and moves only by 'advance S' on stdin");
   cmd->add_option("--seed", args->seed, "seed of weather, operation and sensor noise");
-  cmd->add_option(
-      "--truth-variant", args->truth_variant,
-      std::string("model variant of the simulated plant (default ") + kDefaultTruthVariant + ")");
+  cmd->add_option("--truth-variant", args->truth_variant,
+                  std::string("model variant of the simulated plant (default ") +
+                      kDefaultTruthVariant +
+                      "); an effect added to it (e.g. +pv_clipping) acts at its typical magnitude");
   cmd->add_option("--weather", args->weather, "generate (default) or replay --csv")
       ->check(CLI::IsMember({"generate", "replay"}));
   cmd->add_option(

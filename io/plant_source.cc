@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/effects/effects.h"
+#include "core/effects/registry.h"
 #include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 
@@ -34,6 +36,22 @@ Sample RowOf(const Series& s, std::size_t i) {
   return sample;
 }
 
+// ReferenceTruthParams, with every effect that `spec` adds beyond the
+// default truth at its module's typical magnitude (EffectModule::
+// typical_truth): `--truth-variant …+pv_clipping` clips. The default truth's
+// own parts keep the reference values that recorded data relies on.
+ParamVector SimulatorTruthParams(const Plant& plant, const ModelSpec& spec) {
+  ParamVector p = ReferenceTruthParams(plant);
+  ModelSpec reference;
+  std::string why;
+  ParseVariant(kDefaultTruthVariant, &reference, &why);
+  for (const EffectModule* m : EffectRegistry()) {
+    if (!HasEffect(spec, *m) || HasEffect(reference, *m)) continue;
+    for (const auto& [param, value] : m->typical_truth) p[static_cast<std::size_t>(param)] = value;
+  }
+  return p;
+}
+
 }  // namespace
 
 std::optional<DayType> DayTypeFromName(std::string_view name) {
@@ -51,7 +69,7 @@ std::unique_ptr<PlantSource> PlantSource::Create(const PlantSourceOptions& optio
     errors->push_back({"", 0, "--truth-variant", options.truth_variant, why});
     return nullptr;
   }
-  source->truth_ = ReferenceTruthParams(options.plant);
+  source->truth_ = SimulatorTruthParams(options.plant, source->spec_);
   if (!options.replay_csv.empty()) {
     CsvReadOptions csv;
     csv.fluid_density_kg_m3 = options.plant.fluid_density_kg_m3;

@@ -45,7 +45,9 @@
 namespace pvtwin {
 
 // The richest truth model the variant parser accepts: two nodes, both
-// capacitances, sky radiation, IAM, the physical wind form, transport delay.
+// capacitances, sky radiation, IAM, the physical wind form, transport delay
+// (ReferenceTruthParams). Effects added to it act at their modules' typical
+// magnitudes (EffectModule::typical_truth).
 inline constexpr const char* kDefaultTruthVariant = "2N2CrI+wind+transport_delay";
 
 inline constexpr double kPlantSourceStepS = 5.0;

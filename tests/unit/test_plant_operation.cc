@@ -395,5 +395,38 @@ TEST(ContinuousPlant, ServedValuesAreTheExportedRunsRows) {
       server->At(static_cast<double>(kNov19_2024)).Get(Channel::kTInC)));  // before the run
 }
 
+// An effect added to the simulator's truth acts at its module's typical
+// magnitude: with +pv_clipping (120 W/m² on 1.8 m²: 216 W) a clear June
+// day's electricity stops at the limit (sensor noise aside), where the
+// default truth's runs well above it; the default truth's other rows are
+// unchanged.
+TEST(PlantSourceTruth, AnAddedEffectActsAtItsTypicalMagnitude) {
+  constexpr std::int64_t kJune1_2024 = 1717200000;
+  auto max_p_el = [](const std::string& truth, double* max_w, Series* s) {
+    PlantSourceOptions o;
+    o.plant = DesignExamplePlant();
+    o.truth_variant = truth;
+    o.day_types = {DayType::kClear};
+    Diagnostics errors;
+    auto source = PlantSource::Create(o, &errors);
+    ASSERT_NE(source, nullptr) << (errors.empty() ? "" : errors[0].ToString());
+    *s = source->History(kJune1_2024, 1);
+    *max_w = 0.0;
+    for (const double p : (*s)[Channel::kPElW]) {
+      if (std::isfinite(p)) *max_w = std::max(*max_w, p);
+    }
+  };
+  double reference_w = 0.0, clipped_w = 0.0;
+  Series reference, clipped;
+  max_p_el(kDefaultTruthVariant, &reference_w, &reference);
+  max_p_el(std::string(kDefaultTruthVariant) + "+pv_clipping", &clipped_w, &clipped);
+  const double limit_w = 120.0 * 1.8;
+  EXPECT_GT(reference_w, 1.2 * limit_w);
+  EXPECT_LT(clipped_w, 1.03 * limit_w);
+  EXPECT_GT(clipped_w, 0.97 * limit_w);
+  // Before sunrise both truths read the same.
+  EXPECT_EQ(reference[Channel::kTAmbC][0], clipped[Channel::kTAmbC][0]);
+}
+
 }  // namespace
 }  // namespace pvtwin

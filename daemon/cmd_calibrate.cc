@@ -72,20 +72,9 @@ std::string StatusOf(const ParamEstimate& e) {
   return e.weak ? "weakly determined" : "identified";
 }
 
-// The standard error in the parameter's own unit, from the one in the
-// optimiser's unit coordinates (first order: linear scale x = lo + z·(hi −
-// lo), log scale x = lo·(hi/lo)^z, dx/dz = x·ln(hi/lo)). Empty when fixed.
-// NaN when fixed or not estimated.
-double StdError(const ParamEstimate& e) {
-  if (!e.free || e.undetermined || !(e.se_unit > 0.0)) return std::nan("");
-  const bool log_scale = Info(e.param).scale == ParamScale::kLog;
-  return log_scale ? e.value * std::log(e.upper / e.lower) * e.se_unit
-                   : (e.upper - e.lower) * e.se_unit;
-}
-
 // "± 0.123", empty when StdError is NaN.
 std::string PlusMinus(const ParamEstimate& e) {
-  const double se = StdError(e);
+  const double se = StdErrorInUnit(e);
   if (std::isnan(se)) return "";
   char buf[32];
   std::snprintf(buf, sizeof(buf), "± %.3g", se);
@@ -141,7 +130,7 @@ std::string FitJson(const IdentSummary& s, const ErrorMetrics* held_out) {
   // calibration_param).
   j["parameters"] = nlohmann::ordered_json::array();
   for (const ParamEstimate& e : s.estimates) {
-    const double se = StdError(e);
+    const double se = StdErrorInUnit(e);
     j["parameters"].push_back({{"name", std::string(Info(e.param).name)},
                                {"value", e.value},
                                {"std_error", se},  // NaN is written as null

@@ -84,9 +84,17 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
   }
   std::printf("effects (ranked):\n");
   for (const EffectTrial& t : result.effects) {
-    std::printf("  %-17s %s shrink %6.1f %%  better %zu/%zu %ss  p = %.3g\n", t.name.c_str(),
-                t.significant ? "SIGNIFICANT" : "           ", t.shrink_pct, t.test.positives,
-                t.test.pairs, result.test_unit.c_str(), t.test.wilcoxon_p);
+    std::printf("  %-17s %s shrink %6.1f %%  better %zu/%zu %ss  loss test p = %.3g%s\n",
+                t.name.c_str(), t.significant ? "SIGNIFICANT" : "           ", t.shrink_pct,
+                t.test.positives, t.test.pairs, result.test_unit.c_str(), t.heldout_test.p,
+                t.rejected.empty() ? "" : ("; not accepted: " + t.rejected).c_str());
+  }
+  for (const Extrapolation& x : result.extrapolation) {
+    std::printf(
+        "extrapolated: %s held-out [%.3g, %.3g] vs training [%.3g, %.3g], %.0f %% of rows "
+        "outside\n",
+        x.driver.c_str(), x.heldout_low, x.heldout_high, x.train_low, x.train_high,
+        100 * x.share_outside);
   }
   std::printf("where (regions of concentrated held-out error):\n");
   for (std::size_t k = 0; k < result.where.size() && k < 8; ++k) {

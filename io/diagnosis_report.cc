@@ -142,6 +142,27 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
       e["irradiance_bias_k"] = Number(t.sensor_estimate);
       e["irradiance_bias_p"] = Number(t.sensor_p);
     }
+    if (t.fit_ok) {
+      e["heldout_test"] = Json{{"kind", "loss_difference"},
+                               {"p", Number(t.heldout_test.p)},
+                               {"z", Number(t.heldout_test.z)},
+                               {"rows", t.heldout_test.rows},
+                               {"mean_loss_difference_w", Number(t.heldout_test.mean_difference)},
+                               {"bandwidth_rows", t.heldout_test.bandwidth_rows}};
+      e["mae_p_el_after_w"] = Number(t.mae_p_el_after_w);
+      e["mae_q_th_after_w"] = Number(t.mae_q_th_after_w);
+      e["days_better"] = t.days_improved;
+      Json params = Json::object();
+      for (const ParamEstimate& p : t.estimates) {
+        params[std::string(Info(p.param).name)] = Json{{"value", Number(p.value)},
+                                                       {"std_error", Number(StdErrorInUnit(p))},
+                                                       {"unit", std::string(Info(p.param).unit)}};
+      }
+      e["params"] = params;
+      if (!t.at_bounds.empty()) e["at_bounds"] = t.at_bounds;
+      if (!t.signature_check.empty()) e["signature_check"] = t.signature_check;
+      if (!t.rejected.empty()) e["rejected"] = t.rejected;
+    }
     e["explanation"] = t.explanation;
     if (!t.advice.empty()) e["advice"] = t.advice;
     e["fit_ok"] = t.fit_ok;
@@ -150,7 +171,16 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
   }
   j["effects"] = effects;
   j["verdict"] = r.verdict;
+  if (!r.candidates.empty()) j["candidates"] = r.candidates;
   j["verdict_sentence"] = r.verdict_sentence;
+  Json extrapolation = Json::array();
+  for (const Extrapolation& x : r.extrapolation) {
+    extrapolation.push_back(Json{{"driver", x.driver},
+                                 {"train_range", {Number(x.train_low), Number(x.train_high)}},
+                                 {"heldout_range", {Number(x.heldout_low), Number(x.heldout_high)}},
+                                 {"share_outside", Number(x.share_outside)}});
+  }
+  j["extrapolation"] = extrapolation;
   j["final_variant"] = r.final_variant;
   Json ladder = Json::array();
   for (const LadderStep& s : r.ladder) {

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -46,6 +47,141 @@ void SensorTest(const Series& data, const std::vector<std::int64_t>& day_starts,
   const PairedTest down = OneSidedPairedTest(zeros, k);
   t->sensor_p = std::min(1.0, 2.0 * std::min(up.wilcoxon_p, down.wilcoxon_p));
   t->sensor_days = static_cast<int>(k.size());
+}
+
+// "ε_PVT at its lower bound 0.075" for each of the effect's parameters that
+// ended at a bound, "n_flow = 0.079 ± 0.25 (not determined)" for each whose
+// standard error is as large as its value (or that the fit found
+// undetermined); *all set when every one of them is either (the data did
+// not determine the effect).
+std::vector<std::string> AtBounds(const EffectModule& effect, const EffectTrial& t,
+                                  const Plant& plant, bool* all) {
+  std::vector<std::string> out;
+  std::size_t unsupported = 0;
+  for (const Param param : effect.params) {
+    const ParamInfo info = ResolvedInfo(param, plant);
+    const double v = ParamOf(t.params, param);
+    const double tol = 1e-3 * (info.upper - info.lower);
+    if (v <= info.lower + tol) {
+      out.push_back(std::string(info.symbol) + " at its lower bound " +
+                    FixedDecimals(info.lower, 3));
+      ++unsupported;
+      continue;
+    }
+    if (v >= info.upper - tol) {
+      out.push_back(std::string(info.symbol) + " at its upper bound " +
+                    FixedDecimals(info.upper, 3));
+      ++unsupported;
+      continue;
+    }
+    for (const ParamEstimate& e : t.estimates) {
+      if (e.param != param) continue;
+      const double se = StdErrorInUnit(e);
+      if (e.undetermined || e.weak || (std::isfinite(se) && se >= std::fabs(v))) {
+        out.push_back(std::string(info.symbol) + " = " + FixedDecimals(v, 3) +
+                      (std::isfinite(se) ? " ± " + FixedDecimals(se, 3) : "") +
+                      " (not determined)");
+        ++unsupported;
+      }
+    }
+  }
+  *all = !effect.params.empty() && unsupported == effect.params.size();
+  return out;
+}
+
+// Held-out solar days on which `after`'s loss is lower than `before`'s, of
+// the days with rows in both.
+int DaysImproved(const Score& before, const Score& after, const Part& heldout,
+                 std::int64_t offset_s, int* days) {
+  std::map<std::int64_t, double> gain;
+  for (std::size_t i = 0; i < before.loss_w.size() && i < after.loss_w.size(); ++i) {
+    const double g = before.loss_w[i] - after.loss_w[i];
+    if (std::isfinite(g)) gain[SolarDayStartS(heldout.drivers.time_s[i], offset_s)] += g;
+  }
+  int better = 0;
+  for (const auto& [day, g] : gain) better += g > 0.0 ? 1 : 0;
+  *days = static_cast<int>(gain.size());
+  return better;
+}
+
+// The decision on a trial whose fit succeeded: a held-out improvement that
+// is significant (loss test, p ≤ alpha) and large enough (min_shrink_pct),
+// and that the effect's physics backs: neither output worse beyond what the
+// test can tell from noise, not every parameter at a bound, better on more
+// than one day (where there are several), and the module's own signature in
+// the data. Fills t's tests and, for an improvement turned down, `rejected`.
+void Judge(const TrialInputs& in, const EffectCandidate& c, const Part& ho, const Score& before,
+           const Score& after, EffectTrial* trial) {
+  EffectTrial& t = *trial;
+  const DiagnosisOptions& o = *in.options;
+  const double bw = o.loss_test_bandwidth_s;
+  t.heldout_test = CompareLosses(before, after, ho, bw);
+  t.mae_p_el_before_w = before.errors.mae_p_el_w;
+  t.mae_q_th_before_w = before.errors.mae_q_th_w;
+  t.mae_p_el_after_w = after.errors.mae_p_el_w;
+  t.mae_q_th_after_w = after.errors.mae_q_th_w;
+  int days = 0;
+  t.days_improved = DaysImproved(before, after, ho, in.split->offset_s, &days);
+  bool all_at_bounds = false;
+  t.at_bounds = AtBounds(*c.module, t, *in.plant, &all_at_bounds);
+  t.significant = t.heldout_test.p <= o.alpha && t.shrink_pct >= o.min_shrink_pct;
+  if (!t.significant) return;
+  std::vector<std::string> why;
+  const struct {
+    const char* name;
+    Loss loss;
+    double before_w, after_w;
+  } outputs[] = {{"P_el", Loss::kPEl, t.mae_p_el_before_w, t.mae_p_el_after_w},
+                 {"Q_u", Loss::kQTh, t.mae_q_th_before_w, t.mae_q_th_after_w}};
+  for (const auto& out : outputs) {
+    const LossDifferenceTest worse = CompareLosses(after, before, ho, bw, out.loss);
+    if (worse.p <= o.alpha && out.after_w > out.before_w * (1.0 + o.min_shrink_pct / 100.0)) {
+      why.push_back("it makes " + std::string(out.name) + " worse (" +
+                    FixedDecimals(out.before_w, 2) + " → " + FixedDecimals(out.after_w, 2) +
+                    " W, p = " + PValue(worse.p) + ")");
+    }
+  }
+  // On held-out days outside the training range the base model's error is
+  // mostly a bias that any extra freedom can shift; a gain that is nothing
+  // but that shift is not the effect.
+  if (in.extrapolation != nullptr && !in.extrapolation->empty()) {
+    const double mae_drop =
+        (t.mae_p_el_before_w - t.mae_p_el_after_w) + (t.mae_q_th_before_w - t.mae_q_th_after_w);
+    const double bias_drop = (std::fabs(before.bias_p_el_w) - std::fabs(after.bias_p_el_w)) +
+                             (std::fabs(before.bias_q_th_w) - std::fabs(after.bias_q_th_w));
+    if (mae_drop > 0.0 && bias_drop >= 0.8 * mae_drop) {
+      why.push_back(
+          "its gain is a shift of the bias on held-out days outside the training "
+          "range (bias P_el " +
+          FixedDecimals(before.bias_p_el_w, 2) + " → " + FixedDecimals(after.bias_p_el_w, 2) +
+          " W, Q_u " + FixedDecimals(before.bias_q_th_w, 2) + " → " +
+          FixedDecimals(after.bias_q_th_w, 2) + " W)");
+    }
+  }
+  if (all_at_bounds) {
+    std::string list;
+    for (const std::string& b : t.at_bounds) list += (list.empty() ? "" : ", ") + b;
+    why.push_back("the data do not determine it: " + list);
+  }
+  if (days >= 2 && t.days_improved < 2) {
+    why.push_back("it is better on " + std::to_string(t.days_improved) + " of " +
+                  std::to_string(days) + " held-out days only");
+  }
+  if (c.module->shows_signature != nullptr) {
+    SignatureData sd;
+    sd.drivers = &ho.drivers;
+    sd.rows = &ho.meas.rows;
+    sd.p_el_meas_w = &ho.meas.p_el_w;
+    sd.q_th_meas_w = &ho.meas.q_th_w;
+    sd.before = &before.sim;
+    sd.after = &after.sim;
+    sd.params = &t.params;
+    const SignatureCheck check = c.module->shows_signature(sd);
+    t.signature_check = check.sentence;
+    if (!check.shown) why.push_back("its signature is missing: " + check.sentence);
+  }
+  for (const std::string& w : why) t.rejected += (t.rejected.empty() ? "" : "; ") + w;
+  t.significant = why.empty();
 }
 
 // The candidates of this step: every effect the current model can take with
@@ -127,6 +263,12 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
     const IdentSummary fit = Identify(tr.drivers, tr.meas, start, options.ident);
     t.fit_runtime_s = fit.runtime_s;
     t.params = fit.params;
+    for (const ParamEstimate& e : fit.estimates) {
+      if (std::find(c.module->params.begin(), c.module->params.end(), e.param) !=
+          c.module->params.end()) {
+        t.estimates.push_back(e);
+      }
+    }
     if (!fit.ok) {
       t.failure = "identification failed: " + fit.failure_reason;
     } else {
@@ -139,8 +281,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
         t.shrink_pct = 100.0 * (1.0 - (*score).errors.objective_w_m2() /
                                           current_score.errors.objective_w_m2());
         t.test = CompareUnits(current_score, (*score));
-        t.significant =
-            t.test.wilcoxon_p <= options.alpha && t.shrink_pct >= options.min_shrink_pct;
+        Judge(in, c, ho, current_score, *score, &t);
         if (c.module->sensor_estimate != nullptr) {
           SensorTest(*in.data, in.split->day_starts, plant, c.spec, *c.module, &t);
           t.significant = t.sensor_p <= options.alpha &&
@@ -157,8 +298,10 @@ std::string ProgressLine(int step, int finished, std::size_t candidates, const E
          std::to_string(candidates) + "] +" + t.name + ": " +
          (t.fit_ok ? "shrink " + FixedDecimals(t.shrink_pct, 1) + " %, better on " +
                          std::to_string(t.test.positives) + " of " + std::to_string(t.test.pairs) +
-                         " " + test_unit + "s, p = " + PValue(t.test.wilcoxon_p) +
-                         (t.significant ? " (significant)" : "")
+                         " " + test_unit + "s, loss test p = " + PValue(t.heldout_test.p) +
+                         (t.significant        ? " (significant)"
+                          : t.rejected.empty() ? ""
+                                               : " (not accepted)")
                    : "FAILED: " + t.failure) +
          " (" + FixedDecimals(t.fit_runtime_s, 2) + " s)";
 }
@@ -178,10 +321,15 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
     ev << effect.sensor_evidence(t.sensor_estimate, t.sensor_p, t.sensor_days);
   }
   if (t.fit_ok) {
-    ev << "re-identified " << t.variant << " lowers the held-out MAE on " << t.test.positives
-       << " of " << t.test.pairs << " " << test_unit
-       << "s (one-sided Wilcoxon p = " << PValue(t.test.wilcoxon_p)
-       << ", sign test p = " << PValue(t.test.sign_p) << ")";
+    ev << "re-identified " << t.variant << " lowers the held-out loss by "
+       << FixedDecimals(t.heldout_test.mean_difference, 2)
+       << " W per row (loss test z = " << FixedDecimals(t.heldout_test.z, 1)
+       << ", p = " << PValue(t.heldout_test.p) << ", " << t.heldout_test.rows
+       << " rows), better on " << t.days_improved << " held-out day(s); "
+       << "per " << test_unit << ": lower on " << t.test.positives << " of " << t.test.pairs
+       << " (Wilcoxon p = " << PValue(t.test.wilcoxon_p) << ")";
+    if (!t.signature_check.empty()) ev << "; " << t.signature_check;
+    if (!t.rejected.empty()) ev << "; not accepted: " << t.rejected;
   } else {
     ev << "not tested: " << t.failure;
   }

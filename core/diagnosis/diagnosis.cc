@@ -30,6 +30,12 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
   std::string ident_why;
   if (!ident.IsValid(&ident_why)) out << "ident: " << ident_why << "; ";
   if (!(alpha > 0.0 && alpha < 1.0)) out << "alpha = " << alpha << ": must be in (0, 1); ";
+  if (!(loss_test_bandwidth_s >= 0.0 && loss_test_bandwidth_s <= 86400.0)) {
+    out << "loss_test_bandwidth_s = " << loss_test_bandwidth_s << ": must be in [0, 86400]; ";
+  }
+  if (!(extrapolation_share > 0.0 && extrapolation_share <= 1.0)) {
+    out << "extrapolation_share = " << extrapolation_share << ": must be in (0, 1]; ";
+  }
   if (!(min_shrink_pct >= 0.0 && min_shrink_pct < 100.0)) {
     out << "min_shrink_pct = " << min_shrink_pct << ": must be in [0, 100); ";
   }
@@ -83,6 +89,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   st::BaseFit base_fit;
   if (!st::FitBase(split, plant, base, options, progress, &base_fit, &r, error)) return false;
   const st::BaseResiduals residuals = st::LocaliseBaseGap(split, base_fit, plant, options, &r);
+  r.extrapolation = st::FindExtrapolation(base_fit, options);
 
   st::TrialInputs trials;
   trials.data = &data;
@@ -97,6 +104,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
                        : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   trials.test_unit = r.test_unit;
   trials.progress = progress;
+  trials.extrapolation = &r.extrapolation;
   const st::LadderModel final_model = st::RunLadder(trials, base, &r);
 
   if (!st::EstimateNoiseFloor(split, plant, final_model, &r, error)) return false;

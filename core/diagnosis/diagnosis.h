@@ -72,8 +72,15 @@ struct DiagnosisOptions {
   // Identification of every model (must be valid). Default: the project's
   // defaults with ftol_rel 1e-4 (DiagnosisIdentOptions).
   IdentOptions ident = DiagnosisIdentOptions();
-  // One-sided Wilcoxon p at or below which an improvement is consistent.
+  // One-sided p of the held-out loss test at or below which an improvement
+  // counts (and at which an output made worse counts against an effect).
   double alpha = 0.05;
+  // Bandwidth of the loss test's autocorrelation correction, s: residuals
+  // of a thermal model carry the weather's hours-long memory.
+  double loss_test_bandwidth_s = 10800.0;
+  // Share of held-out rows outside the training range above which a driver
+  // is reported as extrapolated.
+  double extrapolation_share = 0.3;
   // Smallest reduction of the pooled held-out objective, %, that counts.
   // Above what re-identification alone moves it on data without the effect
   // (≤ 0.3 % on the self-test's null cases at ftol 1e-4).
@@ -99,6 +106,16 @@ struct DiagnosisOptions {
   bool IsValid(std::string* why) const;
 };
 
+// A driver of the model whose held-out values lie outside what the training
+// days showed (share_outside of the held-out objective rows beyond the
+// training rows' 1st–99th percentile).
+struct Extrapolation {
+  std::string driver;  // "t_in_minus_t_amb_k", "g_poa_w_m2", "wind_m_s", "flow_kg_s"
+  double train_low = 0.0, train_high = 0.0;      // 1st, 99th percentile
+  double heldout_low = 0.0, heldout_high = 0.0;  // 1st, 99th percentile
+  double share_outside = 0.0;
+};
+
 // The decisive test of one effect against the model it was added to.
 struct EffectTrial {
   std::string name;
@@ -114,12 +131,31 @@ struct EffectTrial {
   double shrink_pct = 0.0;            // reduction of the held-out MAE(P_el) + MAE(Q_u)
   double heldout_mae_before_w = 0.0;  // MAE P_el + MAE Q_u, W, of tested_against
   double heldout_mae_after_w = 0.0;   // … with the effect
-  PairedTest test;                    // over test units (per-unit objective)
-  PartialCorrelation evidence_corr;   // residual evidence (stronger output)
-  std::string evidence_output;        // "p_el" or "q_th"
-  std::string evidence;               // one sentence
+  PairedTest test;                    // over test units (per-unit objective), reported
+  // The decisive test: held-out loss |e_P_el| + |e_Q_u| per row before and
+  // after (OneSidedLossDifferenceTest, bandwidth loss_test_bandwidth_s).
+  LossDifferenceTest heldout_test;
+  // Held-out MAE per output after the effect, W (before: tested_against's).
+  double mae_p_el_after_w = 0.0, mae_q_th_after_w = 0.0;
+  double mae_p_el_before_w = 0.0, mae_q_th_before_w = 0.0;
+  // Held-out days on which the effect lowered the loss (it acts where it
+  // acts: an effect need not help on every day, but on more than one).
+  int days_improved = 0;
+  // Why an effect whose held-out error fell significantly is still not
+  // accepted: an output made worse, its magnitude at a bound, its own
+  // signature absent from the data ("" = not rejected).
+  std::string rejected;
+  // The module's signature check (EffectModule::shows_signature), "" if none.
+  std::string signature_check;
+  // Effect parameters that ended at a bound or that the data do not
+  // determine: "P_limit at its upper bound 300", "n_flow = 0.079 ± 0.247 (not determined)".
+  std::vector<std::string> at_bounds;
+  PartialCorrelation evidence_corr;  // residual evidence (stronger output)
+  std::string evidence_output;       // "p_el" or "q_th"
+  std::string evidence;              // one sentence
   double fit_runtime_s = 0.0;
   ParamVector params{};
+  std::vector<ParamEstimate> estimates;  // of the effect's own parameters
   // A sensor fault (an effect with EffectModule::sensor_estimate, the
   // pyranometer scale error k) is not a prediction error: the fit absorbs it
   // and the held-out MAE does not move. It is significant when its per-day
@@ -138,7 +174,7 @@ struct LadderStep {
   double heldout_mae_w = 0.0;   // MAE P_el + MAE Q_u, W
   double objective_w_m2 = 0.0;  // paper objective, W/m²
   double shrink_pct = 0.0;      // against the previous step
-  double p_value = 1.0;         // Wilcoxon p against the previous step
+  double p_value = 1.0;         // loss test p against the previous step
   ParamVector params{};
 };
 
@@ -177,7 +213,13 @@ struct DiagnosisResult {
   std::vector<EffectTrial> effects;    // ranked, most likely first
   std::vector<SkippedEffect> skipped;  // effects not tried, with the reason
   std::vector<LadderStep> ladder;      // base, + effect 1, …
-  std::string verdict;                 // an effect name, "none" or "unknown"
+  std::string verdict;                 // an effect name, "none", "unknown" or "undecided"
+  // With "undecided" (or a later ladder step that stopped on a tie): the
+  // effects whose held-out errors the data cannot tell apart.
+  std::vector<std::string> candidates;
+  // Drivers whose held-out range leaves the training range (see
+  // FindExtrapolation): parameters not determined by the training data.
+  std::vector<Extrapolation> extrapolation;
   std::string verdict_sentence;
   NoiseFloor noise;
   std::vector<DiagnosisDay> days;

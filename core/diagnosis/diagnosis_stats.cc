@@ -190,6 +190,58 @@ PairedTest OneSidedPairedTest(std::span<const double> before, std::span<const do
   return test;
 }
 
+LossDifferenceTest OneSidedLossDifferenceTest(std::span<const double> before,
+                                              std::span<const double> after,
+                                              std::span<const std::int64_t> time_s,
+                                              double bandwidth_s) {
+  LossDifferenceTest out;
+  std::vector<double> d;
+  std::vector<std::int64_t> t;
+  for (std::size_t i = 0; i < before.size() && i < after.size() && i < time_s.size(); ++i) {
+    if (!std::isfinite(before[i]) || !std::isfinite(after[i])) continue;
+    d.push_back(before[i] - after[i]);
+    t.push_back(time_s[i]);
+  }
+  const std::size_t n = d.size();
+  out.rows = n;
+  if (n < 3) return out;
+  std::vector<std::int64_t> steps;
+  for (std::size_t j = 1; j < n; ++j) {
+    if (t[j] > t[j - 1]) steps.push_back(t[j] - t[j - 1]);
+  }
+  std::int64_t step = 60;
+  if (!steps.empty()) {
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    step = std::max<std::int64_t>(1, steps[steps.size() / 2]);
+  }
+  const int lags = std::max(0, static_cast<int>(bandwidth_s / static_cast<double>(step)));
+  out.bandwidth_rows = lags;
+  const double mean = std::accumulate(d.begin(), d.end(), 0.0) / static_cast<double>(n);
+  out.mean_difference = mean;
+  for (double& x : d) x -= mean;
+  double gamma0 = 0.0;
+  for (const double x : d) gamma0 += x * x;
+  gamma0 /= static_cast<double>(n);
+  double sum = gamma0;
+  for (int k = 1; k <= lags; ++k) {
+    double gk = 0.0;
+    for (std::size_t j = 0; j + static_cast<std::size_t>(k) < n; ++j) {
+      const std::size_t m = j + static_cast<std::size_t>(k);
+      if (static_cast<double>(t[m] - t[j]) <= bandwidth_s) gk += d[j] * d[m];
+    }
+    sum += 2.0 * (1.0 - k / (lags + 1.0)) * gk / static_cast<double>(n);
+  }
+  const double var = std::max(sum, gamma0 / (lags + 1.0)) / static_cast<double>(n);
+  if (!(var > 0.0)) {
+    out.p = mean > 0.0 ? 0.0 : 1.0;
+    return out;
+  }
+  out.std_error = std::sqrt(var);
+  out.z = mean / out.std_error;
+  out.p = 0.5 * std::erfc(out.z / std::sqrt(2.0));
+  return out;
+}
+
 PartialCorrelation PartialCorrelate(std::span<const double> y, std::span<const double> x,
                                     const std::vector<std::vector<double>>& controls) {
   PartialCorrelation out;

@@ -18,6 +18,20 @@ std::size_t BestSignificant(const std::vector<EffectTrial>& trials) {
   return best;
 }
 
+// The significant trials whose held-out loss the loss test cannot tell
+// from the best one's (p > alpha that the best is better): the data cannot
+// separate them.
+std::vector<std::size_t> Ties(const TrialInputs& in, const StepTrials& st, std::size_t best) {
+  std::vector<std::size_t> tied;
+  for (std::size_t k = 0; k < st.trials.size(); ++k) {
+    if (k == best || !st.trials[k].significant) continue;
+    const LossDifferenceTest t = CompareLosses(st.scores[k], st.scores[best], in.base->heldout,
+                                               in.options->loss_test_bandwidth_s);
+    if (t.p > in.options->alpha) tied.push_back(k);
+  }
+  return tied;
+}
+
 // Records the accepted trial: in the effects list (which keeps, for an
 // effect accepted after step 1, its first evidence and its trial at that
 // step) and as a ladder step.
@@ -46,7 +60,7 @@ void Accept(int step, const EffectTrial& chosen, const Score& score, DiagnosisRe
   ls.heldout_mae_w = MaeSumW(score.errors);
   ls.objective_w_m2 = score.errors.objective_w_m2();
   ls.shrink_pct = chosen.shrink_pct;
-  ls.p_value = chosen.test.wilcoxon_p;
+  ls.p_value = chosen.heldout_test.p;
   ls.params = chosen.params;
   r.ladder.push_back(ls);
 }
@@ -80,6 +94,14 @@ LadderModel RunLadder(const TrialInputs& in, const ModelSpec& base, DiagnosisRes
     const std::size_t best = BestSignificant(st.trials);
     if (step == 1) r.effects = st.trials;
     if (best == st.trials.size()) break;
+    const std::vector<std::size_t> tied = Ties(in, st, best);
+    if (!tied.empty()) {
+      r.candidates.push_back(st.trials[best].name);
+      for (const std::size_t k : tied) r.candidates.push_back(st.trials[k].name);
+      in.progress("undecided at step " + std::to_string(step) + ": the data cannot separate " +
+                  std::to_string(r.candidates.size()) + " effects");
+      break;
+    }
     EffectTrial& chosen = st.trials[best];
     chosen.accepted_at_step = step;
     Accept(step, chosen, st.scores[best], &r);

@@ -39,6 +39,19 @@ Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& 
               std::fabs(score.sim.q_th_w[i] - heldout.meas.q_th_w[i]);
     rows[k] += 1.0;
   }
+  score.loss_p_el_w.assign(heldout.meas.size(), kNaN);
+  score.loss_q_th_w.assign(heldout.meas.size(), kNaN);
+  score.loss_w.assign(heldout.meas.size(), kNaN);
+  for (std::uint32_t i : heldout.meas.rows) {
+    score.loss_p_el_w[i] = std::fabs(score.sim.p_el_w[i] - heldout.meas.p_el_w[i]);
+    score.loss_q_th_w[i] = std::fabs(score.sim.q_th_w[i] - heldout.meas.q_th_w[i]);
+    score.loss_w[i] = score.loss_p_el_w[i] + score.loss_q_th_w[i];
+    score.bias_p_el_w += score.sim.p_el_w[i] - heldout.meas.p_el_w[i];
+    score.bias_q_th_w += score.sim.q_th_w[i] - heldout.meas.q_th_w[i];
+  }
+  const double n_rows = static_cast<double>(std::max<std::size_t>(1, heldout.meas.rows.size()));
+  score.bias_p_el_w /= n_rows;
+  score.bias_q_th_w /= n_rows;
   score.unit_objective_w_m2.assign(static_cast<std::size_t>(units.count), kNaN);
   for (std::size_t k = 0; k < sum.size(); ++k) {
     if (rows[k] > 0.0) score.unit_objective_w_m2[k] = sum[k] / rows[k] / area_m2;
@@ -58,6 +71,14 @@ PairedTest CompareUnits(const Score& before, const Score& after) {
     }
   }
   return OneSidedPairedTest(b, a);
+}
+
+LossDifferenceTest CompareLosses(const Score& before, const Score& after, const Part& heldout,
+                                 double bandwidth_s, Loss which) {
+  auto pick = [which](const Score& s) -> const std::vector<double>& {
+    return which == Loss::kPEl ? s.loss_p_el_w : which == Loss::kQTh ? s.loss_q_th_w : s.loss_w;
+  };
+  return OneSidedLossDifferenceTest(pick(before), pick(after), heldout.drivers.time_s, bandwidth_s);
 }
 
 std::vector<double> Residual(const Measurements& m, const std::vector<double>& pred,

@@ -60,6 +60,10 @@ struct Score {
   SimOutputs sim;
   ErrorMetrics errors;
   std::vector<double> unit_objective_w_m2;  // per test unit, NaN if the unit has no rows
+  // Per held-out row: |e_P_el|, |e_Q_u| and their sum, W; NaN off the
+  // objective rows.
+  std::vector<double> loss_p_el_w, loss_q_th_w, loss_w;
+  double bias_p_el_w = 0.0, bias_q_th_w = 0.0;  // mean predicted − measured
 };
 
 Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& units,
@@ -67,6 +71,12 @@ Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& 
 
 // One-sided paired test of the per-unit objectives: is `after` lower?
 PairedTest CompareUnits(const Score& before, const Score& after);
+
+// One-sided held-out loss test (OneSidedLossDifferenceTest): is `after`'s
+// loss lower than `before`'s? `which`: the sum, P_el's or Q_u's loss.
+enum class Loss { kSum, kPEl, kQTh };
+LossDifferenceTest CompareLosses(const Score& before, const Score& after, const Part& heldout,
+                                 double bandwidth_s, Loss which = Loss::kSum);
 
 // Residual (predicted − measured) of one output over the objective rows, NaN elsewhere.
 std::vector<double> Residual(const Measurements& m, const std::vector<double>& pred,
@@ -106,6 +116,11 @@ struct BaseResiduals {
 BaseResiduals LocaliseBaseGap(const Split& split, const BaseFit& base, const Plant& plant,
                               const DiagnosisOptions& options, DiagnosisResult* r);
 
+// Drivers (T_in − T_amb, in-plane irradiance, wind, flow) whose held-out
+// range leaves the training range on more than options.extrapolation_share
+// of the held-out objective rows.
+std::vector<Extrapolation> FindExtrapolation(const BaseFit& base, const DiagnosisOptions& options);
+
 // --- 4. Candidate trials ---
 // Controls of the evidence regression, per held-out row: in-plane
 // irradiance, T_in − T_amb, flow.
@@ -123,6 +138,7 @@ struct TrialInputs {
   int threads = 1;
   std::string test_unit;  // "day" or "hour"
   Progress progress;
+  const std::vector<Extrapolation>* extrapolation = nullptr;  // FindExtrapolation's
 };
 // A model on the ladder.
 struct LadderModel {

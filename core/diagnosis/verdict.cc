@@ -4,6 +4,37 @@
 
 namespace pvtwin::diagnosis_stages {
 
+namespace {
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    out += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+  }
+  return out;
+}
+
+// " The held-out days lie outside …" when drivers are extrapolated, else "".
+std::string ExtrapolationSentence(const DiagnosisResult& r) {
+  if (r.extrapolation.empty()) return "";
+  std::ostringstream s;
+  s << " The held-out days lie outside the training days' range of ";
+  for (std::size_t k = 0; k < r.extrapolation.size(); ++k) {
+    const Extrapolation& e = r.extrapolation[k];
+    s << (k == 0                            ? ""
+          : k + 1 == r.extrapolation.size() ? " and "
+                                            : ", ")
+      << e.driver << " (" << FixedDecimals(100.0 * e.share_outside, 0) << " % of the rows outside ["
+      << FixedDecimals(e.train_low, 1) << ", " << FixedDecimals(e.train_high, 1) << "], held-out ["
+      << FixedDecimals(e.heldout_low, 1) << ", " << FixedDecimals(e.heldout_high, 1) << "])";
+  }
+  s << ": the parameters that act there are not determined by the training data, a likely "
+       "cause of the gap rather than a missing effect.";
+  return s.str();
+}
+
+}  // namespace
+
 // The first accepted effect; else "unknown" when the final held-out
 // objective exceeds unknown_noise_ratio × the noise floor (a gap no
 // catalogued effect removes; `where` locates it); else "none". Each with
@@ -25,8 +56,9 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
       << " %, from " << FixedDecimals(first.heldout_mae_w, 1) << " W to "
       << FixedDecimals(r.ladder[1].heldout_mae_w, 1) << " W";
     if (top != nullptr) {
-      s << ", lower on " << top->test.positives << " of " << top->test.pairs << " held-out "
-        << r.test_unit << "s (Wilcoxon p = " << PValue(top->test.wilcoxon_p) << ")";
+      s << " (held-out loss test p = " << PValue(top->heldout_test.p) << ", better on "
+        << top->days_improved << " held-out day(s))";
+      if (!top->signature_check.empty()) s << "; " << top->signature_check;
     }
     s << ".";
     if (r.ladder.size() > 2) {
@@ -38,8 +70,18 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
       s << ", ending at " << FixedDecimals(last.heldout_mae_w, 1) << " W with " << r.final_variant
         << ".";
     }
+    if (!r.candidates.empty()) {
+      s << " The next step is undecided between " << JoinNames(r.candidates) << ".";
+    }
     if (r.low_confidence) s << " Low confidence: too few held-out days.";
     r.verdict_sentence = s.str();
+  } else if (!r.candidates.empty()) {
+    r.verdict = "undecided";
+    r.verdict_sentence = "Adding any of " + JoinNames(r.candidates) + " to " + r.base_variant +
+                         " lowers its held-out error (" + FixedDecimals(first.heldout_mae_w, 1) +
+                         " W, MAE P_el + Q_u), and the held-out loss test cannot tell them apart: "
+                         "the data do not say which effect is missing." +
+                         ExtrapolationSentence(r);
   } else if (r.noise.ratio > options.unknown_noise_ratio) {
     r.verdict = "unknown";
     std::ostringstream s;
@@ -59,14 +101,15 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
         << (w.output == "q_th" ? "Q_u" : "P_el") << " error in "
         << FixedDecimals(100.0 * w.share_of_rows, 0) << " % of the rows";
     }
-    s << ".";
+    s << "." << ExtrapolationSentence(r);
     r.verdict_sentence = s.str();
   } else {
     r.verdict = "none";
     r.verdict_sentence = "No catalogued effect lowers the held-out error of " + r.base_variant +
                          " consistently; its held-out error (" +
                          FixedDecimals(first.heldout_mae_w, 1) + " W, MAE P_el + Q_u) is " +
-                         FixedDecimals(r.noise.ratio, 1) + "× the sensor-noise floor.";
+                         FixedDecimals(r.noise.ratio, 1) + "× the sensor-noise floor." +
+                         ExtrapolationSentence(r);
   }
 }
 

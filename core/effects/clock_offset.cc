@@ -1,7 +1,10 @@
 #include "core/effects/clock_offset.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "core/common/text.h"
 
 namespace pvtwin {
 
@@ -70,6 +73,33 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) {
   return RatePerMinute(d, d.g_abs_w_m2);
 }
 
+// A clock offset shifts the electricity against the weather: measured
+// P_el's changes follow the model's without the offset at k = −Δt/step rows
+// (the weather at collector time t is the row stamped t + Δt). Shown when
+// the best lag has the fitted offset's sign and size (within one row or
+// half of it).
+SignatureCheck ElectricityLeadsOrLags(const SignatureData& d) {
+  const double step_s = RowStepS(*d.drivers);
+  const double offset_s = ParamOf(*d.params, Param::kClockOffsetS);
+  const double expected = -offset_s / step_s;
+  const int reach = std::max(3, static_cast<int>(std::ceil(2.0 * std::fabs(expected))) + 1);
+  const LagFit lag = BestLag(*d.drivers, *d.rows, *d.p_el_meas_w, d.before->p_el_w, -reach, reach);
+  SignatureCheck c;
+  if (lag.pairs == 0) {
+    c.shown = false;
+    c.sentence = "too few unbroken held-out rows to see a time shift of P_el";
+    return c;
+  }
+  c.shown = lag.lag_rows != 0 && (lag.lag_rows > 0) == (expected > 0) &&
+            std::fabs(lag.lag_rows - expected) <= std::max(1.0, 0.5 * std::fabs(expected));
+  c.sentence = "the measured P_el's changes are shifted by " +
+               FixedDecimals(-lag.lag_rows * step_s, 0) + " s against the model's (correlation " +
+               FixedDecimals(lag.corr_at_lag, 2) + ", unshifted " +
+               FixedDecimals(lag.corr_at_zero, 2) + "), fitted Δt = " + FixedDecimals(offset_s, 0) +
+               " s" + (c.shown ? "" : ": no shift that matches the offset");
+  return c;
+}
+
 }  // namespace
 
 const EffectModule& ClockOffsetEffect() {
@@ -92,6 +122,7 @@ const EffectModule& ClockOffsetEffect() {
         "model the offset with +clock_offset.";
     m.extension = &Extension();
     m.signature_values = Signature;
+    m.shows_signature = ElectricityLeadsOrLags;
     return m;
   }();
   return kModule;

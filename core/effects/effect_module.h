@@ -40,6 +40,25 @@ struct EffectResiduals {
   const std::vector<double>* p_el_meas_w = nullptr;  // measured P_el per row
 };
 
+// What a signature check reads: the held-out days, the model without the
+// effect and the re-identified model with it.
+struct SignatureData {
+  const Drivers* drivers = nullptr;                  // held-out, model with the effect
+  const std::vector<std::uint32_t>* rows = nullptr;  // objective rows
+  const std::vector<double>* p_el_meas_w = nullptr;  // measured, per row
+  const std::vector<double>* q_th_meas_w = nullptr;
+  const SimOutputs* before = nullptr;   // without the effect
+  const SimOutputs* after = nullptr;    // with it
+  const ParamVector* params = nullptr;  // fitted, with the effect
+};
+
+// Whether the data show the effect's own signature, in one sentence with
+// the numbers ("measured P_el sits at the fitted limit …").
+struct SignatureCheck {
+  bool shown = true;
+  std::string sentence;
+};
+
 struct EffectModule {
   std::string_view name;     // DESIGN.md vocabulary, e.g. "pv_clipping"
   std::string_view physics;  // one paragraph of physics, for the report
@@ -88,6 +107,13 @@ struct EffectModule {
   // The evidence sentence of a sensor estimate (median over days, two-sided
   // p of ≠ 0, days), ending in "; ".
   std::string (*sensor_evidence)(double median, double p, int days) = nullptr;
+  // The physics check of a fit that lowered the held-out error: does the
+  // data show what the effect does (a plateau at the fitted limit for
+  // clipping, the improvement recurring at the fitted sun positions on
+  // several days for shading, …)? Null: no check beyond the generic ones
+  // (no output made worse, parameters inside their bounds, better on more
+  // than one day).
+  SignatureCheck (*shows_signature)(const SignatureData& data) = nullptr;
 
   // --- Synthetic truth ---
   // A sensor error: the truth plant runs without the effect and this turns
@@ -98,5 +124,24 @@ struct EffectModule {
 // Central difference per minute of a per-row value, NaN across restarts and
 // gaps (a signature helper).
 std::vector<double> RatePerMinute(const Drivers& d, const std::vector<double>& v);
+
+// The lag k in rows (min_lag ≤ k ≤ max_lag) at which the changes of `meas`
+// follow those of `pred` best: the correlation of meas(i) − meas(i−1) with
+// pred(i−k) − pred(i−k−1) over the objective rows whose rows i−k−1 … i are
+// one unbroken stretch (no restart, equal steps). Differences, not levels,
+// so that a bias does not pick the lag. A signature helper (transport
+// delay, clock offset).
+struct LagFit {
+  int lag_rows = 0;
+  double corr_at_lag = 0.0;
+  double corr_at_zero = 0.0;
+  std::size_t pairs = 0;  // at lag 0; 0 = too few rows (< 30) to say
+};
+LagFit BestLag(const Drivers& d, const std::vector<std::uint32_t>& rows,
+               const std::vector<double>& meas, const std::vector<double>& pred, int min_lag,
+               int max_lag);
+
+// The data's row step, s (the median of the steps; 60 when there are none).
+double RowStepS(const Drivers& d);
 
 }  // namespace pvtwin

@@ -1,6 +1,10 @@
 #include "core/effects/pv_clipping.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
+
+#include "core/common/text.h"
 
 namespace pvtwin {
 
@@ -34,6 +38,39 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs& base) {
   return out;
 }
 
+// A clipping inverter shows a plateau: on the rows the fitted model clips
+// (at least 30 and 1 % of the rows),
+// the measured P_el sits at the fitted limit (median deviation ≤ 5 % of it,
+// room for a soft knee and temperature derating), and the measured P_el
+// hardly ever exceeds it (≤ 2 % of the rows above 1.05 × the limit).
+SignatureCheck Plateau(const SignatureData& d) {
+  SignatureCheck c;
+  const double limit_w = ParamOf(*d.params, Param::kPLimitWM2) * d.drivers->plant.area_m2;
+  std::vector<double> deviation;
+  std::size_t above = 0;
+  for (std::uint32_t i : *d.rows) {
+    const double meas = (*d.p_el_meas_w)[i];
+    if (meas > 1.05 * limit_w) ++above;
+    if (d.after->p_el_w[i] >= 0.999 * limit_w) deviation.push_back(std::fabs(meas - limit_w));
+  }
+  const double share_above = static_cast<double>(above) / std::max<std::size_t>(1, d.rows->size());
+  if (deviation.size() < std::max<std::size_t>(30, d.rows->size() / 100)) {
+    c.shown = false;
+    c.sentence = "the fitted limit " + FixedDecimals(limit_w, 0) + " W is reached on " +
+                 std::to_string(deviation.size()) + " held-out rows only: no plateau to see";
+    return c;
+  }
+  std::nth_element(deviation.begin(), deviation.begin() + deviation.size() / 2, deviation.end());
+  const double median_share = deviation[deviation.size() / 2] / limit_w;
+  c.shown = median_share <= 0.05 && share_above <= 0.02;
+  c.sentence = std::string(c.shown ? "" : "no ") + "plateau of measured P_el at the fitted limit " +
+               FixedDecimals(limit_w, 0) + " W: median |P_el − limit| " +
+               FixedDecimals(100.0 * median_share, 1) + " % of it on the " +
+               std::to_string(deviation.size()) + " clipped rows, " +
+               FixedDecimals(100.0 * share_above, 1) + " % of all rows above 1.05 × the limit";
+  return c;
+}
+
 }  // namespace
 
 const EffectModule& PvClippingEffect() {
@@ -56,6 +93,7 @@ const EffectModule& PvClippingEffect() {
         "the collector as heat; model it with +pv_clipping.";
     m.extension = &Extension();
     m.signature_values = Signature;
+    m.shows_signature = Plateau;
     return m;
   }();
   return kModule;

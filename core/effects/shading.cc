@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
+#include "core/common/text.h"
 #include "core/common/units.h"
 
 namespace pvtwin {
@@ -54,6 +56,50 @@ const ModelExtension& Extension() {
     return e;
   }();
   return kExtension;
+}
+
+// An obstacle shades the same sun positions every day: the improvement of
+// the fit lies on the rows the fitted obstacle reaches (shaded fraction ≥
+// 0.1; at least half of the improvement) and recurs there on at least two
+// days.
+SignatureCheck RecursAtTheSameSunPosition(const SignatureData& d) {
+  const ParamVector& p = *d.params;
+  const Drivers& dr = *d.drivers;
+  const double solar_offset_s = dr.plant.longitude_rad / (2.0 * kPi) * 86400.0;
+  std::map<std::int64_t, double> by_day;
+  double total = 0.0, shaded = 0.0;
+  std::size_t shaded_rows = 0;
+  for (std::uint32_t i : *d.rows) {
+    const double gain = std::fabs(d.before->p_el_w[i] - (*d.p_el_meas_w)[i]) +
+                        std::fabs(d.before->q_th_w[i] - (*d.q_th_meas_w)[i]) -
+                        std::fabs(d.after->p_el_w[i] - (*d.p_el_meas_w)[i]) -
+                        std::fabs(d.after->q_th_w[i] - (*d.q_th_meas_w)[i]);
+    if (!std::isfinite(gain)) continue;
+    total += gain;
+    const double s = ShadedFraction(
+        dr.sun_azimuth_rad[i], dr.sun_elevation_rad[i], ParamOf(p, Param::kShadeAzimuthRad),
+        ParamOf(p, Param::kShadeWidthRad), ParamOf(p, Param::kShadeElevationRad));
+    if (s < 0.1) continue;
+    ++shaded_rows;
+    shaded += gain;
+    const auto day = static_cast<std::int64_t>(
+        std::floor((static_cast<double>(dr.time_s[i]) + solar_offset_s) / 86400.0));
+    by_day[day] += gain;
+  }
+  int days = 0;
+  for (const auto& [day, gain] : by_day) days += gain > 0.0 ? 1 : 0;
+  SignatureCheck c;
+  const double share = total > 0.0 ? shaded / total : 0.0;
+  c.shown = days >= 2 && share >= 0.5;
+  c.sentence = "the fitted obstacle (azimuth " +
+               FixedDecimals(RadToDeg(ParamOf(p, Param::kShadeAzimuthRad)), 0) + "° ± " +
+               FixedDecimals(RadToDeg(0.5 * ParamOf(p, Param::kShadeWidthRad)), 0) + "°, up to " +
+               FixedDecimals(RadToDeg(ParamOf(p, Param::kShadeElevationRad)), 0) +
+               "° elevation) shades " + std::to_string(shaded_rows) + " held-out rows holding " +
+               FixedDecimals(100.0 * share, 0) + " % of the improvement, better there on " +
+               std::to_string(days) + " of " + std::to_string(by_day.size()) + " days" +
+               (c.shown ? "" : ": the improvement does not recur at the same sun positions");
+  return c;
 }
 
 std::string DataLacks(const Series& data) {
@@ -135,6 +181,7 @@ const EffectModule& ShadingEffect() {
     m.extension = &Extension();
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
+    m.shows_signature = RecursAtTheSameSunPosition;
     m.start_from_residuals = StartFromResiduals;
     return m;
   }();

@@ -1,7 +1,10 @@
 #include "core/effects/transport_delay.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "core/common/text.h"
 
 namespace pvtwin {
 
@@ -59,6 +62,38 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs& base) {
   return std::vector<double>(d.size(), std::numeric_limits<double>::quiet_NaN());
 }
 
+// A dead time shows as a lag: the measured heat follows the changes of the
+// model without the delay some rows later, at about the fitted τ (within
+// one row or half of it). A pipe loss alone (or a fit that shifts a bias)
+// leaves the changes in step. A τ below half the row step cannot show as a
+// lag: the check then has nothing to say.
+SignatureCheck MeasuredHeatLags(const SignatureData& d) {
+  const double step_s = RowStepS(*d.drivers);
+  const double tau_s = ParamOf(*d.params, Param::kTransportDelayS);
+  const double expected = tau_s / step_s;
+  const int max_lag = std::max(3, static_cast<int>(std::ceil(2.0 * expected)) + 1);
+  const LagFit lag = BestLag(*d.drivers, *d.rows, *d.q_th_meas_w, d.before->q_th_w, 0, max_lag);
+  SignatureCheck c;
+  if (expected < 0.5) {
+    c.sentence = "the fitted τ = " + FixedDecimals(tau_s, 0) + " s is below half the " +
+                 FixedDecimals(step_s, 0) + " s row step: no lag the data can show";
+    return c;
+  }
+  if (lag.pairs == 0) {
+    c.shown = false;
+    c.sentence = "too few unbroken held-out rows to see a lag of the measured heat";
+    return c;
+  }
+  c.shown =
+      lag.lag_rows >= 1 && std::fabs(lag.lag_rows - expected) <= std::max(1.0, 0.5 * expected);
+  c.sentence = "the measured Q_u's changes follow the model's " +
+               FixedDecimals(lag.lag_rows * step_s, 0) + " s later (correlation " +
+               FixedDecimals(lag.corr_at_lag, 2) + ", in step " +
+               FixedDecimals(lag.corr_at_zero, 2) + "), fitted τ = " + FixedDecimals(tau_s, 0) +
+               " s" + (c.shown ? "" : ": no lag that matches the dead time");
+  return c;
+}
+
 }  // namespace
 
 const EffectModule& TransportDelayEffect() {
@@ -81,6 +116,7 @@ const EffectModule& TransportDelayEffect() {
         "the collector outlet and insulate the pipe.";
     m.extension = &Extension();
     m.signature_values = Signature;
+    m.shows_signature = MeasuredHeatLags;
     return m;
   }();
   return kModule;

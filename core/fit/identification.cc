@@ -902,4 +902,11 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   return finish(true, "");
 }
 
+double StdErrorInUnit(const ParamEstimate& e) {
+  if (!e.free || e.undetermined || !(e.se_unit > 0.0)) return std::nan("");
+  const bool log_scale = Info(e.param).scale == ParamScale::kLog;
+  return log_scale ? e.value * std::log(e.upper / e.lower) * e.se_unit
+                   : (e.upper - e.lower) * e.se_unit;
+}
+
 }  // namespace pvtwin

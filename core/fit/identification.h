@@ -119,6 +119,12 @@ struct ParamEstimate {
   double se_unit = 0.0;       // standard error in unit coordinates (0 when not free)
 };
 
+// The standard error in the parameter's own unit, from the one in the
+// optimiser's unit coordinates (first order: linear scale x = lo + z·(hi −
+// lo), log scale x = lo·(hi/lo)^z, dx/dz = x·ln(hi/lo)). NaN when fixed or
+// not estimated.
+double StdErrorInUnit(const ParamEstimate& e);
+
 // Name used on the command line: "lad_lm" or an NLopt algorithm name.
 std::string IdentAlgorithmName(const IdentOptions& options);
 // Sets method (and optimizer.algorithm) from such a name; false if unknown.

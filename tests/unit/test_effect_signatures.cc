@@ -1,0 +1,89 @@
+// The effects' signature checks (EffectModule::shows_signature) and their
+// helper BestLag on data whose answer is known by construction: a signal
+// shifted by a known number of rows, a measured P_el that stops at an
+// inverter limit and one that does not.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/effects/effect_module.h"
+#include "core/effects/pv_clipping.h"
+
+namespace pvtwin {
+namespace {
+
+// n rows at 60 s, all usable, one stretch; rows 0 … n−1 are objective rows.
+Drivers Rows(std::size_t n, std::vector<std::uint32_t>* rows) {
+  Drivers d;
+  d.plant.area_m2 = 2.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    d.time_s.push_back(static_cast<std::int64_t>(60 * i));
+    d.restart.push_back(i == 0 ? 1 : 0);
+    d.usable.push_back(1);
+    rows->push_back(static_cast<std::uint32_t>(i));
+  }
+  return d;
+}
+
+TEST(BestLag, FindsTheShiftOfARandomWalkInEitherDirection) {
+  std::vector<std::uint32_t> rows;
+  const Drivers d = Rows(600, &rows);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> step(0.0, 1.0);
+  std::vector<double> pred(600, 0.0), late(600, 0.0), early(600, 0.0);
+  for (std::size_t i = 1; i < 600; ++i) pred[i] = pred[i - 1] + step(rng);
+  for (std::size_t i = 0; i < 600; ++i) {
+    late[i] = i >= 2 ? pred[i - 2] + 5.0 : pred[0] + 5.0;  // follows 2 rows later, biased
+    early[i] = i + 3 < 600 ? pred[i + 3] : pred[599];      // 3 rows ahead
+  }
+  const LagFit l = BestLag(d, rows, late, pred, -5, 5);
+  EXPECT_EQ(l.lag_rows, 2);
+  EXPECT_GT(l.corr_at_lag, 0.99);
+  EXPECT_LT(l.corr_at_zero, 0.2);
+  EXPECT_EQ(BestLag(d, rows, early, pred, -5, 5).lag_rows, -3);
+  // A restart in every row leaves no unbroken pairs to correlate.
+  Drivers broken = d;
+  for (std::size_t i = 0; i < 600; ++i) broken.restart[i] = 1;
+  EXPECT_EQ(BestLag(broken, rows, late, pred, -5, 5).pairs, 0u);
+}
+
+// A bell-shaped DC power up to 300 W on 2 m²; measured = min(DC, 200 W)
+// with 0.5 W noise for a clipping inverter, = DC for one that does not clip.
+TEST(PvClippingSignature, APlateauAtTheFittedLimitIsShownAndMissingWithoutOne) {
+  std::vector<std::uint32_t> rows;
+  const Drivers d = Rows(720, &rows);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  SimOutputs before, after;
+  std::vector<double> clipped(720), unclipped(720), q(720, 0.0);
+  ParamVector params{};
+  params[static_cast<std::size_t>(Param::kPLimitWM2)] = 100.0;  // 200 W on 2 m²
+  params[static_cast<std::size_t>(Param::kAreaM2)] = 2.0;
+  for (std::size_t i = 0; i < 720; ++i) {
+    const double x = (static_cast<double>(i) - 360.0) / 150.0;
+    const double dc = 300.0 * std::exp(-x * x);
+    before.p_el_w.push_back(dc);
+    after.p_el_w.push_back(std::min(dc, 200.0));
+    clipped[i] = std::min(dc, 200.0) + noise(rng);
+    unclipped[i] = dc + noise(rng);
+  }
+  before.q_th_w = after.q_th_w = q;
+  SignatureData s;
+  s.drivers = &d;
+  s.rows = &rows;
+  s.q_th_meas_w = &q;
+  s.before = &before;
+  s.after = &after;
+  s.params = &params;
+  s.p_el_meas_w = &clipped;
+  const SignatureCheck shown = PvClippingEffect().shows_signature(s);
+  EXPECT_TRUE(shown.shown) << shown.sentence;
+  EXPECT_NE(shown.sentence.find("200 W"), std::string::npos) << shown.sentence;
+  s.p_el_meas_w = &unclipped;
+  const SignatureCheck missing = PvClippingEffect().shows_signature(s);
+  EXPECT_FALSE(missing.shown) << missing.sentence;
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -69,24 +69,35 @@ class DaemonE2E : public ::testing::Test {
   void SetUp() override {
     ASSERT_TRUE(fs::exists(kExampleMap)) << kExampleMap;
     fs::copy_file(kExampleMap, dir_ / "sim.toml");
+    const std::string truth = truth_variant_.empty() ? "" : " --truth-variant " + truth_variant_;
     const auto exported = RunPvtwin(
         dir_.path(), "sim --config sim.toml --export history.csv --days 14 --step 60 --start " +
-                         std::to_string(t0_ - 14 * 86400));
+                         std::to_string(t0_ - 14 * 86400) + truth);
     ASSERT_EQ(exported.exit_code, 0) << exported.err;
     const auto imported =
         RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + Db());
     ASSERT_EQ(imported.exit_code, 0) << imported.err;
     anchor_ = WallNowS();
     std::string error;
-    ASSERT_TRUE(sim_.StartPiped({PVTWIN_BINARY, "sim", "--config", (dir_ / "sim.toml").string(),
-                                 "--ephemeral-ports", "--speed", std::to_string(kSpeed), "--start",
-                                 std::to_string(t0_), "--wall-anchor", std::to_string(anchor_)},
-                                (dir_ / "sim.log").string(), &error))
-        << error;
+    std::vector<std::string> sim_args = {PVTWIN_BINARY,
+                                         "sim",
+                                         "--config",
+                                         (dir_ / "sim.toml").string(),
+                                         "--ephemeral-ports",
+                                         "--speed",
+                                         std::to_string(speed_),
+                                         "--start",
+                                         std::to_string(t0_),
+                                         "--wall-anchor",
+                                         std::to_string(anchor_)};
+    if (!truth_variant_.empty())
+      sim_args.insert(sim_args.end(), {"--truth-variant", truth_variant_});
+    for (const std::string& f : faults_) sim_args.insert(sim_args.end(), {"--fault", f});
+    ASSERT_TRUE(sim_.StartPiped(sim_args, (dir_ / "sim.log").string(), &error)) << error;
     std::vector<std::string> lines;
     ASSERT_TRUE(sim_.ReadUntil("ready", 20.0, &lines)) << ReadFile(dir_ / "sim.log");
-    DaemonSettings settings;
-    settings.db_path = Db();
+    settings_.db_path = Db();
+    DaemonSettings& settings = settings_;
     std::string text;
     ASSERT_TRUE(
         EditConfig(ReadFile(kExampleMap), ParseListeningLines(lines), settings, &text, &error))
@@ -104,7 +115,7 @@ class DaemonE2E : public ::testing::Test {
   void StartDaemon() {
     std::string error;
     ASSERT_TRUE(daemon_.Start({PVTWIN_BINARY, "run", "--config", (dir_ / "pvtwin.toml").string(),
-                               "--speed", std::to_string(kSpeed), "--sim-start",
+                               "--speed", std::to_string(speed_), "--sim-start",
                                std::to_string(t0_), "--wall-anchor", std::to_string(anchor_)},
                               (dir_ / "daemon.log").string(), &error))
         << error;
@@ -122,7 +133,11 @@ class DaemonE2E : public ::testing::Test {
   std::string DaemonLog() const { return ReadFile(dir_ / "daemon.log"); }
 
   ScratchDir dir_{"e2e"};
-  std::int64_t t0_ = kMorning;  // simulated time at which live polling starts
+  std::int64_t t0_ = kMorning;       // simulated time at which live polling starts
+  double speed_ = kSpeed;            // simulated seconds per wall second
+  std::string truth_variant_;        // of `pvtwin sim`; empty: its default
+  std::vector<std::string> faults_;  // `pvtwin sim --fault` specs
+  DaemonSettings settings_;          // of the daemon's config
   double anchor_ = 0.0;
   ChildProcess sim_;
   ChildProcess daemon_;
@@ -177,6 +192,86 @@ TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
       << DaemonLog();
   EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
   EXPECT_NE(DaemonLog().find("stopping"), std::string::npos);
+}
+
+// Two simulated nights of the twin watching a plant whose inverter clips
+// (the simulator's truth has +pv_clipping, the configured model does not)
+// and whose weather station freezes for two hours on the first day: each
+// night the daemon calibrates, diagnoses its window and checks the days;
+// the diagnosis names the missing effect, the frozen channels are QC
+// events, and the operator's `event` view holds all of it.
+class DaemonE2ETwoNights : public DaemonE2E {
+ protected:
+  DaemonE2ETwoNights() {
+    t0_ = kFirstNight;
+    speed_ = 720.0;  // a simulated day in two minutes
+    truth_variant_ = "2N2CrI+wind+transport_delay+pv_clipping";
+    // The weather device repeats its last registers from 10:00 to 12:00 UTC.
+    faults_ = {"weather:freeze:from=" + std::to_string(kFreezeFrom - kFirstNight) + ":for=7200"};
+    settings_.variant = "2N2CrI+wind+transport_delay";
+    settings_.poll_period_s = 30;
+    settings_.calibrate_at = "02:00";
+  }
+  // 2024-06-01 23:00 UTC: the first calibration runs at the start, the
+  // second at 02:00 UTC of June 3, the second night.
+  static constexpr std::int64_t kFirstNight = 1717282800;
+  static constexpr std::int64_t kFreezeFrom = kFirstNight + 11 * 3600;  // June 2, 10:00
+};
+
+TEST_F(DaemonE2ETwoNights, DiagnosesTheMissingEffectAndRecordsTheFrozenSensor) {
+  std::ofstream(dir_ / "pvtwin.toml", std::ios::app) << "\n[diagnosis]\nevery_days = 1\n";
+  StartDaemon();
+  const class Db db(Db());
+  ASSERT_TRUE(WaitFor(300, [&] { return db.Count("SELECT count(*) FROM diagnosis") >= 2; }))
+      << DaemonLog();
+  // Each night's diagnosis names the clipping the configured model lacks.
+  EXPECT_EQ(db.Count("SELECT count(*) FROM diagnosis WHERE verdict = 'pv_clipping' AND "
+                     "base_variant = '2N2CrI+wind+transport_delay' AND shrink_pct > 20"),
+            2)
+      << db.Text("SELECT group_concat(verdict || ' ' || shrink_pct, '; ') FROM diagnosis");
+  // Each names the accepted calibration whose parameters were in use.
+  EXPECT_EQ(db.Count("SELECT count(*) FROM diagnosis d JOIN calibration c ON c.id = "
+                     "d.calibration_id WHERE c.accepted = 1"),
+            2);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM diagnosis WHERE run_at - (SELECT min(run_at) FROM "
+                     "diagnosis) >= 23 * 3600"),
+            1);
+  // Both nights' reports are kept (default keep), named by their dates.
+  EXPECT_TRUE(fs::exists(dir_ / "reports" / "diagnosis-2024-06-01.html")) << DaemonLog();
+  // (the daemon files the child's report once the child has ended)
+  EXPECT_TRUE(WaitFor(30, [&] {
+    return fs::exists(dir_ / "reports" / "diagnosis-2024-06-03.html");
+  })) << DaemonLog();
+  // The parameter history of every night's calibration (accepted or
+  // not), and scored days.
+  EXPECT_GE(db.Count("SELECT count(DISTINCT calibration_id) FROM parameter_history"), 3);
+  EXPECT_GE(db.Count("SELECT count(*) FROM parameter_history WHERE accepted = 1"), 10);
+  EXPECT_GE(db.Count("SELECT count(*) FROM performance_daily WHERE pi_th IS NOT NULL"), 7);
+  // The frozen weather station: the poller rejects a device whose every
+  // register stands still, so its channels are QC events inside the freeze
+  // (missing, or frozen where a stuck value got through), found by the
+  // second night's checks.
+  const std::string faulty = "kind IN ('frozen', 'missing') AND channel IN ('t_amb_c', 'wind_m_s')";
+  ASSERT_TRUE(WaitFor(30, [&] {
+    return db.Count("SELECT count(*) FROM qc_event WHERE " + faulty) >= 1;
+  })) << DaemonLog();
+  const std::string window =
+      std::to_string(kFreezeFrom - 600) + " AND " + std::to_string(kFreezeFrom + 7200 + 600);
+  EXPECT_GE(db.Count("SELECT count(*) FROM qc_event WHERE " + faulty + " AND start_ts BETWEEN " +
+                     window + " AND end_ts BETWEEN " + window),
+            2)
+      << db.Text(
+             "SELECT group_concat(channel || ' ' || kind || ' ' || start_ts || '-' || end_ts, "
+             "'; ') FROM qc_event");
+  // What the operator reads first.
+  for (const char* kind : {"diagnosis", "qc", "calibration_accepted"}) {
+    EXPECT_GE(db.Count(std::string("SELECT count(*) FROM event WHERE kind LIKE '") + kind + "%'"),
+              1)
+        << kind << ": " << db.Text("SELECT group_concat(DISTINCT kind) FROM event");
+  }
+  int code = 0;
+  EXPECT_FALSE(daemon_.Finished(&code)) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
 }
 
 TEST_F(DaemonE2E, KillNineLosesNoCommittedRowAndCorruptsNothing) {

@@ -215,11 +215,14 @@ PowerCheckResult CheckPowerAgainstDatasheet(const Series& s, const Plant& plant,
 
 namespace {
 
-// Runs of rows where `bad(i)` holds, at least min_rows long, as faults.
+// Runs of consecutive rows (at most one row step apart) where `bad(i)`
+// holds, lasting at least min_minutes, as faults. Rows are 1-min means in
+// the store; an imported or diagnosed file may hold coarser steps.
 template <typename Pred>
-void AddRuns(const Series& s, const std::string& channel, const std::string& kind, int min_rows,
+void AddRuns(const Series& s, const std::string& channel, const std::string& kind, int min_minutes,
              Pred bad, const std::string& detail, std::vector<SensorFault>* out) {
   const std::size_t n = s.size();
+  const auto step = static_cast<std::int64_t>(s.step_s >= 60.0 ? s.step_s : 60.0);
   std::size_t i = 0;
   while (i < n) {
     if (!bad(i)) {
@@ -227,10 +230,11 @@ void AddRuns(const Series& s, const std::string& channel, const std::string& kin
       continue;
     }
     std::size_t j = i;
-    while (j < n && bad(j) && (j == i || s.time_s[j] - s.time_s[j - 1] <= 60)) ++j;
-    if (static_cast<int>(j - i) >= min_rows) {
-      out->push_back({channel, s.time_s[i], s.time_s[j - 1] + 60, kind,
-                      detail + " for " + std::to_string(j - i) + " min"});
+    while (j < n && bad(j) && (j == i || s.time_s[j] - s.time_s[j - 1] <= step)) ++j;
+    const std::int64_t minutes = (s.time_s[j - 1] + step - s.time_s[i]) / 60;
+    if (minutes >= min_minutes) {
+      out->push_back({channel, s.time_s[i], s.time_s[j - 1] + step, kind,
+                      detail + " for " + std::to_string(minutes) + " min"});
     }
     i = j;
   }

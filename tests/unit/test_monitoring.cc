@@ -332,10 +332,12 @@ TEST(PowerCheck, TheHtwSaarCollectorAgainstItsDatasheet) {
 }
 
 // Real data: the two htw saar days come from a research test bench with
-// calibrated sensors (PROVENANCE.md) and no known fault; the sensor checks
-// must raise nothing on them (a check that fires on healthy real data would
-// bury an operator's real faults).
-TEST(SensorFaults, NoneOnTheHtwSaarDays) {
+// calibrated sensors (PROVENANCE.md) at 2-min steps. The one finding is the
+// long-wave channel: its pyrgeometer implies a sky 14–17 K warmer than the
+// air in full sun on both clear days (lw_down ≈ 550–620 W/m² at 27–35 °C
+// air), which no clear sky does. Nothing else may fire (a check that fires
+// on healthy real data would bury an operator's real faults).
+TEST(SensorFaults, OnlyTheLongWaveChannelOnTheHtwSaarDays) {
   Config config;
   Diagnostics errors;
   const std::string dir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
@@ -343,9 +345,15 @@ TEST(SensorFaults, NoneOnTheHtwSaarDays) {
   for (const char* day : {"day1_clear_low_dT.csv", "day3_clear_medium_dT.csv"}) {
     Series s;
     ASSERT_TRUE(ReadCanonicalCsv(dir + day, CsvReadOptions{}, &s, &errors, nullptr)) << day;
+    std::int64_t sky_s = 0;
     for (const SensorFault& f : FindSensorFaults(s, config.plant)) {
-      ADD_FAILURE() << day << ": " << f.channel << " " << f.kind << " " << f.detail;
+      if (f.channel == "lw_down_w_m2" && f.kind == "sky_warmer_than_air") {
+        sky_s += f.end_s - f.start_s;
+      } else {
+        ADD_FAILURE() << day << ": " << f.channel << " " << f.kind << " " << f.detail;
+      }
     }
+    EXPECT_GE(sky_s, 2 * 3600) << day;
   }
 }
 

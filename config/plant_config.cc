@@ -58,6 +58,14 @@ void ReadPlant(SectionReader& r, Plant* plant) {
       plant->*k.member = k.degrees ? DegToRad(value) : value;
     }
   }
+  // Where the sky temperature comes from (core/model/thermal_model.h,
+  // SkyTemperaturesC).
+  std::string sky;
+  if (r.Choice("sky", kOptional, {"auto", "measured", "estimated"}, &sky)) {
+    plant->sky = sky == "measured"    ? SkySource::kMeasured
+                 : sky == "estimated" ? SkySource::kEstimated
+                                      : SkySource::kAuto;
+  }
 }
 
 void ReadStorage(SectionReader& r, StorageConfig* storage) {

@@ -4,7 +4,9 @@
 //   [plant]        required; the collector field (core/plant.h). Required keys:
 //                  latitude_deg, longitude_deg, tilt_deg, azimuth_deg, area_m2;
 //                  the others default to the values of core/plant.h.
-//                  Extension: elevation_m (default 0).
+//                  Extension: elevation_m (default 0); sky = "auto" | "measured" |
+//                  "estimated" (where the sky temperature comes from, default auto:
+//                  the long-wave channel unless it is implausible).
 //   [storage]      path, raw_retention_days
 //   [poll]         period_s
 //   [calibration]  variant, window_days, step_s, at, timezone, refit_full_window

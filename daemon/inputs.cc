@@ -60,7 +60,12 @@ bool ParseVariantOrReport(const std::string& name, ModelSpec* spec) {
 bool PrepareDriversOrReport(const Series& series, const std::string& csv_path, const Config& config,
                             const ModelSpec& spec, Drivers* drivers) {
   std::string error;
-  if (PrepareDrivers(series, config.plant, spec, drivers, &error)) return true;
+  if (PrepareDrivers(series, config.plant, spec, drivers, &error)) {
+    if (spec.sky && !drivers->sky_note.empty()) {
+      std::cerr << csv_path << ": note: " << drivers->sky_note << "\n";
+    }
+    return true;
+  }
   std::cerr << csv_path << ": " << error << "\n";
   return false;
 }

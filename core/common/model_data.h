@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "core/common/model_spec.h"
@@ -40,7 +41,7 @@ struct Drivers {
   // spec so that a base model's drivers also carry the effects' signatures;
   // NaN where the data lack the channel.
   std::vector<double> wind_m_s;           // measured wind speed
-  std::vector<double> t_sky_c;            // sky temperature (t_sky_c, else from lw_down)
+  std::vector<double> t_sky_c;            // sky temperature (SkyTemperaturesC)
   std::vector<double> sun_azimuth_rad;    // at the row's middle, from north clockwise
   std::vector<double> sun_elevation_rad;  // refraction-corrected
   std::vector<double> aoi_rad;            // beam angle of incidence (measured or computed)
@@ -58,6 +59,9 @@ struct Drivers {
   // the plane-of-array sensors are already multiplied by (1 + k). 0 without
   // the effect.
   double irradiance_bias = 0.0;
+  // Non-empty when the sky temperature is not the measured channel's: why
+  // (an implausible long-wave channel, or [plant] sky = "estimated").
+  std::string sky_note;
 
   std::size_t size() const { return time_s.size(); }
 };

@@ -5,6 +5,13 @@
 
 namespace pvtwin {
 
+// Where the model's sky temperature comes from ([plant] sky).
+enum class SkySource {
+  kAuto,       // the long-wave channel, unless it is implausible (then kEstimated)
+  kMeasured,   // t_sky_c, else lw_down_w_m2, always
+  kEstimated,  // from the air temperature (Swinbank 1963)
+};
+
 struct Plant {
   double latitude_rad = 0.0;   // north positive
   double longitude_rad = 0.0;  // east positive
@@ -20,6 +27,7 @@ struct Plant {
   double pv_g_ref_w_m2 = 1000.0;        // paper I_gtref
   double pv_temp_coeff_per_k = -0.004;  // paper f_corr_T
   double pv_irr_coeff_m2_w = 3.6e-5;    // paper f_corr_I
+  SkySource sky = SkySource::kAuto;
 };
 
 }  // namespace pvtwin

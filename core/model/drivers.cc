@@ -1,6 +1,7 @@
 // PrepareDrivers: measured series → per-row model inputs (thermal_model.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "core/common/units.h"
@@ -33,14 +34,7 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
   const std::size_t n = s.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   d->wind_m_s = s.Has(Channel::kWindMS) ? s[Channel::kWindMS] : std::vector<double>(n, nan);
-  d->t_sky_c.assign(n, nan);
-  for (std::size_t i = 0; i < n; ++i) {
-    double t_sky_c = s.At(Channel::kTSkyC, i);
-    if (std::isnan(t_sky_c) && s.Has(Channel::kLwDownWM2)) {
-      t_sky_c = KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
-    }
-    d->t_sky_c[i] = t_sky_c;
-  }
+  d->t_sky_c = SkyTemperaturesC(s, plant, &d->sky_note);
   const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   d->sun_azimuth_rad.resize(n);
   d->sun_elevation_rad.resize(n);
@@ -196,12 +190,8 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
   }
   out.t_sky_k4.assign(n, 0.0);
   if (spec.sky) {
-    const bool have_t_sky = s.Has(Channel::kTSkyC);
     for (std::size_t i = 0; i < n; ++i) {
-      double t_sky_k = have_t_sky ? CToK(s[Channel::kTSkyC][i]) : std::nan("");
-      if (std::isnan(t_sky_k) && s.Has(Channel::kLwDownWM2)) {
-        t_sky_k = SkyTemperatureK(s[Channel::kLwDownWM2][i]);
-      }
+      const double t_sky_k = CToK(out.t_sky_c[i]);
       out.t_sky_k4[i] = t_sky_k * t_sky_k * t_sky_k * t_sky_k;
     }
   }
@@ -220,6 +210,49 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
   }
   *d = std::move(out);
   return true;
+}
+
+std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::string* note) {
+  const std::size_t n = s.size();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (note != nullptr) note->clear();
+  std::vector<double> measured(n, nan), estimated(n, nan);
+  for (std::size_t i = 0; i < n; ++i) {
+    double t_sky_c = s.At(Channel::kTSkyC, i);
+    if (std::isnan(t_sky_c) && s.Has(Channel::kLwDownWM2)) {
+      t_sky_c = KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
+    }
+    measured[i] = t_sky_c;
+    estimated[i] = KToC(SwinbankSkyTemperatureK(CToK(s.At(Channel::kTAmbC, i))));
+  }
+  const char* kHow = "the sky temperature is estimated from the air temperature (Swinbank 1963)";
+  if (plant.sky == SkySource::kMeasured) return measured;
+  if (plant.sky == SkySource::kEstimated) {
+    if (note != nullptr) *note = std::string(kHow) + " as [plant] sky = \"estimated\" asks";
+    return estimated;
+  }
+  const Channel sun = s.Has(Channel::kGPoaWM2) ? Channel::kGPoaWM2 : Channel::kGhiWM2;
+  if (!s.Has(sun)) return measured;
+  std::vector<double> excess;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t_amb = s.At(Channel::kTAmbC, i);
+    if (s[sun][i] >= 600.0 && std::isfinite(measured[i]) && std::isfinite(t_amb)) {
+      excess.push_back(measured[i] - t_amb);
+    }
+  }
+  const auto warmer = std::count_if(excess.begin(), excess.end(), [](double e) { return e > 2.0; });
+  if (excess.size() < 30 || 2 * static_cast<std::size_t>(warmer) <= excess.size()) return measured;
+  std::nth_element(excess.begin(), excess.begin() + excess.size() / 2, excess.end());
+  if (note != nullptr) {
+    char text[320];
+    std::snprintf(text, sizeof(text),
+                  "the long-wave channel is implausible: it puts the sky more than 2 K above the "
+                  "air on %zu of %zu rows in full sun (median %+.1f K); %s instead ([plant] sky "
+                  "= \"measured\" keeps the channel)",
+                  static_cast<std::size_t>(warmer), excess.size(), excess[excess.size() / 2], kHow);
+    *note = text;
+  }
+  return estimated;
 }
 
 }  // namespace pvtwin

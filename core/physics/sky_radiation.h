@@ -14,6 +14,14 @@ inline double SkyTemperatureK(double lw_down_w_m2) {
   return std::sqrt(std::sqrt(lw_down_w_m2 / kStefanBoltzmannW_m2k4));
 }
 
+// Clear-sky equivalent sky temperature from the screen-level air
+// temperature alone (Swinbank 1963, "Long-wave radiation from clear skies",
+// Q. J. R. Meteorol. Soc. 89, 339–348): T_sky = 0.0552·T_air^1.5, both in K.
+// At 20 °C it gives 277.0 K, 16 K below the air.
+inline double SwinbankSkyTemperatureK(double t_air_k) {
+  return 0.0552 * t_air_k * std::sqrt(t_air_k);
+}
+
 // Net long-wave loss of the PV surface to the sky per m² (W/m²):
 //   q_rad = ε_PVT·σ·(T_PV⁴ − T_sky⁴)
 // which is the paper's U_rad·(T_PV − T_sky) with (paper eq. 2.6, per m²)

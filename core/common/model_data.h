@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -84,6 +85,10 @@ struct SimOutputs {
 
 struct SimOptions {
   bool energy_terms = false;
+  // Called after the spec's extensions have set the run's inputs (and before
+  // the integration), for per-row inputs that no variant expresses: the
+  // synthetic truth's other forms (core/synth/synthetic_plant.h). Empty: none.
+  std::function<void(const Drivers& drivers, RunInputs* run)> after_extensions = nullptr;
 };
 
 // The per-row inputs of one Simulate call: the Drivers' arrays, or arrays

@@ -18,6 +18,15 @@
 //     is counted separately);
 //   * disturbance: verdict == "unknown" and the first flagged region on the
 //     "day" driver is one of the disturbed days.
+//
+// Two batteries (issue 11, item 2): the same-form battery's truth uses the
+// candidates' own equations, so a present candidate fits it exactly; the
+// other-form battery's truth gives each effect another functional form
+// (EffectModule::other_truth, TruthForm::kOtherForm), and "the truth model's
+// held-out error" is then that of the truth plant's noise-free outputs. No
+// candidate fits an other-form truth exactly, so there a case is correct on
+// its verdict and first ladder step (issue 11's target: right verdicts); the
+// held-out errors after the ladder and of the truth are reported beside it.
 #pragma once
 
 #include <cstdint>
@@ -43,6 +52,8 @@ struct SelftestCase {
   // Uncatalogued disturbance on two held-out days (the "unknown" cases).
   std::optional<DisturbanceKind> disturbance;
   double severity = 0.0;  // Disturbance::severity
+  // Same-form or other-form truth (SyntheticOptions::truth_form).
+  TruthForm form = TruthForm::kSameForm;
 };
 
 struct SelftestOptions {
@@ -61,6 +72,7 @@ struct SelftestOptions {
 
 struct SelftestOutcome {
   std::string case_name;
+  TruthForm form = TruthForm::kSameForm;
   std::uint64_t seed = 0;
   std::string expected;
   std::string verdict;
@@ -79,9 +91,22 @@ struct SelftestOutcome {
 // null case, and the two disturbances.
 std::vector<SelftestCase> SelftestCases(const Plant& plant);
 
-// The synthetic measured data of one case and seed.
+// The other-form battery: one case per effect that has an other-form truth
+// (with the same base as its same-form case; only the withheld effect takes
+// its other form), the null case and the
+// disturbances (their truth has no effect: the same data as the same-form
+// battery's).
+std::vector<SelftestCase> OtherFormSelftestCases(const Plant& plant);
+
+// Whether the case's data differ from its same-form twin's (its withheld
+// effect runs in another form; the base's own effects keep their form).
+bool OtherFormChangesData(const SelftestCase& c);
+
+// The synthetic measured data of one case and seed; *truth_outputs (may be
+// null) receives the truth's noise-free outputs.
 Series SelftestData(const Plant& plant, const SelftestCase& c, std::uint64_t seed,
-                    const SelftestOptions& options, std::vector<std::int64_t>* disturbed_days);
+                    const SelftestOptions& options, std::vector<std::int64_t>* disturbed_days,
+                    SimOutputs* truth_outputs = nullptr);
 
 SelftestOutcome RunSelftestCase(const Plant& plant, const SelftestCase& c, std::uint64_t seed,
                                 const SelftestOptions& options,
@@ -90,5 +115,9 @@ SelftestOutcome RunSelftestCase(const Plant& plant, const SelftestCase& c, std::
 // Confusion table (expected × verdict, counts), per-case lines and the hit
 // rate.
 std::string FormatSelftestReport(const std::vector<SelftestOutcome>& outcomes);
+
+// One FormatSelftestReport per battery present in outcomes, same-form first,
+// each under a heading that says what its truth is.
+std::string FormatSelftestBatteries(const std::vector<SelftestOutcome>& outcomes);
 
 }  // namespace pvtwin

@@ -26,7 +26,67 @@ void ShiftInTime(const Drivers& d, const double* v, double offset_s, std::vector
   }
 }
 
+double CubicAt(const std::vector<std::int64_t>& time_s, const std::vector<double>& v, double t_s) {
+  const std::size_t n = time_s.size();
+  if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+  if (t_s <= static_cast<double>(time_s.front())) return v.front();
+  if (t_s >= static_cast<double>(time_s.back())) return v.back();
+  const auto it = std::upper_bound(time_s.begin(), time_s.end(), t_s, [](double t, std::int64_t x) {
+    return t < static_cast<double>(x);
+  });
+  const std::size_t k = static_cast<std::size_t>(it - time_s.begin()) - 1;
+  const double t0 = static_cast<double>(time_s[k]), t1 = static_cast<double>(time_s[k + 1]);
+  const double h = t1 - t0, u = (t_s - t0) / h;
+  const double v0 = v[k], v1 = v[k + 1];
+  const double linear = v0 + u * (v1 - v0);
+  if (k == 0 || k + 2 >= n) return linear;
+  const double vm = v[k - 1], vp = v[k + 2];
+  if (!std::isfinite(vm) || !std::isfinite(vp) || !std::isfinite(linear)) return linear;
+  const double m0 = (v1 - vm) / static_cast<double>(time_s[k + 1] - time_s[k - 1]) * h;
+  const double m1 = (vp - v0) / static_cast<double>(time_s[k + 2] - time_s[k]) * h;
+  const double u2 = u * u, u3 = u2 * u;
+  return (2 * u3 - 3 * u2 + 1) * v0 + (u3 - 2 * u2 + u) * m0 + (-2 * u3 + 3 * u2) * v1 +
+         (u3 - u2) * m1;
+}
+
 namespace {
+
+// Other-form truth: the collector saw at t the weather the logger stamped
+// t + Δt(t), cubic between rows; irradiance and wind stay ≥ 0. Sun geometry
+// (and a logged angle of incidence) follows the collector clock.
+void DriftingWeatherClock(const OtherTruthContext&, Series* physics) {
+  const std::vector<std::int64_t>& t = physics->time_s;
+  if (t.empty()) return;
+  const DriftingClock& clock = kOtherTruthClock;
+  for (Channel c : {Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2, Channel::kGhiWM2, Channel::kDhiWM2,
+                    Channel::kTAmbC, Channel::kWindMS, Channel::kTSkyC, Channel::kLwDownWM2,
+                    Channel::kTBackC}) {
+    if (!physics->Has(c)) continue;
+    const std::vector<double> logged = (*physics)[c];
+    const bool non_negative = c != Channel::kTAmbC && c != Channel::kTSkyC && c != Channel::kTBackC;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const double days = static_cast<double>(t[i] - t.front()) / 86400.0;
+      const double offset_s = clock.offset_s + clock.drift_s_per_day * days;
+      const double v = CubicAt(t, logged, static_cast<double>(t[i]) + offset_s);
+      (*physics)[c][i] = non_negative ? std::max(0.0, v) : v;
+    }
+  }
+}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "The weather logger runs Δt(t) = 97 s + 2 s/day·(t − t_first) ahead (no whole number "
+        "of 60-s rows, drifting 23 ppm); the plant's weather at t is the logged weather at "
+        "t + Δt(t), cubic (Catmull–Rom) between rows. The candidate is a constant offset, "
+        "linear between rows.";
+    t.source = "IEC 61724-1 (time-stamp accuracy of monitoring loggers); Catmull & Rom 1974";
+    t.weather = DriftingWeatherClock;
+    return t;
+  }();
+  return kTruth;
+}
 
 // The weather the collector saw at t is the weather row stamped t + Δt:
 // irradiance, ambient, back and sky temperature and wind interpolated at
@@ -123,6 +183,7 @@ const EffectModule& ClockOffsetEffect() {
     m.extension = &Extension();
     m.signature_values = Signature;
     m.shows_signature = ElectricityLeadsOrLags;
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

@@ -74,4 +74,12 @@ LagFit BestLag(const Drivers& d, const std::vector<std::uint32_t>& rows,
   return fit;
 }
 
+double UnitDraw(std::uint64_t seed, std::int64_t key) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (static_cast<std::uint64_t>(key) + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
 }  // namespace pvtwin

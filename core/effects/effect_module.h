@@ -15,7 +15,9 @@
 // scale); the channels it needs; its equations as pure functions in its
 // header; how it enters the model (ModelExtension's hooks, or the paper's
 // letters of a variant); its residual signature for evidence; its truth form
-// for synthetic data; and its advice sentence for the report.
+// for synthetic data (and a second truth form, different from the
+// candidate's, for a self-test that does not flatter itself); and its advice
+// sentence for the report.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +30,7 @@
 #include "core/common/model_data.h"
 #include "core/common/model_spec.h"
 #include "core/common/params.h"
+#include "core/common/plant.h"
 #include "core/common/series.h"
 
 namespace pvtwin {
@@ -58,6 +61,56 @@ struct SignatureCheck {
   bool shown = true;
   std::string sentence;
 };
+
+// What an other-form truth hook reads (OtherFormTruth).
+struct OtherTruthContext {
+  const Plant* plant = nullptr;
+  const ParamVector* truth = nullptr;  // the truth plant's parameters
+  // Seed of the form's own draws (days with the obstacle, rain days), so that
+  // a case and seed always give the same data.
+  std::uint64_t seed = 1;
+  // The plant's true weather and operation (after the weather hooks); set for
+  // the drivers, run, outputs and measured hooks.
+  const Series* physics = nullptr;
+  // The previous pass's outputs (run hook of a form with passes > 1); null on
+  // the first pass.
+  const SimOutputs* previous = nullptr;
+};
+
+// The effect in another functional form than its candidate (issue 11, item
+// 2): synthetic truth that the candidate meant to find it cannot fit exactly,
+// the way real physics always differs from a catalogue formula. The truth
+// plant runs without the effect's same form (remove_same_form) and the hooks
+// below make it show instead, in this order; every hook may be null. The
+// physics are pure functions in the module's header, with their source.
+struct OtherFormTruth {
+  std::string_view form;    // the truth's equations and constants, one paragraph
+  std::string_view source;  // where they come from
+  // Removes the same form from the truth's spec; null: spec->Remove(*extension)
+  // for an effect with an extension, nothing otherwise.
+  void (*remove_same_form)(ModelSpec* spec) = nullptr;
+  // 1. The plant's true weather before its drivers are prepared (the
+  //    measured weather channels keep what the sensors logged).
+  void (*weather)(const OtherTruthContext& ctx, Series* physics) = nullptr;
+  // 2. The truth's drivers after PrepareDrivers (e.g. the absorbed irradiance).
+  void (*drivers)(const OtherTruthContext& ctx, Drivers* drivers) = nullptr;
+  // 3. Per-row inputs of the truth run after the spec's extensions
+  //    (SimOptions::after_extensions); run `passes` times, each pass seeing
+  //    the previous pass's outputs in ctx.previous (a fixed point for forms
+  //    that depend on the outputs, e.g. an inverter curve of P_dc).
+  void (*run)(const OtherTruthContext& ctx, const Drivers& drivers, RunInputs* run) = nullptr;
+  int passes = 1;
+  // 4. The truth's outputs after the run (e.g. what a sensor behind a pipe sees).
+  void (*outputs)(const OtherTruthContext& ctx, const Drivers& drivers, SimOutputs* out) = nullptr;
+  // 5. The measured series after noise: a sensor error (instead of
+  //    EffectModule::apply_sensor_error).
+  void (*measured)(const OtherTruthContext& ctx, const Drivers& drivers,
+                   Series* measured) = nullptr;
+};
+
+// A uniform draw in [0, 1) from (seed, key), e.g. key = a day number: the
+// other-form truths' per-day events (splitmix64).
+double UnitDraw(std::uint64_t seed, std::int64_t key);
 
 struct EffectModule {
   std::string_view name;     // DESIGN.md vocabulary, e.g. "pv_clipping"
@@ -119,6 +172,8 @@ struct EffectModule {
   // A sensor error: the truth plant runs without the effect and this turns
   // the true measurements into what the faulty sensor reads.
   void (*apply_sensor_error)(const ParamVector& truth, Series* measured) = nullptr;
+  // The truth in another functional form than the candidate (null: none).
+  const OtherFormTruth* other_truth = nullptr;
 };
 
 // Central difference per minute of a per-row value, NaN across restarts and

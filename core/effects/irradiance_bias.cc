@@ -108,6 +108,39 @@ void ApplySensorError(const ParamVector& truth, Series* s) {
   }
 }
 
+// Other-form truth: the plane-of-array pyranometer reads (f(θ)·B + D)/(1 + k)
+// + a, the shaded in-plane diffuse sensor D/(1 + k) + a (no beam).
+void CosineOffsetAndScale(const OtherTruthContext& ctx, const Drivers& d, Series* s) {
+  const double k = ParamOf(*ctx.truth, Param::kIrradianceBias);
+  const PyranometerErrors& e = kOtherTruthPyranometer;
+  if (!s->Has(Channel::kGPoaWM2)) return;
+  const bool has_diffuse = s->Has(Channel::kGPoaDiffuseWM2);
+  for (std::size_t i = 0; i < s->size(); ++i) {
+    const double global = (*s)[Channel::kGPoaWM2][i];
+    const double diffuse = has_diffuse ? (*s)[Channel::kGPoaDiffuseWM2][i] : 0.0;
+    if (!std::isfinite(global) || !std::isfinite(diffuse)) continue;
+    const double beam = std::max(0.0, global - diffuse);
+    (*s)[Channel::kGPoaWM2][i] = PyranometerReadingWM2(beam, global - beam, d.aoi_rad[i], k, e);
+    if (has_diffuse) {
+      (*s)[Channel::kGPoaDiffuseWM2][i] = PyranometerReadingWM2(0.0, diffuse, 0.0, k, e);
+    }
+  }
+}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "The plane-of-array pyranometer reads G_meas = (f(θ)·B + D)/(1 + k) + a with a "
+        "cosine error f(θ) = 1 − 0.11·(θ/80°)³ on the beam and a zero offset a = −8 W/m² "
+        "by day besides the scale error k = 6 %; the candidate is the scale error alone.";
+    t.source = "ISO 9060:2018 (directional response at 80°, zero offset a)";
+    t.measured = CosineOffsetAndScale;
+    return t;
+  }();
+  return kTruth;
+}
+
 }  // namespace
 
 const EffectModule& IrradianceBiasEffect() {
@@ -136,6 +169,7 @@ const EffectModule& IrradianceBiasEffect() {
     m.sensor_estimate = EstimateIrradianceBias;
     m.sensor_evidence = SensorEvidence;
     m.apply_sensor_error = ApplySensorError;
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

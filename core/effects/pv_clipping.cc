@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/common/text.h"
+#include "core/physics/pv_efficiency.h"
 
 namespace pvtwin {
 
@@ -27,6 +28,49 @@ const ModelExtension& Extension() {
     return e;
   }();
   return kExtension;
+}
+
+// Other-form truth: P_el = SoftKnee(P_dc, P_lim(T_amb)) with P_dc = η(T_PV)·A·I_at
+// at the previous pass's T_PV (a fixed point over the passes); the power not
+// converted stays as heat (RunInputs::electric_effects), as in the candidate.
+void SoftKneeAndDerating(const OtherTruthContext& ctx, const Drivers& d, RunInputs* run) {
+  if (ctx.previous == nullptr) return;  // the first pass finds P_dc
+  const ParamVector& p = *ctx.truth;
+  const PvEfficiencyParams pv{ParamOf(p, Param::kEtaPvRef), ParamOf(p, Param::kPvTempCoeffPerK),
+                              ParamOf(p, Param::kPvIrrCoeffM2W), d.plant.pv_t_ref_c,
+                              d.plant.pv_g_ref_w_m2};
+  const double area_m2 = ParamOf(p, Param::kAreaM2);
+  const SoftInverter& inv = kOtherTruthInverter;
+  std::vector<double>& factor = run->Scratch();
+  factor.assign(run->n, 1.0);
+  for (std::size_t i = 0; i < run->n; ++i) {
+    const double t_pv_c = ctx.previous->t_pv_c[i];
+    if (!std::isfinite(t_pv_c)) continue;
+    const double base = run->pv_factor != nullptr ? run->pv_factor[i] : 1.0;
+    const double p_dc_w =
+        PvEfficiencyAt(pv, run->g_poa_w_m2[i]).At(t_pv_c) * area_m2 * run->g_abs_w_m2[i] * base;
+    const double limit_w = DeratedLimitW(inv.limit_w_m2 * area_m2, run->t_amb_c[i],
+                                         inv.derate_from_c, inv.derate_per_k);
+    factor[i] =
+        base * (p_dc_w > 0.0 ? SoftKneeAcPowerW(p_dc_w, limit_w, inv.sharpness) / p_dc_w : 1.0);
+  }
+  run->pv_factor = factor.data();
+  run->electric_effects = true;
+}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "A soft knee instead of a hard clip, P_ac = P_dc/(1 + (P_dc/P_lim)^m)^(1/m) with "
+        "m = 8, and a limit derated with the ambient temperature, P_lim(T) = 120 W/m²·A·"
+        "(1 − 0.01/K·max(0, T_amb − 25 °C)); the power not converted stays as heat.";
+    t.source = "p-norm smooth minimum (soft limiter); inverter data sheets' linear derating";
+    t.run = SoftKneeAndDerating;
+    t.passes = 3;
+    return t;
+  }();
+  return kTruth;
 }
 
 // Base model P_el per m².
@@ -94,6 +138,7 @@ const EffectModule& PvClippingEffect() {
     m.extension = &Extension();
     m.signature_values = Signature;
     m.shows_signature = Plateau;
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

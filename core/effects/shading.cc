@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <utility>
+#include <vector>
 
+#include "core/common/calendar.h"
 #include "core/common/text.h"
 #include "core/common/units.h"
 
@@ -19,7 +22,102 @@ double ShadedFraction(double sun_azimuth_rad, double sun_elevation_rad, double c
          logistic((edge_elevation_rad - sun_elevation_rad) / kEdgeRad);
 }
 
+double HorizonElevationRad(const HorizonProfile& p, double azimuth_rad) {
+  const std::vector<double>& az = p.azimuth_rad;
+  const std::vector<double>& el = p.elevation_rad;
+  if (az.empty() || azimuth_rad < az.front() || azimuth_rad > az.back()) return 0.0;
+  double best = 0.0;
+  bool found = false;
+  for (std::size_t k = 0; k + 1 < az.size(); ++k) {
+    if (azimuth_rad < az[k] || azimuth_rad > az[k + 1]) continue;
+    const double span = az[k + 1] - az[k];
+    const double h = span > 0.0 ? el[k] + (el[k + 1] - el[k]) * (azimuth_rad - az[k]) / span
+                                : std::max(el[k], el[k + 1]);
+    best = found ? std::max(best, h) : h;
+    found = true;
+  }
+  return found ? best : el.front();
+}
+
+double HorizonBeamShare(const HorizonProfile& p, double sun_azimuth_rad, double sun_elevation_rad,
+                        double edge_width_rad) {
+  if (!(sun_elevation_rad > 0.0)) return 0.0;
+  const double h = HorizonElevationRad(p, sun_azimuth_rad);
+  if (!(h > 0.0)) return 0.0;
+  return std::clamp((h - sun_elevation_rad) / edge_width_rad + 0.5, 0.0, 1.0);
+}
+
+double HorizonDiffuseShare(const HorizonProfile& p) {
+  double integral = 0.0;
+  for (std::size_t k = 0; k + 1 < p.azimuth_rad.size(); ++k) {
+    const double span = p.azimuth_rad[k + 1] - p.azimuth_rad[k];
+    const double h0 = p.elevation_rad[k], h1 = p.elevation_rad[k + 1];
+    if (!(span > 0.0)) continue;
+    if (std::fabs(h1 - h0) < 1e-12) {
+      integral += span * std::sin(h0) * std::sin(h0);
+    } else {
+      integral += 0.5 * span - span * (std::sin(2.0 * h1) - std::sin(2.0 * h0)) / (4.0 * (h1 - h0));
+    }
+  }
+  return integral / (2.0 * kPi);
+}
+
+const HorizonObstacle& OtherTruthObstacle() {
+  static const HorizonObstacle kObstacle = [] {
+    HorizonObstacle o;
+    for (const auto& [az_deg, el_deg] : std::vector<std::pair<double, double>>{
+             {235, 0}, {245, 30}, {258, 45}, {272, 40}, {288, 22}, {300, 0}}) {
+      o.profile.azimuth_rad.push_back(DegToRad(az_deg));
+      o.profile.elevation_rad.push_back(DegToRad(el_deg));
+    }
+    o.edge_width_rad = DegToRad(1.5);
+    o.day_probability = 0.5;
+    return o;
+  }();
+  return kObstacle;
+}
+
+bool ObstacleOnDay(std::uint64_t seed, std::int64_t day) {
+  return UnitDraw(seed ^ 0x5AD1A6ull, day) < OtherTruthObstacle().day_probability;
+}
+
 namespace {
+
+// Other-form truth: on the obstacle's days I_at loses s·I_beam + f_d·I_dsky
+// (the sky part from the plant's DHI, paper 2.5); P_el follows I_at (no
+// bypass-diode mismatch term).
+void HorizonOnSomeDays(const OtherTruthContext& ctx, Drivers* d) {
+  const HorizonObstacle& o = OtherTruthObstacle();
+  const double diffuse_share = HorizonDiffuseShare(o.profile);
+  const double sky_view = 0.5 * (1.0 + std::cos(ctx.plant->tilt_rad));
+  const bool has_dhi = ctx.physics->Has(Channel::kDhiWM2);
+  for (std::size_t i = 0; i < d->size(); ++i) {
+    const std::int64_t day = d->time_s[i] / kSecondsPerDay;
+    if (!ObstacleOnDay(ctx.seed, day)) continue;
+    const double s = HorizonBeamShare(o.profile, d->sun_azimuth_rad[i], d->sun_elevation_rad[i],
+                                      o.edge_width_rad);
+    const double beam = std::isfinite(d->g_beam_w_m2[i]) ? d->g_beam_w_m2[i] : 0.0;
+    const double dhi = has_dhi ? (*ctx.physics)[Channel::kDhiWM2][i] : 0.0;
+    const double sky = std::isfinite(dhi) ? std::max(0.0, sky_view * dhi) : 0.0;
+    d->g_abs_w_m2[i] = std::max(0.0, d->g_abs_w_m2[i] - s * beam - diffuse_share * sky);
+    if (std::isfinite(d->g_beam_w_m2[i])) d->g_beam_w_m2[i] -= s * beam;
+  }
+}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "A horizon profile (polygon in azimuth × elevation: 235–300°, up to 45° at 258°) "
+        "with a linear penumbra of 1.5° blocks the beam, s = clamp((h(γ_sun) − α_sun)/w + "
+        "1/2, 0, 1), and the share f_d = (1/2π)∫sin²h dγ of the sky diffuse, on drawn days "
+        "only (probability 0.5 per day); P_el follows the absorbed irradiance.";
+    t.source = "Dozier & Frew 1990 (sky view factor from the horizon angle)";
+    t.drivers = HorizonOnSomeDays;
+    return t;
+  }();
+  return kTruth;
+}
 
 // I_at loses s·I_beam; P_el is multiplied by (1 − f_mismatch·s), the power
 // not converted staying as heat (RunInputs::electric_effects).
@@ -183,6 +281,7 @@ const EffectModule& ShadingEffect() {
     m.signature_values = Signature;
     m.shows_signature = RecursAtTheSameSunPosition;
     m.start_from_residuals = StartFromResiduals;
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

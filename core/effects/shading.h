@@ -3,6 +3,9 @@
 // absorbed irradiance and sets the P_el factor of the bypass diodes.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "core/effects/effect_module.h"
 
 namespace pvtwin {
@@ -15,6 +18,52 @@ namespace pvtwin {
 // γ_shade, full width Δγ, edge elevation α_shade. 0 with the sun down.
 double ShadedFraction(double sun_azimuth_rad, double sun_elevation_rad, double centre_rad,
                       double width_rad, double edge_elevation_rad);
+
+// --- Other-form truth: an obstacle's horizon profile, on some days ---
+
+// The upper edge of an obstacle seen from the collector: vertices (γ_k, h_k),
+// sun azimuth from north clockwise and elevation above the horizon in rad,
+// γ non-decreasing (a repeated γ is a vertical edge); no obstacle outside
+// [γ_first, γ_last].
+struct HorizonProfile {
+  std::vector<double> azimuth_rad;
+  std::vector<double> elevation_rad;
+};
+
+// Horizon elevation h(γ): linear between vertices, the higher side at a
+// vertical edge, 0 outside the profile.
+double HorizonElevationRad(const HorizonProfile& profile, double azimuth_rad);
+
+// Share of the beam that the obstacle blocks, with a soft edge of width w
+// (the sun's disc, 0.53°, and the leaves or the edge's blur):
+//   s = clamp((h(γ_sun) − α_sun)/w + 1/2, 0, 1),  0 with the sun down,
+// i.e. a linear penumbra across h ± w/2 (the candidate's box has logistic
+// edges on a rectangle in azimuth × elevation).
+double HorizonBeamShare(const HorizonProfile& profile, double sun_azimuth_rad,
+                        double sun_elevation_rad, double edge_width_rad);
+
+// Share of the isotropic sky diffuse on a horizontal plane that the obstacle
+// hides, from the horizon-angle form of the sky view factor (Dozier & Frew
+// 1990, IEEE TGRS 28(5), eq. for a horizontal surface, V = (1/2π)∫cos²h dγ):
+//   f_d = 1 − V = (1/2π)·∫ sin² h(γ) dγ,
+// integrated exactly on each linear segment (∫ sin²h dγ = Δγ/2 −
+// Δγ·(sin 2h₁ − sin 2h₀)/(4·(h₁ − h₀))). Used for the tilted plane too (an
+// approximation for the usual tilts ≤ 30°).
+double HorizonDiffuseShare(const HorizonProfile& profile);
+
+// The other-form truth's obstacle: a tree or a building to the
+// west-south-west, up to 45°, soft edge 1.5°, present on a day with
+// probability `day_probability` (scaffolding, a parked vehicle, a crown in
+// leaf: drawn per UTC day from the truth's seed).
+struct HorizonObstacle {
+  HorizonProfile profile;
+  double edge_width_rad = 0.0;
+  double day_probability = 0.0;
+};
+const HorizonObstacle& OtherTruthObstacle();
+
+// Whether the obstacle stands on the UTC day `day` (unix s / 86400) for seed.
+bool ObstacleOnDay(std::uint64_t seed, std::int64_t day);
 
 const EffectModule& ShadingEffect();
 

@@ -1,5 +1,8 @@
 #include "core/effects/sky_radiation.h"
 
+#include <cmath>
+#include <vector>
+
 namespace pvtwin {
 
 namespace {
@@ -19,6 +22,56 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) {
   std::vector<double> out(d.size());
   for (std::size_t i = 0; i < d.size(); ++i) out[i] = d.t_amb_c[i] - d.t_sky_c[i];
   return out;
+}
+
+// Other-form truth: the sky the collector exchanges with is Swinbank's clear
+// sky with Crawford & Duchon's cloud correction, the cloud fraction from the
+// diffuse fraction while GHI > 50 W/m² and held through the night (0.5
+// before the first daylight); the logged lw_down_w_m2 / t_sky_c keep the
+// weather station's (another model's) values.
+void SwinbankCrawfordDuchonSky(const OtherTruthContext& ctx, Series* physics) {
+  if (!physics->Has(Channel::kTAmbC) || !physics->Has(Channel::kGhiWM2) ||
+      !physics->Has(Channel::kDhiWM2)) {
+    return;
+  }
+  const std::vector<double>& t_amb = (*physics)[Channel::kTAmbC];
+  const std::vector<double>& ghi = (*physics)[Channel::kGhiWM2];
+  const std::vector<double>& dhi = (*physics)[Channel::kDhiWM2];
+  const bool has_lw = physics->Has(Channel::kLwDownWM2);
+  const bool has_t_sky = physics->Has(Channel::kTSkyC);
+  double cover = 0.5;
+  for (std::size_t i = 0; i < physics->size(); ++i) {
+    if (ghi[i] > 50.0 && std::isfinite(dhi[i])) {
+      cover = CloudFractionFromDiffuseFraction(dhi[i] / ghi[i]);
+    }
+    const double t_amb_k = CToK(t_amb[i]);
+    const double eps = CloudySkyEmissivity(SwinbankClearSkyEmissivity(t_amb_k), cover);
+    const double lw_w_m2 = LongWaveOnPlaneWM2(eps, t_amb_k, ctx.plant->tilt_rad);
+    if (has_lw) (*physics)[Channel::kLwDownWM2][i] = lw_w_m2;
+    if (has_t_sky) {
+      (*physics)[Channel::kTSkyC][i] =
+          std::sqrt(std::sqrt(lw_w_m2 / kStefanBoltzmannW_m2k4)) - CToK(0.0);
+    }
+  }
+}
+
+// The long-wave exchange itself ('r') stays.
+void KeepTheLetter(ModelSpec*) {}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "The collector exchanges long-wave with Swinbank's clear sky, ε_clr = 5.31e-13·T_a²/σ, "
+        "made cloudy by Crawford & Duchon's ε = c + (1 − c)·ε_clr (c from the diffuse "
+        "fraction), on the plane with the ground at air temperature; the logged long-wave "
+        "channel, which the candidate reads, follows Brunt's humidity-based sky.";
+    t.source = "Swinbank 1963; Crawford & Duchon 1999";
+    t.remove_same_form = KeepTheLetter;
+    t.weather = SwinbankCrawfordDuchonSky;
+    return t;
+  }();
+  return kTruth;
 }
 
 }  // namespace
@@ -43,6 +96,7 @@ const EffectModule& SkyRadiationEffect() {
     m.add_to_spec = AddToSpec;
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

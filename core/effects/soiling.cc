@@ -1,8 +1,65 @@
 #include "core/effects/soiling.h"
 
+#include "core/common/calendar.h"
+
 namespace pvtwin {
 
+bool RainOnDay(std::uint64_t seed, std::int64_t day, const SoilingWithRain& soiling) {
+  return UnitDraw(seed ^ 0x4A1Bull, day) < soiling.rain_probability_per_day;
+}
+
+std::vector<double> SoilingTransmittanceWithRain(const std::vector<std::int64_t>& time_s,
+                                                 const SoilingWithRain& soiling,
+                                                 std::uint64_t seed) {
+  std::vector<double> tau(time_s.size(), 1.0);
+  if (time_s.empty()) return tau;
+  double loss = 0.0;  // at `since_s`
+  std::int64_t since_s = time_s.front();
+  std::int64_t day = time_s.front() / kSecondsPerDay;
+  auto advance = [&](std::int64_t to_s) {
+    const double days = static_cast<double>(to_s - since_s) / kSecondsPerDay;
+    loss = SaturatingSoilingLoss(loss, days, soiling.max_loss, soiling.time_constant_days);
+    since_s = to_s;
+  };
+  for (std::size_t i = 0; i < time_s.size(); ++i) {
+    while (time_s[i] / kSecondsPerDay > day) {
+      ++day;
+      if (!RainOnDay(seed, day, soiling)) continue;
+      advance(day * kSecondsPerDay);
+      loss = SoilingLossAfterRain(loss, soiling.cleaned_share);
+    }
+    advance(time_s[i]);
+    tau[i] = 1.0 - loss;
+  }
+  return tau;
+}
+
 namespace {
+
+// Other-form truth: I_at·τ_soil(t) with the saturating, rain-washed loss.
+void SoilAndRain(const OtherTruthContext& ctx, Drivers* d) {
+  const std::vector<double> tau =
+      SoilingTransmittanceWithRain(d->time_s, kOtherTruthSoiling, ctx.seed);
+  for (std::size_t i = 0; i < d->size(); ++i) {
+    d->g_abs_w_m2[i] *= tau[i];
+    d->g_beam_w_m2[i] *= tau[i];
+  }
+}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "Soiling saturates, L(d) = L_max − (L_max − L0)·exp(−d/τ_s) with L_max = 10 %, "
+        "τ_s = 8 d, and a rain at the start of a drawn day (probability 0.1 per day) washes "
+        "off 60 % of it, L ← 0.4·L; τ_soil = 1 − L multiplies the absorbed irradiance. The "
+        "candidate's loss is linear in the days since the last known cleaning.";
+    t.source = "Hegazy 2001 (saturating dust deposit); Kimber et al. 2006 (rain cleaning)";
+    t.drivers = SoilAndRain;
+    return t;
+  }();
+  return kTruth;
+}
 
 // I_at · τ_soil.
 void SoilTheCover(const Drivers& d, const ParamVector& p, RunInputs* run) {
@@ -53,6 +110,7 @@ const EffectModule& SoilingEffect() {
     // A drift over days is not seen within fewer than three training days.
     m.min_train_days = 3;
     m.min_train_days_why = "to see a drift over days";
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

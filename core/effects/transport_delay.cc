@@ -3,12 +3,76 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "core/common/text.h"
 
 namespace pvtwin {
 
+TankStep MixedTankStep(double t0_c, double t_in_c, double t_amb_c, double mdot_kg_s,
+                       double cp_j_kgk, double mass_kg, double ua_w_k, double dt_s) {
+  const double flow_w_k = std::max(0.0, mdot_kg_s) * cp_j_kgk;
+  const double g_w_k = flow_w_k + ua_w_k;
+  if (!(g_w_k > 0.0) || !(dt_s > 0.0)) return {t0_c, t0_c};
+  const double t_eq_c = (flow_w_k * t_in_c + ua_w_k * t_amb_c) / g_w_k;
+  const double a_dt = g_w_k / (mass_kg * cp_j_kgk) * dt_s;
+  const double decay = std::exp(-a_dt);
+  return {t_eq_c + (t0_c - t_eq_c) * decay, t_eq_c + (t0_c - t_eq_c) * (1.0 - decay) / a_dt};
+}
+
 namespace {
+
+// Other-form truth: the sensor sees the collector's outlet after the plug
+// (the fluid that left when the cumulative mass was M_plug less, taken at the
+// row's middle) and the tanks; the measured heat is ṁ·c_p·(T_sensor − T_in).
+// A restart (gap) refills the pipe with the row's outlet temperature.
+void MixedPipeToSensor(const OtherTruthContext&, const Drivers& d, SimOutputs* out) {
+  const MixedPipe& pipe = kOtherTruthPipe;
+  const double cp = d.plant.fluid_cp_j_kgk;
+  const std::size_t n = d.size();
+  const std::vector<double> t_out = out->t_out_c;  // at the collector
+  std::vector<double> mass_end(n, 0.0);            // cumulative mass at row ends
+  std::vector<double> tank(static_cast<std::size_t>(pipe.tanks), 0.0);
+  std::size_t first = 0, j = 0;  // this segment's first row; the plug's exit row
+  for (std::size_t i = 0; i < n; ++i) {
+    const double mdot = d.usable[i] && d.mdot_kg_s[i] > 0.0 ? d.mdot_kg_s[i] : 0.0;
+    if (i == 0 || d.restart[i]) {
+      first = j = i;
+      std::fill(tank.begin(), tank.end(), t_out[i]);
+    }
+    const double mass_start = i > first ? mass_end[i - 1] : 0.0;
+    mass_end[i] = mass_start + mdot * d.dt_s[i];
+    if (!d.usable[i] || !std::isfinite(t_out[i])) continue;
+    const double exit_mass = 0.5 * (mass_start + mass_end[i]) - pipe.plug_mass_kg;
+    while (j < i && mass_end[j] <= exit_mass) ++j;
+    double t_c = exit_mass < 0.0 ? t_out[first] : t_out[j];
+    if (!std::isfinite(t_c)) t_c = t_out[i];
+    for (double& t_tank : tank) {
+      if (!std::isfinite(t_tank)) t_tank = t_c;
+      const TankStep step = MixedTankStep(t_tank, t_c, d.t_amb_c[i], mdot, cp, pipe.tank_mass_kg,
+                                          pipe.loss_w_k / pipe.tanks, d.dt_s[i]);
+      t_tank = step.t_end_c;
+      t_c = step.t_mean_c;
+    }
+    out->t_out_c[i] = t_c;
+    if (mdot > 0.0) out->q_th_w[i] = mdot * cp * (t_c - d.t_in_c[i]);
+  }
+}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "The pipe to the outlet sensor is plug flow of 1.6 kg (a dead time 1.6 kg/ṁ: 44 s at "
+        "0.036 kg/s, 148 s at 0.3 of it) followed by 3 mixed tanks of 0.8 kg each (axial "
+        "mixing, a first-order lag per tank) losing 1.8 W/K to ambient; the candidate is "
+        "a fixed dead time with a plug-flow loss.";
+    t.source = "Levenspiel 1999, Chemical Reaction Engineering ch. 14 (tanks in series)";
+    t.outputs = MixedPipeToSensor;
+    return t;
+  }();
+  return kTruth;
+}
 
 // The outlet sensor sees the fluid that left the collector τ earlier,
 // T_out(t − τ) (linear interpolation between row means), cooled on the way by
@@ -117,6 +181,7 @@ const EffectModule& TransportDelayEffect() {
     m.extension = &Extension();
     m.signature_values = Signature;
     m.shows_signature = MeasuredHeatLags;
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

@@ -1,5 +1,9 @@
 #include "core/effects/wind.h"
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "core/physics/wind.h"
 
 namespace pvtwin {
@@ -47,6 +51,39 @@ std::string DataLacks(const Series& data) {
 
 std::vector<double> Signature(const Drivers& d, const SimOutputs&) { return d.wind_m_s; }
 
+// Other-form truth: U_front(v) per row from Test et al.'s correlation (calm
+// where the wind is not measured).
+void TestEtAlFront(const OtherTruthContext& ctx, const Drivers& d, RunInputs* run) {
+  const double u_front_w_m2k = ParamOf(*ctx.truth, Param::kUFrontWM2K);
+  std::vector<double>& u = run->Scratch();
+  u.resize(run->n);
+  for (std::size_t i = 0; i < run->n; ++i) {
+    const double v = std::isfinite(d.wind_m_s[i]) ? std::max(0.0, d.wind_m_s[i]) : 0.0;
+    u[i] = FrontConductanceTestWM2K(u_front_w_m2k, v);
+  }
+  run->u_front_w_m2k = u.data();
+}
+
+void RemoveSameForm(ModelSpec* spec) {
+  spec->wind_paper = false;
+  spec->Remove(Extension());
+}
+
+const OtherFormTruth& OtherTruth() {
+  static const OtherFormTruth kTruth = [] {
+    OtherFormTruth t;
+    t.form =
+        "The front loses U_front + h_w(v) − h_w(0) with Test et al.'s h_w = 8.55 + 2.56·v "
+        "W/(m²K): convection rising linearly with the wind; the candidate is the paper's "
+        "printed form 1/(1/U_front + r_refwind·v^n).";
+    t.source = "Test, Lessmann & Johary 1981, J. Heat Transfer 103";
+    t.remove_same_form = RemoveSameForm;
+    t.run = TestEtAlFront;
+    return t;
+  }();
+  return kTruth;
+}
+
 }  // namespace
 
 const EffectModule& WindEffect() {
@@ -71,6 +108,7 @@ const EffectModule& WindEffect() {
     m.add_to_spec = AddToSpec;
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
+    m.other_truth = &OtherTruth();
     return m;
   }();
   return kModule;

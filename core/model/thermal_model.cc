@@ -263,6 +263,7 @@ void Simulate(const Drivers& d, const ParamVector& params, SimOutputs* out,
   const RunConstants k = MakeConstants(d, params);
   RunInputs w;
   MakeRunInputs(d, params, out, &w);
+  if (options.after_extensions) options.after_extensions(d, &w);
   double state[2] = {0.0, 0.0};  // node temperatures at the start of the row
   // Step-mean PV temperatures of the last two rows: their linear
   // extrapolation is the first linearisation point, which usually meets the

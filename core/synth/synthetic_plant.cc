@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <random>
+#include <utility>
 
 #include "core/common/units.h"
 #include "core/effects/effects.h"
@@ -160,14 +161,23 @@ void InjectDefects(const DataDefects& defects, Series* s) {
 
 }  // namespace
 
-Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options) {
-  WeatherOptions weather = options.weather;
-  weather.absorber = SensorParamsFromTruth(options.truth_spec, options.truth);
-  Series s = GenerateWeather(plant, weather);
-  const std::size_t n = s.size();
-  // The plant's physics: the real flow and irradiance under disturbances, the
-  // true irradiance (irradiance_bias is a sensor error, applied below).
+std::string_view TruthFormName(TruthForm form) {
+  return form == TruthForm::kOtherForm ? "other-form" : "same-form";
+}
+
+bool UsesOtherForm(const SyntheticOptions& options, const EffectModule& effect) {
+  const std::vector<const EffectModule*>& listed = options.other_form_effects;
+  return options.truth_form == TruthForm::kOtherForm && effect.other_truth != nullptr &&
+         std::find(listed.begin(), listed.end(), &effect) != listed.end() &&
+         HasEffect(options.truth_spec, effect);
+}
+
+namespace {
+
+// The plant's physics: the real flow and irradiance under disturbances.
+Series DisturbedPhysics(const Series& s, const SyntheticOptions& options) {
   Series physics = s;
+  const std::size_t n = s.size();
   for (const Disturbance& d : options.disturbances) {
     for (std::size_t i = 0; i < n; ++i) {
       if (!InWindow(d, s.time_s[i])) continue;
@@ -187,30 +197,86 @@ Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& option
       }
     }
   }
-  // Sensor errors act on the measurements below, not on the physics.
-  ModelSpec physics_spec = options.truth_spec;
+  return physics;
+}
+
+// The modules whose other form the truth runs (UsesOtherForm).
+std::vector<const EffectModule*> OtherForms(const SyntheticOptions& options) {
+  std::vector<const EffectModule*> out;
   for (const EffectModule* m : EffectRegistry()) {
-    if (m->apply_sensor_error != nullptr && m->extension != nullptr) {
-      physics_spec.Remove(*m->extension);
+    if (UsesOtherForm(options, *m)) out.push_back(m);
+  }
+  return out;
+}
+
+// The truth's spec for its physics: without the sensor errors (they act on
+// the measurements) and without the same form of each other-form effect.
+ModelSpec PhysicsSpec(const SyntheticOptions& options,
+                      const std::vector<const EffectModule*>& other) {
+  ModelSpec spec = options.truth_spec;
+  for (const EffectModule* m : EffectRegistry()) {
+    if (m->apply_sensor_error != nullptr && m->extension != nullptr) spec.Remove(*m->extension);
+  }
+  for (const EffectModule* m : other) {
+    if (m->other_truth->remove_same_form != nullptr) {
+      m->other_truth->remove_same_form(&spec);
+    } else if (m->extension != nullptr) {
+      spec.Remove(*m->extension);
     }
   }
-  Drivers drivers;
-  std::string error;
-  if (!PrepareDrivers(physics, plant, physics_spec, &drivers, &error)) {
-    std::cerr << "MakeSyntheticPlantData: " << error << "\n";
-    std::abort();  // the generator provides every channel: a bug
+  return spec;
+}
+
+// Runs the truth: the other forms' drivers hooks, then `passes` runs with
+// their run hooks (each seeing the previous pass), then their outputs hooks.
+void RunTruth(const std::vector<const EffectModule*>& other, OtherTruthContext ctx,
+              const ParamVector& truth, Drivers* drivers, SimOutputs* out) {
+  int passes = 1;
+  bool any_run_hook = false;
+  for (const EffectModule* m : other) {
+    if (m->other_truth->drivers != nullptr) m->other_truth->drivers(ctx, drivers);
+    if (m->other_truth->run != nullptr) {
+      any_run_hook = true;
+      passes = std::max(passes, m->other_truth->passes);
+    }
   }
-  if (!options.cleaning_times_s.empty()) SetCleaningTimes(options.cleaning_times_s, &drivers);
-  SimOutputs out;
-  Simulate(drivers, options.truth, &out);
-  const SensorNoise& noise = options.noise;
+  SimOutputs previous;
+  for (int pass = 0; pass < passes; ++pass) {
+    ctx.previous = pass > 0 ? &previous : nullptr;
+    SimOptions sim;
+    if (any_run_hook) {
+      sim.after_extensions = [&other, &ctx](const Drivers& d, RunInputs* run) {
+        for (const EffectModule* m : other) {
+          if (m->other_truth->run != nullptr) m->other_truth->run(ctx, d, run);
+        }
+      };
+    }
+    Simulate(*drivers, truth, out, sim);
+    if (pass + 1 < passes) {
+      previous.p_el_w = out->p_el_w;
+      previous.q_th_w = out->q_th_w;
+      previous.t_pv_c = out->t_pv_c;
+      previous.t_coll_c = out->t_coll_c;
+      previous.t_out_c = out->t_out_c;
+    }
+  }
+  ctx.previous = nullptr;
+  for (const EffectModule* m : other) {
+    if (m->other_truth->outputs != nullptr) m->other_truth->outputs(ctx, *drivers, out);
+  }
+}
+
+// The meters' readings of the truth's outputs with noise; the heat meter of
+// a disturbed flow multiplies its flow reading by the real temperature rise.
+void WriteMeasuredOutputs(const Plant& plant, const SensorNoise& noise, const Drivers& drivers,
+                          const SimOutputs& out, Series* s) {
   std::mt19937_64 rng(noise.seed);
-  auto& p_el = s.Ensure(Channel::kPElW);
-  auto& q_th = s.Ensure(Channel::kQThW);
-  auto& t_out = s.Ensure(Channel::kTOutC);
-  auto& t_pv = s.Ensure(Channel::kTPvC);
-  const auto& flow_read = s[Channel::kMdotKgS];
-  for (std::size_t i = 0; i < n; ++i) {
+  auto& p_el = s->Ensure(Channel::kPElW);
+  auto& q_th = s->Ensure(Channel::kQThW);
+  auto& t_out = s->Ensure(Channel::kTOutC);
+  auto& t_pv = s->Ensure(Channel::kTPvC);
+  const auto& flow_read = (*s)[Channel::kMdotKgS];
+  for (std::size_t i = 0; i < s->size(); ++i) {
     p_el[i] = out.p_el_w[i] * (1.0 + noise.p_el_rel * Normal(rng));
     // A heat meter reads zero without flow.
     const double q_noise = noise.q_th_w * Normal(rng);
@@ -218,19 +284,56 @@ Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& option
     t_out[i] = out.t_out_c[i] + noise.t_out_c * Normal(rng);
     t_pv[i] = out.t_pv_c[i];
     if (flow_read[i] != drivers.mdot_kg_s[i]) {
-      // Disturbed flow: the heat meter multiplies its flow reading by the
-      // real temperature rise.
       q_th[i] = flow_read[i] > 0.0
-                    ? flow_read[i] * plant.fluid_cp_j_kgk * (t_out[i] - s[Channel::kTInC][i])
+                    ? flow_read[i] * plant.fluid_cp_j_kgk * (t_out[i] - (*s)[Channel::kTInC][i])
                     : 0.0;
     }
   }
+}
+
+}  // namespace
+
+Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options) {
+  return MakeSyntheticPlantData(plant, options, nullptr);
+}
+
+Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options,
+                              SimOutputs* truth_outputs) {
+  WeatherOptions weather = options.weather;
+  weather.absorber = SensorParamsFromTruth(options.truth_spec, options.truth);
+  Series s = GenerateWeather(plant, weather);
+  const std::vector<const EffectModule*> other = OtherForms(options);
+  OtherTruthContext ctx;
+  ctx.plant = &plant;
+  ctx.truth = &options.truth;
+  ctx.seed = options.weather.seed;
+  // The true irradiance (irradiance_bias is a sensor error, applied below).
+  Series physics = DisturbedPhysics(s, options);
+  for (const EffectModule* m : other) {
+    if (m->other_truth->weather != nullptr) m->other_truth->weather(ctx, &physics);
+  }
+  ctx.physics = &physics;
+  Drivers drivers;
+  std::string error;
+  if (!PrepareDrivers(physics, plant, PhysicsSpec(options, other), &drivers, &error)) {
+    std::cerr << "MakeSyntheticPlantData: " << error << "\n";
+    std::abort();  // the generator provides every channel: a bug
+  }
+  if (!options.cleaning_times_s.empty()) SetCleaningTimes(options.cleaning_times_s, &drivers);
+  SimOutputs out;
+  RunTruth(other, ctx, options.truth, &drivers, &out);
+  WriteMeasuredOutputs(plant, options.noise, drivers, out, &s);
   for (const EffectModule* m : EffectRegistry()) {
-    if (m->apply_sensor_error != nullptr && HasEffect(options.truth_spec, *m)) {
+    const bool other_form = std::find(other.begin(), other.end(), m) != other.end();
+    if (other_form && m->other_truth->measured != nullptr) {
+      m->other_truth->measured(ctx, drivers, &s);
+    } else if (!other_form && m->apply_sensor_error != nullptr &&
+               HasEffect(options.truth_spec, *m)) {
       m->apply_sensor_error(options.truth, &s);
     }
   }
   InjectDefects(options.defects, &s);
+  if (truth_outputs != nullptr) *truth_outputs = std::move(out);
   return s;
 }
 

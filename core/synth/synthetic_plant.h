@@ -9,8 +9,10 @@
 #include <string_view>
 #include <vector>
 
+#include "core/common/model_data.h"
 #include "core/common/params.h"
 #include "core/common/series.h"
+#include "core/effects/effect_module.h"
 #include "core/model/variant.h"
 #include "core/synth/weather_generator.h"
 
@@ -103,7 +105,26 @@ struct DataDefects {
 
 inline DataDefects PaperDataDefects(std::uint64_t seed) { return {6, true, 4, 4, seed}; }
 
+// Which form the truth gives the effects under test (issue 11, item 2).
+enum class TruthForm {
+  // The candidate's own equations (the effect's extension or letter with its
+  // typical_truth): a present candidate can fit the truth exactly.
+  kSameForm,
+  // The effects listed in SyntheticOptions::other_form_effects in another
+  // functional form (EffectModule::other_truth: a horizon profile on some
+  // days for an obstacle box, a soft inverter knee for a hard clip, …), so
+  // that their candidates cannot fit exactly.
+  kOtherForm,
+};
+
+std::string_view TruthFormName(TruthForm form);  // "same-form", "other-form"
+
 struct SyntheticOptions {
+  TruthForm truth_form = TruthForm::kSameForm;
+  // With kOtherForm: the effects of truth_spec that run in their other form
+  // (typically the one a diagnosis withholds; the base model's own letters
+  // keep the form the base model has).
+  std::vector<const EffectModule*> other_form_effects;
   WeatherOptions weather;
   ModelSpec truth_spec;
   ParamVector truth{};
@@ -127,6 +148,16 @@ bool DefaultSyntheticOptions(const Plant& plant, std::string_view truth_variant,
 // options.truth; irradiance_bias is a sensor error: the physics sees the true
 // irradiance and g_poa_w_m2 (and g_poa_diffuse_w_m2) are written divided by
 // (1 + k). Aborts on a bad weather option (a caller bug, as GenerateWeather).
+// With options.truth_form == kOtherForm, each effect of other_form_effects
+// that truth_spec has and that has an other-form truth runs in that form
+// instead (its hooks, seeded by options.weather.seed). *truth_outputs (may be null) receives the
+// truth's noise-free outputs (what the meters would read without noise and defects).
 Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options);
+Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& options,
+                              SimOutputs* truth_outputs);
+
+// Whether the effect runs in its other form under options (options ask for
+// it, the truth has it and the module has one).
+bool UsesOtherForm(const SyntheticOptions& options, const EffectModule& effect);
 
 }  // namespace pvtwin

@@ -168,6 +168,9 @@ class Service {
   bool StoreStillAtPath();
   void UpdateDeviceStatus();
   void StartUpload();
+  // The [plant] in use into the store's plant_config, for commands given
+  // only the store (import-weather --db).
+  void RecordPlant();
   double Now() const { return clock_->NowS(); }
 
   ServiceOptions options_;
@@ -656,6 +659,10 @@ void Service::IssueForecast() {
     LogToStderr(kWarning, "no forecast issued: " + error);
     return;
   }
+  if (weather.size() > 0 && !store_->ReadWeatherSources(request.issued_at_s, horizon_end,
+                                                        &forecast.inputs.weather_sources, &error)) {
+    LogToStderr(kWarning, "the weather_forecast sources could not be read: " + error);
+  }
   std::vector<Store::ForecastRow> rows(forecast.rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     rows[i] = {forecast.rows.time_s[i], forecast.rows[Channel::kPElW][i],
@@ -686,6 +693,13 @@ void Service::StartUpload() {
       settings, config_.upload.interval_s,
       [](int priority, const std::string& line) { LogToStderr(priority, line); });
   upload_->Start();
+}
+
+void Service::RecordPlant() {
+  std::string error;
+  if (!store_->WritePlantConfig(PlantKeyValues(config_.plant), &error)) {
+    LogToStderr(kWarning, "recording the plant in the store failed: " + error);
+  }
 }
 
 void Service::UpdateDeviceStatus() {
@@ -779,6 +793,7 @@ int Service::Run() {
     LogToStderr(kErr, error);
     return 1;
   }
+  RecordPlant();
   work_dir_ = fs::path(config_.storage.path).parent_path() / "calibration";
   diagnosis_ =
       std::make_unique<cli::NightlyDiagnosis>(fs::path(config_.storage.path).parent_path());
@@ -824,7 +839,11 @@ int Service::Run() {
     if (options_.reload && options_.reload->exchange(false)) {
       NotifyReloading();
       LogToStderr(kInfo, "SIGHUP: reloading " + options_.config_path);
-      if (!LoadAndApplyConfig(false)) LogToStderr(kErr, "reload failed; the old config stays");
+      if (!LoadAndApplyConfig(false)) {
+        LogToStderr(kErr, "reload failed; the old config stays");
+      } else {
+        RecordPlant();
+      }
       NotifyReady("reloaded");
     }
     if (!StoreStillAtPath()) return 1;

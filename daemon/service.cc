@@ -29,6 +29,7 @@
 #include "daemon/notify.h"
 #include "daemon/store_cli.h"
 #include "daemon/upload_worker.h"
+#include "daemon/weather_worker.h"
 #include "io/child_process.h"
 #include "io/csv.h"
 #include "io/local_time.h"
@@ -171,6 +172,9 @@ class Service {
   // The [plant] in use into the store's plant_config, for commands given
   // only the store (import-weather --db).
   void RecordPlant();
+  // Starts, restarts (after a reload changed them) or stops the weather
+  // fetch to match [forecast] weather_url and the plant.
+  void UpdateWeatherFetch();
   double Now() const { return clock_->NowS(); }
 
   ServiceOptions options_;
@@ -183,6 +187,8 @@ class Service {
   std::unique_ptr<ModbusPoller> poller_;
   // [upload]: its own thread, so the loop never waits for the server.
   std::unique_ptr<UploadWorker> upload_;
+  // [forecast] weather_url: its own thread too.
+  std::unique_ptr<WeatherWorker> weather_;
   SampleQueue queue_;
   std::vector<Sample> pending_;
   bool store_failing_ = false;
@@ -695,6 +701,30 @@ void Service::StartUpload() {
   upload_->Start();
 }
 
+void Service::UpdateWeatherFetch() {
+  WeatherFetchSettings settings;
+  settings.store_path = config_.storage.path;
+  settings.plant = config_.plant;
+  settings.url = config_.forecast.weather_url.empty()
+                     ? ""
+                     : ExpandWeatherUrl(config_.forecast.weather_url, config_.plant);
+  settings.refresh_s = config_.forecast.weather_refresh_min * 60.0;
+  settings.timeout_s = config_.forecast.weather_timeout_s;
+  if (weather_ && weather_->settings().url == settings.url &&
+      weather_->settings().refresh_s == settings.refresh_s &&
+      weather_->settings().timeout_s == settings.timeout_s &&
+      PlantKeyValues(weather_->settings().plant) == PlantKeyValues(settings.plant)) {
+    return;
+  }
+  weather_.reset();  // stops and joins the old thread
+  if (settings.url.empty()) return;
+  LogToStderr(kInfo, "weather: fetching " + settings.url + " every " +
+                         Format("%.0f", config_.forecast.weather_refresh_min) + " min");
+  weather_ = std::make_unique<WeatherWorker>(
+      settings, [](int priority, const std::string& line) { LogToStderr(priority, line); });
+  weather_->Start();
+}
+
 void Service::RecordPlant() {
   std::string error;
   if (!store_->WritePlantConfig(PlantKeyValues(config_.plant), &error)) {
@@ -749,6 +779,7 @@ bool Service::StoreStillAtPath() {
 void Service::Shutdown() {
   NotifyStopping();
   LogToStderr(kInfo, "stopping");
+  weather_.reset();  // aborts a fetch in progress
   if (poller_) poller_->Stop();
   StoreSamples();
   if (store_) Aggregate();
@@ -815,6 +846,7 @@ int Service::Run() {
                 "forecasts use the data imported into the database");
   }
   if (config_.upload.enabled) StartUpload();
+  UpdateWeatherFetch();
   const double now = Now();
   next_calibration_s_ = !have_params_ && options_.calibrate_when_uncalibrated
                             ? now
@@ -843,6 +875,7 @@ int Service::Run() {
         LogToStderr(kErr, "reload failed; the old config stays");
       } else {
         RecordPlant();
+        UpdateWeatherFetch();
       }
       NotifyReady("reloaded");
     }
@@ -852,7 +885,9 @@ int Service::Run() {
     CheckCalibration();
     diagnosis_->Check(config_.diagnosis, *store_, LogToStderr);
     MaybeStartCalibration();
-    if (Now() >= next_forecast_s_) IssueForecast();
+    // A fresh weather forecast is used at once, not at the next refresh.
+    const bool fresh_weather = weather_ && weather_->TakeFresh();
+    if (Now() >= next_forecast_s_ || (fresh_weather && have_params_)) IssueForecast();
     if (Now() >= next_retention_s_) {
       next_retention_s_ = Now() + kRetentionPeriodS;
       if (!store_->ApplyRetention(static_cast<std::int64_t>(Now()),

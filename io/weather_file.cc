@@ -22,6 +22,26 @@ using nlohmann::json;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kKmPerHourToMS = 1.0 / 3.6;
+// The longest step and span read: a provider's step is 15 or 60 min; a
+// forecast with its past days spans weeks. Beyond, a file is refused rather
+// than turned into millions of 1-min rows.
+constexpr std::int64_t kMaxStepS = 3600;
+constexpr std::int64_t kMaxSpanS = 100 * 86400;
+constexpr std::int64_t kLatestTimeS = 4102444800;  // 2100-01-01
+
+// "" when the stamps t (evenly spaced, checked) are within the limits.
+std::string SpanProblem(const std::vector<std::int64_t>& t) {
+  const std::int64_t step = t[1] - t[0];
+  if (t.front() < 0 || t.back() > kLatestTimeS) return "expected times between 1970 and 2100";
+  if (step > kMaxStepS) {
+    return "a step of " + std::to_string(step) + " s: expected at most 3600 s (hourly)";
+  }
+  if (t.back() - t.front() > kMaxSpanS) {
+    return "spans " + std::to_string((t.back() - t.front()) / 86400) +
+           " days: expected at most 100 days";
+  }
+  return "";
+}
 
 // One Open-Meteo variable pvtwin reads: its name, the units it accepts with
 // the factor to pvtwin's unit, and where it goes.
@@ -155,6 +175,10 @@ class OpenMeteoReader {
               times[i].dump());
         return false;
       }
+      if (unix_s < 0 || unix_s > kLatestTimeS) {
+        Error(Field("time", i), "expected a time between 1970 and 2100", times[i].dump());
+        return false;
+      }
       if (!t.empty() && unix_s <= t.back()) {
         Error(Field("time", i), "must be later than " + Field("time", i - 1), times[i].dump());
         return false;
@@ -179,6 +203,10 @@ class OpenMeteoReader {
               FormatIsoUtc(t[i]));
         return false;
       }
+    }
+    if (const std::string problem = SpanProblem(t); !problem.empty()) {
+      Error(Field("time"), problem);
+      return false;
     }
     out_->weather.step_s = static_cast<double>(step);
     out_->weather.irradiance_offset_s = -static_cast<double>(step);  // the preceding interval
@@ -339,6 +367,10 @@ bool ParseCsv(const std::string& text, const std::string& name, WeatherFile* out
                              std::to_string(step) + " s from the first two rows)"});
       return false;
     }
+  }
+  if (const std::string problem = SpanProblem(s.time_s); !problem.empty()) {
+    errors->push_back({name, 0, "time", "", problem});
+    return false;
   }
   ProviderWeather& w = out->weather;
   w.time_s = s.time_s;

@@ -153,14 +153,25 @@ std::vector<double> InterpolateInstants(const ProviderWeather& in, const MinuteG
 
 bool CheckInput(const ProviderWeather& in, std::string* error) {
   const std::size_t n = in.time_s.size();
+  *error =
+      "weather input: no rows, a step or offset that is not whole minutes, a step over a day, "
+      "times outside 1900-2200 or a span over 400 days";
+  constexpr std::int64_t kEarliest = -2208988800, kLatest = 7258118400;  // 1900, 2200
+  if (n == 0 || !(in.step_s >= 60.0 && in.step_s <= 86400.0) ||
+      !(std::abs(in.irradiance_offset_s) <= in.step_s) ||
+      !(in.instant_offset_s >= 0.0 && in.instant_offset_s <= in.step_s) ||
+      in.time_s.front() < kEarliest || in.time_s.back() > kLatest ||
+      in.time_s.back() - in.time_s.front() > 400 * 86400) {
+    return false;
+  }
   const auto step = static_cast<std::int64_t>(in.step_s);
-  if (n == 0 || step < kMinute || step % kMinute != 0 || static_cast<double>(step) != in.step_s ||
+  if (step % kMinute != 0 || static_cast<double>(step) != in.step_s ||
       static_cast<std::int64_t>(in.irradiance_offset_s) % kMinute != 0) {
-    *error = "weather input: no rows, or a step or offset that is not whole minutes";
     return false;
   }
   for (std::size_t i = 0; i < n; ++i) {
-    if (in.time_s[i] % kMinute != 0 || (i > 0 && in.time_s[i] - in.time_s[i - 1] != step)) {
+    if (in.time_s[i] < kEarliest || in.time_s[i] > kLatest || in.time_s[i] % kMinute != 0 ||
+        (i > 0 && in.time_s[i] - in.time_s[i - 1] != step)) {
       *error =
           "weather input: time stamps not whole minutes step_s apart at row " + std::to_string(i);
       return false;
@@ -175,6 +186,7 @@ bool CheckInput(const ProviderWeather& in, std::string* error) {
       return false;
     }
   }
+  error->clear();
   return true;
 }
 

@@ -85,6 +85,22 @@ std::pair<std::size_t, std::size_t> MinutesOf(const MinuteGrid& g, std::int64_t 
   return {first, first + static_cast<std::size_t>(step / kMinute)};
 }
 
+// The interval's value spread evenly over its minutes with the sun above the
+// horizon (all minutes when there are none): the minutes' mean is the value,
+// and no light falls into the minutes of the night.
+void SpreadOverDaylight(const MinuteGrid& g, std::size_t first, std::size_t last, double value,
+                        std::vector<double>* out) {
+  std::size_t daylight = 0;
+  for (std::size_t k = first; k < last; ++k) daylight += g.zenith_rad[k] < kPi / 2 ? 1 : 0;
+  const std::size_t n = last - first;
+  for (std::size_t k = first; k < last; ++k) {
+    const bool up = daylight == 0 || g.zenith_rad[k] < kPi / 2;
+    (*out)[k] =
+        up ? value * static_cast<double>(n) / static_cast<double>(daylight == 0 ? n : daylight)
+           : 0.0;
+  }
+}
+
 // Interval means to minutes through the clear-sky index of each interval
 // (see the header): the minutes' mean equals the interval's value.
 std::vector<double> IntervalMeansToMinutes(const ProviderWeather& in, const MinuteGrid& g,
@@ -104,8 +120,12 @@ std::vector<double> IntervalMeansToMinutes(const ProviderWeather& in, const Minu
     const double index = values[i] / shape_mean;
     const bool flat =
         shape_mean < options.min_clear_sky_mean_w_m2 || !(index <= options.max_clear_sky_index);
-    if (flat && values[i] > 0.0) ++summary->flat_intervals;
-    for (std::size_t k = first; k < last; ++k) out[k] = flat ? values[i] : index * shape[k];
+    if (!flat) {
+      for (std::size_t k = first; k < last; ++k) out[k] = index * shape[k];
+      continue;
+    }
+    if (values[i] > 0.0) ++summary->flat_intervals;
+    SpreadOverDaylight(g, first, last, values[i], &out);
   }
   return out;
 }

@@ -15,7 +15,8 @@
 //                min_clear_sky_mean_w_m2 or k would exceed
 //                max_clear_sky_index (sunrise and sunset hours that the
 //                provider's and our sun disagree on), the value is spread
-//                evenly over the interval: also exact in energy.
+//                evenly over the interval's minutes with the sun above the
+//                horizon (over all of them if none): also exact in energy.
 //                Without GTI, g_poa_w_m2 (and g_poa_diffuse_w_m2) are GHI/DHI
 //                transposed with the model's isotropic sky (paper 2.5,
 //                core/physics/irradiance.h). DHI missing but DNI given:
@@ -83,7 +84,7 @@ struct WeatherResampleOptions {
 struct WeatherResampleSummary {
   std::size_t rows = 0;
   std::size_t irradiance_intervals = 0;
-  std::size_t flat_intervals = 0;  // spread evenly (see above)
+  std::size_t flat_intervals = 0;  // spread evenly over their daylight minutes (see above)
   double wind_factor = 1.0;        // (z / z_ref)^α applied to the wind
   // Where each written channel came from, e.g. "g_poa_w_m2 from GHI/DHI
   // (isotropic sky)", in channel order.

@@ -150,6 +150,31 @@ TEST(WeatherFile, NonMonotonicAndUnevenTimesNameTheIndex) {
   EXPECT_NE(gap.find("evenly spaced"), std::string::npos) << gap;
 }
 
+// A file that would become millions of 1-min rows is refused, not imported.
+TEST(WeatherFile, RefusesStepsOverAnHourSpansOver100DaysAndFarTimes) {
+  const std::string units = R"("hourly_units":{"temperature_2m":"°C"})";
+  const std::string coarse =
+      ErrorsOf("{" + units + R"(,"hourly":{"time":[0,10800],"temperature_2m":[1,2]}})", "s.json");
+  EXPECT_NE(coarse.find("s.json: hourly.time: a step of 10800 s: expected at most 3600 s"),
+            std::string::npos)
+      << coarse;
+  std::string times = "0", temps = "1";
+  for (int i = 1; i <= 2500; ++i) {
+    times += "," + std::to_string(i * 3600);
+    temps += ",1";
+  }
+  const std::string long_file = ErrorsOf("{" + units + R"(,"hourly":{"time":[)" + times +
+                                         R"(],"temperature_2m":[)" + temps + "]}}");
+  EXPECT_NE(long_file.find("spans 104 days: expected at most 100 days"), std::string::npos)
+      << long_file;
+  const std::string far =
+      ErrorsOf("{" + units + R"(,"hourly":{"time":[9000000000000000000,9000000000000003600],)" +
+               R"("temperature_2m":[1,2]}})");
+  EXPECT_NE(far.find("hourly.time[0] = 9000000000000000000: expected a time between 1970 and 2100"),
+            std::string::npos)
+      << far;
+}
+
 TEST(WeatherFile, AStringWhereANumberBelongsNamesTheIndex) {
   const std::string e =
       ErrorsOf(Hourly([](auto& j) { j["hourly"]["shortwave_radiation"][7] = "430"; }));

@@ -122,6 +122,26 @@ TEST(WeatherResample, EveryIntervalKeepsItsEnergy) {
   }
 }
 
+// 18:00-19:00 UTC holds the sunset (about 18:47 UTC at the plant on 1 June).
+// A value the clear sky cannot shape (index above 2) is spread over the
+// minutes with the sun up: the hour's energy kept, nothing after sunset.
+TEST(WeatherResample, AnUnshapeableSunsetHourKeepsItsEnergyInDaylight) {
+  ProviderWeather w = HourlyDay();
+  w.ghi_w_m2[19] = 100.0;
+  w.dhi_w_m2[19] = 90.0;
+  Series out;
+  WeatherResampleSummary summary;
+  std::string error;
+  ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error)) << error;
+  EXPECT_GE(summary.flat_intervals, 1u);
+  const std::int64_t from = kDay + 18 * 3600, to = kDay + 19 * 3600;
+  EXPECT_NEAR(MeanOver(out, Channel::kGhiWM2, from, to), 100.0, 1e-9);
+  EXPECT_NEAR(MeanOver(out, Channel::kDhiWM2, from, to), 90.0, 1e-9);
+  const std::size_t first = static_cast<std::size_t>((from - out.time_s[0]) / 60);
+  EXPECT_GT(out[Channel::kGhiWM2][first], 100.0);     // daylight minutes carry the hour
+  EXPECT_EQ(out[Channel::kGhiWM2][first + 59], 0.0);  // 18:59, after sunset
+}
+
 TEST(WeatherResample, GhiDhiAreTransposedToThePlaneWithoutTiltedIrradiance) {
   Series out;
   WeatherResampleSummary summary;

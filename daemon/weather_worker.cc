@@ -8,7 +8,6 @@
 #include "core/common/clock.h"
 #include "daemon/weather_import.h"
 #include "io/http_client.h"
-#include "io/store.h"
 
 namespace pvtwin {
 
@@ -45,76 +44,73 @@ void WeatherWorker::Stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-bool WeatherWorker::FetchOnce(std::string* reason) {
+WeatherWorker::Outcome WeatherWorker::FetchOnce() {
   HttpOptions options;
   options.total_timeout_s = settings_.timeout_s;
   options.connect_timeout_s = std::min(10.0, settings_.timeout_s);
   const HttpResponse response = HttpGet(settings_.url, options, stop_.Flag());
-  if (response.outcome == HttpResponse::Outcome::kAborted) {
-    *reason = "stopped";
-    return false;
-  }
   if (response.outcome != HttpResponse::Outcome::kOk) {
-    *reason =
-        std::string(OutcomeName(response.outcome)) + " (" + response.error +
-        (response.outcome == HttpResponse::Outcome::kHttpError ? ServerReason(response.body) : "") +
-        ")";
-    return false;
+    const bool http = response.outcome == HttpResponse::Outcome::kHttpError;
+    return {false, OutcomeName(response.outcome),
+            std::string(OutcomeName(response.outcome)) + " (" + response.error +
+                (http ? ServerReason(response.body) : "") + ")"};
   }
   std::string error;
-  std::unique_ptr<Store> store = Store::Open(settings_.store_path, &error);
-  if (!store) {
-    *reason = "the store cannot be opened: " + error;
-    return false;
-  }
+  if (!store_) store_ = Store::Open(settings_.store_path, &error);
+  if (!store_) return {false, "store", "the store cannot be opened: " + error};
   const std::string source = "fetch " + settings_.url;
   const cli::WeatherImportResult r =
-      cli::ImportWeatherText(*store, settings_.plant, response.body, settings_.url, source);
+      cli::ImportWeatherText(*store_, settings_.plant, response.body, settings_.url, source);
   switch (r.status) {
     case cli::WeatherImportResult::Status::kBadInput:
-      *reason = "the answer is not a usable forecast: " +
-                (r.errors.empty() ? std::string("?") : r.errors.front().ToString());
-      return false;
+      return {false, "bad answer",
+              "the answer is not a usable forecast: " +
+                  (r.errors.empty() ? std::string("?") : r.errors.front().ToString())};
     case cli::WeatherImportResult::Status::kStoreFailed:
-      *reason = "writing weather_forecast failed: " + r.store_error;
-      return false;
+      store_.reset();  // opened again for the next try
+      return {false, "store", "writing weather_forecast failed: " + r.store_error};
     case cli::WeatherImportResult::Status::kOk:
       break;
   }
   for (const std::string& note : r.file.notes) log_(kWarning, "weather: " + note);
-  *reason = r.SummaryLine(source);
-  return true;
+  return {true, "", r.SummaryLine(source)};
+}
+
+void WeatherWorker::Report(const Outcome& outcome) {
+  if (outcome.ok) {
+    if (state_ == State::kFailing) {
+      log_(kNotice, "weather: " + settings_.url + " answers again after " +
+                        Seconds(WallNowS() - failing_since_s_) + " of failures; " + outcome.text);
+    } else {
+      log_(kInfo, "weather: " + outcome.text);
+    }
+    state_ = State::kOk;
+    return;
+  }
+  if (state_ != State::kFailing || outcome.kind != failure_kind_) {
+    log_(kWarning, "weather: fetching " + settings_.url + " failed: " + outcome.text +
+                       "; forecasts use the weather_forecast rows they have, else persistence; "
+                       "retried with backoff");
+  }
+  if (state_ != State::kFailing) failing_since_s_ = WallNowS();
+  state_ = State::kFailing;
+  failure_kind_ = outcome.kind;
 }
 
 void WeatherWorker::Loop() {
   Backoff backoff(settings_.first_retry_s,
                   std::clamp(settings_.refresh_s / 4.0, settings_.first_retry_s, 300.0));
   while (!stop_.IsSet()) {
-    std::string reason;
-    const bool ok = FetchOnce(&reason);
-    if (stop_.IsSet()) break;
-    if (ok) {
-      if (state_ == State::kFailing) {
-        log_(kNotice, "weather: " + settings_.url + " answers again after " +
-                          Seconds(WallNowS() - failing_since_s_) + " of failures; " + reason);
-      } else {
-        log_(kInfo, "weather: " + reason);
-      }
-      state_ = State::kOk;
+    const Outcome outcome = FetchOnce();
+    if (stop_.IsSet()) break;  // an aborted transfer is no failure of the server
+    Report(outcome);
+    if (outcome.ok) {
       fresh_ = true;
       backoff.Reset();
       stop_.WaitFor(settings_.refresh_s);
-      continue;
+    } else {
+      stop_.WaitFor(backoff.Next());
     }
-    if (state_ != State::kFailing || reason.substr(0, 12) != last_reason_.substr(0, 12)) {
-      log_(kWarning, "weather: fetching " + settings_.url + " failed: " + reason +
-                         "; forecasts use the weather_forecast rows they have, else persistence; "
-                         "retried with backoff");
-      if (state_ != State::kFailing) failing_since_s_ = WallNowS();
-    }
-    state_ = State::kFailing;
-    last_reason_ = reason;
-    stop_.WaitFor(backoff.Next());
   }
 }
 

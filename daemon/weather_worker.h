@@ -12,12 +12,14 @@
 #pragma once
 
 #include <atomic>
+#include <memory>
 #include <string>
 #include <thread>
 
 #include "core/common/plant.h"
 #include "daemon/worker_thread.h"
 #include "io/log.h"
+#include "io/store.h"
 
 namespace pvtwin {
 
@@ -45,17 +47,26 @@ class WeatherWorker {
 
  private:
   enum class State { kStarting, kOk, kFailing };
+  // What one fetch did: ok with the summary line, or a failure of a kind
+  // ("unreachable", "HTTP error", "bad answer", "store", ...) with its reason.
+  struct Outcome {
+    bool ok = false;
+    std::string kind;
+    std::string text;
+  };
   void Loop();
-  // One fetch; false with a one-line reason.
-  bool FetchOnce(std::string* reason);
+  Outcome FetchOnce();
+  // Logs the outcome when it changes the state (or the kind of failure).
+  void Report(const Outcome& outcome);
 
   WeatherFetchSettings settings_;
   LogFn log_;
   std::thread thread_;
   StopRequest stop_;
   std::atomic<bool> fresh_{false};
+  std::unique_ptr<Store> store_;  // this thread's connection, opened at the first answer
   State state_ = State::kStarting;
-  std::string last_reason_;
+  std::string failure_kind_;
   double failing_since_s_ = 0.0;
 };
 

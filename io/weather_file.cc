@@ -102,6 +102,9 @@ class OpenMeteoReader {
     const json* units =
         root.contains(units_name) && root[units_name].is_object() ? &root[units_name] : nullptr;
     out_->format = "Open-Meteo JSON, " + block_;
+    if (block_ == "minutely_15" && root.contains("hourly")) {
+      out_->notes.push_back("hourly: ignored, minutely_15 is read (ask for one of them)");
+    }
     out_->weather.irradiance_offset_s = 0.0;  // set with the step below
     if (!ReadTimes(root, data)) return;
     bool any = false;

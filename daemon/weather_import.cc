@@ -14,7 +14,7 @@ std::string WeatherImportResult::SummaryLine(const std::string& source) const {
   }
   if (summary.flat_intervals > 0) {
     line += "; " + std::to_string(summary.flat_intervals) +
-            " irradiance intervals near sunrise/sunset spread evenly";
+            " irradiance intervals near sunrise/sunset spread over their daylight minutes";
   }
   return line;
 }

@@ -332,10 +332,11 @@ bool ParseJson(const std::string& text, const std::string& name, WeatherFile* ou
     } locator;
     json::sax_parse(text, &locator);
     const bool truncated = locator.at >= text.size();
-    errors->push_back(
-        {name, 0, "", "",
-         std::string(truncated ? "truncated JSON (it ends inside a value)" : "not valid JSON") +
-             " at byte " + std::to_string(locator.at) + " of " + std::to_string(text.size())});
+    errors->push_back({name, 0, "", "",
+                       truncated ? "truncated JSON: the text ends inside a value (after " +
+                                       std::to_string(text.size()) + " bytes)"
+                                 : "not valid JSON at byte " + std::to_string(locator.at) + " of " +
+                                       std::to_string(text.size())});
     return false;
   }
   if (!root.is_object()) {

@@ -32,6 +32,7 @@
 #include "daemon/weather_worker.h"
 #include "io/child_process.h"
 #include "io/csv.h"
+#include "io/http_client.h"
 #include "io/local_time.h"
 #include "io/log.h"
 #include "io/modbus_poller.h"
@@ -718,7 +719,7 @@ void Service::UpdateWeatherFetch() {
   }
   weather_.reset();  // stops and joins the old thread
   if (settings.url.empty()) return;
-  LogToStderr(kInfo, "weather: fetching " + settings.url + " every " +
+  LogToStderr(kInfo, "weather: fetching " + UrlForLogs(settings.url) + " every " +
                          Format("%.0f", config_.forecast.weather_refresh_min) + " min");
   weather_ = std::make_unique<WeatherWorker>(
       settings, [](int priority, const std::string& line) { LogToStderr(priority, line); });

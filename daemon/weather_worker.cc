@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/common/clock.h"
+#include "core/common/diagnostic.h"
 #include "daemon/weather_import.h"
 #include "io/http_client.h"
 
@@ -23,7 +24,7 @@ std::string Seconds(double s) {
 std::string ServerReason(const std::string& body) {
   const nlohmann::json j = nlohmann::json::parse(body, nullptr, false);
   if (j.is_object() && j.contains("reason") && j["reason"].is_string()) {
-    return ": " + j["reason"].get<std::string>();
+    return ": " + PrintableExcerpt(j["reason"].get<std::string>());
   }
   return "";
 }
@@ -58,9 +59,10 @@ WeatherWorker::Outcome WeatherWorker::FetchOnce() {
   std::string error;
   if (!store_) store_ = Store::Open(settings_.store_path, &error);
   if (!store_) return {false, "store", "the store cannot be opened: " + error};
-  const std::string source = "fetch " + settings_.url;
+  const std::string shown_url = UrlForLogs(settings_.url);
+  const std::string source = "fetch " + shown_url;
   const cli::WeatherImportResult r =
-      cli::ImportWeatherText(*store_, settings_.plant, response.body, settings_.url, source);
+      cli::ImportWeatherText(*store_, settings_.plant, response.body, shown_url, source);
   switch (r.status) {
     case cli::WeatherImportResult::Status::kBadInput:
       return {false, "bad answer",
@@ -79,7 +81,7 @@ WeatherWorker::Outcome WeatherWorker::FetchOnce() {
 void WeatherWorker::Report(const Outcome& outcome) {
   if (outcome.ok) {
     if (state_ == State::kFailing) {
-      log_(kNotice, "weather: " + settings_.url + " answers again after " +
+      log_(kNotice, "weather: " + UrlForLogs(settings_.url) + " answers again after " +
                         Seconds(WallNowS() - failing_since_s_) + " of failures; " + outcome.text);
     } else {
       log_(kInfo, "weather: " + outcome.text);
@@ -88,7 +90,7 @@ void WeatherWorker::Report(const Outcome& outcome) {
     return;
   }
   if (state_ != State::kFailing || outcome.kind != failure_kind_) {
-    log_(kWarning, "weather: fetching " + settings_.url + " failed: " + outcome.text +
+    log_(kWarning, "weather: fetching " + UrlForLogs(settings_.url) + " failed: " + outcome.text +
                        "; forecasts use the weather_forecast rows they have, else persistence; "
                        "retried with backoff");
   }

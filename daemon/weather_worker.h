@@ -2,8 +2,9 @@
 // as a thread of its own: every weather_refresh_min it GETs the URL
 // (io/http_client.h: connect and total time limits), reads the body as
 // import-weather reads a file (daemon/weather_import.h) and writes 1-min
-// rows to weather_forecast with the source "fetch <url>", on its own store
-// connection. The daemon's loop never waits for it: polling goes on while
+// rows to weather_forecast with the source "fetch <url>" (credential-like
+// query parameters shown as ***, io/http_client.h UrlForLogs), on its own
+// store connection. The daemon's loop never waits for it: polling goes on while
 // the server is slow or down. A failed fetch (unreachable, timed out,
 // HTTP error, a body that is not a forecast) is retried with exponential
 // backoff (10 s doubling up to clamp(refresh / 4, 10 s, 300 s)); the log gets

@@ -3,6 +3,7 @@
 #include <curl/curl.h>
 
 #include <algorithm>
+#include <cctype>
 #include <mutex>
 
 namespace pvtwin {
@@ -50,6 +51,31 @@ HttpResponse::Outcome OutcomeOf(CURLcode rc) {
 }
 
 }  // namespace
+
+std::string UrlForLogs(const std::string& url) {
+  static const char* const kSecretKeys[] = {"apikey", "api_key",      "key",
+                                            "token",  "access_token", "password"};
+  const std::size_t query = url.find('?');
+  if (query == std::string::npos) return url;
+  std::string out = url.substr(0, query + 1);
+  std::size_t at = query + 1;
+  while (at <= url.size()) {
+    std::size_t end = url.find('&', at);
+    if (end == std::string::npos) end = url.size();
+    const std::string pair = url.substr(at, end - at);
+    const std::size_t eq = pair.find('=');
+    std::string name = pair.substr(0, eq);
+    std::transform(name.begin(), name.end(), name.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const bool secret =
+        eq != std::string::npos &&
+        std::find(std::begin(kSecretKeys), std::end(kSecretKeys), name) != std::end(kSecretKeys);
+    out += secret ? pair.substr(0, eq + 1) + "***" : pair;
+    if (end < url.size()) out += '&';
+    at = end + 1;
+  }
+  return out;
+}
 
 const char* OutcomeName(HttpResponse::Outcome outcome) {
   switch (outcome) {

@@ -34,6 +34,12 @@ struct HttpOptions {
 HttpResponse HttpGet(const std::string& url, const HttpOptions& options,
                      const std::atomic<bool>* abort);
 
+// url with the values of credential-like query parameters (apikey, api_key,
+// key, token, access_token, password) replaced by "***", for log lines and
+// stored sources: a commercial weather API's key must not end up in the
+// journal or the database.
+std::string UrlForLogs(const std::string& url);
+
 // "connection refused" etc.: the outcome as a word for log lines.
 const char* OutcomeName(HttpResponse::Outcome outcome);
 

@@ -139,6 +139,16 @@ TEST_F(HttpClientTest, TheAbortFlagEndsATransferInProgress) {
   EXPECT_LT(WallNowS() - start, 2.0);
 }
 
+// A commercial weather API's key stays out of log lines and the store.
+TEST(UrlForLogs, HidesCredentialLikeQueryParameters) {
+  EXPECT_EQ(UrlForLogs("https://customer-api.open-meteo.com/v1/forecast?latitude=47.4&apikey="
+                       "s3cr3t&hourly=temperature_2m&Token=abc"),
+            "https://customer-api.open-meteo.com/v1/forecast?latitude=47.4&apikey=***&hourly="
+            "temperature_2m&Token=***");
+  EXPECT_EQ(UrlForLogs("http://127.0.0.1:8080/v1/forecast"), "http://127.0.0.1:8080/v1/forecast");
+  EXPECT_EQ(UrlForLogs("http://h/f?keyword=1&key="), "http://h/f?keyword=1&key=***");
+}
+
 // --- the daemon's fetch thread --------------------------------------------
 
 Plant ExamplePlant() {

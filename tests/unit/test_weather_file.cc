@@ -78,6 +78,27 @@ TEST(WeatherFile, ReadsOpenMeteo15MinutelyInLocalTimeWithANull) {
       << file.notes[0];
 }
 
+// Without a zone the tz database knows, the fixed utc_offset_seconds holds:
+// 00:00 at +01:00 is 23:00 UTC the day before; unix times need neither.
+TEST(WeatherFile, FallsBackToTheFixedUtcOffset) {
+  WeatherFile file;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseWeatherFile(Hourly([](auto& j) {
+                                 j.erase("timezone");
+                                 j["utc_offset_seconds"] = 3600;
+                               }),
+                               "o.json", &file, &errors));
+  EXPECT_EQ(file.weather.time_s.front(), 1717200000 - 3600);
+  nlohmann::json unix_times = nlohmann::json::array();
+  for (int i = 0; i < 48; ++i) unix_times.push_back(1717200000 + 3600 * i);
+  ASSERT_TRUE(ParseWeatherFile(Hourly([&](auto& j) {
+                                 j["timezone"] = "Europe/Vienna";
+                                 j["hourly"]["time"] = unix_times;
+                               }),
+                               "u.json", &file, &errors));
+  EXPECT_EQ(file.weather.time_s.front(), 1717200000);
+}
+
 TEST(WeatherFile, ReadsTheCanonicalCsvAsIntervalMeans) {
   WeatherFile file;
   Diagnostics errors;

@@ -52,8 +52,13 @@ bool EditConfig(std::string_view config_text, const std::map<std::string, TcpEnd
                                                      {"step_s", 60},
                                                      {"at", s.calibrate_at},
                                                      {"timezone", s.timezone}});
-  config.insert_or_assign("forecast",
-                          toml::table{{"horizon_h", s.horizon_h}, {"refresh_min", s.refresh_min}});
+  toml::table forecast{{"horizon_h", s.horizon_h}, {"refresh_min", s.refresh_min}};
+  if (!s.weather_url.empty()) {
+    forecast.insert_or_assign("weather_url", s.weather_url);
+    forecast.insert_or_assign("weather_refresh_min", s.weather_refresh_min);
+    forecast.insert_or_assign("weather_timeout_s", s.weather_timeout_s);
+  }
+  config.insert_or_assign("forecast", std::move(forecast));
   std::ostringstream text;
   text << config << "\n";
   *out = text.str();

@@ -29,6 +29,10 @@ struct DaemonSettings {
   std::string timezone = "UTC";
   double horizon_h = 24;
   double refresh_min = 60;
+  // [forecast] weather fetch; left out of the config while weather_url is empty.
+  std::string weather_url;
+  double weather_refresh_min = 60;
+  double weather_timeout_s = 30;
 };
 
 // `config_text` with every [[modbus.device]] moved to its endpoint and the

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -49,6 +50,7 @@ constexpr PlantKey kPlantKeys[] = {
     {"pv_g_ref_w_m2", kOptional, Closed(100, 1500), &Plant::pv_g_ref_w_m2, false},
     {"pv_temp_coeff_per_k", kOptional, Closed(-0.02, 0.01), &Plant::pv_temp_coeff_per_k, false},
     {"pv_irr_coeff_m2_w", kOptional, Closed(-1e-3, 1e-3), &Plant::pv_irr_coeff_m2_w, false},
+    {"collector_height_m", kOptional, Closed(0.5, 200), &Plant::collector_height_m, false},
 };
 
 void ReadPlant(SectionReader& r, Plant* plant) {
@@ -67,6 +69,121 @@ void ReadPlant(SectionReader& r, Plant* plant) {
                                       : SkySource::kAuto;
   }
 }
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> PlantKeyValues(const Plant& plant) {
+  std::vector<std::pair<std::string, double>> values;
+  for (const PlantKey& k : kPlantKeys) {
+    values.emplace_back(std::string(k.key),
+                        k.degrees ? RadToDeg(plant.*k.member) : plant.*k.member);
+  }
+  // [plant] sky as a code: 0 auto, 1 measured, 2 estimated.
+  values.emplace_back("sky", static_cast<double>(plant.sky));
+  return values;
+}
+
+bool PlantFromKeyValues(const std::vector<std::pair<std::string, double>>& values, Plant* plant,
+                        std::string* error) {
+  Plant result;
+  for (const PlantKey& k : kPlantKeys) {
+    const auto it = std::find_if(values.begin(), values.end(),
+                                 [&](const auto& kv) { return kv.first == k.key; });
+    if (it == values.end()) {
+      if (!k.required) continue;
+      *error = std::string(k.key) + ": missing";
+      return false;
+    }
+    if (!k.range.Contains(it->second)) {
+      *error = std::string(k.key) + " = " + FormatNumber(it->second) + ": out of range";
+      return false;
+    }
+    result.*k.member = k.degrees ? DegToRad(it->second) : it->second;
+  }
+  for (const auto& [key, value] : values) {
+    if (key != "sky") continue;
+    if (value != 0.0 && value != 1.0 && value != 2.0) {
+      *error = "sky = " + FormatNumber(value) + ": expected 0 (auto), 1 (measured) or 2 (estimated)";
+      return false;
+    }
+    result.sky = static_cast<SkySource>(static_cast<int>(value));
+  }
+  *plant = result;
+  return true;
+}
+
+namespace {
+
+struct UrlPlaceholder {
+  std::string_view name;
+  double (*value)(const Plant&);
+};
+constexpr UrlPlaceholder kUrlPlaceholders[] = {
+    {"lat", [](const Plant& p) { return RadToDeg(p.latitude_rad); }},
+    {"lon", [](const Plant& p) { return RadToDeg(p.longitude_rad); }},
+    {"tilt", [](const Plant& p) { return RadToDeg(p.tilt_rad); }},
+    {"azimuth", [](const Plant& p) { return RadToDeg(p.azimuth_rad); }},
+    {"om_azimuth", [](const Plant& p) { return RadToDeg(p.azimuth_rad) - 180.0; }},
+    {"elevation", [](const Plant& p) { return p.elevation_m; }},
+};
+
+// Calls on_text / on_placeholder for the pieces of url; false with *error
+// at an unknown or unclosed placeholder.
+template <class OnText, class OnPlaceholder>
+bool WalkUrlTemplate(const std::string& url, OnText on_text, OnPlaceholder on_placeholder,
+                     std::string* error) {
+  std::size_t at = 0;
+  while (at < url.size()) {
+    const std::size_t open = url.find('{', at);
+    on_text(url.substr(at, open == std::string::npos ? std::string::npos : open - at));
+    if (open == std::string::npos) break;
+    const std::size_t close = url.find('}', open);
+    if (close == std::string::npos) {
+      *error = "unclosed '{' at character " + std::to_string(open + 1);
+      return false;
+    }
+    const std::string_view name(url.data() + open + 1, close - open - 1);
+    const auto it = std::find_if(std::begin(kUrlPlaceholders), std::end(kUrlPlaceholders),
+                                 [&](const UrlPlaceholder& p) { return p.name == name; });
+    if (it == std::end(kUrlPlaceholders)) {
+      *error = "unknown placeholder {" + std::string(name) +
+               "} (known: {lat}, {lon}, {tilt}, {azimuth}, {om_azimuth}, {elevation})";
+      return false;
+    }
+    on_placeholder(*it);
+    at = close + 1;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool CheckWeatherUrlTemplate(const std::string& url, std::string* error) {
+  if (!url.starts_with("http://") && !url.starts_with("https://")) {
+    *error = "expected an http:// or https:// URL";
+    return false;
+  }
+  return WalkUrlTemplate(
+      url, [](const std::string&) {}, [](const UrlPlaceholder&) {}, error);
+}
+
+std::string ExpandWeatherUrl(const std::string& url, const Plant& plant) {
+  std::string out, error;
+  WalkUrlTemplate(
+      url, [&](const std::string& text) { out += text; },
+      [&](const UrlPlaceholder& p) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%.4f", p.value(plant));
+        std::string number = buf;
+        while (number.back() == '0') number.pop_back();
+        if (number.back() == '.') number.pop_back();
+        out += number;
+      },
+      &error);
+  return out;
+}
+
+namespace {
 
 void ReadStorage(SectionReader& r, StorageConfig* storage) {
   r.String("path", kOptional, &storage->path);
@@ -133,6 +250,20 @@ void ReadCalibration(SectionReader& r, CalibrationConfig* calibration) {
 void ReadForecast(SectionReader& r, ForecastConfig* forecast) {
   r.Number("horizon_h", kOptional, LeftOpen(0, 168), &forecast->horizon_h);
   r.Number("refresh_min", kOptional, Closed(1, 1440), &forecast->refresh_min);
+  constexpr std::string_view kUrlRule =
+      "expected an http:// or https:// URL; placeholders {lat}, {lon}, {tilt}, {azimuth}, "
+      "{om_azimuth}, {elevation}";
+  std::string url;
+  if (r.String("weather_url", kOptional, &url, kUrlRule)) {
+    std::string why;
+    if (!url.empty() && !CheckWeatherUrlTemplate(url, &why)) {
+      r.Reject("weather_url", why);
+    } else {
+      forecast->weather_url = url;
+    }
+  }
+  r.Number("weather_refresh_min", kOptional, Closed(5, 1440), &forecast->weather_refresh_min);
+  r.Number("weather_timeout_s", kOptional, Closed(1, 600), &forecast->weather_timeout_s);
 }
 
 void ReadDiagnosis(SectionReader& r, DiagnosisConfig* d) {

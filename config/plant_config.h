@@ -4,13 +4,16 @@
 //   [plant]        required; the collector field (core/plant.h). Required keys:
 //                  latitude_deg, longitude_deg, tilt_deg, azimuth_deg, area_m2;
 //                  the others default to the values of core/plant.h.
-//                  Extension: elevation_m (default 0); sky = "auto" | "measured" |
-//                  "estimated" (where the sky temperature comes from, default auto:
-//                  the long-wave channel unless it is implausible).
+//                  Extensions: elevation_m (default 0), collector_height_m
+//                  (default 10, the height a forecast's wind is brought to), sky =
+//                  "auto" | "measured" | "estimated" (where the sky temperature
+//                  comes from, default auto: the long-wave channel unless it is
+//                  implausible).
 //   [storage]      path, raw_retention_days
 //   [poll]         period_s
 //   [calibration]  variant, window_days, step_s, at, timezone, refit_full_window
-//   [forecast]     horizon_h, refresh_min
+//   [forecast]     horizon_h, refresh_min, weather_url, weather_refresh_min,
+//                  weather_timeout_s
 //   [diagnosis]    enabled, every_days, timeout_s, keep (the nightly diagnosis)
 //   [monitor]      drift_days, alarm_days, datasheet_eta0, datasheet_c1_w_m2k …
 //                  datasheet_c6_s_m, datasheet_kd, power_check_safety_factor
@@ -31,6 +34,8 @@
 
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "config/modbus_config.h"
 #include "core/common/diagnostic.h"
@@ -61,6 +66,11 @@ struct CalibrationConfig {
 struct ForecastConfig {
   double horizon_h = 24;    // forecast length, (0, 168]
   double refresh_min = 60;  // re-issue period, [1, 1440]
+  // Weather forecast fetched by the daemon (issue 15): a URL template of an
+  // Open-Meteo-compatible server (ExpandWeatherUrl); empty = no fetch.
+  std::string weather_url;
+  double weather_refresh_min = 60;  // fetch period, [5, 1440]
+  double weather_timeout_s = 30;    // connect + transfer limit of one fetch, [1, 600]
 };
 
 // [diagnosis]: the daemon's diagnosis of the sim-to-real gap, run after a
@@ -129,6 +139,24 @@ struct Config {
   ModbusConfig modbus;
   std::string source_path;  // the file it was read from
 };
+
+// The [plant] keys with their values in the config's units (degrees), in
+// the order of the config's key table (the store's plant_config), and back:
+// false with *error naming the key when a required key is missing or a
+// value is out of its range.
+std::vector<std::pair<std::string, double>> PlantKeyValues(const Plant& plant);
+bool PlantFromKeyValues(const std::vector<std::pair<std::string, double>>& values, Plant* plant,
+                        std::string* error);
+
+// [forecast] weather_url: an http:// or https:// URL whose placeholders are
+// {lat}, {lon} (degrees, north and east positive), {tilt} (degrees from
+// horizontal), {azimuth} (degrees from north, clockwise: pvtwin's),
+// {om_azimuth} (Open-Meteo's: degrees from south, west positive, = azimuth
+// − 180) and {elevation} (m). False with *error for another scheme, an
+// unknown or unclosed placeholder.
+bool CheckWeatherUrlTemplate(const std::string& url, std::string* error);
+// The URL with the plant's values in place of the placeholders.
+std::string ExpandWeatherUrl(const std::string& url, const Plant& plant);
 
 // "HH:MM" (00:00 … 23:59) → hour, minute; false otherwise.
 bool ParseClockTime(std::string_view text, int* hour, int* minute);

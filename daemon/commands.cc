@@ -34,6 +34,11 @@ const std::vector<std::pair<std::string, std::string>>& Examples() {
        "pvtwin backtest --config plant.toml --csv data.csv --variants paper --train-days 14"},
       {"import",
        "pvtwin import --config /etc/pvtwin/pvtwin.toml --csv logger.csv --timezone Europe/Vienna"},
+      {"import-weather",
+       "pvtwin import-weather --db /var/lib/pvtwin/pvtwin.db forecast.json   # from "
+       "https://api.open-meteo.com/v1/forecast?latitude=47.36&longitude=16.13&hourly="
+       "shortwave_radiation,diffuse_radiation,temperature_2m,wind_speed_10m,dew_point_2m,"
+       "cloud_cover&wind_speed_unit=ms&timezone=GMT"},
       {"export",
        "pvtwin export --db /var/lib/pvtwin/pvtwin.db --from -14d --out last-two-weeks.csv"},
       {"sim", "pvtwin sim --config config/examples/sim-plant.toml --speed 10"},
@@ -72,6 +77,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterBench(app);
   RegisterBacktest(app);
   RegisterImport(app);
+  RegisterImportWeather(app);
   RegisterExport(app);
   RegisterSim(app);
   RegisterRun(app);

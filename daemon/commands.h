@@ -23,6 +23,7 @@ void RegisterCalibrate(CLI::App& app);
 void RegisterBench(CLI::App& app);
 void RegisterBacktest(CLI::App& app);
 void RegisterImport(CLI::App& app);
+void RegisterImportWeather(CLI::App& app);
 void RegisterExport(CLI::App& app);
 void RegisterSim(CLI::App& app);
 void RegisterRun(CLI::App& app);

@@ -29,8 +29,10 @@
 #include "daemon/notify.h"
 #include "daemon/store_cli.h"
 #include "daemon/upload_worker.h"
+#include "daemon/weather_worker.h"
 #include "io/child_process.h"
 #include "io/csv.h"
+#include "io/http_client.h"
 #include "io/local_time.h"
 #include "io/log.h"
 #include "io/modbus_poller.h"
@@ -168,6 +170,12 @@ class Service {
   bool StoreStillAtPath();
   void UpdateDeviceStatus();
   void StartUpload();
+  // The [plant] in use into the store's plant_config, for commands given
+  // only the store (import-weather --db).
+  void RecordPlant();
+  // Starts, restarts (after a reload changed them) or stops the weather
+  // fetch to match [forecast] weather_url and the plant.
+  void UpdateWeatherFetch();
   double Now() const { return clock_->NowS(); }
 
   ServiceOptions options_;
@@ -180,6 +188,8 @@ class Service {
   std::unique_ptr<ModbusPoller> poller_;
   // [upload]: its own thread, so the loop never waits for the server.
   std::unique_ptr<UploadWorker> upload_;
+  // [forecast] weather_url: its own thread too.
+  std::unique_ptr<WeatherWorker> weather_;
   SampleQueue queue_;
   std::vector<Sample> pending_;
   bool store_failing_ = false;
@@ -656,6 +666,10 @@ void Service::IssueForecast() {
     LogToStderr(kWarning, "no forecast issued: " + error);
     return;
   }
+  if (weather.size() > 0 && !store_->ReadWeatherSources(request.issued_at_s, horizon_end,
+                                                        &forecast.inputs.weather_sources, &error)) {
+    LogToStderr(kWarning, "the weather_forecast sources could not be read: " + error);
+  }
   std::vector<Store::ForecastRow> rows(forecast.rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     rows[i] = {forecast.rows.time_s[i], forecast.rows[Channel::kPElW][i],
@@ -686,6 +700,37 @@ void Service::StartUpload() {
       settings, config_.upload.interval_s,
       [](int priority, const std::string& line) { LogToStderr(priority, line); });
   upload_->Start();
+}
+
+void Service::UpdateWeatherFetch() {
+  WeatherFetchSettings settings;
+  settings.store_path = config_.storage.path;
+  settings.plant = config_.plant;
+  settings.url = config_.forecast.weather_url.empty()
+                     ? ""
+                     : ExpandWeatherUrl(config_.forecast.weather_url, config_.plant);
+  settings.refresh_s = config_.forecast.weather_refresh_min * 60.0;
+  settings.timeout_s = config_.forecast.weather_timeout_s;
+  if (weather_ && weather_->settings().url == settings.url &&
+      weather_->settings().refresh_s == settings.refresh_s &&
+      weather_->settings().timeout_s == settings.timeout_s &&
+      PlantKeyValues(weather_->settings().plant) == PlantKeyValues(settings.plant)) {
+    return;
+  }
+  weather_.reset();  // stops and joins the old thread
+  if (settings.url.empty()) return;
+  LogToStderr(kInfo, "weather: fetching " + UrlForLogs(settings.url) + " every " +
+                         Format("%.0f", config_.forecast.weather_refresh_min) + " min");
+  weather_ = std::make_unique<WeatherWorker>(
+      settings, [](int priority, const std::string& line) { LogToStderr(priority, line); });
+  weather_->Start();
+}
+
+void Service::RecordPlant() {
+  std::string error;
+  if (!store_->WritePlantConfig(PlantKeyValues(config_.plant), &error)) {
+    LogToStderr(kWarning, "recording the plant in the store failed: " + error);
+  }
 }
 
 void Service::UpdateDeviceStatus() {
@@ -735,6 +780,7 @@ bool Service::StoreStillAtPath() {
 void Service::Shutdown() {
   NotifyStopping();
   LogToStderr(kInfo, "stopping");
+  weather_.reset();  // aborts a fetch in progress
   if (poller_) poller_->Stop();
   StoreSamples();
   if (store_) Aggregate();
@@ -779,6 +825,7 @@ int Service::Run() {
     LogToStderr(kErr, error);
     return 1;
   }
+  RecordPlant();
   work_dir_ = fs::path(config_.storage.path).parent_path() / "calibration";
   diagnosis_ =
       std::make_unique<cli::NightlyDiagnosis>(fs::path(config_.storage.path).parent_path());
@@ -800,6 +847,7 @@ int Service::Run() {
                 "forecasts use the data imported into the database");
   }
   if (config_.upload.enabled) StartUpload();
+  UpdateWeatherFetch();
   const double now = Now();
   next_calibration_s_ = !have_params_ && options_.calibrate_when_uncalibrated
                             ? now
@@ -824,7 +872,12 @@ int Service::Run() {
     if (options_.reload && options_.reload->exchange(false)) {
       NotifyReloading();
       LogToStderr(kInfo, "SIGHUP: reloading " + options_.config_path);
-      if (!LoadAndApplyConfig(false)) LogToStderr(kErr, "reload failed; the old config stays");
+      if (!LoadAndApplyConfig(false)) {
+        LogToStderr(kErr, "reload failed; the old config stays");
+      } else {
+        RecordPlant();
+        UpdateWeatherFetch();
+      }
       NotifyReady("reloaded");
     }
     if (!StoreStillAtPath()) return 1;
@@ -833,7 +886,9 @@ int Service::Run() {
     CheckCalibration();
     diagnosis_->Check(config_.diagnosis, *store_, LogToStderr);
     MaybeStartCalibration();
-    if (Now() >= next_forecast_s_) IssueForecast();
+    // A fresh weather forecast is used at once, not at the next refresh.
+    const bool fresh_weather = weather_ && weather_->TakeFresh();
+    if (Now() >= next_forecast_s_ || (fresh_weather && have_params_)) IssueForecast();
     if (Now() >= next_retention_s_) {
       next_retention_s_ = Now() + kRetentionPeriodS;
       if (!store_->ApplyRetention(static_cast<std::int64_t>(Now()),

@@ -1,7 +1,6 @@
 #include "daemon/upload_worker.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 
 #include "core/common/clock.h"
@@ -28,26 +27,14 @@ void UploadWorker::Start() {
 }
 
 void UploadWorker::Stop() {
-  {
-    std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
+  stop_.Set();
   if (thread_.joinable()) thread_.join();
-}
-
-void UploadWorker::Wait(double s) {
-  std::unique_lock lock(mutex_);
-  wake_.wait_for(lock, std::chrono::duration<double>(s), [this] { return stop_; });
 }
 
 bool UploadWorker::Round(PgError* error) {
   bool more = true;
   while (more) {
-    {
-      std::lock_guard lock(mutex_);
-      if (stop_) return true;
-    }
+    if (stop_.IsSet()) return true;
     std::int64_t rows = 0;
     if (!uploader_->UploadBatches(&rows, &more, error)) return false;
     rows_ += rows;
@@ -96,13 +83,8 @@ void UploadWorker::Enter(UploadState next, const PgError& error) {
 }
 
 void UploadWorker::Loop() {
-  const double cap_s = std::clamp(5.0 * interval_s_, 5.0, 300.0);
-  double backoff_s = 1.0;
-  for (;;) {
-    {
-      std::lock_guard lock(mutex_);
-      if (stop_) break;
-    }
+  Backoff backoff(1.0, std::clamp(5.0 * interval_s_, 5.0, 300.0));
+  while (!stop_.IsSet()) {
     PgError error;
     if (!uploader_) {
       std::string why;
@@ -110,13 +92,12 @@ void UploadWorker::Loop() {
       if (!uploader_) error = {PgFault::kLocal, why, ""};
     }
     if (uploader_ && Round(&error)) {
-      backoff_s = 1.0;
-      Wait(interval_s_);
+      backoff.Reset();
+      stop_.WaitFor(interval_s_);
       continue;
     }
     Enter(StateForFault(error.fault), error);
-    Wait(backoff_s);
-    backoff_s = std::min(2.0 * backoff_s, cap_s);
+    stop_.WaitFor(backoff.Next());
   }
 }
 

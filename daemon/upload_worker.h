@@ -9,13 +9,12 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <thread>
 
+#include "daemon/worker_thread.h"
 #include "io/log.h"
 #include "io/upload.h"
 
@@ -40,17 +39,13 @@ class UploadWorker {
   // One round: batches until nothing is pending. False after a fault.
   bool Round(PgError* error);
   void Enter(UploadState next, const PgError& error);
-  // Sleeps s seconds or until Stop.
-  void Wait(double s);
 
   UploadSettings settings_;
   double interval_s_;
   LogFn log_;
   std::unique_ptr<Uploader> uploader_;
   std::thread thread_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stop_ = false;
+  StopRequest stop_;
   std::atomic<UploadState> state_{UploadState::kStarting};
   std::atomic<std::int64_t> rows_{0};
   double down_since_s_ = 0.0;

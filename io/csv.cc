@@ -235,11 +235,12 @@ class CsvParser {
       Error(1, name, "", std::string("required column missing") + alternative);
     };
     if (!time_index_) missing(kTimeColumn, "");
-    if (!has(Channel::kQThW)) {
+    if (!has(Channel::kQThW) && !options_.weather_only) {
       if (!has(Channel::kTInC)) missing("t_in_c", " (or give q_th_w)");
       if (!has(Channel::kTOutC)) missing("t_out_c", " (or give q_th_w)");
     }
-    if (!has(Channel::kMdotKgS)) missing("flow_kg_s", " (or give flow_l_h)");
+    if (!has(Channel::kMdotKgS) && !options_.weather_only)
+      missing("flow_kg_s", " (or give flow_l_h)");
     if (!has(Channel::kGPoaWM2)) {
       const bool ghi = has(Channel::kGhiWM2);
       const bool dhi = has(Channel::kDhiWM2);
@@ -252,7 +253,7 @@ class CsvParser {
       }
     }
     if (!has(Channel::kTAmbC)) missing("t_amb_c", "");
-    if (!has(Channel::kPElW)) missing("p_el_w", "");
+    if (!has(Channel::kPElW) && !options_.weather_only) missing("p_el_w", "");
 
     for (const Column& column : columns_) {
       if (column.channel) series_[*column.channel].clear();

@@ -48,6 +48,9 @@ struct CsvReadOptions {
   // Zone of `time` cells without Z or offset (io/local_time.h); null: such
   // cells are an error, a local time says nothing about its instant.
   const NaiveTimeZone* naive_time_zone = nullptr;
+  // A weather file (pvtwin import-weather): required are only `time`,
+  // g_poa_w_m2 or ghi_w_m2 + dhi_w_m2, and t_amb_c.
+  bool weather_only = false;
 };
 
 // Reads the file at path. Returns true if it was read without errors; then

@@ -194,11 +194,22 @@ std::vector<std::string> SchemaV4() {
   };
 }
 
+// Version 5: where each weather_forecast row came from (import-weather, the
+// daemon's fetch; NULL for rows other programs wrote), and the plant the
+// store belongs to, so that commands given only the store know the site.
+std::vector<std::string> SchemaV5() {
+  return {
+      "ALTER TABLE weather_forecast ADD COLUMN source TEXT",
+      "CREATE TABLE plant_config(key TEXT PRIMARY KEY, value REAL NOT NULL) WITHOUT ROWID",
+  };
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}, {4, &SchemaV4}};
+const Migration kMigrations[] = {
+    {1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}, {4, &SchemaV4}, {5, &SchemaV5}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 
@@ -1420,6 +1431,101 @@ bool Store::ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out,
 bool Store::ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error) {
   std::lock_guard lock(impl_->mutex);
   return impl_->ReadInputTable("operation_plan", kOperationChannels, from, to, out, error);
+}
+
+bool Store::WriteWeatherForecast(const Series& rows, const std::string& source,
+                                 std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::string sql = "INSERT OR REPLACE INTO weather_forecast(ts";
+  for (const Channel c : kWeatherChannels) sql += ", " + std::string(ChannelName(c));
+  sql += ", source) VALUES(" + Placeholders(std::size(kWeatherChannels) + 2) + ")";
+  return db.Run(
+      true, "write weather_forecast",
+      [&]() -> DbStatus {
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare(sql, &stmt);
+        if (!s.ok()) return s;
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+          sqlite3_reset(stmt);
+          sqlite3_bind_int64(stmt, 1, rows.time_s[i]);
+          int k = 2;
+          for (const Channel c : kWeatherChannels) BindReal(stmt, k++, ToSql(c, rows.At(c, i)));
+          sqlite3_bind_text(stmt, k, source.c_str(), -1, SQLITE_TRANSIENT);
+          s = db.StepDone(stmt, "write weather_forecast ts " + std::to_string(rows.time_s[i]));
+          if (!s.ok()) return s;
+        }
+        return {};
+      },
+      error);
+}
+
+bool Store::ReadWeatherSources(std::int64_t from, std::int64_t to,
+                               std::vector<std::string>* sources, std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::vector<std::string> result;
+  const bool ok = db.Run(
+      false, "read weather_forecast sources",
+      [&]() -> DbStatus {
+        result.clear();
+        return db.SelectRange(
+            "SELECT COALESCE(source, 'weather_forecast') FROM weather_forecast WHERE ts >= ? AND "
+            "ts < ? GROUP BY 1 ORDER BY COUNT(*) DESC, 1",
+            from, to, [&](sqlite3_stmt* stmt) { result.push_back(ColumnText(stmt, 0)); },
+            "read weather_forecast sources");
+      },
+      error);
+  if (ok) *sources = std::move(result);
+  return ok;
+}
+
+bool Store::WritePlantConfig(const std::vector<std::pair<std::string, double>>& values,
+                             std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  return db.Run(
+      true, "write plant_config",
+      [&]() -> DbStatus {
+        DbStatus s = db.Exec("DELETE FROM plant_config");
+        if (!s.ok()) return s;
+        sqlite3_stmt* stmt = nullptr;
+        s = db.Prepare("INSERT INTO plant_config(key, value) VALUES(?, ?)", &stmt);
+        if (!s.ok()) return s;
+        for (const auto& [key, value] : values) {
+          sqlite3_reset(stmt);
+          sqlite3_bind_text(stmt, 1, key.c_str(), -1, SQLITE_TRANSIENT);
+          sqlite3_bind_double(stmt, 2, value);
+          s = db.StepDone(stmt, "write plant_config " + key);
+          if (!s.ok()) return s;
+        }
+        return {};
+      },
+      error);
+}
+
+bool Store::ReadPlantConfig(std::vector<std::pair<std::string, double>>* values,
+                            std::string* error) {
+  Impl& db = *impl_;
+  std::lock_guard lock(db.mutex);
+  std::vector<std::pair<std::string, double>> result;
+  const bool ok = db.Run(
+      false, "read plant_config",
+      [&]() -> DbStatus {
+        result.clear();
+        sqlite3_stmt* stmt = nullptr;
+        DbStatus s = db.Prepare("SELECT key, value FROM plant_config ORDER BY key", &stmt);
+        if (!s.ok()) return s;
+        int rc;
+        while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+          result.emplace_back(ColumnText(stmt, 0), sqlite3_column_double(stmt, 1));
+        }
+        sqlite3_reset(stmt);
+        return rc == SQLITE_DONE ? DbStatus{} : db.Fail(rc, "read plant_config");
+      },
+      error);
+  if (ok) *values = std::move(result);
+  return ok;
 }
 
 bool Store::Checkpoint(std::int64_t* db_bytes, std::string* error) {

@@ -42,8 +42,10 @@
 //                    g_poa_diffuse_w_m2, t_amb_c, wind_m_s, t_sky_c,
 //                    lw_down_w_m2 REAL)
 //   operation_plan(ts INTEGER PRIMARY KEY, t_in_c REAL, flow_kg_s REAL)
-//       forecast inputs that outside programs fill by SQL; pvtwin only reads
-//       them. A NULL is a missing value.
+//       forecast inputs: weather_forecast is filled by `pvtwin
+//       import-weather`, the daemon's fetch ([forecast] weather_url) or
+//       outside programs by SQL; operation_plan by outside programs. A NULL
+//       is a missing value.
 //
 // Version 2 adds:
 //   measurement_interval(ts INTEGER PRIMARY KEY, step_s INTEGER,
@@ -87,6 +89,18 @@
 //   view event(ts, kind, severity, message)
 //       newest first: monitor_event, qc_event, every calibration (accepted:
 //       info, otherwise warning) and every diagnosis.
+//
+// Version 5 adds:
+//   weather_forecast.source TEXT
+//       where the row came from: "import-weather <file> (<format>)" or
+//       "fetch <url> (<format>)"; NULL for rows other programs wrote.
+//       import-weather and the daemon's fetch write 1-min rows, each fetch
+//       or import replacing the rows of its minutes (io/weather_file.h,
+//       core/forecast/weather_resample.h).
+//   plant_config(key TEXT PRIMARY KEY, value REAL)
+//       the [plant] keys of the config the daemon (or import-weather
+//       --config) last ran with, in the config's units (degrees), so that a
+//       command given only the store knows the site.
 //
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
@@ -138,7 +152,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 4;
+inline constexpr int kStoreSchemaVersion = 5;
 
 struct StoreOptions {
   // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
@@ -309,6 +323,17 @@ class Store {
   // that is NULL in every row is absent.
   bool ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out, std::string* error);
   bool ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error);
+  // Upserts 1-min weather_forecast rows (the table's channels of `rows`,
+  // NULL for the absent ones) with their source, in one transaction.
+  bool WriteWeatherForecast(const Series& rows, const std::string& source, std::string* error);
+  // The distinct sources of the weather_forecast rows with from <= ts < to,
+  // most rows first ("weather_forecast" for rows without a source).
+  bool ReadWeatherSources(std::int64_t from, std::int64_t to, std::vector<std::string>* sources,
+                          std::string* error);
+  // plant_config: replaced as a whole / all rows, by key.
+  bool WritePlantConfig(const std::vector<std::pair<std::string, double>>& values,
+                        std::string* error);
+  bool ReadPlantConfig(std::vector<std::pair<std::string, double>>* values, std::string* error);
 
   // Writes the WAL back into the database file and truncates it (best effort
   // while readers hold old snapshots). *db_bytes (may be null) gets the bytes

@@ -24,7 +24,7 @@ ctest --test-dir build --output-on-failure -j"$jobs"
 step "2/3 fuzzing, ${fuzz_seconds} s per harness"
 CXX=clang++ cmake -S . -B build-fuzz -DPVTWIN_FUZZ=ON -DPVTWIN_LTO=OFF -DPVTWIN_BUILD_TESTS=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-harnesses=(modbus_reply csv config model)
+harnesses=(modbus_reply csv config model weather)
 cmake --build build-fuzz -j"$jobs" --target "${harnesses[@]/#/fuzz_}"
 ctest --test-dir build-fuzz --output-on-failure -L fuzz  # every kept seed and crash
 mkdir -p build-fuzz/crashes
@@ -36,6 +36,7 @@ for name in "${harnesses[@]}"; do
   case "$name" in
     csv | model) seeds+=(tests/golden/csv ../shared/data/htwsaar-pvt) ;;
     config) seeds+=(tests/golden/config config/examples) ;;
+    weather) seeds+=(tests/weather/data) ;;
   esac
   existing=()
   for d in "${seeds[@]}"; do [ -d "$d" ] && existing+=("$d"); done

@@ -27,6 +27,10 @@ struct Plant {
   double pv_g_ref_w_m2 = 1000.0;        // paper I_gtref
   double pv_temp_coeff_per_k = -0.004;  // paper f_corr_T
   double pv_irr_coeff_m2_w = 3.6e-5;    // paper f_corr_I
+  // Height of the collector (and of the wind the model was calibrated on)
+  // above ground, m: a weather forecast's 10 m wind is brought to it
+  // (core/forecast/weather_resample.h). 10 = the forecast's wind as it is.
+  double collector_height_m = 10.0;
   SkySource sky = SkySource::kAuto;
 };
 

@@ -110,7 +110,31 @@ std::string ForecastInputUse::Describe() const {
                 "operation: plan %zu/%zu, typical day %zu/%zu",
                 weather_forecast, rows, weather_persistence, rows, weather_missing, rows,
                 operation_plan, rows, operation_typical, rows);
-  return buf;
+  std::string text = buf;
+  std::string list;
+  bool table_used = false;
+  for (const ChannelInputUse& c : channels) {
+    const char* primary = c.operation ? "operation_plan" : "weather_forecast";
+    const char* fallback = c.operation ? "typical_day" : "persistence";
+    std::string parts;
+    const auto add = [&parts](const char* name, std::size_t n) {
+      if (n > 0) parts += (parts.empty() ? "" : "+") + std::string(name) + " " + std::to_string(n);
+    };
+    add(primary, c.forecast);
+    add(fallback, c.fallback);
+    add("missing", c.missing);
+    if (parts.empty()) continue;
+    table_used = table_used || (!c.operation && c.forecast > 0);
+    list += (list.empty() ? "" : ", ") + std::string(ChannelName(c.channel)) + "=" + parts;
+  }
+  if (!list.empty()) text += "; channels: " + list;
+  if (table_used && !weather_sources.empty()) {
+    text += "; weather_forecast source: ";
+    for (std::size_t i = 0; i < weather_sources.size(); ++i) {
+      text += (i ? " | " : "") + weather_sources[i];
+    }
+  }
+  return text;
 }
 
 bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
@@ -155,18 +179,23 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
     const Track measured(history, c);
     if (measured.time_s.empty()) continue;
     const Track predicted(weather_forecast, c);
+    ChannelInputUse channel_use{c};
     FillColumn(measured, n_warm, &in, c, [&](std::size_t h, std::int64_t t) {
       double v = predicted.Interpolated(t, request.max_interp_gap_s);
-      if (std::isnan(v)) {
+      if (!std::isnan(v)) {
+        ++channel_use.forecast;
+      } else {
         row_from_forecast[h] = 0;
         for (std::int64_t back = 86400; back <= history_span_s + 86400 && std::isnan(v);
              back += 86400) {
           v = measured.Exact(t - back);
         }
         (std::isnan(v) ? row_missing : row_persisted)[h] = 1;
+        ++(std::isnan(v) ? channel_use.missing : channel_use.fallback);
       }
       return v;
     });
+    use.channels.push_back(channel_use);
   }
   for (std::size_t h = 0; h < n_horizon; ++h) {
     use.weather_forecast += row_from_forecast[h] && !row_missing[h];
@@ -179,17 +208,23 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
     const Track measured(history, c);
     const Track planned(operation_plan, c);
     const std::vector<double> typical = TypicalDay(measured, request.step_s);
+    ChannelInputUse channel_use{c};
+    channel_use.operation = true;
     FillColumn(measured, n_warm, &in, c, [&](std::size_t h, std::int64_t t) {
       double v = planned.Held(t, request.max_interp_gap_s);
-      if (std::isnan(v)) {
+      if (!std::isnan(v)) {
+        ++channel_use.forecast;
+      } else {
         row_planned[h] = 0;
         const std::int64_t second_of_day = ((t % 86400) + 86400) % 86400;
         const auto slot = static_cast<std::size_t>(second_of_day / step);
         v = slot < typical.size() ? typical[slot] : kNaN;
         if (!std::isnan(v)) row_typical[h] = 1;
+        ++(std::isnan(v) ? channel_use.missing : channel_use.fallback);
       }
       return v;
     });
+    use.channels.push_back(channel_use);
   }
   for (std::size_t h = 0; h < n_horizon; ++h) {
     use.operation_plan += row_planned[h];

@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/common/params.h"
 #include "core/common/plant.h"
@@ -38,6 +39,15 @@ struct ForecastRequest {
   double max_interp_gap_s = 3600.0;  // longest gap in a forecast input bridged linearly
 };
 
+// Where one input channel's horizon values came from, counted in rows.
+struct ChannelInputUse {
+  Channel channel = Channel::kTAmbC;
+  std::size_t forecast = 0;  // weather_forecast (or, for operation, operation_plan)
+  std::size_t fallback = 0;  // persistence (weather) or the typical day (operation)
+  std::size_t missing = 0;
+  bool operation = false;  // t_in_c, flow_kg_s
+};
+
 // Where each forecast row's inputs came from, counted over the horizon rows.
 struct ForecastInputUse {
   std::size_t rows = 0;
@@ -46,8 +56,16 @@ struct ForecastInputUse {
   std::size_t weather_missing = 0;      // rows without a value for a needed weather channel
   std::size_t operation_plan = 0;       // rows whose t_in_c and flow came from the plan
   std::size_t operation_typical = 0;    // rows with a typical-day operation value
+  // Per input channel the model reads, in channel order.
+  std::vector<ChannelInputUse> channels;
+  // The weather_forecast rows' sources (Store::ReadWeatherSources), named
+  // where a channel used the table; set by the caller.
+  std::vector<std::string> weather_sources;
   // One line for the forecast row's `inputs` column, e.g.
-  // "weather: forecast 1440/1440; operation: plan 0/1440, typical day 1440/1440".
+  // "weather: forecast 1440/1440, persistence 0/1440, missing 0/1440; operation: plan 0/1440,
+  // typical day 1440/1440; channels: g_poa_w_m2=weather_forecast 1440, t_sky_c=persistence
+  // 1440, t_in_c=typical_day 1440, ...; weather_forecast source: fetch https://... (Open-Meteo
+  // JSON, hourly)".
   std::string Describe() const;
 };
 

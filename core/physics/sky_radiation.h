@@ -45,4 +45,40 @@ inline double URadWM2K(double eps_pvt, double t_pv_k, double t_sky_k) {
          (t_pv_k * t_pv_k + t_sky_k * t_sky_k);
 }
 
+// Saturation vapour pressure over water, Magnus form (WMO 2008, Guide to
+// Meteorological Instruments, annex 4.B): e_s = 6.112·exp(17.62·t/(243.12 + t))
+// hPa, t in °C. The vapour pressure at dew point t_d is e_a = e_s(t_d); at
+// relative humidity RH (0 … 1) it is RH·e_s(t_air). Holds for −45 … 60 °C.
+inline double SaturationVapourPressureHpa(double t_c) {
+  return 6.112 * std::exp(17.62 * t_c / (243.12 + t_c));
+}
+
+// Clear-sky emissivity of Brunt (1932), "Notes on radiation in the
+// atmosphere", Q. J. R. Meteorol. Soc. 58, with the coefficients of
+// Sellers (1965) for e_a in hPa:
+//   ε_clr = 0.52 + 0.065·√e_a,   e_a = screen-level vapour pressure (hPa).
+inline double BruntClearSkyEmissivity(double vapour_pressure_hpa) {
+  return 0.52 + 0.065 * std::sqrt(vapour_pressure_hpa);
+}
+
+// Cloudy-sky emissivity with the cloud fraction c (0 … 1) as in Crawford &
+// Duchon (1999), J. Appl. Meteor. 38, eq. 19: ε = c + (1 − c)·ε_clr (a cloud
+// layer radiates as a black body at air temperature).
+inline double CloudySkyEmissivity(double eps_clear, double cloud_fraction) {
+  return cloud_fraction + (1.0 - cloud_fraction) * eps_clear;
+}
+
+// Long-wave irradiance on a plane of slope β (W/m²), the quantity a
+// pyrgeometer in the collector plane reads (paper 3.1): the sky part
+// (1 + cos β)/2·ε_sky·σ·T_a⁴ and the ground part (1 − cos β)/2·σ·T_a⁴, the
+// ground at air temperature T_a (°C). SkyTemperatureK of the result is the
+// equivalent sky temperature the model uses.
+inline double LongWaveOnPlaneWM2(double eps_sky, double t_air_c, double tilt_rad) {
+  const double cos_tilt = std::cos(tilt_rad);
+  const double sky_view = 0.5 * (1.0 + cos_tilt);
+  const double ground_view = 0.5 * (1.0 - cos_tilt);
+  const double black_body_w_m2 = kStefanBoltzmannW_m2k4 * std::pow(CToK(t_air_c), 4);
+  return sky_view * eps_sky * black_body_w_m2 + ground_view * black_body_w_m2;
+}
+
 }  // namespace pvtwin

@@ -29,4 +29,16 @@ inline double FrontConductanceConvectiveWM2K(double u_front_w_m2k, double u_wind
   return u_front_w_m2k + u_wind_w_m2k * wind_pow;
 }
 
+// Wind speed at height z from a speed measured or forecast at z_ref, by the
+// power law with the Hellmann exponent α (Hellmann 1916; α = 1/7 for open
+// terrain, the value of IEC 61400-1 and of most engineering use):
+//   v(z) = v(z_ref)·(z / z_ref)^α,   heights in m above ground, speeds in m/s.
+// Holds within the surface layer (up to about 100 m), for neutral
+// stratification; v = 0 stays 0.
+inline constexpr double kHellmannExponentOpenTerrain = 1.0 / 7.0;
+inline double WindAtHeightPowerLaw(double v_ref_m_s, double z_ref_m, double z_m,
+                                   double alpha = kHellmannExponentOpenTerrain) {
+  return v_ref_m_s * std::pow(z_m / z_ref_m, alpha);
+}
+
 }  // namespace pvtwin

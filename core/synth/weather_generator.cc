@@ -8,6 +8,7 @@
 
 #include "core/common/units.h"
 #include "core/physics/irradiance.h"
+#include "core/physics/sky_radiation.h"
 #include "core/physics/solar_position.h"
 #include "core/synth/pump_controller.h"
 
@@ -17,16 +18,7 @@ namespace {
 constexpr double kSecondsPerDay = 86400.0;
 constexpr double kTwoPi = 2.0 * kPi;
 
-// Day of year (1 = 1 January 00:00 UTC, fractional) from unix seconds, using
-// the mean Gregorian year anchored at 2000-01-01 (unix day 10957); within
-// one day of the calendar value, ample for I0 and the temperature season.
-double DayOfYear(double time_s) {
-  constexpr double kMeanYearDays = 365.2425;
-  const double days_since_2000 = time_s / kSecondsPerDay - 10957.0;
-  double doy = std::fmod(days_since_2000, kMeanYearDays);
-  if (doy < 0.0) doy += kMeanYearDays;
-  return doy + 1.0;
-}
+double DayOfYear(double time_s) { return DayOfYearUtc(time_s); }
 
 // SplitMix64 step: decorrelated seeds for the separate random streams.
 std::uint64_t SplitMix64(std::uint64_t x) {
@@ -174,11 +166,6 @@ double SolarHour(double hour_angle_rad) {
   return hour < 0.0 ? hour + 24.0 : hour;
 }
 
-// Saturation vapour pressure over water, Magnus form (WMO 2008), hPa.
-double SaturationVapourPressureHpa(double t_c) {
-  return 6.112 * std::exp(17.62 * t_c / (243.12 + t_c));
-}
-
 // The weather of one row, as the plant's operation sees it.
 struct RowWeather {
   double g_poa_w_m2 = 0.0;
@@ -321,33 +308,6 @@ std::string Describe(const char* field, double value, const char* rule) {
 }
 
 }  // namespace
-
-double ExtraterrestrialNormalWM2(double day_of_year) {
-  return 1366.1 * (1.0 + 0.033 * std::cos(kTwoPi * day_of_year / 365.0));
-}
-
-ClearSkyIrradiance ClearSkyIneichenPerez(const ClearSkyInput& in) {
-  const double cos_zenith = std::cos(in.zenith_rad);
-  if (!(cos_zenith > 0.0)) return {};
-  const double zenith_deg = RadToDeg(in.zenith_rad);
-  const double air_mass = 1.0 / (cos_zenith + 0.50572 * std::pow(96.07995 - zenith_deg, -1.6364));
-  const double h = in.elevation_m;
-  const double fh1 = std::exp(-h / 8000.0);
-  const double fh2 = std::exp(-h / 1250.0);
-  const double cg1 = 5.09e-5 * h + 0.868;
-  const double cg2 = 3.92e-5 * h + 0.0387;
-  const double tl = in.linke_turbidity;
-  const double i0_w_m2 = ExtraterrestrialNormalWM2(in.day_of_year);
-  ClearSkyIrradiance out;
-  out.ghi_w_m2 = cg1 * i0_w_m2 * cos_zenith * std::exp(-cg2 * air_mass * (fh1 + fh2 * (tl - 1.0)));
-  const double dni_turbidity_w_m2 =
-      (0.664 + 0.163 / fh1) * i0_w_m2 * std::exp(-0.09 * air_mass * (tl - 1.0));
-  const double dni_ghi_bound_w_m2 =
-      out.ghi_w_m2 * (1.0 - (0.1 - 0.2 * std::exp(-tl)) / (0.1 + 0.882 / fh1)) / cos_zenith;
-  out.dni_w_m2 = std::max(0.0, std::min(dni_turbidity_w_m2, dni_ghi_bound_w_m2));
-  out.dhi_w_m2 = std::max(0.0, out.ghi_w_m2 - out.dni_w_m2 * cos_zenith);
-  return out;
-}
 
 double ErbsDiffuseFraction(double clearness_index) {
   const double kt = std::max(0.0, clearness_index);
@@ -587,14 +547,9 @@ void IrradianceRow(const Plant& plant, const WeatherOptions& options, const Sola
 // cloud-cover increase for the sky part, ground at air temperature, each
 // weighted by its view factor from the tilted plane.
 double LongWaveDownWM2(double relative_humidity, double cover, double t_amb_c, double tilt_rad) {
-  const double cos_tilt = std::cos(tilt_rad);
-  const double sky_view = 0.5 * (1.0 + cos_tilt);
-  const double ground_view = 0.5 * (1.0 - cos_tilt);
   const double vapour_hpa = relative_humidity * SaturationVapourPressureHpa(t_amb_c);
-  const double eps_clear = 0.52 + 0.065 * std::sqrt(vapour_hpa);
-  const double eps_sky = cover + (1.0 - cover) * eps_clear;
-  const double black_body_w_m2 = kStefanBoltzmannW_m2k4 * std::pow(CToK(t_amb_c), 4);
-  return sky_view * eps_sky * black_body_w_m2 + ground_view * black_body_w_m2;
+  const double eps_sky = CloudySkyEmissivity(BruntClearSkyEmissivity(vapour_hpa), cover);
+  return LongWaveOnPlaneWM2(eps_sky, t_amb_c, tilt_rad);
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Hostile inputs against the real pvtwin binary: malformed and impossible CSV
-# files, bad configs, foreign, damaged, read-only and deleted stores, two
-# daemons on one store. Prints a Markdown table (case, what was tried, what
-# pvtwin must do, what it did) — the README's reliability table — and exits 1
+# and weather-forecast files, bad configs, foreign, damaged, read-only and
+# deleted stores, two daemons on one store. Prints a Markdown table (case,
+# what was tried, what pvtwin must do, what it did) — the README's
+# reliability table — and exits 1
 # if any case is not handled as it must be.
 #
 #   tests/hostile/run.sh [BUILD_DIR]        (default: build)
@@ -92,6 +93,26 @@ row "time going back" "a row earlier than the one before" "exit 2 naming both li
 : >empty.csv
 expect_exit 2 "$pvtwin" import --config plant.toml --csv empty.csv --db x.db
 row "empty file" "0 bytes" "exit 2" $? "$said"
+
+# --- weather forecasts (import-weather, the daemon's fetch reads the same way) ---
+weather="$OLDPWD/tests/weather/data/open-meteo-hourly.json"
+head -c 900 "$weather" >cut.json
+expect_exit 2 "$pvtwin" import-weather --config plant.toml --db w.db cut.json
+row "weather: truncated JSON" "an Open-Meteo answer cut after 900 bytes" "exit 2 naming the file" $? "$said"
+
+sed 's/"wind_speed_10m":"km\/h"/"wind_speed_10m":"mph"/' "$weather" >mph.json
+expect_exit 2 "$pvtwin" import-weather --config plant.toml --db w.db mph.json
+row "weather: unknown unit" "wind_speed_10m in mph" "exit 2 naming the field and the units read" $? "$said"
+
+sed 's/"temperature_2m":\[14.2,/"temperature_2m":[/' "$weather" >short.json
+expect_exit 2 "$pvtwin" import-weather --config plant.toml --db w.db short.json
+row "weather: arrays of other lengths" "temperature_2m one value short" "exit 2 naming both arrays" $? "$said"
+
+sed 's/"shortwave_radiation":\[0,0,0,0,25,120,270,430,580,705,800,850,850/"shortwave_radiation":[0,0,0,0,25,120,270,430,580,705,800,850,null/' "$weather" >null.json
+expect_exit 0 "$pvtwin" import-weather --config plant.toml --db w.db null.json
+ok=$?
+[ "$(sqlite3 w.db "SELECT COUNT(*) FROM weather_forecast WHERE ts >= 1717239600 AND ts < 1717243200 AND ghi_w_m2 IS NULL")" = 60 ] || ok=1
+row "weather: null value" "shortwave_radiation null at 12:00" "that hour missing, not zero; counted" $ok "$(grep -h -m1 'null values' err.txt)"
 
 # --- config ------------------------------------------------------------------
 config_case() {  # NAME TEXT MUST-CONTAIN

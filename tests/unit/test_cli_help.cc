@@ -12,9 +12,10 @@ namespace pvtwin {
 namespace {
 
 TEST(CliHelp, EveryVerbShowsAnExampleAndItsDefaults) {
-  const std::string verbs[] = {"check-config", "calibrate", "simulate", "bench",
-                               "backtest",     "import",    "export",   "sim",
-                               "run",          "demo",      "diagnose", "diagnose-selftest"};
+  const std::string verbs[] = {"check-config",  "calibrate", "simulate", "bench",
+                               "backtest",      "import",    "export",   "sim",
+                               "run",           "demo",      "diagnose", "diagnose-selftest",
+                               "import-weather"};
   for (const std::string& verb : verbs) {
     const testing::ProcessResult r = testing::RunPvtwin(".", verb + " --help");
     EXPECT_EQ(r.exit_code, 0) << verb;

@@ -47,7 +47,35 @@ TEST(ConfigLoad, FullConfigValuesAreReadAndAnglesConvertedToRadians) {
   EXPECT_EQ(config.calibration.timezone, "America/Santiago");
   EXPECT_DOUBLE_EQ(config.forecast.horizon_h, 48);
   EXPECT_DOUBLE_EQ(config.forecast.refresh_min, 15);
+  EXPECT_DOUBLE_EQ(config.forecast.weather_refresh_min, 30);
+  EXPECT_DOUBLE_EQ(config.forecast.weather_timeout_s, 20);
+  EXPECT_DOUBLE_EQ(p.collector_height_m, 4);
+  // The template's placeholders take the plant's values; Open-Meteo's azimuth
+  // counts from south (a north-facing plane in the southern hemisphere: -180).
+  EXPECT_EQ(ExpandWeatherUrl(config.forecast.weather_url, p),
+            "https://api.open-meteo.com/v1/forecast?latitude=-33.9&longitude=-70.6&tilt=35&"
+            "azimuth=-180&minutely_15=global_tilted_irradiance");
   EXPECT_EQ(config.source_path, path);
+}
+
+TEST(ConfigLoad, PlantKeyValuesRoundTrip) {
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(LoadConfig(kGoldenConfigDir + "ok_full/config.toml", &config, &errors));
+  const std::vector<std::pair<std::string, double>> values = PlantKeyValues(config.plant);
+  EXPECT_EQ(values[0].first, "latitude_deg");
+  EXPECT_NEAR(values[0].second, -33.9, 1e-12);
+  Plant back;
+  std::string error;
+  ASSERT_TRUE(PlantFromKeyValues(values, &back, &error)) << error;
+  const std::vector<std::pair<std::string, double>> again = PlantKeyValues(back);
+  ASSERT_EQ(again.size(), values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    EXPECT_EQ(again[i].first, values[i].first);
+    EXPECT_NEAR(again[i].second, values[i].second, 1e-9) << values[i].first;
+  }
+  EXPECT_FALSE(PlantFromKeyValues({{"latitude_deg", 47.0}}, &back, &error));
+  EXPECT_EQ(error, "longitude_deg: missing");
 }
 
 TEST(ConfigLoad, OmittedKeysTakeTheDocumentedDefaults) {

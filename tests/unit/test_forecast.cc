@@ -114,6 +114,35 @@ TEST(Forecast, WithoutPlanRunsTheMedianDayOfTheWindow) {
   for (double v : f.inputs_used[Channel::kTInC]) ASSERT_EQ(v, 30.0);
 }
 
+// The inputs column says, per channel, where the values came from, and names
+// the weather_forecast rows' source where the table was used.
+TEST(Forecast, InputsNameTheSourceOfEachChannel) {
+  const Case c;
+  Series weather = c.From(c.t_forecast);
+  weather[Channel::kTAmbC].clear();  // the air temperature is not forecast: persisted
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  Forecast f;
+  std::string error;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), weather, Series{},
+                           request, &f, &error))
+      << error;
+  f.inputs.weather_sources = {"fetch http://127.0.0.1:8080/v1/forecast (Open-Meteo JSON, hourly)"};
+  const std::string text = f.inputs.Describe();
+  EXPECT_NE(text.find("g_poa_w_m2=weather_forecast 1440"), std::string::npos) << text;
+  EXPECT_NE(text.find("t_amb_c=persistence 1440"), std::string::npos) << text;
+  EXPECT_NE(text.find("t_in_c=typical_day 1440"), std::string::npos) << text;
+  EXPECT_NE(text.find("; weather_forecast source: fetch http://127.0.0.1:8080/v1/forecast"),
+            std::string::npos)
+      << text;
+  // Without any weather_forecast row used, no source is named.
+  Forecast persisted;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), Series{}, Series{},
+                           request, &persisted, &error));
+  persisted.inputs.weather_sources = f.inputs.weather_sources;
+  EXPECT_EQ(persisted.inputs.Describe().find("source:"), std::string::npos);
+}
+
 TEST(Forecast, RefusesHistoryShorterThanADay) {
   const Case c;
   ForecastRequest request;

@@ -85,7 +85,9 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   EXPECT_EQ(
       db.Columns("weather_forecast"),
       (std::vector<std::string>{"ts", "g_poa_w_m2", "ghi_w_m2", "dhi_w_m2", "g_poa_diffuse_w_m2",
-                                "t_amb_c", "wind_m_s", "t_sky_c", "lw_down_w_m2"}));
+                                "t_amb_c", "wind_m_s", "t_sky_c", "lw_down_w_m2", "source"}));
+  // Version 5: the weather rows' source, the plant the store belongs to.
+  EXPECT_EQ(db.Columns("plant_config"), (std::vector<std::string>{"key", "value"}));
   EXPECT_EQ(db.Columns("operation_plan"), (std::vector<std::string>{"ts", "t_in_c", "flow_kg_s"}));
   // Version 2: rows of a coarser logger at their own step.
   EXPECT_EQ(db.Columns("measurement_interval"), WithChannels({"ts", "step_s"}, {"qc_flags"}));
@@ -135,12 +137,13 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   }
   {
     RawDb db(DbPath());
-    // Back to what version 1 wrote: without the tables and views of 2 to 4.
+    // Back to what version 1 wrote: without the tables and views of 2 to 5.
     for (const char* sql :
          {"DROP TABLE measurement_interval", "DROP VIEW parameter_history",
           "DROP TABLE calibration_param", "DROP VIEW event", "DROP VIEW measurement_qc",
           "DROP TABLE performance_daily", "DROP TABLE qc_event", "DROP TABLE monitor_event",
-          "DROP TABLE diagnosis", "PRAGMA user_version = 1"}) {
+          "DROP TABLE diagnosis", "ALTER TABLE weather_forecast DROP COLUMN source",
+          "DROP TABLE plant_config", "PRAGMA user_version = 1"}) {
       ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
     }
   }
@@ -551,6 +554,48 @@ TEST_F(StoreTest, ForecastInputsWrittenBySqlAreReadAsSeries) {
   ASSERT_TRUE(store->ReadOperationPlan(kMinute0, kMinute0 + 3600, &plan, &error)) << error;
   EXPECT_EQ(plan[Channel::kTInC], (std::vector<double>{25.0, 26.0}));
   EXPECT_EQ(plan[Channel::kMdotKgS], (std::vector<double>{0.03, 0.0}));
+}
+
+TEST_F(StoreTest, WeatherForecastRowsKeepTheirSourceAndAreReplacedPerMinute) {
+  auto store = OpenStore();
+  Series rows;
+  rows.step_s = 60.0;
+  rows.time_s = {kMinute0, kMinute0 + 60};
+  rows[Channel::kGPoaWM2] = {500.0, 510.0};
+  rows[Channel::kTAmbC] = {20.0, std::nan("")};
+  std::string error;
+  ASSERT_TRUE(store->WriteWeatherForecast(rows, "import-weather a.json", &error)) << error;
+  rows.time_s = {kMinute0 + 60, kMinute0 + 120};
+  rows[Channel::kGPoaWM2] = {600.0, 610.0};
+  rows[Channel::kTAmbC] = {21.0, 22.0};
+  ASSERT_TRUE(store->WriteWeatherForecast(rows, "fetch http://x", &error)) << error;
+  {
+    RawDb db(DbPath());
+    ASSERT_EQ(db.Exec("INSERT INTO weather_forecast(ts, t_amb_c) VALUES (" +
+                      std::to_string(kMinute0 + 180) + ", 23)"),
+              SQLITE_OK);
+  }
+  Series weather;
+  ASSERT_TRUE(store->ReadWeatherForecast(kMinute0, kMinute0 + 240, &weather, &error)) << error;
+  ASSERT_EQ(weather.size(), 4u);
+  EXPECT_EQ(weather[Channel::kGPoaWM2][1], 600.0);  // the later write replaced the minute
+  EXPECT_EQ(weather[Channel::kTAmbC][0], 20.0);
+  std::vector<std::string> sources;
+  ASSERT_TRUE(store->ReadWeatherSources(kMinute0, kMinute0 + 240, &sources, &error)) << error;
+  EXPECT_EQ(sources, (std::vector<std::string>{"fetch http://x", "import-weather a.json",
+                                               "weather_forecast"}));
+}
+
+TEST_F(StoreTest, PlantConfigRoundTrips) {
+  auto store = OpenStore();
+  std::vector<std::pair<std::string, double>> values = {{"latitude_deg", 47.4}, {"tilt_deg", 20.0}};
+  std::string error;
+  ASSERT_TRUE(store->WritePlantConfig(values, &error)) << error;
+  values[0].second = 48.0;
+  ASSERT_TRUE(store->WritePlantConfig(values, &error)) << error;
+  std::vector<std::pair<std::string, double>> read;
+  ASSERT_TRUE(store->ReadPlantConfig(&read, &error)) << error;
+  EXPECT_EQ(read, values);
 }
 
 }  // namespace

@@ -1,0 +1,104 @@
+// A weather forecast as a provider gives it (hourly or 15-min values) brought
+// to the 1-min rows of table weather_forecast (issue 15), without inventing
+// energy:
+//
+//   irradiance   each provider value is the mean over its interval; the
+//                interval's clear-sky index k = value / mean(clear sky over
+//                the interval's minutes) times each minute's clear sky
+//                gives the minute, so the minutes' mean is the value
+//                exactly. Clear sky: Ineichen & Perez (core/physics/
+//                clear_sky.h) at the middle of each minute; the in-plane
+//                value (GTI) takes the clear sky transposed to the plane as
+//                its shape, GHI and DHI the clear-sky GHI (so DHI ≤ GHI
+//                holds in every minute when it holds for the interval).
+//                Where the interval's clear sky is below
+//                min_clear_sky_mean_w_m2 or k would exceed
+//                max_clear_sky_index (sunrise and sunset hours that the
+//                provider's and our sun disagree on), the value is spread
+//                evenly over the interval's minutes with the sun above the
+//                horizon (over all of them if none): also exact in energy.
+//                Without GTI, g_poa_w_m2 (and g_poa_diffuse_w_m2) are GHI/DHI
+//                transposed with the model's isotropic sky (paper 2.5,
+//                core/physics/irradiance.h). DHI missing but DNI given:
+//                DHI = GHI − DNI·mean cos θ_z over the interval, within
+//                [0, GHI].
+//   temperature, linear between the provider's time stamps, taken at each
+//   wind         minute's middle; held for up to one provider step beyond
+//                the first and last stamp. Wind is brought from the
+//                provider's height (10 m) to the collector's height by the
+//                power law v(z) = v_ref·(z/z_ref)^α, α = 1/7
+//                (core/physics/wind.h).
+//   long-wave    as given (t_sky_c or lw_down_w_m2, the other derived with
+//                T_sky = (L/σ)^(1/4)); else, with air temperature, dew point
+//                or relative humidity, and cloud cover: Brunt's clear-sky
+//                emissivity with the cloud correction of Crawford & Duchon
+//                on the collector plane (core/physics/sky_radiation.h).
+//
+// Time convention: output rows start at whole minutes and are means over
+// [ts, ts + 60) like measurement_1min; the input's conventions are fields of
+// ProviderWeather.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/common/plant.h"
+#include "core/common/series.h"
+
+namespace pvtwin {
+
+struct ProviderWeather {
+  // Provider time stamps (unix s UTC), strictly increasing, step_s apart,
+  // whole minutes.
+  std::vector<std::int64_t> time_s;
+  double step_s = 3600.0;
+  // The irradiance value at stamp t is the mean over
+  // [t + irradiance_offset_s, t + irradiance_offset_s + step_s): −step_s for
+  // Open-Meteo (the preceding interval), 0 for the canonical CSV (time marks
+  // the interval's start).
+  double irradiance_offset_s = -3600.0;
+  // Instantaneous values stand for the moment t + instant_offset_s
+  // (Open-Meteo: 0; the canonical CSV's interval means: step_s / 2).
+  double instant_offset_s = 0.0;
+  // Channels, one value per stamp: an empty vector is a channel the
+  // provider did not give, NaN a missing value.
+  std::vector<double> gti_w_m2, ghi_w_m2, dhi_w_m2, dni_w_m2;  // interval means, W/m²
+  std::vector<double> t_amb_c;                                 // °C
+  std::vector<double> wind_m_s;                                // m/s at wind_height_m
+  std::vector<double> dew_point_c;                             // °C
+  std::vector<double> relative_humidity_pct;                   // %, 0 … 100
+  std::vector<double> cloud_cover_pct;                         // %, 0 … 100
+  std::vector<double> t_sky_c, lw_down_w_m2;                   // long-wave, when given
+  double wind_height_m = 10.0;                                 // z_ref of wind_m_s
+};
+
+struct WeatherResampleOptions {
+  double collector_height_m = 10.0;    // z of the wind the model wants, m
+  double hellmann_exponent = 1.0 / 7;  // α of the power law
+  double linke_turbidity = 3.0;        // of the clear-sky shape (a typical rural value)
+  double min_clear_sky_mean_w_m2 = 5.0;
+  double max_clear_sky_index = 2.0;
+};
+
+struct WeatherResampleSummary {
+  std::size_t rows = 0;
+  std::size_t irradiance_intervals = 0;
+  std::size_t flat_intervals = 0;  // spread evenly over their daylight minutes (see above)
+  double wind_factor = 1.0;        // (z / z_ref)^α applied to the wind
+  // Where each written channel came from, e.g. "g_poa_w_m2 from GHI/DHI
+  // (isotropic sky)", in channel order.
+  std::vector<std::string> origins;
+};
+
+// Rows of whole minutes covering every irradiance interval (or, without
+// irradiance, the instantaneous stamps), with the channels of table
+// weather_forecast that the input allows: g_poa_w_m2, ghi_w_m2, dhi_w_m2,
+// g_poa_diffuse_w_m2, t_amb_c, wind_m_s, t_sky_c, lw_down_w_m2. False and
+// *error for inconsistent input (lengths, steps, order): a caller bug or a
+// file the I/O layer should have refused.
+bool ResampleWeatherTo1Min(const Plant& plant, const ProviderWeather& in,
+                           const WeatherResampleOptions& options, Series* out,
+                           WeatherResampleSummary* summary, std::string* error);
+
+}  // namespace pvtwin

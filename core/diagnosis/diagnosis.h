@@ -77,7 +77,7 @@ struct DiagnosisOptions {
   double alpha = 0.05;
   // Bandwidth of the loss test's autocorrelation correction, s: residuals
   // of a thermal model carry the weather's hours-long memory.
-  double loss_test_bandwidth_s = 10800.0;
+  double loss_test_bandwidth_s = 3600.0;
   // Share of held-out rows outside the training range above which a driver
   // is reported as extrapolated.
   double extrapolation_share = 0.3;

@@ -46,7 +46,7 @@ void SwinbankCrawfordDuchonSky(const OtherTruthContext& ctx, Series* physics) {
     }
     const double t_amb_k = CToK(t_amb[i]);
     const double eps = CloudySkyEmissivity(SwinbankClearSkyEmissivity(t_amb_k), cover);
-    const double lw_w_m2 = LongWaveOnPlaneWM2(eps, t_amb_k, ctx.plant->tilt_rad);
+    const double lw_w_m2 = LongWaveOnPlaneWM2(eps, KToC(t_amb_k), ctx.plant->tilt_rad);
     if (has_lw) (*physics)[Channel::kLwDownWM2][i] = lw_w_m2;
     if (has_t_sky) {
       (*physics)[Channel::kTSkyC][i] =

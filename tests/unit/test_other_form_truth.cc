@@ -200,7 +200,7 @@ TEST(OtherFormTruth, TestEtAlConvectionAndSwinbankSky) {
   // Swinbank at 20 °C: 5.31e-13·293.15²/σ = 0.804753.
   EXPECT_NEAR(SwinbankClearSkyEmissivity(293.15), 0.804753, 1e-6);
   EXPECT_DOUBLE_EQ(CloudySkyEmissivity(0.8, 0.5), 0.9);
-  EXPECT_NEAR(LongWaveOnPlaneWM2(0.8, 293.15, 0.0),
+  EXPECT_NEAR(LongWaveOnPlaneWM2(0.8, 20.0, 0.0),
               0.8 * kStefanBoltzmannW_m2k4 * std::pow(293.15, 4), 1e-9);
   EXPECT_EQ(CloudFractionFromDiffuseFraction(0.1), 0.0);
   EXPECT_EQ(CloudFractionFromDiffuseFraction(1.0), 1.0);

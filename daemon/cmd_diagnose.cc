@@ -89,6 +89,13 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
                 t.test.positives, t.test.pairs, result.test_unit.c_str(), t.heldout_test.p,
                 t.rejected.empty() ? "" : ("; not accepted: " + t.rejected).c_str());
   }
+  for (const SensorFinding& f : result.sensors) {
+    std::printf(
+        "sensor: %s %s on %zu rows (%.1f %%)%s: %s\n", f.channel.c_str(), f.kind.c_str(), f.rows,
+        100 * f.share,
+        std::isfinite(f.size) ? (", median " + FixedDecimals(f.size, 1) + " K").c_str() : "",
+        f.detail.c_str());
+  }
   for (const Extrapolation& x : result.extrapolation) {
     std::printf(
         "extrapolated: %s held-out [%.3g, %.3g] vs training [%.3g, %.3g], %.0f %% of rows "

@@ -181,6 +181,16 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
                                  {"share_outside", Number(x.share_outside)}});
   }
   j["extrapolation"] = extrapolation;
+  Json sensors = Json::array();
+  for (const SensorFinding& f : r.sensors) {
+    sensors.push_back(Json{{"channel", f.channel},
+                           {"kind", f.kind},
+                           {"rows", f.rows},
+                           {"share", Number(f.share)},
+                           {"size", Number(f.size)},
+                           {"detail", f.detail}});
+  }
+  j["sensors"] = sensors;
   j["final_variant"] = r.final_variant;
   Json ladder = Json::array();
   for (const LadderStep& s : r.ladder) {

@@ -90,6 +90,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   if (!st::FitBase(split, plant, base, options, progress, &base_fit, &r, error)) return false;
   const st::BaseResiduals residuals = st::LocaliseBaseGap(split, base_fit, plant, options, &r);
   r.extrapolation = st::FindExtrapolation(base_fit, options);
+  r.sensors = st::CheckSensors(data, plant);
   if (!base_fit.train.drivers.sky_note.empty()) r.notes.push_back(base_fit.train.drivers.sky_note);
 
   st::TrialInputs trials;

@@ -106,6 +106,17 @@ struct DiagnosisOptions {
   bool IsValid(std::string* why) const;
 };
 
+// A sensor finding of the data (the sensor checks of core/monitor/
+// monitoring.h, FindSensorFaults, over all days), one per channel and kind.
+struct SensorFinding {
+  std::string channel;         // canonical name, "time" for a clock shift
+  std::string kind;            // sky_warmer_than_air, frozen, missing, above_clear_sky, …
+  std::size_t rows = 0;        // rows in the flagged intervals
+  double share = 0.0;          // of all rows
+  double size = std::nan("");  // sky_warmer_than_air: median sky − air on those rows, K
+  std::string detail;          // the first interval's sentence, and how many there are
+};
+
 // A driver of the model whose held-out values lie outside what the training
 // days showed (share_outside of the held-out objective rows beyond the
 // training rows' 1st–99th percentile).
@@ -220,6 +231,7 @@ struct DiagnosisResult {
   // Drivers whose held-out range leaves the training range (see
   // FindExtrapolation): parameters not determined by the training data.
   std::vector<Extrapolation> extrapolation;
+  std::vector<SensorFinding> sensors;
   std::string verdict_sentence;
   NoiseFloor noise;
   std::vector<DiagnosisDay> days;

@@ -121,6 +121,10 @@ BaseResiduals LocaliseBaseGap(const Split& split, const BaseFit& base, const Pla
 // of the held-out objective rows.
 std::vector<Extrapolation> FindExtrapolation(const BaseFit& base, const DiagnosisOptions& options);
 
+// The sensor checks of the monitor (FindSensorFaults) over the whole data,
+// one finding per channel and kind, most rows first (sensors.cc).
+std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant);
+
 // --- 4. Candidate trials ---
 // Controls of the evidence regression, per held-out row: in-plane
 // irradiance, T_in − T_amb, flow.

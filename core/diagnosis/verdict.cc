@@ -1,3 +1,4 @@
+#include <cmath>
 #include <sstream>
 
 #include "core/diagnosis/stages.h"
@@ -110,6 +111,13 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
                          FixedDecimals(first.heldout_mae_w, 1) + " W, MAE P_el + Q_u) is " +
                          FixedDecimals(r.noise.ratio, 1) + "× the sensor-noise floor." +
                          ExtrapolationSentence(r);
+  }
+  for (const SensorFinding& f : r.sensors) {
+    r.verdict_sentence +=
+        " Sensor check: " + f.channel + " " + f.kind + " on " + std::to_string(f.rows) + " rows (" +
+        FixedDecimals(100.0 * f.share, 1) + " % of the data" +
+        (std::isfinite(f.size) ? ", median " + FixedDecimals(f.size, 1) + " K" : std::string()) +
+        ").";
   }
 }
 

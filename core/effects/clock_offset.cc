@@ -160,6 +160,12 @@ SignatureCheck ElectricityLeadsOrLags(const SignatureData& d) {
   return c;
 }
 
+// "The weather logger's clock is 97 s off: …".
+std::string OffsetAdvice(const ParamVector& p, const Plant&) {
+  return "The weather logger's clock is " +
+         FixedDecimals(std::fabs(ParamOf(p, Param::kClockOffsetS)), 0) +
+         " s off the collector logger's: synchronise both (NTP) and check their time zones.";
+}
 }  // namespace
 
 const EffectModule& ClockOffsetEffect() {
@@ -181,6 +187,7 @@ const EffectModule& ClockOffsetEffect() {
         "Synchronise the loggers' clocks (NTP) and check their time zones; until then "
         "model the offset with +clock_offset.";
     m.extension = &Extension();
+    m.advice_for = OffsetAdvice;
     m.signature_values = Signature;
     m.shows_signature = ElectricityLeadsOrLags;
     m.other_truth = &OtherTruth();

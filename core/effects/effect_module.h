@@ -124,6 +124,9 @@ struct EffectModule {
   std::string_view signature;
   // One sentence for the site when the diagnosis finds the effect.
   std::string_view advice;
+  // The same with the fitted parameters in physical units ("Inverter limit ≈
+  // 260 W: …"); null: `advice` as it is.
+  std::string (*advice_for)(const ParamVector& fitted, const Plant& plant) = nullptr;
   // A realistic magnitude for synthetic truth data (applied on top of
   // ReferenceTruthParams, core/synth/synthetic_plant.h).
   std::vector<std::pair<Param, double>> typical_truth;

@@ -141,6 +141,12 @@ const OtherFormTruth& OtherTruth() {
   return kTruth;
 }
 
+// "The in-plane pyranometer reads 6 % high: …".
+std::string PyranometerAdvice(const ParamVector& p, const Plant&) {
+  const double k = ParamOf(p, Param::kIrradianceBias);
+  return "The in-plane pyranometer reads " + FixedDecimals(100.0 * std::fabs(k), 1) + " % " +
+         (k >= 0.0 ? "high" : "low") + " against GHI/DHI: clean, level and recalibrate it.";
+}
 }  // namespace
 
 const EffectModule& IrradianceBiasEffect() {
@@ -164,6 +170,7 @@ const EffectModule& IrradianceBiasEffect() {
         "Clean, level and recalibrate the plane-of-array pyranometer (or compare it with a "
         "reference); until then the fitted η_PV and F_th carry its scale error.";
     m.extension = &Extension();
+    m.advice_for = PyranometerAdvice;
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
     m.sensor_estimate = EstimateIrradianceBias;

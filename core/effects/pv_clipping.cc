@@ -115,6 +115,12 @@ SignatureCheck Plateau(const SignatureData& d) {
   return c;
 }
 
+// "Inverter limit ≈ 216 W (120 W/m²): …".
+std::string LimitAdvice(const ParamVector& p, const Plant& plant) {
+  const double limit_w_m2 = ParamOf(p, Param::kPLimitWM2);
+  return "Inverter limit ≈ " + FixedDecimals(limit_w_m2 * plant.area_m2, 0) + " W (" +
+         FixedDecimals(limit_w_m2, 0) + " W/m²): check the inverter's AC rating against the array.";
+}
 }  // namespace
 
 const EffectModule& PvClippingEffect() {
@@ -136,6 +142,7 @@ const EffectModule& PvClippingEffect() {
         "Check the inverter's AC limit against the array: clipped electricity stays in "
         "the collector as heat; model it with +pv_clipping.";
     m.extension = &Extension();
+    m.advice_for = LimitAdvice;
     m.signature_values = Signature;
     m.shows_signature = Plateau;
     m.other_truth = &OtherTruth();

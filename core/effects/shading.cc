@@ -248,6 +248,15 @@ bool StartFromResiduals(const EffectResiduals& res, ParamVector* start) {
   return true;
 }
 
+// "Obstacle at azimuth 230–270°, up to 25° elevation: …".
+std::string ObstacleAdvice(const ParamVector& p, const Plant&) {
+  const double centre = RadToDeg(ParamOf(p, Param::kShadeAzimuthRad));
+  const double half = RadToDeg(0.5 * ParamOf(p, Param::kShadeWidthRad));
+  return "Obstacle at azimuth " + FixedDecimals(centre - half, 0) + "–" +
+         FixedDecimals(centre + half, 0) + "°, up to " +
+         FixedDecimals(RadToDeg(ParamOf(p, Param::kShadeElevationRad)), 0) +
+         "° elevation: look for it on site (tree, building, mast) and check the string layout.";
+}
 }  // namespace
 
 const EffectModule& ShadingEffect() {
@@ -277,6 +286,7 @@ const EffectModule& ShadingEffect() {
         "Look for the obstacle in the sun's path at the azimuth and elevation the fit "
         "reports; if it stays, model it with +shading and check the string layout.";
     m.extension = &Extension();
+    m.advice_for = ObstacleAdvice;
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
     m.shows_signature = RecursAtTheSameSunPosition;

@@ -1,6 +1,7 @@
 #include "core/effects/soiling.h"
 
 #include "core/common/calendar.h"
+#include "core/common/text.h"
 
 namespace pvtwin {
 
@@ -84,6 +85,11 @@ const ModelExtension& Extension() {
 
 std::vector<double> Signature(const Drivers& d, const SimOutputs&) { return d.days_since_clean; }
 
+// "The front loses 0.4 % of its transmittance per day: …".
+std::string SoilingAdvice(const ParamVector& p, const Plant&) {
+  return "The front loses " + FixedDecimals(100.0 * ParamOf(p, Param::kSoilingPerDay), 2) +
+         " % of its transmittance per day: clean it, and log cleanings and heavy rain.";
+}
 }  // namespace
 
 const EffectModule& SoilingEffect() {
@@ -106,6 +112,7 @@ const EffectModule& SoilingEffect() {
         "Clean the collector front and log cleanings and heavy rain; the loss grows by "
         "r_soil per day until then.";
     m.extension = &Extension();
+    m.advice_for = SoilingAdvice;
     m.signature_values = Signature;
     // A drift over days is not seen within fewer than three training days.
     m.min_train_days = 3;

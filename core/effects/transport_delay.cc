@@ -158,6 +158,13 @@ SignatureCheck ChangesFollowTheDelay(const SignatureData& d) {
   return c;
 }
 
+// "Outlet sensor sees the fluid 95 s late: …".
+std::string DelayAdvice(const ParamVector& p, const Plant&) {
+  return "The outlet sensor sees the fluid " +
+         FixedDecimals(ParamOf(p, Param::kTransportDelayS), 0) +
+         " s late (pipe loss U_pipe = " + FixedDecimals(ParamOf(p, Param::kUPipeWM2K), 2) +
+         " W/(m²K)): move the sensor to the collector outlet or model the pipe.";
+}
 }  // namespace
 
 const EffectModule& TransportDelayEffect() {
@@ -179,6 +186,7 @@ const EffectModule& TransportDelayEffect() {
         "Model the pipe to the outlet sensor (+transport_delay), or move the sensor to "
         "the collector outlet and insulate the pipe.";
     m.extension = &Extension();
+    m.advice_for = DelayAdvice;
     m.signature_values = Signature;
     m.shows_signature = ChangesFollowTheDelay;
     m.other_truth = &OtherTruth();

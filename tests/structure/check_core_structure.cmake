@@ -21,7 +21,7 @@ set(allowed_model common physics effects)
 set(allowed_fit common data physics effects model)
 set(allowed_forecast common data physics effects model fit)
 set(allowed_synth common data physics effects model)
-set(allowed_diagnosis common data physics effects model fit forecast synth)
+set(allowed_diagnosis common data physics effects model fit forecast synth monitor)
 set(allowed_monitor common data physics effects model fit synth)
 
 set(vocabulary capacitance second_node wind sky_radiation iam flow_dependent_u

@@ -440,7 +440,8 @@ TEST_F(DiagnoseCli, TheReportStatesTheBiasOfTheHeldOutErrorOnRealData) {
 // ambient where the training day ran 7 K above it: the report says so
 // (extrapolation), and the verdict is the removed effect, `undecided` with it
 // among the candidates, or `unknown` — never another effect; no accepted
-// effect makes an output worse.
+// effect makes an output worse; the implausible long-wave channel is a
+// sensor finding.
 TEST_F(DiagnoseCli, OnRealDataAnAblationIsNeverBlamedOnAnotherEffect) {
   const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
   std::ofstream out(dir_ / "htw.csv");
@@ -474,6 +475,15 @@ TEST_F(DiagnoseCli, OnRealDataAnAblationIsNeverBlamedOnAnotherEffect) {
       }
     }
     EXPECT_TRUE(extrapolated) << variant << ": " << j.at("extrapolation").dump();
+    // The pyrgeometer's sky 15 K above the air in full sun, named with its size.
+    bool sky = false;
+    for (const auto& f : j.at("sensors")) {
+      if (f.at("channel") == "lw_down_w_m2" && f.at("kind") == "sky_warmer_than_air" &&
+          f.at("size").get<double>() > 10.0 && f.at("rows").get<int>() > 100) {
+        sky = true;
+      }
+    }
+    EXPECT_TRUE(sky) << variant << ": " << j.at("sensors").dump();
     for (const auto& e : j.at("effects")) {
       if (e.at("accepted_at_step").get<int>() == 0) continue;
       EXPECT_LE(e.at("mae_p_el_after_w").get<double>(),

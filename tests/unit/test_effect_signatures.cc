@@ -1,14 +1,17 @@
 // The effects' signature checks (EffectModule::shows_signature) and their
 // helper BestLag on data whose answer is known by construction: a signal
 // shifted by a known number of rows, a measured P_el that stops at an
-// inverter limit and one that does not.
+// inverter limit and one that does not; and the advice sentences with the
+// fitted values (EffectModule::advice_for).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "core/common/units.h"
 #include "core/effects/effect_module.h"
 #include "core/effects/pv_clipping.h"
+#include "core/effects/shading.h"
 
 namespace pvtwin {
 namespace {
@@ -83,6 +86,23 @@ TEST(PvClippingSignature, APlateauAtTheFittedLimitIsShownAndMissingWithoutOne) {
   s.p_el_meas_w = &unclipped;
   const SignatureCheck missing = PvClippingEffect().shows_signature(s);
   EXPECT_FALSE(missing.shown) << missing.sentence;
+}
+
+// Advice in the site's units from the fitted parameters: 120 W/m² on 1.8 m²
+// is 216 W; an obstacle centred at 250° with a 40° width reaches 230–270°.
+TEST(EffectAdvice, SaysTheFittedValuesInPhysicalUnits) {
+  Plant plant;
+  plant.area_m2 = 1.8;
+  ParamVector p{};
+  p[static_cast<std::size_t>(Param::kPLimitWM2)] = 120.0;
+  EXPECT_EQ(PvClippingEffect().advice_for(p, plant).rfind("Inverter limit ≈ 216 W (120 W/m²)", 0),
+            0u);
+  p[static_cast<std::size_t>(Param::kShadeAzimuthRad)] = 250.0 * kPi / 180.0;
+  p[static_cast<std::size_t>(Param::kShadeWidthRad)] = 40.0 * kPi / 180.0;
+  p[static_cast<std::size_t>(Param::kShadeElevationRad)] = 25.0 * kPi / 180.0;
+  EXPECT_NE(ShadingEffect().advice_for(p, plant).find("azimuth 230–270°, up to 25° elevation"),
+            std::string::npos)
+      << ShadingEffect().advice_for(p, plant);
 }
 
 }  // namespace

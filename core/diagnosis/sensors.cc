@@ -1,0 +1,61 @@
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "core/common/units.h"
+#include "core/diagnosis/stages.h"
+#include "core/monitor/monitoring.h"
+#include "core/physics/sky_radiation.h"
+
+namespace pvtwin::diagnosis_stages {
+
+namespace {
+
+// Sky temperature minus air temperature of row i from the measured sky
+// channel (t_sky_c, else lw_down_w_m2), NaN without one.
+double SkyExcessK(const Series& s, std::size_t i) {
+  double t_sky_c = s.At(Channel::kTSkyC, i);
+  if (std::isnan(t_sky_c) && s.Has(Channel::kLwDownWM2)) {
+    t_sky_c = KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
+  }
+  return t_sky_c - s.At(Channel::kTAmbC, i);
+}
+
+}  // namespace
+
+std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant) {
+  std::map<std::pair<std::string, std::string>, std::vector<SensorFault>> by_kind;
+  for (SensorFault& f : FindSensorFaults(data, plant)) {
+    by_kind[{f.channel, f.kind}].push_back(std::move(f));
+  }
+  std::vector<SensorFinding> out;
+  for (const auto& [key, faults] : by_kind) {
+    SensorFinding s;
+    s.channel = key.first;
+    s.kind = key.second;
+    std::vector<double> excess;
+    for (const SensorFault& f : faults) {
+      for (std::size_t i = data.RowAtOrAfter(f.start_s); i < data.RowAtOrAfter(f.end_s); ++i) {
+        ++s.rows;
+        if (s.kind == "sky_warmer_than_air") excess.push_back(SkyExcessK(data, i));
+      }
+    }
+    s.share =
+        data.size() > 0 ? static_cast<double>(s.rows) / static_cast<double>(data.size()) : 0.0;
+    std::erase_if(excess, [](double e) { return !std::isfinite(e); });
+    if (!excess.empty()) {
+      std::nth_element(excess.begin(), excess.begin() + excess.size() / 2, excess.end());
+      s.size = excess[excess.size() / 2];
+    }
+    s.detail =
+        faults.front().detail +
+        (faults.size() > 1 ? " (first of " + std::to_string(faults.size()) + " intervals)" : "");
+    out.push_back(std::move(s));
+  }
+  std::sort(out.begin(), out.end(),
+            [](const SensorFinding& a, const SensorFinding& b) { return a.rows > b.rows; });
+  return out;
+}
+
+}  // namespace pvtwin::diagnosis_stages

@@ -409,6 +409,16 @@ TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
   EXPECT_NE(run.err.find("train_days = 5"), std::string::npos) << run.err;
 }
 
+// The htw saar days in time order, day 3 (2017-07-25) then day 1
+// (2017-08-07), as one CSV.
+void WriteHtwDay3ThenDay1(const fs::path& csv) {
+  const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+  std::ofstream out(csv);
+  out << testing::ReadFile(data / "day3_clear_medium_dT.csv");
+  const std::string day1 = testing::ReadFile(data / "day1_clear_low_dT.csv");
+  out << day1.substr(day1.find('\n') + 1);
+}
+
 // Real data: the htw saar collector trained on day 3 (inlet 7 K above
 // ambient) and predicting day 1 (inlet 4 K below) with 2N1CcolwrI. The held-
 // out heat error is a bias: the model predicts more heat on every scored
@@ -416,11 +426,7 @@ TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
 // (gap.bias_q_th_w, gap.bias_share_q_th) and the summary prints.
 TEST_F(DiagnoseCli, TheReportStatesTheBiasOfTheHeldOutErrorOnRealData) {
   const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
-  std::ofstream out(dir_ / "htw.csv");
-  out << testing::ReadFile(data / "day3_clear_medium_dT.csv");
-  const std::string day1 = testing::ReadFile(data / "day1_clear_low_dT.csv");
-  out << day1.substr(day1.find('\n') + 1);
-  out.close();
+  WriteHtwDay3ThenDay1(dir_ / "htw.csv");
   const testing::ProcessResult run = testing::RunPvtwin(
       dir_,
       "diagnose --config '" + (data / "plant.toml").string() +
@@ -444,11 +450,7 @@ TEST_F(DiagnoseCli, TheReportStatesTheBiasOfTheHeldOutErrorOnRealData) {
 // sensor finding.
 TEST_F(DiagnoseCli, OnRealDataAnAblationIsNeverBlamedOnAnotherEffect) {
   const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
-  std::ofstream out(dir_ / "htw.csv");
-  out << testing::ReadFile(data / "day3_clear_medium_dT.csv");
-  const std::string day1 = testing::ReadFile(data / "day1_clear_low_dT.csv");
-  out << day1.substr(day1.find('\n') + 1);
-  out.close();
+  WriteHtwDay3ThenDay1(dir_ / "htw.csv");
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"2N1CcolwrI", ""}, {"2N1Ccolwr", "iam"}, {"2N1CcolwI", "sky_radiation"}};
   for (const auto& [variant, removed] : cases) {

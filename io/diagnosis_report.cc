@@ -201,7 +201,8 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
                           {"mae_q_th_w", Number(s.heldout.mae_q_th_w)},
                           {"objective_w_m2", Number(s.objective_w_m2)},
                           {"shrink_pct", Number(s.shrink_pct)},
-                          {"p_value", Number(s.p_value)}});
+                          {"p_value", Number(s.p_value)},
+                          {"loss_test_p", Number(s.loss_test_p)}});
   }
   j["ladder"] = ladder;
   j["noise_floor"] = Json{{"mae_p_el_w", Number(r.noise.mae_p_el_w)},
@@ -263,7 +264,7 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
 
   h << "<h2>Ladder</h2>\n<table><tr><th class='l'>step</th><th class='l'>model</th>"
     << "<th>MAE P<sub>el</sub> W</th><th>MAE Q<sub>u</sub> W</th><th>sum W</th>"
-    << "<th>objective W/m²</th><th>shrink %</th><th>p</th></tr>\n";
+    << "<th>objective W/m²</th><th>shrink %</th><th>loss test p</th></tr>\n";
   for (std::size_t k = 0; k < r.ladder.size(); ++k) {
     const LadderStep& s = r.ladder[k];
     h << "<tr><td class='l'>" << (k == 0 ? "base" : "+" + XmlEscape(s.added))
@@ -271,7 +272,7 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
       << Fixed(s.heldout.mae_p_el_w, 2) << "</td><td>" << Fixed(s.heldout.mae_q_th_w, 2)
       << "</td><td>" << Fixed(s.heldout_mae_w, 2) << "</td><td>" << Fixed(s.objective_w_m2, 3)
       << "</td><td>" << (k ? Fixed(s.shrink_pct, 1) : "") << "</td><td>"
-      << (k ? Fixed(s.p_value, 4) : "") << "</td></tr>\n";
+      << (k ? Fixed(s.loss_test_p, 4) : "") << "</td></tr>\n";
   }
   h << "</table>\n";
 

@@ -185,7 +185,8 @@ struct LadderStep {
   double heldout_mae_w = 0.0;   // MAE P_el + MAE Q_u, W
   double objective_w_m2 = 0.0;  // paper objective, W/m²
   double shrink_pct = 0.0;      // against the previous step
-  double p_value = 1.0;         // loss test p against the previous step
+  double p_value = 1.0;         // Wilcoxon p against the previous step
+  double loss_test_p = 1.0;     // held-out loss test p against the previous step
   ParamVector params{};
 };
 

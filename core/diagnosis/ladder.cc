@@ -60,7 +60,8 @@ void Accept(int step, const EffectTrial& chosen, const Score& score, DiagnosisRe
   ls.heldout_mae_w = MaeSumW(score.errors);
   ls.objective_w_m2 = score.errors.objective_w_m2();
   ls.shrink_pct = chosen.shrink_pct;
-  ls.p_value = chosen.heldout_test.p;
+  ls.p_value = chosen.test.wilcoxon_p;
+  ls.loss_test_p = chosen.heldout_test.p;
   ls.params = chosen.params;
   r.ladder.push_back(ls);
 }

@@ -3,23 +3,17 @@
 #include <map>
 #include <utility>
 
-#include "core/common/units.h"
 #include "core/diagnosis/stages.h"
+#include "core/model/thermal_model.h"
 #include "core/monitor/monitoring.h"
-#include "core/physics/sky_radiation.h"
 
 namespace pvtwin::diagnosis_stages {
 
 namespace {
 
-// Sky temperature minus air temperature of row i from the measured sky
-// channel (t_sky_c, else lw_down_w_m2), NaN without one.
+// Sky temperature minus air temperature of row i, NaN without a sky channel.
 double SkyExcessK(const Series& s, std::size_t i) {
-  double t_sky_c = s.At(Channel::kTSkyC, i);
-  if (std::isnan(t_sky_c) && s.Has(Channel::kLwDownWM2)) {
-    t_sky_c = KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
-  }
-  return t_sky_c - s.At(Channel::kTAmbC, i);
+  return MeasuredSkyTemperatureC(s, i) - s.At(Channel::kTAmbC, i);
 }
 
 }  // namespace

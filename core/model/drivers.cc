@@ -212,17 +212,19 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
   return true;
 }
 
+double MeasuredSkyTemperatureC(const Series& s, std::size_t i) {
+  const double t_sky_c = s.At(Channel::kTSkyC, i);
+  if (!std::isnan(t_sky_c) || !s.Has(Channel::kLwDownWM2)) return t_sky_c;
+  return KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
+}
+
 std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::string* note) {
   const std::size_t n = s.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (note != nullptr) note->clear();
   std::vector<double> measured(n, nan), estimated(n, nan);
   for (std::size_t i = 0; i < n; ++i) {
-    double t_sky_c = s.At(Channel::kTSkyC, i);
-    if (std::isnan(t_sky_c) && s.Has(Channel::kLwDownWM2)) {
-      t_sky_c = KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
-    }
-    measured[i] = t_sky_c;
+    measured[i] = MeasuredSkyTemperatureC(s, i);
     estimated[i] = KToC(SwinbankSkyTemperatureK(CToK(s.At(Channel::kTAmbC, i))));
   }
   const char* kHow = "the sky temperature is estimated from the air temperature (Swinbank 1963)";

@@ -51,6 +51,10 @@ inline constexpr int kMaxNodeIterations = 8;
 bool PrepareDrivers(const Series& series, const Plant& plant, const ModelSpec& spec,
                     Drivers* drivers, std::string* error);
 
+// The measured sky temperature of row i, °C: t_sky_c, else the equivalent of
+// lw_down_w_m2 (paper 3.1); NaN without either.
+double MeasuredSkyTemperatureC(const Series& series, std::size_t i);
+
 // The sky temperature of every row, °C, as plant.sky says: the measured
 // t_sky_c (else the equivalent of lw_down_w_m2, paper 3.1), or the Swinbank
 // estimate from t_amb_c. kAuto uses the measured channel unless it is

@@ -415,13 +415,7 @@ std::vector<SensorFault> FindSensorFaults(const Series& s, const Plant& plant,
   if (sky && s.Has(Channel::kTAmbC) && s.Has(sun)) {
     const std::vector<double>& g = s[sun];
     const std::vector<double>& t_amb = s[Channel::kTAmbC];
-    auto t_sky_c = [&s](std::size_t i) {
-      if (s.Has(Channel::kTSkyC) && std::isfinite(s[Channel::kTSkyC][i])) {
-        return s[Channel::kTSkyC][i];
-      }
-      if (!s.Has(Channel::kLwDownWM2)) return kNaN;
-      return KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
-    };
+    auto t_sky_c = [&s](std::size_t i) { return MeasuredSkyTemperatureC(s, i); };
     AddRuns(
         s, s.Has(Channel::kLwDownWM2) ? "lw_down_w_m2" : "t_sky_c", "sky_warmer_than_air",
         o.min_run_minutes,

@@ -6,6 +6,8 @@
 #include <limits>
 #include <vector>
 
+#include "core/forecast/operation_forecast.h"
+#include "core/forecast/weather_resample.h"
 #include "core/model/thermal_model.h"
 
 namespace pvtwin {
@@ -107,15 +109,16 @@ std::string ForecastInputUse::Describe() const {
   char buf[256];
   std::snprintf(buf, sizeof(buf),
                 "weather: forecast %zu/%zu, persistence %zu/%zu, missing %zu/%zu; "
-                "operation: plan %zu/%zu, typical day %zu/%zu",
+                "operation: plan %zu/%zu, typical day %zu/%zu, learned %zu/%zu",
                 weather_forecast, rows, weather_persistence, rows, weather_missing, rows,
-                operation_plan, rows, operation_typical, rows);
+                operation_plan, rows, operation_typical, rows, operation_learned, rows);
   std::string text = buf;
   std::string list;
   bool table_used = false;
   for (const ChannelInputUse& c : channels) {
     const char* primary = c.operation ? "operation_plan" : "weather_forecast";
-    const char* fallback = c.operation ? "typical_day" : "persistence";
+    const char* fallback =
+        c.operation ? (c.learned ? "learned_rule" : "typical_day") : "persistence";
     std::string parts;
     const auto add = [&parts](const char* name, std::size_t n) {
       if (n > 0) parts += (parts.empty() ? "" : "+") + std::string(name) + " " + std::to_string(n);
@@ -128,6 +131,7 @@ std::string ForecastInputUse::Describe() const {
     list += (list.empty() ? "" : ", ") + std::string(ChannelName(c.channel)) + "=" + parts;
   }
   if (!list.empty()) text += "; channels: " + list;
+  if (!pump_rule.empty()) text += "; " + pump_rule;
   if (table_used && !weather_sources.empty()) {
     text += "; weather_forecast source: ";
     for (std::size_t i = 0; i < weather_sources.size(); ++i) {
@@ -136,6 +140,231 @@ std::string ForecastInputUse::Describe() const {
   }
   return text;
 }
+
+namespace {
+
+const Series kNoRows;
+
+bool IsIrradiance(Channel c) {
+  return c == Channel::kGPoaWM2 || c == Channel::kGhiWM2 || c == Channel::kDhiWM2 ||
+         c == Channel::kGPoaDiffuseWM2;
+}
+
+// The rows of a forecast run: the warm-up, then the horizon.
+Series MakeFrame(const ForecastRequest& request, std::size_t n_warm, std::size_t n) {
+  const std::int64_t step = std::llround(request.step_s);
+  Series in;
+  in.step_s = request.step_s;
+  in.time_s.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    in.time_s[k] = request.issued_at_s - static_cast<std::int64_t>(n_warm) * step +
+                   static_cast<std::int64_t>(k) * step;
+  }
+  in[Channel::kValid].assign(n, 1.0);
+  return in;
+}
+
+// The measured value 24 h before t, else 48 h, … back over the history's span.
+double Persisted(const Track& measured, std::int64_t t, std::int64_t history_span_s,
+                 std::int64_t* back_s) {
+  double v = kNaN;
+  std::int64_t back = 86400;
+  for (; back <= history_span_s + 86400 && std::isnan(v); back += 86400)
+    v = measured.Exact(t - back);
+  if (back_s != nullptr) *back_s = back - 86400;
+  return v;
+}
+
+// The weather channels: warm-up measured; horizon from the weather forecast
+// table where it has the channel (when use_table), else persisted. Counts the
+// sources into *use and flags the rows whose irradiance all came from the
+// table (and no weather channel is missing).
+void FillWeather(const Series& history, const Series& weather_forecast,
+                 const ForecastRequest& request, std::size_t n_warm, bool use_table, Series* in,
+                 ForecastInputUse* use, std::vector<std::uint8_t>* from_table) {
+  const std::size_t n_horizon = in->size() - n_warm;
+  const std::int64_t history_span_s = history.time_s.back() - history.time_s.front();
+  from_table->assign(n_horizon, use_table ? 1 : 0);
+  std::vector<std::uint8_t> persisted(n_horizon, 0), missing(n_horizon, 0);
+  for (Channel c : kWeatherChannels) {
+    if (!history.Has(c)) continue;
+    const Track measured(history, c);
+    if (measured.time_s.empty()) continue;
+    const Track predicted(use_table ? weather_forecast : kNoRows, c);
+    ChannelInputUse channel_use{c};
+    FillColumn(measured, n_warm, in, c, [&](std::size_t h, std::int64_t t) {
+      double v = predicted.Interpolated(t, request.max_interp_gap_s);
+      if (!std::isnan(v)) {
+        ++channel_use.forecast;
+        return v;
+      }
+      if (IsIrradiance(c)) (*from_table)[h] = 0;
+      v = Persisted(measured, t, history_span_s, nullptr);
+      (std::isnan(v) ? missing : persisted)[h] = 1;
+      ++(std::isnan(v) ? channel_use.missing : channel_use.fallback);
+      return v;
+    });
+    use->channels.push_back(channel_use);
+  }
+  for (std::size_t h = 0; h < n_horizon; ++h) {
+    (*from_table)[h] = (*from_table)[h] && !missing[h];
+    use->weather_forecast += (*from_table)[h];
+    use->weather_persistence += persisted[h];
+    use->weather_missing += missing[h];
+  }
+}
+
+// The inlet's typical day shifted to the level of the history's last 24 h
+// (operation_forecast.h), per slot of the day.
+std::vector<double> ShiftedToLastDay(const Track& measured, std::vector<double> typical,
+                                     double step_s) {
+  if (measured.time_s.empty()) return typical;
+  const std::int64_t last = measured.time_s.back();
+  double sum_measured = 0.0, sum_typical = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = measured.time_s.size(); i-- > 0 && measured.time_s[i] > last - 86400;) {
+    const std::int64_t second_of_day = ((measured.time_s[i] % 86400) + 86400) % 86400;
+    const auto slot = static_cast<std::size_t>(static_cast<double>(second_of_day) / step_s);
+    if (slot >= typical.size() || std::isnan(typical[slot])) continue;
+    sum_measured += measured.value[i];
+    sum_typical += typical[slot];
+    ++n;
+  }
+  if (n == 0) return typical;
+  const double offset = (sum_measured - sum_typical) / static_cast<double>(n);
+  for (double& v : typical) v += offset;
+  return typical;
+}
+
+// The operation channels without a plan, per row of `in`: the typical day,
+// or the learned rule (operation_forecast.h) on the rows' irradiance.
+std::vector<double> OperationFallback(const Plant& plant, const Series& history,
+                                      const ForecastRequest& request, Channel c, const Series& in,
+                                      const PumpRule* rule) {
+  const Track measured(history, c);
+  std::vector<double> typical = TypicalDay(measured, request.step_s);
+  if (rule != nullptr && c == Channel::kMdotKgS) return PumpFlow(plant, *rule, in, false);
+  if (rule != nullptr) typical = ShiftedToLastDay(measured, std::move(typical), request.step_s);
+  const std::int64_t step = std::llround(request.step_s);
+  std::vector<double> v(in.size(), kNaN);
+  for (std::size_t k = 0; k < in.size(); ++k) {
+    const std::int64_t second_of_day = ((in.time_s[k] % 86400) + 86400) % 86400;
+    const auto slot = static_cast<std::size_t>(second_of_day / step);
+    if (slot < typical.size()) v[k] = typical[slot];
+  }
+  return v;
+}
+
+// The operation channels: warm-up measured; horizon from the plan (when
+// use_plan), else the window's typical day or the learned rule.
+void FillOperation(const Plant& plant, const Series& history, const Series& operation_plan,
+                   const ForecastRequest& request, std::size_t n_warm, bool use_plan,
+                   const PumpRule* rule, Series* in, ForecastInputUse* use) {
+  const std::size_t n_horizon = in->size() - n_warm;
+  std::vector<std::uint8_t> planned(n_horizon, 1), fallback_used(n_horizon, 0);
+  for (Channel c : kOperationChannels) {
+    const Track measured(history, c);
+    const Track planned_track(use_plan ? operation_plan : kNoRows, c);
+    const std::vector<double> fallback = OperationFallback(plant, history, request, c, *in, rule);
+    ChannelInputUse channel_use{c};
+    channel_use.operation = true;
+    channel_use.learned = rule != nullptr;
+    FillColumn(measured, n_warm, in, c, [&](std::size_t h, std::int64_t t) {
+      double v = planned_track.Held(t, request.max_interp_gap_s);
+      if (!std::isnan(v)) {
+        ++channel_use.forecast;
+        return v;
+      }
+      planned[h] = 0;
+      v = fallback[n_warm + h];
+      if (!std::isnan(v)) fallback_used[h] = 1;
+      ++(std::isnan(v) ? channel_use.missing : channel_use.fallback);
+      return v;
+    });
+    use->channels.push_back(channel_use);
+  }
+  for (std::size_t h = 0; h < n_horizon; ++h) {
+    use->operation_plan += planned[h];
+    (rule != nullptr ? use->operation_learned : use->operation_typical) += fallback_used[h];
+  }
+}
+
+// Smart persistence of the irradiance channels (the reference forecast, see
+// the header): the horizon value at t is k·clear(t), k the clear-sky index
+// of the measured hour around t − back (the persistence day) against the
+// clear sky of the channel's kind (in-plane or horizontal), 0 ≤ k ≤
+// kMaxClearSkyIndex. Near the horizon (clear-sky mean of that hour below
+// kMinClearSkyWM2) and beyond two days back the plain persisted value stays.
+constexpr double kMaxClearSkyIndex = 1.5;
+constexpr double kMinClearSkyWM2 = 5.0;
+constexpr double kLinkeTurbidity = 3.0;
+
+void SmartPersistIrradiance(const Plant& plant, const Series& history, std::size_t n_warm,
+                            Series* in) {
+  constexpr Channel kIrradiance[] = {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2,
+                                     Channel::kGPoaDiffuseWM2};
+  if (in->size() <= n_warm) return;
+  const std::int64_t h0 = in->time_s[n_warm];
+  const std::int64_t grid_begin = h0 - 2 * 86400 - 3600;
+  const ClearSkyGrid grid =
+      MakeClearSkyGrid(plant, grid_begin, in->time_s.back() + 3600, kLinkeTurbidity);
+  const std::int64_t history_span_s = history.time_s.back() - history.time_s.front();
+  for (Channel c : kIrradiance) {
+    if (!in->Has(c) || !history.Has(c)) continue;
+    const bool on_plane = c == Channel::kGPoaWM2 || c == Channel::kGPoaDiffuseWM2;
+    const std::vector<double>& clear = on_plane ? grid.clear_poa_w_m2 : grid.clear_ghi_w_m2;
+    const auto clear_at = [&](std::int64_t t) {
+      const std::int64_t k = (t - grid_begin) / 60;
+      return k >= 0 && static_cast<std::size_t>(k) < clear.size()
+                 ? clear[static_cast<std::size_t>(k)]
+                 : kNaN;
+    };
+    const Track measured(history, c);
+    std::vector<double>& col = (*in)[c];
+    for (std::size_t k = n_warm; k < in->size(); ++k) {
+      const std::int64_t t = in->time_s[k];
+      std::int64_t back = 0;
+      if (std::isnan(Persisted(measured, t, history_span_s, &back)) || back > 2 * 86400) continue;
+      double sum = 0.0, sum_clear = 0.0;
+      std::size_t minutes = 0;
+      auto it = std::lower_bound(measured.time_s.begin(), measured.time_s.end(), t - back - 1800);
+      for (; it != measured.time_s.end() && *it < t - back + 1800; ++it) {
+        const double cs = clear_at(*it);
+        if (std::isnan(cs)) continue;
+        sum += measured.value[static_cast<std::size_t>(it - measured.time_s.begin())];
+        sum_clear += cs;
+        ++minutes;
+      }
+      if (minutes == 0 || sum_clear < kMinClearSkyWM2 * static_cast<double>(minutes)) continue;
+      const double index = std::clamp(sum / sum_clear, 0.0, kMaxClearSkyIndex);
+      col[k] = index * clear_at(t);
+    }
+  }
+}
+
+// Runs the model over `in` and keeps the horizon rows of its outputs.
+bool RunHorizon(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                const Series& in, std::size_t n_warm, bool all_outputs, Series* rows,
+                std::string* error) {
+  Drivers drivers;
+  if (!PrepareDrivers(in, plant, spec, &drivers, error)) return false;
+  SimOutputs sim;
+  Simulate(drivers, params, &sim);
+  *rows = Series{};
+  rows->step_s = in.step_s;
+  rows->time_s.assign(in.time_s.begin() + static_cast<std::ptrdiff_t>(n_warm), in.time_s.end());
+  auto take = [&](Channel c, const std::vector<double>& v) {
+    (*rows)[c].assign(v.begin() + static_cast<std::ptrdiff_t>(n_warm), v.end());
+  };
+  take(Channel::kPElW, sim.p_el_w);
+  take(Channel::kQThW, sim.q_th_w);
+  if (!all_outputs) return true;
+  take(Channel::kTPvC, sim.t_pv_c);
+  take(Channel::kTOutC, sim.t_out_c);
+  return true;
+}
+
+}  // namespace
 
 bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
                   const Series& history, const Series& weather_forecast,
@@ -150,106 +379,38 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
     return false;
   }
   const std::int64_t step = std::llround(request.step_s);
-  const std::int64_t t0 = request.issued_at_s;
   const std::size_t n_warm = static_cast<std::size_t>(request.warmup_s / request.step_s);
-  const std::size_t n_horizon = static_cast<std::size_t>(request.horizon_s / request.step_s);
-  const std::size_t n = n_warm + n_horizon;
+  const std::size_t n = n_warm + static_cast<std::size_t>(request.horizon_s / request.step_s);
   // Persistence reaches back at most over the history's span.
-  const std::int64_t history_span_s = history.time_s.back() - history.time_s.front();
-  if (history_span_s < 86400 - step) {
+  if (history.time_s.back() - history.time_s.front() < 86400 - step) {
     *error = "the measured history spans less than one day; persistence needs a full day";
     return false;
   }
 
-  Series in;
-  in.step_s = request.step_s;
-  in.time_s.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    in.time_s[k] =
-        t0 - static_cast<std::int64_t>(n_warm) * step + static_cast<std::int64_t>(k) * step;
-  }
-  in[Channel::kValid].assign(n, 1.0);
-
+  Series in = MakeFrame(request, n_warm, n);
   ForecastInputUse use;
-  use.rows = n_horizon;
-  std::vector<std::uint8_t> row_from_forecast(n_horizon, 1), row_persisted(n_horizon, 0),
-      row_missing(n_horizon, 0);
-  for (Channel c : kWeatherChannels) {
-    if (!history.Has(c)) continue;
-    const Track measured(history, c);
-    if (measured.time_s.empty()) continue;
-    const Track predicted(weather_forecast, c);
-    ChannelInputUse channel_use{c};
-    FillColumn(measured, n_warm, &in, c, [&](std::size_t h, std::int64_t t) {
-      double v = predicted.Interpolated(t, request.max_interp_gap_s);
-      if (!std::isnan(v)) {
-        ++channel_use.forecast;
-      } else {
-        row_from_forecast[h] = 0;
-        for (std::int64_t back = 86400; back <= history_span_s + 86400 && std::isnan(v);
-             back += 86400) {
-          v = measured.Exact(t - back);
-        }
-        (std::isnan(v) ? row_missing : row_persisted)[h] = 1;
-        ++(std::isnan(v) ? channel_use.missing : channel_use.fallback);
-      }
-      return v;
-    });
-    use.channels.push_back(channel_use);
+  use.rows = n - n_warm;
+  FillWeather(history, weather_forecast, request, n_warm, true, &in, &use,
+              &out->weather_from_forecast);
+  PumpRule rule;
+  if (request.operation == OperationForecast::kLearned) {
+    rule = LearnPumpRule(plant, history);
+    use.pump_rule = rule.Describe();
   }
-  for (std::size_t h = 0; h < n_horizon; ++h) {
-    use.weather_forecast += row_from_forecast[h] && !row_missing[h];
-    use.weather_persistence += row_persisted[h];
-    use.weather_missing += row_missing[h];
-  }
-
-  std::vector<std::uint8_t> row_planned(n_horizon, 1), row_typical(n_horizon, 0);
-  for (Channel c : kOperationChannels) {
-    const Track measured(history, c);
-    const Track planned(operation_plan, c);
-    const std::vector<double> typical = TypicalDay(measured, request.step_s);
-    ChannelInputUse channel_use{c};
-    channel_use.operation = true;
-    FillColumn(measured, n_warm, &in, c, [&](std::size_t h, std::int64_t t) {
-      double v = planned.Held(t, request.max_interp_gap_s);
-      if (!std::isnan(v)) {
-        ++channel_use.forecast;
-      } else {
-        row_planned[h] = 0;
-        const std::int64_t second_of_day = ((t % 86400) + 86400) % 86400;
-        const auto slot = static_cast<std::size_t>(second_of_day / step);
-        v = slot < typical.size() ? typical[slot] : kNaN;
-        if (!std::isnan(v)) row_typical[h] = 1;
-        ++(std::isnan(v) ? channel_use.missing : channel_use.fallback);
-      }
-      return v;
-    });
-    use.channels.push_back(channel_use);
-  }
-  for (std::size_t h = 0; h < n_horizon; ++h) {
-    use.operation_plan += row_planned[h];
-    use.operation_typical += row_typical[h];
-  }
-
-  Drivers drivers;
-  if (!PrepareDrivers(in, plant, spec, &drivers, error)) return false;
-  SimOutputs sim;
-  Simulate(drivers, params, &sim);
-
-  Series& rows = out->rows;
-  rows = Series{};
-  rows.step_s = request.step_s;
-  rows.time_s.assign(in.time_s.begin() + static_cast<std::ptrdiff_t>(n_warm), in.time_s.end());
-  auto take = [&](Channel c, const std::vector<double>& v) {
-    rows[c].assign(v.begin() + static_cast<std::ptrdiff_t>(n_warm), v.end());
-  };
-  take(Channel::kPElW, sim.p_el_w);
-  take(Channel::kQThW, sim.q_th_w);
-  take(Channel::kTPvC, sim.t_pv_c);
-  take(Channel::kTOutC, sim.t_out_c);
+  FillOperation(plant, history, operation_plan, request, n_warm, true, rule.valid ? &rule : nullptr,
+                &in, &use);
+  if (!RunHorizon(plant, spec, params, in, n_warm, true, &out->rows, error)) return false;
   out->inputs = use;
   out->inputs_used = in.Slice(n_warm, n);
-  return true;
+  if (!request.with_reference) return true;
+
+  Series ref = MakeFrame(request, n_warm, n);
+  ForecastInputUse ref_use;
+  std::vector<std::uint8_t> ref_from_table;
+  FillWeather(history, Series{}, request, n_warm, false, &ref, &ref_use, &ref_from_table);
+  SmartPersistIrradiance(plant, history, n_warm, &ref);
+  FillOperation(plant, history, Series{}, request, n_warm, false, nullptr, &ref, &ref_use);
+  return RunHorizon(plant, spec, params, ref, n_warm, false, &out->reference, error);
 }
 
 }  // namespace pvtwin

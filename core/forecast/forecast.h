@@ -13,7 +13,19 @@
 //                  the window), the usual baseline of day-ahead PV forecasting;
 //   operation   1. the operation plan (table operation_plan: t_in_c, flow_kg_s);
 //   (t_in_c,    2. the typical day of the window: the median, over the window's
-//    flow_kg_s)    days, of the value at the same minute of the (UTC) day.
+//    flow_kg_s)    days, of the value at the same minute of the (UTC) day; or,
+//                  with request.operation = kLearned, the controller learned
+//                  from the window (core/forecast/operation_forecast.h).
+//
+// Beside it, the same model runs a reference forecast, the baseline that
+// forecast_skill scores against (issue 15): smart persistence of the
+// weather — each irradiance channel's clear-sky index of 24 h earlier (over
+// the hour around that minute) times the clear sky of the forecast minute
+// (core/forecast/weather_resample.h), the other weather channels persisted —
+// with the typical day's operation. A forecast that only persists the
+// weather scores at most about zero against it (the reference smooths the
+// clouds over the hour); a weather forecast or an operation plan worth
+// having scores above.
 //
 // Timestamp convention as everywhere: a row's time is the start of its
 // interval; outputs are interval means (core/model/thermal_model.h). Forecast rows
@@ -31,12 +43,20 @@
 
 namespace pvtwin {
 
+// The operation over the horizon where no plan covers it.
+enum class OperationForecast {
+  kTypicalDay,  // the window's median day
+  kLearned,     // the controller learned from the window (operation_forecast.h)
+};
+
 struct ForecastRequest {
   std::int64_t issued_at_s = 0;      // first forecast row (unix s UTC)
   double horizon_s = 86400.0;        // forecast length
   double step_s = 60.0;              // row spacing of the forecast and of the inputs
   double warmup_s = 86400.0;         // measured history simulated before the horizon
   double max_interp_gap_s = 3600.0;  // longest gap in a forecast input bridged linearly
+  bool with_reference = true;        // also run the reference forecast (Forecast::reference)
+  OperationForecast operation = OperationForecast::kTypicalDay;
 };
 
 // Where one input channel's horizon values came from, counted in rows.
@@ -46,6 +66,7 @@ struct ChannelInputUse {
   std::size_t fallback = 0;  // persistence (weather) or the typical day (operation)
   std::size_t missing = 0;
   bool operation = false;  // t_in_c, flow_kg_s
+  bool learned = false;    // an operation channel's fallback was the learned rule
 };
 
 // Where each forecast row's inputs came from, counted over the horizon rows.
@@ -56,6 +77,8 @@ struct ForecastInputUse {
   std::size_t weather_missing = 0;      // rows without a value for a needed weather channel
   std::size_t operation_plan = 0;       // rows whose t_in_c and flow came from the plan
   std::size_t operation_typical = 0;    // rows with a typical-day operation value
+  std::size_t operation_learned = 0;    // rows with an operation value of the learned rule
+  std::string pump_rule;                // the learned rule (PumpRule::Describe), if used
   // Per input channel the model reads, in channel order.
   std::vector<ChannelInputUse> channels;
   // The weather_forecast rows' sources (Store::ReadWeatherSources), named
@@ -73,6 +96,14 @@ struct Forecast {
   // time_s and the output channels p_el_w, q_th_w, t_pv_c, t_out_c (NaN
   // where an input was missing); the horizon rows only.
   Series rows;
+  // The reference forecast (smart persistence, typical-day operation):
+  // p_el_w and q_th_w on the same rows.
+  Series reference;
+  // Per horizon row: 1 when all its irradiance channels came from the
+  // weather forecast table (the irradiance carries most of a forecast's
+  // error), 0 when one was persisted or a weather channel is missing. The
+  // uncertainty bands take the errors of that source (forecast_bands.h).
+  std::vector<std::uint8_t> weather_from_forecast;
   ForecastInputUse inputs;
   // The model inputs of the horizon rows as used (weather and operation
   // channels), for inspection.

@@ -25,60 +25,8 @@ std::string Shortest(double v) {
   return buf;
 }
 
-// The minute grid and, per minute, the sun and the clear sky.
-struct MinuteGrid {
-  std::vector<std::int64_t> time_s;  // minute starts
-  std::vector<double> zenith_rad, aoi_rad;
-  std::vector<double> clear_ghi_w_m2, clear_dhi_w_m2, clear_poa_w_m2;
-};
-
-MinuteGrid MakeGrid(const Plant& plant, std::int64_t begin, std::int64_t end,
-                    double linke_turbidity) {
-  MinuteGrid g;
-  std::vector<double> middles;
-  for (std::int64_t t = begin; t < end; t += kMinute) {
-    g.time_s.push_back(t);
-    middles.push_back(static_cast<double>(t) + 30.0);
-  }
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  site.pressure_hpa = 1013.25 * std::exp(-plant.elevation_m / 8434.5);  // scale height 8.4 km
-  std::vector<SolarPosition> sun;
-  ComputeSolarPositions(middles, site, &sun);
-  const std::size_t n = middles.size();
-  g.zenith_rad.resize(n);
-  g.aoi_rad.resize(n);
-  g.clear_ghi_w_m2.resize(n);
-  g.clear_dhi_w_m2.resize(n);
-  g.clear_poa_w_m2.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    g.zenith_rad[k] = sun[k].zenith_rad;
-    g.aoi_rad[k] = AngleOfIncidenceRad(sun[k].zenith_rad, sun[k].azimuth_rad, plant.tilt_rad,
-                                       plant.azimuth_rad);
-    ClearSkyInput cs;
-    cs.zenith_rad = sun[k].zenith_rad;
-    cs.day_of_year = DayOfYearUtc(middles[k]);
-    cs.elevation_m = plant.elevation_m;
-    cs.linke_turbidity = linke_turbidity;
-    const ClearSkyIrradiance clear = ClearSkyIneichenPerez(cs);
-    g.clear_ghi_w_m2[k] = clear.ghi_w_m2;
-    g.clear_dhi_w_m2[k] = clear.dhi_w_m2;
-    IsotropicSkyInput poa;
-    poa.ghi_w_m2 = clear.ghi_w_m2;
-    poa.dhi_w_m2 = clear.dhi_w_m2;
-    poa.zenith_rad = sun[k].zenith_rad;
-    poa.aoi_rad = g.aoi_rad[k];
-    poa.tilt_rad = plant.tilt_rad;
-    poa.ground_albedo = plant.ground_albedo;
-    g.clear_poa_w_m2[k] = TransposeIsotropicSky(poa).global_w_m2();
-  }
-  return g;
-}
-
 // Minute indices [first, last) of the interval [from, from + step).
-std::pair<std::size_t, std::size_t> MinutesOf(const MinuteGrid& g, std::int64_t from,
+std::pair<std::size_t, std::size_t> MinutesOf(const ClearSkyGrid& g, std::int64_t from,
                                               std::int64_t step) {
   const std::int64_t begin = g.time_s.front();
   const auto first = static_cast<std::size_t>((from - begin) / kMinute);
@@ -88,7 +36,7 @@ std::pair<std::size_t, std::size_t> MinutesOf(const MinuteGrid& g, std::int64_t 
 // The interval's value spread evenly over its minutes with the sun above the
 // horizon (all minutes when there are none): the minutes' mean is the value,
 // and no light falls into the minutes of the night.
-void SpreadOverDaylight(const MinuteGrid& g, std::size_t first, std::size_t last, double value,
+void SpreadOverDaylight(const ClearSkyGrid& g, std::size_t first, std::size_t last, double value,
                         std::vector<double>* out) {
   std::size_t daylight = 0;
   for (std::size_t k = first; k < last; ++k) daylight += g.zenith_rad[k] < kPi / 2 ? 1 : 0;
@@ -103,7 +51,7 @@ void SpreadOverDaylight(const MinuteGrid& g, std::size_t first, std::size_t last
 
 // Interval means to minutes through the clear-sky index of each interval
 // (see the header): the minutes' mean equals the interval's value.
-std::vector<double> IntervalMeansToMinutes(const ProviderWeather& in, const MinuteGrid& g,
+std::vector<double> IntervalMeansToMinutes(const ProviderWeather& in, const ClearSkyGrid& g,
                                            const std::vector<double>& values,
                                            const std::vector<double>& shape,
                                            const WeatherResampleOptions& options,
@@ -131,7 +79,7 @@ std::vector<double> IntervalMeansToMinutes(const ProviderWeather& in, const Minu
 }
 
 // DHI = GHI − DNI·mean cos θ_z of each interval, within [0, GHI].
-std::vector<double> DiffuseFromBeam(const ProviderWeather& in, const MinuteGrid& g) {
+std::vector<double> DiffuseFromBeam(const ProviderWeather& in, const ClearSkyGrid& g) {
   std::vector<double> dhi(in.time_s.size(), kNaN);
   const auto step = static_cast<std::int64_t>(in.step_s);
   const auto offset = static_cast<std::int64_t>(in.irradiance_offset_s);
@@ -147,7 +95,7 @@ std::vector<double> DiffuseFromBeam(const ProviderWeather& in, const MinuteGrid&
 
 // Linear interpolation of stamp values at each minute's middle; held for up
 // to one step beyond the first and last stamp; NaN across a missing stamp.
-std::vector<double> InterpolateInstants(const ProviderWeather& in, const MinuteGrid& g,
+std::vector<double> InterpolateInstants(const ProviderWeather& in, const ClearSkyGrid& g,
                                         const std::vector<double>& values) {
   std::vector<double> out(g.time_s.size(), kNaN);
   const std::size_t n = in.time_s.size();
@@ -215,7 +163,7 @@ bool HasIrradiance(const ProviderWeather& in) {
 }
 
 // g_poa_w_m2 and g_poa_diffuse_w_m2 from 1-min GHI/DHI (isotropic sky).
-void Transpose(const Plant& plant, const MinuteGrid& g, Series* out) {
+void Transpose(const Plant& plant, const ClearSkyGrid& g, Series* out) {
   const std::vector<double>& ghi = (*out)[Channel::kGhiWM2];
   const std::vector<double>& dhi = (*out)[Channel::kDhiWM2];
   std::vector<double> poa(ghi.size(), kNaN), poa_diffuse(ghi.size(), kNaN);
@@ -236,7 +184,7 @@ void Transpose(const Plant& plant, const MinuteGrid& g, Series* out) {
   (*out)[Channel::kGPoaDiffuseWM2] = std::move(poa_diffuse);
 }
 
-void ResampleIrradiance(const Plant& plant, const ProviderWeather& in, const MinuteGrid& g,
+void ResampleIrradiance(const Plant& plant, const ProviderWeather& in, const ClearSkyGrid& g,
                         const WeatherResampleOptions& options, Series* out,
                         WeatherResampleSummary* summary) {
   summary->irradiance_intervals = in.time_s.size();
@@ -267,7 +215,7 @@ void ResampleIrradiance(const Plant& plant, const ProviderWeather& in, const Min
 }
 
 // t_sky_c and lw_down_w_m2: as given, or from the sky model.
-void ResampleLongWave(const Plant& plant, const ProviderWeather& in, const MinuteGrid& g,
+void ResampleLongWave(const Plant& plant, const ProviderWeather& in, const ClearSkyGrid& g,
                       Series* out, WeatherResampleSummary* summary) {
   const std::size_t n = g.time_s.size();
   std::vector<double> t_sky(n, kNaN), lw(n, kNaN);
@@ -309,6 +257,51 @@ void ResampleLongWave(const Plant& plant, const ProviderWeather& in, const Minut
 
 }  // namespace
 
+ClearSkyGrid MakeClearSkyGrid(const Plant& plant, std::int64_t begin, std::int64_t end,
+                              double linke_turbidity) {
+  ClearSkyGrid g;
+  std::vector<double> middles;
+  for (std::int64_t t = begin; t < end; t += kMinute) {
+    g.time_s.push_back(t);
+    middles.push_back(static_cast<double>(t) + 30.0);
+  }
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  site.elevation_m = plant.elevation_m;
+  site.pressure_hpa = 1013.25 * std::exp(-plant.elevation_m / 8434.5);  // scale height 8.4 km
+  std::vector<SolarPosition> sun;
+  ComputeSolarPositions(middles, site, &sun);
+  const std::size_t n = middles.size();
+  g.zenith_rad.resize(n);
+  g.aoi_rad.resize(n);
+  g.clear_ghi_w_m2.resize(n);
+  g.clear_dhi_w_m2.resize(n);
+  g.clear_poa_w_m2.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    g.zenith_rad[k] = sun[k].zenith_rad;
+    g.aoi_rad[k] = AngleOfIncidenceRad(sun[k].zenith_rad, sun[k].azimuth_rad, plant.tilt_rad,
+                                       plant.azimuth_rad);
+    ClearSkyInput cs;
+    cs.zenith_rad = sun[k].zenith_rad;
+    cs.day_of_year = DayOfYearUtc(middles[k]);
+    cs.elevation_m = plant.elevation_m;
+    cs.linke_turbidity = linke_turbidity;
+    const ClearSkyIrradiance clear = ClearSkyIneichenPerez(cs);
+    g.clear_ghi_w_m2[k] = clear.ghi_w_m2;
+    g.clear_dhi_w_m2[k] = clear.dhi_w_m2;
+    IsotropicSkyInput poa;
+    poa.ghi_w_m2 = clear.ghi_w_m2;
+    poa.dhi_w_m2 = clear.dhi_w_m2;
+    poa.zenith_rad = sun[k].zenith_rad;
+    poa.aoi_rad = g.aoi_rad[k];
+    poa.tilt_rad = plant.tilt_rad;
+    poa.ground_albedo = plant.ground_albedo;
+    g.clear_poa_w_m2[k] = TransposeIsotropicSky(poa).global_w_m2();
+  }
+  return g;
+}
+
 bool ResampleWeatherTo1Min(const Plant& plant, const ProviderWeather& in,
                            const WeatherResampleOptions& options, Series* out,
                            WeatherResampleSummary* summary, std::string* error) {
@@ -320,7 +313,7 @@ bool ResampleWeatherTo1Min(const Plant& plant, const ProviderWeather& in,
                         : static_cast<std::int64_t>(in.instant_offset_s) / kMinute * kMinute;
   const std::int64_t begin = in.time_s.front() + offset;
   const std::int64_t end = in.time_s.back() + offset + (HasIrradiance(in) ? step : kMinute);
-  const MinuteGrid g = MakeGrid(plant, begin, end, options.linke_turbidity);
+  const ClearSkyGrid g = MakeClearSkyGrid(plant, begin, end, options.linke_turbidity);
 
   Series result;
   result.step_s = 60.0;

@@ -73,6 +73,19 @@ struct ProviderWeather {
   double wind_height_m = 10.0;                                 // z_ref of wind_m_s
 };
 
+// The minutes [begin, end) and, per minute (at its middle), the sun and the
+// clear sky of Ineichen & Perez (core/physics/clear_sky.h): horizontal and
+// transposed to the collector plane with the model's isotropic sky. The
+// reference of a clear-sky index (the resampling below, the forecast's
+// smart persistence).
+struct ClearSkyGrid {
+  std::vector<std::int64_t> time_s;  // minute starts
+  std::vector<double> zenith_rad, aoi_rad;
+  std::vector<double> clear_ghi_w_m2, clear_dhi_w_m2, clear_poa_w_m2;
+};
+ClearSkyGrid MakeClearSkyGrid(const Plant& plant, std::int64_t begin, std::int64_t end,
+                              double linke_turbidity);
+
 struct WeatherResampleOptions {
   double collector_height_m = 10.0;    // z of the wind the model wants, m
   double hellmann_exponent = 1.0 / 7;  // α of the power law

@@ -1,0 +1,311 @@
+#include "core/forecast/forecast_bands.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "core/common/units.h"
+#include "core/forecast/operation_forecast.h"
+#include "core/forecast/weather_resample.h"
+
+namespace pvtwin {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::int64_t kDayS = 86400;
+constexpr double kIrradianceEdgesWM2[] = {20.0, 200.0, 600.0};
+constexpr double kClearIndex = 0.6;
+constexpr double kLinkeTurbidity = 3.0;
+
+std::int64_t DayStart(std::int64_t t) { return t - ((t % kDayS) + kDayS) % kDayS; }
+
+// Regime levels, finest first: which features a level's key keeps.
+constexpr int kLevels = 5;
+std::uint32_t KeyAt(const ForecastRegime& r, int level) {
+  const bool sky = level <= 1, time = level == 0, pump = level <= 2, irradiance = level <= 3;
+  std::uint32_t key = static_cast<std::uint32_t>(level) << 16;
+  if (irradiance) key |= static_cast<std::uint32_t>(r.irradiance + 1);
+  if (sky) key |= static_cast<std::uint32_t>(r.sky + 1) << 4;
+  if (time) key |= static_cast<std::uint32_t>(r.time + 1) << 8;
+  if (pump) key |= static_cast<std::uint32_t>(r.pump + 1) << 12;
+  return key;
+}
+
+struct Quantiles {
+  double p_lo = kNaN, p_hi = kNaN, q_lo = kNaN, q_hi = kNaN;
+};
+
+// Per regime key (all levels) of one source: the quantiles of the keys
+// holding at least min_samples errors of an output.
+std::map<std::uint32_t, Quantiles> QuantileTable(const std::vector<ForecastError>& errors,
+                                                 const BandOptions& options) {
+  struct Samples {
+    std::vector<double> p, q;
+    std::set<std::int64_t> p_days, q_days;
+  };
+  std::map<std::uint32_t, Samples> samples;
+  for (const ForecastError& e : errors) {
+    const std::int64_t day = DayStart(e.time_s);
+    for (int level = 0; level < kLevels; ++level) {
+      Samples& s = samples[KeyAt(e.regime, level)];
+      if (std::isfinite(e.p_el_w)) {
+        s.p.push_back(e.p_el_w);
+        s.p_days.insert(day);
+      }
+      if (std::isfinite(e.q_th_w)) {
+        s.q.push_back(e.q_th_w);
+        s.q_days.insert(day);
+      }
+    }
+  }
+  std::map<std::uint32_t, Quantiles> table;
+  for (auto& [key, s] : samples) {
+    const bool all_rows = (key >> 16) == kLevels - 1;
+    const auto enough = [&](const std::vector<double>& v, const std::set<std::int64_t>& d) {
+      return v.size() >= options.min_samples && (all_rows || d.size() >= options.min_days);
+    };
+    Quantiles& out = table[key];
+    // The days are the exchangeable units (a day's minutes err together):
+    // split-conformal's n/(n+1) moves the levels outward for n days, so that
+    // a new day is covered as often as the levels say, not less.
+    const auto levels = [&options](std::size_t days) {
+      const double shrink = static_cast<double>(days) / static_cast<double>(days + 1);
+      return std::pair{options.lower_quantile * shrink,
+                       1.0 - (1.0 - options.upper_quantile) * shrink};
+    };
+    if (enough(s.p, s.p_days)) {
+      const auto [lo, hi] = levels(s.p_days.size());
+      out.p_lo = SampleQuantile(&s.p, lo);
+      out.p_hi = SampleQuantile(&s.p, hi);
+    }
+    if (enough(s.q, s.q_days)) {
+      const auto [lo, hi] = levels(s.q_days.size());
+      out.q_lo = SampleQuantile(&s.q, lo);
+      out.q_hi = SampleQuantile(&s.q, hi);
+    }
+  }
+  return table;
+}
+
+// The finest level's quantiles of one output (lo, hi) for a regime.
+std::pair<double, double> Lookup(const std::map<std::uint32_t, Quantiles>& table,
+                                 const ForecastRegime& r, bool p_el) {
+  for (int level = 0; level < kLevels; ++level) {
+    const auto it = table.find(KeyAt(r, level));
+    if (it == table.end()) continue;
+    const Quantiles& q = it->second;
+    const double lo = p_el ? q.p_lo : q.q_lo, hi = p_el ? q.p_hi : q.q_hi;
+    if (!std::isnan(lo)) return {lo, hi};
+  }
+  return {kNaN, kNaN};
+}
+
+// Errors of one replayed forecast against the measured rows, into *out.
+void Score(const Forecast& f, const std::vector<ForecastRegime>& regimes, const Series& history,
+           bool only_table_rows, std::vector<ForecastError>* out) {
+  const std::vector<double>& p = history[Channel::kPElW];
+  const std::vector<double>& q = history[Channel::kQThW];
+  const bool has_valid = history.Has(Channel::kValid);
+  for (std::size_t h = 0; h < f.rows.size(); ++h) {
+    if (only_table_rows && !f.weather_from_forecast[h]) continue;
+    const std::int64_t t = f.rows.time_s[h];
+    const auto it = std::lower_bound(history.time_s.begin(), history.time_s.end(), t);
+    if (it == history.time_s.end() || *it != t) continue;
+    const auto i = static_cast<std::size_t>(it - history.time_s.begin());
+    if (has_valid && history[Channel::kValid][i] == 0.0) continue;
+    ForecastError e{regimes[h], t, p[i] - f.rows[Channel::kPElW][h],
+                    q[i] - f.rows[Channel::kQThW][h]};
+    if (std::isfinite(e.p_el_w) || std::isfinite(e.q_th_w)) out->push_back(e);
+  }
+}
+
+}  // namespace
+
+const char* WeatherSourceName(WeatherSource source) {
+  return source == WeatherSource::kWeatherForecast ? "weather_forecast" : "persistence";
+}
+
+double SampleQuantile(std::vector<double>* values, double q) {
+  if (values->empty()) return kNaN;
+  std::sort(values->begin(), values->end());
+  const double pos = std::clamp(q, 0.0, 1.0) * static_cast<double>(values->size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, values->size() - 1);
+  return (*values)[lo] + (pos - static_cast<double>(lo)) * ((*values)[hi] - (*values)[lo]);
+}
+
+std::vector<ForecastRegime> RegimesOf(const Plant& plant, const Series& inputs) {
+  std::vector<ForecastRegime> regimes(inputs.size());
+  if (inputs.size() == 0) return regimes;
+  const bool on_plane = inputs.Has(Channel::kGPoaWM2);
+  const Channel g_channel = on_plane ? Channel::kGPoaWM2 : Channel::kGhiWM2;
+  const ClearSkyGrid grid =
+      MakeClearSkyGrid(plant, inputs.time_s.front(), inputs.time_s.back() + 60, kLinkeTurbidity);
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    ForecastRegime& r = regimes[k];
+    const double g = inputs.Has(g_channel) ? inputs[g_channel][k] : kNaN;
+    const double g0 = std::isnan(g) ? 0.0 : g;
+    r.irradiance = static_cast<std::uint8_t>(
+        std::upper_bound(std::begin(kIrradianceEdgesWM2), std::end(kIrradianceEdgesWM2), g0) -
+        std::begin(kIrradianceEdgesWM2));
+    const auto m = static_cast<std::size_t>((inputs.time_s[k] - grid.time_s.front()) / 60);
+    const double clear =
+        m < grid.time_s.size() ? (on_plane ? grid.clear_poa_w_m2 : grid.clear_ghi_w_m2)[m] : 0.0;
+    r.sky = clear > 0.0 && g0 >= kClearIndex * clear ? 0 : 1;
+    const double solar_h = SolarHour(plant, inputs.time_s[k] + 30);
+    r.time = solar_h < 10.0 ? 0 : (solar_h < 14.0 ? 1 : 2);
+    const double flow = inputs.Has(Channel::kMdotKgS) ? inputs[Channel::kMdotKgS][k] : kNaN;
+    r.pump = std::isfinite(flow) && flow > 0.0 ? 1 : 0;
+  }
+  return regimes;
+}
+
+namespace {
+
+// Calls per_day(request of the day, history before it) for each UTC day of
+// the history with a full day of history before it, until it returns false.
+template <class PerDay>
+void ForEachReplayDay(const Series& history, const ForecastRequest& request, PerDay per_day) {
+  if (history.size() == 0) return;
+  ForecastRequest day = request;
+  day.horizon_s = static_cast<double>(kDayS);
+  day.with_reference = false;
+  const std::int64_t first_day = DayStart(history.time_s.front()) + kDayS;
+  for (std::int64_t d = first_day; d <= history.time_s.back(); d += kDayS) {
+    const auto end = static_cast<std::size_t>(
+        std::lower_bound(history.time_s.begin(), history.time_s.end(), d) - history.time_s.begin());
+    const Series before = history.Slice(0, end);
+    if (before.size() == 0 ||
+        before.time_s.back() - before.time_s.front() < kDayS - std::llround(request.step_s)) {
+      continue;
+    }
+    day.issued_at_s = d;
+    if (!per_day(day, before)) return;
+  }
+}
+
+}  // namespace
+
+bool ReplayForecastErrors(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                          const Series& history, const Series& past_weather_forecast,
+                          const ForecastRequest& request, ForecastErrors* out, std::string* error) {
+  *out = ForecastErrors{};
+  bool ok = true;
+  ForEachReplayDay(history, request, [&](const ForecastRequest& day, const Series& before) {
+    const std::int64_t d = day.issued_at_s;
+    const bool table = past_weather_forecast.size() > 0 &&
+                       past_weather_forecast.time_s.back() >= d &&
+                       past_weather_forecast.time_s.front() < d + kDayS;
+    for (std::size_t s = 0; s < (table ? 2u : 1u); ++s) {
+      Forecast f;
+      ok = MakeForecast(plant, spec, params, before, s == 1 ? past_weather_forecast : Series{},
+                        Series{}, day, &f, error);
+      if (!ok) return false;
+      const std::size_t n_before = out->by_source[s].size();
+      Score(f, RegimesOf(plant, f.inputs_used), history, s == 1, &out->by_source[s]);
+      if (out->by_source[s].size() > n_before) ++out->days[s];
+    }
+    return true;
+  });
+  return ok;
+}
+
+std::string OperationChoice::Describe() const {
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "operation forecast: %s (replayed %zu days with persisted weather: MAE q_th "
+                "typical day %.1f W, learned rule %.1f W)",
+                chosen == OperationForecast::kLearned ? "learned rule" : "typical day", days,
+                mae_q_th_typical_w, mae_q_th_learned_w);
+  return buf;
+}
+
+bool ChooseOperation(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                     const Series& history, const ForecastRequest& request, OperationChoice* out,
+                     std::string* error) {
+  *out = OperationChoice{};
+  double sum[2] = {0.0, 0.0};
+  std::size_t n = 0;
+  bool ok = true;
+  ForEachReplayDay(history, request, [&](ForecastRequest day, const Series& before) {
+    std::vector<ForecastError> errors[2];
+    for (int mode = 0; mode < 2 && ok; ++mode) {
+      day.operation = mode ? OperationForecast::kLearned : OperationForecast::kTypicalDay;
+      Forecast f;
+      ok = MakeForecast(plant, spec, params, before, Series{}, Series{}, day, &f, error);
+      if (ok) Score(f, std::vector<ForecastRegime>(f.rows.size()), history, false, &errors[mode]);
+    }
+    if (!ok) return false;
+    // The same minutes for both: those where both forecasts have Q.
+    std::size_t j = 0;
+    for (const ForecastError& a : errors[0]) {
+      while (j < errors[1].size() && errors[1][j].time_s < a.time_s) ++j;
+      if (j == errors[1].size() || errors[1][j].time_s != a.time_s) continue;
+      if (!std::isfinite(a.q_th_w) || !std::isfinite(errors[1][j].q_th_w)) continue;
+      sum[0] += std::fabs(a.q_th_w);
+      sum[1] += std::fabs(errors[1][j].q_th_w);
+      ++n;
+    }
+    ++out->days;
+    return true;
+  });
+  if (!ok) return false;
+  if (n > 0) {
+    out->mae_q_th_typical_w = sum[0] / static_cast<double>(n);
+    out->mae_q_th_learned_w = sum[1] / static_cast<double>(n);
+    if (out->mae_q_th_learned_w < out->mae_q_th_typical_w) {
+      out->chosen = OperationForecast::kLearned;
+    }
+  }
+  return true;
+}
+
+ForecastBands BandsFor(const Plant& plant, const Forecast& forecast, const ForecastErrors& errors,
+                       const BandOptions& options) {
+  const std::size_t n = forecast.rows.size();
+  ForecastBands b;
+  b.p_el_p10.assign(n, kNaN);
+  b.p_el_p90.assign(n, kNaN);
+  b.q_th_p10.assign(n, kNaN);
+  b.q_th_p90.assign(n, kNaN);
+  std::array<std::map<std::uint32_t, Quantiles>, kWeatherSources> tables;
+  std::array<bool, kWeatherSources> usable{};
+  for (std::size_t s = 0; s < kWeatherSources; ++s) {
+    tables[s] = QuantileTable(errors.by_source[s], options);
+    usable[s] = errors.by_source[s].size() >= options.min_samples;
+  }
+  const std::vector<ForecastRegime> regimes = RegimesOf(plant, forecast.inputs_used);
+  bool substituted = false;
+  for (std::size_t h = 0; h < n; ++h) {
+    std::size_t s =
+        h < forecast.weather_from_forecast.size() && forecast.weather_from_forecast[h] ? 1 : 0;
+    if (!usable[s]) {
+      substituted = substituted || s == 1;
+      s = 0;
+    }
+    if (!usable[s]) continue;
+    ++b.rows_from[s];
+    const auto [p_lo, p_hi] = Lookup(tables[s], regimes[h], true);
+    const auto [q_lo, q_hi] = Lookup(tables[s], regimes[h], false);
+    const double p = forecast.rows[Channel::kPElW][h], q = forecast.rows[Channel::kQThW][h];
+    b.p_el_p10[h] = std::max(0.0, p + p_lo);
+    b.p_el_p90[h] = std::max(0.0, p + p_hi);
+    b.q_th_p10[h] = q + q_lo;
+    b.q_th_p90[h] = q + q_hi;
+  }
+  char buf[160];
+  b.note = "bands:";
+  for (std::size_t s = 0; s < kWeatherSources; ++s) {
+    std::snprintf(buf, sizeof buf, "%s %s errors of %zu days (%zu rows)", s ? ";" : "",
+                  WeatherSourceName(static_cast<WeatherSource>(s)), errors.days[s], b.rows_from[s]);
+    b.note += buf;
+  }
+  if (substituted) b.note += "; weather_forecast rows banded with persistence errors";
+  return b;
+}
+
+}  // namespace pvtwin

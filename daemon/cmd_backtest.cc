@@ -1,17 +1,26 @@
 // pvtwin backtest: the paper's rolling evaluation (section 3.3) on a CSV.
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "config/plant_config.h"
+#include "core/common/calendar.h"
 #include "core/forecast/backtest.h"
+#include "core/forecast/forecast_backtest.h"
 #include "core/model/variant.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
+#include "daemon/weather_import.h"
 #include "io/backtest_report.h"
+#include "io/local_time.h"
 #include "io/params_json.h"
 #include "io/quantity_text.h"
+#include "io/time_format.h"
 
 namespace pvtwin::cli {
 
@@ -27,6 +36,11 @@ struct BacktestArgs {
   int test_days = 29;
   std::string json;
   int threads = 0;
+  // --forecast: the daily forecast's backtest instead of the fit's.
+  bool forecast = false;
+  std::string issue_at = "00:00";
+  std::string weather;
+  std::string params;
 };
 
 // "YYYY-MM-DD" → year, month, day. False unless it is a calendar date.
@@ -72,6 +86,102 @@ void PrintProgress(int done, int total, const BacktestDay& day, std::int64_t sol
   }
 }
 
+// The issue times: the first local issue_at on or after the first test day's
+// start, then one a day, while the data reach into the horizon.
+bool IssueTimes(const BacktestArgs& a, const Config& config, const Series& series,
+                std::int64_t first_day_start, std::vector<std::int64_t>* out) {
+  int hour = 0, minute = 0;
+  std::string error;
+  if (!ParseClockTime(a.issue_at, &hour, &minute)) {
+    std::cerr << "--issue-at = " << a.issue_at << ": expected HH:MM (local time of [calibration] "
+              << "timezone)\n";
+    return false;
+  }
+  if (!UseTimeZone(config.calibration.timezone, &error)) {
+    std::cerr << a.config << ": [calibration] timezone = " << config.calibration.timezone << ": "
+              << error << "\n";
+    return false;
+  }
+  std::int64_t t = NextLocalTime(first_day_start - 1, hour, minute);
+  for (int k = 0; k < a.test_days && t < series.time_s.back(); ++k) {
+    out->push_back(t);
+    t = NextLocalTime(t, hour, minute);
+  }
+  return true;
+}
+
+int RunForecastBacktestCommand(const BacktestArgs& a, const Config& config, const Series& series,
+                               std::optional<std::int64_t> first_test_day_s) {
+  ForecastBacktestOptions options;
+  std::string error;
+  const std::string variant = a.variants.empty() ? config.calibration.variant : a.variants[0];
+  if (!ParseVariant(variant, &options.spec, &error)) {
+    std::cerr << "--variants = " << variant << ": " << error << "\n";
+    return kExitBadInput;
+  }
+  options.window_days = a.train_days.empty() ? config.calibration.window_days : a.train_days[0];
+  if (series.step_s != 60.0) {
+    std::cerr << a.csv << ": backtest --forecast needs 1-min rows, as the daemon forecasts; the "
+              << "file's step is " << series.step_s << " s\n";
+    return kExitBadInput;
+  }
+  if (!a.params.empty()) {
+    options.fixed_params = true;
+    ParamsFile file;
+    file.values = StartParams(config.plant);
+    Diagnostics errors;
+    if (!ReadParamsJson(a.params, config.plant, &file, &errors)) {
+      for (const Diagnostic& d : errors) std::cerr << d.ToString() << "\n";
+      return kExitBadInput;
+    }
+    options.params = file.values;
+  }
+  Series weather;
+  if (!a.weather.empty()) {
+    std::ifstream in(a.weather, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    WeatherImportResult r;
+    if (!in || !WeatherTextTo1Min(config.plant, text.str(), a.weather, &r, &weather)) {
+      if (!in) std::cerr << a.weather << ": cannot be read\n";
+      for (const Diagnostic& d : r.errors) std::cerr << d.ToString() << "\n";
+      return kExitBadInput;
+    }
+    std::cerr << "weather forecast " << a.weather << " (" << r.file.format
+              << "): " << weather.size() << " 1-min rows\n";
+  }
+  const std::int64_t offset_s = SolarDayOffsetS(config.plant);
+  const std::int64_t first_day =
+      first_test_day_s ? *first_test_day_s
+                       : SolarDayStartS(series.time_s.front(), offset_s) +
+                             static_cast<std::int64_t>(options.window_days) * kSecondsPerDay;
+  if (!IssueTimes(a, config, series, first_day, &options.issue_times_s)) return kExitBadInput;
+  if (options.issue_times_s.empty()) {
+    std::cerr << a.csv << ": no issue time with " << options.window_days
+              << " days of data before it and data after it\n";
+    return kExitBadInput;
+  }
+  ForecastBacktestResult result;
+  const auto progress = [](int done, int total, const ForecastBacktestDay& d) {
+    if (d.ok) {
+      std::fprintf(stderr, "[%d/%d] forecast issued %s: skill P_el %.3f, Q_u %.3f\n", done, total,
+                   FormatIsoUtc(d.issued_at_s).c_str(), d.p_el.skill, d.q_th.skill);
+    } else {
+      std::fprintf(stderr, "[%d/%d] forecast issued %s: not scored: %s\n", done, total,
+                   FormatIsoUtc(d.issued_at_s).c_str(), d.failure.c_str());
+    }
+  };
+  if (!RunForecastBacktest(series, weather, config.plant, options, &result, &error, progress)) {
+    std::cerr << error << "\n";
+    return kExitBadInput;
+  }
+  std::cout << FormatForecastBacktest(result) << "\nall days: MAE P_el "
+            << WattsAndPerM2(result.total_p_el.mae_w, config.plant.area_m2) << ", MAE Q_u "
+            << WattsAndPerM2(result.total_q_th.mae_w, config.plant.area_m2) << "\n";
+  std::cout.flush();
+  return result.days_ok > 0 ? kExitOk : kExitRuntime;
+}
+
 int RunBacktestCommand(const BacktestArgs& a) {
   // Every variant name first, each bad one reported.
   Config config;
@@ -107,6 +217,7 @@ int RunBacktestCommand(const BacktestArgs& a) {
   }
   Series series;
   if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
+  if (a.forecast) return RunForecastBacktestCommand(a, config, series, options.first_test_day_s);
   // Default: the data's own step, as the file holds them.
   const std::vector<double> steps_s =
       a.steps_s.empty() ? std::vector<double>{series.step_s} : a.steps_s;
@@ -213,6 +324,23 @@ void RegisterBacktest(CLI::App& app) {
   cmd->add_option("--json", args->json, "write the report (every job and the means) as JSON");
   cmd->add_option("--threads", args->threads, "worker threads, 0 = all cores (default 0)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--forecast", args->forecast,
+                "backtest the daily 24 h forecast instead of the fit: for each test day, "
+                "identify on the window before the issue (the first --train-days, default "
+                "[calibration] window_days), issue the forecast as the daemon does and score it "
+                "against the measured day: MAE, skill against smart persistence and the 10-90 % "
+                "band's coverage. Needs 1-min rows. Example: pvtwin backtest --forecast "
+                "--config plant.toml --csv plant.csv --weather forecast.json --test-days 14");
+  cmd->add_option("--issue-at", args->issue_at,
+                  "with --forecast: local time HH:MM of [calibration] timezone at which each "
+                  "day's forecast is issued (default 00:00)");
+  cmd->add_option("--weather", args->weather,
+                  "with --forecast: a weather forecast file (Open-Meteo JSON or canonical CSV, as "
+                  "import-weather reads) for the horizons and the replayed days; without it "
+                  "the weather is persisted");
+  cmd->add_option("--params", args->params,
+                  "with --forecast: fixed parameters (JSON of calibrate) instead of identifying "
+                  "each day");
   cmd->callback([args] { SetExitCode(RunBacktestCommand(*args)); });
 }
 

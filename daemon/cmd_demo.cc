@@ -27,12 +27,16 @@
 #include "config/config_edit.h"
 #include "core/common/clock.h"
 #include "core/common/units.h"
+#include "core/forecast/forecast_backtest.h"
+#include "core/model/variant.h"
 #include "daemon/commands.h"
 #include "daemon/demo_config.h"
 #include "daemon/inputs.h"
 #include "daemon/service.h"
 #include "io/child_process.h"
 #include "io/csv.h"
+#include "io/local_time.h"
+#include "io/params_json.h"
 #include "io/quantity_text.h"
 #include "io/store.h"
 #include "io/time_format.h"
@@ -99,10 +103,73 @@ void PrintNoonForecast(Store* store, const Plant& plant, std::int64_t from_ts) {
   }
   if (at_noon == nullptr || best == nullptr) return;
   std::printf(
-      "      forecast at solar noon (%s): P_el %.0f W, Q_u %.0f W; that day's highest Q_u "
-      "%.0f W at %s\n",
-      FormatIsoUtc(at_noon->ts).c_str(), at_noon->p_el_w, at_noon->q_th_w, best->q_th_w,
+      "      forecast at solar noon (%s): P_el %.0f W (10-90 %%: %.0f-%.0f W), Q_u %.0f W "
+      "(%.0f-%.0f W); that day's highest Q_u %.0f W at %s\n",
+      FormatIsoUtc(at_noon->ts).c_str(), at_noon->p_el_w, at_noon->p_el_w_p10, at_noon->p_el_w_p90,
+      at_noon->q_th_w, at_noon->q_th_w_p10, at_noon->q_th_w_p90, best->q_th_w,
       FormatIsoUtc(best->ts).c_str());
+}
+
+// The skill of the day-ahead forecasts: forecast_skill's days where the live
+// run scored one; else the forecast as the daemon issues it (its accepted
+// calibration, issued at local midnight) replayed over the last days of the
+// imported history and scored like forecast_skill (core/forecast/
+// forecast_backtest.h).
+void PrintForecastSkill(Store* store, const Config& config, const Store::CalibrationRow& cal,
+                        const Series& history) {
+  std::vector<Store::SkillRow> days;
+  std::string error;
+  if (store->ReadForecastSkill(0, std::numeric_limits<std::int64_t>::max(), &days, &error)) {
+    bool printed = false;
+    for (const Store::SkillRow& d : days) {
+      if (std::isnan(d.skill_p_el)) continue;
+      std::printf(
+          "      forecast_skill %s: skill P_el %.3f, Q_u %.3f, band coverage %.2f over %lld "
+          "minutes\n",
+          FormatIsoUtc(d.day).c_str(), d.skill_p_el, d.skill_q_th, d.coverage_p10_p90,
+          static_cast<long long>(d.minutes));
+      printed = true;
+    }
+    if (printed) return;
+  }
+  ForecastBacktestOptions options;
+  ParamsFile params;
+  Diagnostics errors;
+  if (!ParseVariant(cal.variant, &options.spec, &error) ||
+      !ParseParamsJson(cal.params_json, "calibration " + std::to_string(cal.id), config.plant,
+                       &params, &errors) ||
+      !UseTimeZone(config.calibration.timezone, &error) || history.size() == 0) {
+    return;
+  }
+  options.fixed_params = true;
+  options.params = params.values;
+  options.window_days = 7;
+  constexpr int kDays = 3;
+  for (std::int64_t t = history.time_s.back() - (kDays + 1) * 86400;
+       options.issue_times_s.size() < kDays;) {
+    t = NextLocalTime(t, 0, 0);
+    if (t + 86400 <= history.time_s.back() + 60) options.issue_times_s.push_back(t);
+  }
+  ForecastBacktestResult result;
+  if (!RunForecastBacktest(history, Series{}, config.plant, options, &result, &error) ||
+      result.days_ok == 0) {
+    return;
+  }
+  std::printf(
+      "      day-ahead forecasts of calibration %lld replayed over the last %d imported days "
+      "(persisted weather; skill against smart persistence):\n",
+      static_cast<long long>(cal.id), kDays);
+  for (const ForecastBacktestDay& d : result.days) {
+    if (!d.ok) continue;
+    std::printf("        issued %s (%s operation): skill P_el %.3f, Q_u %.3f\n",
+                FormatIsoUtc(d.issued_at_s).c_str(), d.operation.c_str(), d.p_el.skill,
+                d.q_th.skill);
+  }
+  std::printf(
+      "        all %d days: skill P_el %.3f, Q_u %.3f; the 10-90 %% band covers %.0f %% (P_el) "
+      "and %.0f %% (Q_u) of the measured minutes\n",
+      result.days_ok, result.total_p_el.skill, result.total_q_th.skill,
+      100.0 * result.total_p_el.coverage, 100.0 * result.total_q_th.coverage);
 }
 
 // What the daily checks and the diagnosis left in the store.
@@ -300,6 +367,12 @@ int RunDemo(const DemoArgs& a) {
   std::printf("      forecast rows written: %zu (24 h at 1 min)\n", last.last_forecast_rows);
   if (store) PrintNoonForecast(store.get(), demo_plant.plant, t0);
   if (store) PrintMonitoring(store.get(), fs::path(db).parent_path());
+  if (store && found) {
+    Series history;
+    if (LoadCsvOrReport(history_csv.string(), demo_plant, &history)) {
+      PrintForecastSkill(store.get(), demo_plant, cal, history);
+    }
+  }
   std::printf("      plant: %s\n", OperationSummary(demo_plant.sim).c_str());
   std::printf("      live polling: %llu samples, %llu 1-min rows; runtime %.0f s\n",
               static_cast<unsigned long long>(last.samples_stored),

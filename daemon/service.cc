@@ -21,6 +21,7 @@
 #include "core/common/sample.h"
 #include "core/fit/identification.h"
 #include "core/forecast/forecast.h"
+#include "core/forecast/forecast_bands.h"
 #include "core/model/thermal_model.h"
 #include "core/model/variant.h"
 #include "daemon/calibration_acceptance.h"
@@ -225,6 +226,12 @@ class Service {
   std::vector<std::pair<int, std::string>> device_events_;  // poller state changes, for events
   // Forecast and housekeeping.
   double next_forecast_s_ = 0.0;
+  // What the forecasts learn from the window (operation choice, replayed
+  // errors for the bands): recomputed on a new UTC day or calibration.
+  ForecastWindowStats forecast_stats_;
+  std::int64_t forecast_stats_day_ = -1;
+  std::int64_t forecast_stats_params_id_ = -1;
+  bool UpdateForecastStats(const Series& history, const ForecastRequest& request);
   double next_retention_s_ = 0.0;
   double next_watchdog_wall_s_ = 0.0;
 };
@@ -660,23 +667,34 @@ void Service::IssueForecast() {
     LogToStderr(kErr, "forecast inputs could not be read: " + error);
     return;
   }
-  Forecast forecast;
-  if (!MakeForecast(config_.plant, spec_, params_, history, weather, plan, request, &forecast,
-                    &error)) {
+  if (!UpdateForecastStats(history, request)) return;
+  BandedForecast banded;
+  if (!MakeBandedForecast(config_.plant, spec_, params_, history, weather, plan, request,
+                          forecast_stats_, &banded, &error)) {
     LogToStderr(kWarning, "no forecast issued: " + error);
     return;
   }
+  Forecast& forecast = banded.forecast;
   if (weather.size() > 0 && !store_->ReadWeatherSources(request.issued_at_s, horizon_end,
                                                         &forecast.inputs.weather_sources, &error)) {
     LogToStderr(kWarning, "the weather_forecast sources could not be read: " + error);
   }
   std::vector<Store::ForecastRow> rows(forecast.rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    rows[i] = {forecast.rows.time_s[i], forecast.rows[Channel::kPElW][i],
-               forecast.rows[Channel::kQThW][i], forecast.rows[Channel::kTPvC][i],
-               forecast.rows[Channel::kTOutC][i]};
+    Store::ForecastRow& r = rows[i];
+    r.ts = forecast.rows.time_s[i];
+    r.p_el_w = forecast.rows[Channel::kPElW][i];
+    r.q_th_w = forecast.rows[Channel::kQThW][i];
+    r.t_pv_c = forecast.rows[Channel::kTPvC][i];
+    r.t_out_c = forecast.rows[Channel::kTOutC][i];
+    r.p_el_w_p10 = banded.bands.p_el_p10[i];
+    r.p_el_w_p90 = banded.bands.p_el_p90[i];
+    r.q_th_w_p10 = banded.bands.q_th_p10[i];
+    r.q_th_w_p90 = banded.bands.q_th_p90[i];
+    r.p_el_w_ref = forecast.reference[Channel::kPElW][i];
+    r.q_th_w_ref = forecast.reference[Channel::kQThW][i];
   }
-  const std::string inputs = forecast.inputs.Describe();
+  const std::string inputs = banded.Inputs();
   if (!store_->InsertForecast(request.issued_at_s, params_id_, inputs, rows, &error)) {
     LogToStderr(kErr, "writing the forecast failed: " + error);
     return;
@@ -686,6 +704,24 @@ void Service::IssueForecast() {
   LogToStderr(kInfo, "forecast issued at " + FormatIsoUtc(request.issued_at_s) + ": " +
                          std::to_string(rows.size()) + " rows, calibration " +
                          std::to_string(params_id_) + "; " + inputs);
+}
+
+bool Service::UpdateForecastStats(const Series& history, const ForecastRequest& request) {
+  const std::int64_t day = request.issued_at_s - ((request.issued_at_s % kDayS) + kDayS) % kDayS;
+  if (day == forecast_stats_day_ && params_id_ == forecast_stats_params_id_) return true;
+  Series past_weather;
+  std::string error;
+  if (!store_->ReadWeatherForecast(history.size() ? history.time_s.front() : day, day + kDayS,
+                                   &past_weather, &error) ||
+      !ReplayWindow(config_.plant, spec_, params_, history, past_weather, request, &forecast_stats_,
+                    &error)) {
+    LogToStderr(kWarning, "the forecast's window could not be replayed: " + error);
+    return false;
+  }
+  forecast_stats_day_ = day;
+  forecast_stats_params_id_ = params_id_;
+  LogToStderr(kInfo, forecast_stats_.operation.Describe());
+  return true;
 }
 
 void Service::StartUpload() {

@@ -19,24 +19,31 @@ std::string WeatherImportResult::SummaryLine(const std::string& source) const {
   return line;
 }
 
-WeatherImportResult ImportWeatherText(Store& store, const Plant& plant, const std::string& text,
-                                      const std::string& name, const std::string& source) {
-  WeatherImportResult result;
-  if (!ParseWeatherFile(text, name, &result.file, &result.errors)) {
-    result.status = WeatherImportResult::Status::kBadInput;
-    return result;
+bool WeatherTextTo1Min(const Plant& plant, const std::string& text, const std::string& name,
+                       WeatherImportResult* result, Series* rows) {
+  if (!ParseWeatherFile(text, name, &result->file, &result->errors)) {
+    result->status = WeatherImportResult::Status::kBadInput;
+    return false;
   }
   WeatherResampleOptions options;
   options.collector_height_m = plant.collector_height_m;
-  Series rows;
   std::string error;
-  if (!ResampleWeatherTo1Min(plant, result.file.weather, options, &rows, &result.summary, &error)) {
-    result.errors.push_back({name, 0, "", "", error});
-    result.status = WeatherImportResult::Status::kBadInput;
-    return result;
+  if (!ResampleWeatherTo1Min(plant, result->file.weather, options, rows, &result->summary,
+                             &error)) {
+    result->errors.push_back({name, 0, "", "", error});
+    result->status = WeatherImportResult::Status::kBadInput;
+    return false;
   }
-  result.from_ts = rows.time_s.front();
-  result.to_ts = rows.time_s.back() + 60;
+  result->from_ts = rows->time_s.front();
+  result->to_ts = rows->time_s.back() + 60;
+  return true;
+}
+
+WeatherImportResult ImportWeatherText(Store& store, const Plant& plant, const std::string& text,
+                                      const std::string& name, const std::string& source) {
+  WeatherImportResult result;
+  Series rows;
+  if (!WeatherTextTo1Min(plant, text, name, &result, &rows)) return result;
   if (!store.WriteWeatherForecast(rows, source + " (" + result.file.format + ")",
                                   &result.store_error)) {
     result.status = WeatherImportResult::Status::kStoreFailed;

@@ -25,6 +25,11 @@ struct WeatherImportResult {
   std::string SummaryLine(const std::string& source) const;
 };
 
+// Parses and resamples without writing: the 1-min rows into *rows; false
+// (result->status kBadInput, result->errors) on bad input.
+bool WeatherTextTo1Min(const Plant& plant, const std::string& text, const std::string& name,
+                       WeatherImportResult* result, Series* rows);
+
 // source: what weather_forecast.source records, e.g. "import-weather
 // forecast.json" or "fetch https://api.open-meteo.com/...".
 WeatherImportResult ImportWeatherText(Store& store, const Plant& plant, const std::string& text,

@@ -21,6 +21,7 @@
 
 #include "core/common/units.h"
 #include "core/data/physical_limits.h"
+#include "core/forecast/forecast.h"
 
 namespace pvtwin {
 
@@ -204,12 +205,75 @@ std::vector<std::string> SchemaV5() {
   };
 }
 
+// Version 6: forecasts with uncertainty bands and the reference forecast
+// they are scored against (issue 15, core/forecast/forecast_bands.h); the
+// views gain the bands, the skill against the reference, the band's
+// coverage and the scored minutes. Views are dropped and created again with
+// their old columns first.
+std::vector<std::string> SchemaV6() {
+  std::vector<std::string> s;
+  for (const char* column :
+       {"p_el_w_p10", "p_el_w_p90", "q_th_w_p10", "q_th_w_p90", "p_el_w_ref", "q_th_w_ref"}) {
+    s.push_back(std::string("ALTER TABLE forecast ADD COLUMN ") + column + " REAL");
+  }
+  s.push_back("DROP VIEW forecast_latest");
+  s.push_back(
+      "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c, p_el_w_p10, "
+      "p_el_w_p90, q_th_w_p10, q_th_w_p90) AS "
+      "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c, f.p_el_w_p10, "
+      "f.p_el_w_p90, f.q_th_w_p10, f.q_th_w_p90 FROM forecast f "
+      "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)");
+  s.push_back("DROP VIEW forecast_skill");
+  // The pairs of version 1, plus per minute: the reference's error where the
+  // forecast has a value, and whether the measurement lies in a band of
+  // width (NULL without one). Skill compares MAEs over the minutes where
+  // both are known; skill and coverage need kMinScoredMinutes scored minutes.
+  const std::string min_minutes = std::to_string(kMinScoredMinutes);
+  s.push_back(
+      "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, "
+      "skill_q_th, coverage_p10_p90, minutes) AS "
+      "WITH pairs AS ("
+      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
+      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
+      "  CASE WHEN f.p_el_w IS NOT NULL THEN f.p_el_w_ref - m.p_el_w END AS ref_p,"
+      "  CASE WHEN f.q_th_w IS NOT NULL THEN f.q_th_w_ref - m.q_th_w END AS ref_q,"
+      "  CASE WHEN f.p_el_w_p90 > f.p_el_w_p10 AND m.p_el_w IS NOT NULL"
+      "   THEN m.p_el_w BETWEEN f.p_el_w_p10 AND f.p_el_w_p90 END AS in_p,"
+      "  CASE WHEN f.q_th_w_p90 > f.q_th_w_p10 AND m.q_th_w IS NOT NULL"
+      "   THEN m.q_th_w BETWEEN f.q_th_w_p10 AND f.q_th_w_p90 END AS in_q"
+      " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
+      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+      "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+      " WHERE m.valid IS NULL OR m.valid != 0)"
+      " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
+      "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
+      "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END)),"
+      "  CASE WHEN COUNT(*) >= " +
+      min_minutes +
+      " THEN 1.0 -"
+      "   SUM(CASE WHEN ref_p IS NOT NULL THEN ABS(err_p) END) /"
+      "   NULLIF(SUM(CASE WHEN err_p IS NOT NULL THEN ABS(ref_p) END), 0) END,"
+      "  CASE WHEN COUNT(*) >= " +
+      min_minutes +
+      " THEN 1.0 -"
+      "   SUM(CASE WHEN ref_q IS NOT NULL THEN ABS(err_q) END) /"
+      "   NULLIF(SUM(CASE WHEN err_q IS NOT NULL THEN ABS(ref_q) END), 0) END,"
+      "  CASE WHEN COUNT(*) >= " +
+      min_minutes +
+      " THEN"
+      "   (TOTAL(in_p) + TOTAL(in_q)) / NULLIF(COUNT(in_p) + COUNT(in_q), 0) END,"
+      "  COUNT(*)"
+      " FROM pairs GROUP BY day");
+  return s;
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {
-    {1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}, {4, &SchemaV4}, {5, &SchemaV5}};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3},
+                                 {4, &SchemaV4}, {5, &SchemaV5}, {6, &SchemaV6}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 
@@ -416,11 +480,10 @@ struct Store::Impl {
   // Reads the samples of [from, to) whose minute has no 1-min row yet (all of
   // them if `all`), aggregates and writes them (inside a transaction).
   DbStatus AggregateRange(std::int64_t from_ts, std::int64_t to_ts, bool all, int* minutes_written);
-  // Rows of (INTEGER time, 4 REAL) from a query over a time range, as Row
-  // (ForecastRow or SkillRow, which have that layout).
-  template <typename Row>
-  bool ReadTimeAndFourReals(const std::string& sql, const std::string& what, std::int64_t from,
-                            std::int64_t to, std::vector<Row>* out, std::string* error);
+  // The rows of a [from, to) query, each built by from_statement(stmt).
+  template <typename Row, typename FromStatement>
+  bool ReadRows(const std::string& sql, const std::string& what, std::int64_t from, std::int64_t to,
+                FromStatement from_statement, std::vector<Row>* out, std::string* error);
   // Deletes the forecast rows in [from_ts, to_ts) that neither view uses.
   DbStatus PruneForecasts(std::int64_t from_ts, std::int64_t to_ts);
   bool ReadInputTable(const std::string& table, std::span<const Channel> channels,
@@ -1325,7 +1388,8 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
         sqlite3_stmt* stmt = nullptr;
         DbStatus s = db.Prepare(
             "INSERT OR REPLACE INTO forecast(issued_at, ts, calibration_id, p_el_w, q_th_w, "
-            "t_pv_c, t_out_c, inputs) VALUES(?, ?, ?, ?, ?, ?, ?, ?)",
+            "t_pv_c, t_out_c, inputs, p_el_w_p10, p_el_w_p90, q_th_w_p10, q_th_w_p90, "
+            "p_el_w_ref, q_th_w_ref) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             &stmt);
         if (!s.ok()) return s;
         for (const ForecastRow& row : rows) {
@@ -1337,11 +1401,15 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
           } else {
             sqlite3_bind_null(stmt, 3);
           }
-          BindReal(stmt, 4, row.p_el_w);
-          BindReal(stmt, 5, row.q_th_w);
-          BindReal(stmt, 6, row.t_pv_c);
-          BindReal(stmt, 7, row.t_out_c);
-          sqlite3_bind_text(stmt, 8, inputs.c_str(), -1, SQLITE_TRANSIENT);
+          int column = 4;
+          for (double v : {row.p_el_w, row.q_th_w, row.t_pv_c, row.t_out_c}) {
+            BindReal(stmt, column++, v);
+          }
+          sqlite3_bind_text(stmt, column++, inputs.c_str(), -1, SQLITE_TRANSIENT);
+          for (double v : {row.p_el_w_p10, row.p_el_w_p90, row.q_th_w_p10, row.q_th_w_p90,
+                           row.p_el_w_ref, row.q_th_w_ref}) {
+            BindReal(stmt, column++, v);
+          }
           s = db.StepDone(stmt, "insert forecast row ts " + std::to_string(row.ts));
           if (!s.ok()) return s;
         }
@@ -1350,21 +1418,17 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
       error);
 }
 
-template <typename Row>
-bool Store::Impl::ReadTimeAndFourReals(const std::string& sql, const std::string& what,
-                                       std::int64_t from, std::int64_t to, std::vector<Row>* out,
-                                       std::string* error) {
+template <typename Row, typename FromStatement>
+bool Store::Impl::ReadRows(const std::string& sql, const std::string& what, std::int64_t from,
+                           std::int64_t to, FromStatement from_statement, std::vector<Row>* out,
+                           std::string* error) {
   Impl& db = *this;
-  std::lock_guard lock(db.mutex);
   std::vector<Row> rows;
   const bool ok = db.Run(
       false, what,
       [&]() -> DbStatus {
         rows.clear();
-        auto on_row = [&rows](sqlite3_stmt* stmt) {
-          rows.push_back({sqlite3_column_int64(stmt, 0), ColumnReal(stmt, 1), ColumnReal(stmt, 2),
-                          ColumnReal(stmt, 3), ColumnReal(stmt, 4)});
-        };
+        auto on_row = [&](sqlite3_stmt* stmt) { rows.push_back(from_statement(stmt)); };
         return db.SelectRange(sql, from, to, on_row, what);
       },
       error);
@@ -1374,18 +1438,37 @@ bool Store::Impl::ReadTimeAndFourReals(const std::string& sql, const std::string
 
 bool Store::ReadLatestForecast(std::int64_t from_ts, std::int64_t to_ts,
                                std::vector<ForecastRow>* out, std::string* error) {
-  return impl_->ReadTimeAndFourReals(
-      "SELECT ts, p_el_w, q_th_w, t_pv_c, t_out_c FROM forecast_latest "
-      "WHERE ts >= ? AND ts < ? ORDER BY ts",
-      "read forecast_latest", from_ts, to_ts, out, error);
+  return impl_->ReadRows(
+      "SELECT ts, p_el_w, q_th_w, t_pv_c, t_out_c, p_el_w_p10, p_el_w_p90, q_th_w_p10, "
+      "q_th_w_p90 FROM forecast_latest WHERE ts >= ? AND ts < ? ORDER BY ts",
+      "read forecast_latest", from_ts, to_ts,
+      [](sqlite3_stmt* stmt) {
+        ForecastRow r;
+        r.ts = sqlite3_column_int64(stmt, 0);
+        double* fields[] = {&r.p_el_w,     &r.q_th_w,     &r.t_pv_c,     &r.t_out_c,
+                            &r.p_el_w_p10, &r.p_el_w_p90, &r.q_th_w_p10, &r.q_th_w_p90};
+        for (int i = 0; i < 8; ++i) *fields[i] = ColumnReal(stmt, i + 1);
+        return r;
+      },
+      out, error);
 }
 
 bool Store::ReadForecastSkill(std::int64_t from_day, std::int64_t to_day,
                               std::vector<SkillRow>* out, std::string* error) {
-  return impl_->ReadTimeAndFourReals(
-      "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th FROM "
-      "forecast_skill WHERE day >= ? AND day < ? ORDER BY day",
-      "read forecast_skill", from_day, to_day, out, error);
+  return impl_->ReadRows(
+      "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
+      "coverage_p10_p90, minutes FROM forecast_skill WHERE day >= ? AND day < ? ORDER BY day",
+      "read forecast_skill", from_day, to_day,
+      [](sqlite3_stmt* stmt) {
+        SkillRow r;
+        r.day = sqlite3_column_int64(stmt, 0);
+        double* fields[] = {&r.mae_p_el_w, &r.mae_q_th_w, &r.nmae_p_el,       &r.nmae_q_th,
+                            &r.skill_p_el, &r.skill_q_th, &r.coverage_p10_p90};
+        for (int i = 0; i < 7; ++i) *fields[i] = ColumnReal(stmt, i + 1);
+        r.minutes = sqlite3_column_int64(stmt, 8);
+        return r;
+      },
+      out, error);
 }
 
 bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Channel> channels,

@@ -102,6 +102,23 @@
 //       --config) last ran with, in the config's units (degrees), so that a
 //       command given only the store knows the site.
 //
+// Version 6 adds (issue 15, core/forecast/forecast_bands.h):
+//   forecast.p_el_w_p10, p_el_w_p90, q_th_w_p10, q_th_w_p90 REAL
+//       the 10–90 % band of each output: empirical quantiles of the
+//       replayed day-ahead errors of the window by regime and weather
+//       source; NULL where no band could be made.
+//   forecast.p_el_w_ref, q_th_w_ref REAL
+//       the reference forecast issued with it: smart persistence of the
+//       weather with the typical day's operation (core/forecast/forecast.h).
+//   view forecast_latest gains p_el_w_p10, p_el_w_p90, q_th_w_p10, q_th_w_p90.
+//   view forecast_skill gains skill_p_el, skill_q_th = 1 − MAE / MAE of the
+//       reference over the minutes where both are known; coverage_p10_p90 =
+//       the share of measured values inside their band, over both outputs'
+//       minutes whose band has a width (p90 > p10); minutes = the day's
+//       scored minutes. skill and coverage are NULL on days with fewer than
+//       kMinScoredMinutes (core/forecast/forecast.h) scored minutes (and where the reference is
+//       exact).
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -140,6 +157,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -152,7 +170,9 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 5;
+inline constexpr int kStoreSchemaVersion = 6;
+// NULL in a row struct.
+inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
 struct StoreOptions {
   // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
@@ -193,12 +213,18 @@ class Store {
   struct ForecastRow {
     std::int64_t ts = 0;
     double p_el_w = 0.0, q_th_w = 0.0, t_pv_c = 0.0, t_out_c = 0.0;
+    // The 10–90 % band and the reference forecast (version 6); NaN: NULL.
+    double p_el_w_p10 = kNoValue, p_el_w_p90 = kNoValue, q_th_w_p10 = kNoValue,
+           q_th_w_p90 = kNoValue;
+    double p_el_w_ref = kNoValue, q_th_w_ref = kNoValue;  // written, not read back
   };
 
-  // One row of the forecast_skill view.
+  // One row of the forecast_skill view (NaN: NULL).
   struct SkillRow {
     std::int64_t day = 0;  // unix s of 00:00 UTC
     double mae_p_el_w = 0.0, mae_q_th_w = 0.0, nmae_p_el = 0.0, nmae_q_th = 0.0;
+    double skill_p_el = kNoValue, skill_q_th = kNoValue, coverage_p10_p90 = kNoValue;
+    std::int64_t minutes = 0;
   };
 
   // Opens (creating if needed) and migrates the database at path. Returns

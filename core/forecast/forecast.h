@@ -49,6 +49,11 @@ enum class OperationForecast {
   kLearned,     // the controller learned from the window (operation_forecast.h)
 };
 
+// A day of forecast scores (forecast_skill's skill and coverage, `backtest
+// --forecast`) needs this many scored minutes, a quarter of a day: fewer
+// would score the time of day rather than the forecast.
+inline constexpr int kMinScoredMinutes = 360;
+
 struct ForecastRequest {
   std::int64_t issued_at_s = 0;      // first forecast row (unix s UTC)
   double horizon_s = 86400.0;        // forecast length

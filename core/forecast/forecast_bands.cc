@@ -264,6 +264,36 @@ bool ChooseOperation(const Plant& plant, const ModelSpec& spec, const ParamVecto
   return true;
 }
 
+bool ReplayWindow(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                  const Series& history, const Series& past_weather_forecast,
+                  const ForecastRequest& request, ForecastWindowStats* out, std::string* error) {
+  if (!ChooseOperation(plant, spec, params, history, request, &out->operation, error)) {
+    return false;
+  }
+  ForecastRequest replay = request;
+  replay.operation = out->operation.chosen;
+  return ReplayForecastErrors(plant, spec, params, history, past_weather_forecast, replay,
+                              &out->errors, error);
+}
+
+std::string BandedForecast::Inputs() const {
+  return forecast.inputs.Describe() + "; " + bands.note;
+}
+
+bool MakeBandedForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                        const Series& history, const Series& weather_forecast,
+                        const Series& operation_plan, ForecastRequest request,
+                        const ForecastWindowStats& stats, BandedForecast* out, std::string* error) {
+  request.operation = stats.operation.chosen;
+  if (!MakeForecast(plant, spec, params, history, weather_forecast, operation_plan, request,
+                    &out->forecast, error)) {
+    return false;
+  }
+  out->bands = BandsFor(plant, out->forecast, stats.errors);
+  out->bands.note = stats.operation.Describe() + "; " + out->bands.note;
+  return true;
+}
+
 ForecastBands BandsFor(const Plant& plant, const Forecast& forecast, const ForecastErrors& errors,
                        const BandOptions& options) {
   const std::size_t n = forecast.rows.size();

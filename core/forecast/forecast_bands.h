@@ -120,6 +120,32 @@ bool ChooseOperation(const Plant& plant, const ModelSpec& spec, const ParamVecto
                      const Series& history, const ForecastRequest& request, OperationChoice* out,
                      std::string* error);
 
+// What a forecast learns from its window before it is issued: the
+// operation forecast that predicted the replayed days better, and the
+// replayed errors (with that operation) its bands come from. Depends only on
+// the window and the parameters: a daemon computes it once a day and per
+// calibration.
+struct ForecastWindowStats {
+  OperationChoice operation;
+  ForecastErrors errors;
+};
+bool ReplayWindow(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                  const Series& history, const Series& past_weather_forecast,
+                  const ForecastRequest& request, ForecastWindowStats* out, std::string* error);
+
+// A forecast as the daemon issues it: MakeForecast with the window's
+// operation choice, then its bands.
+struct BandedForecast {
+  Forecast forecast;
+  ForecastBands bands;
+  // The forecast rows' `inputs`: Describe(), the operation choice, the bands' note.
+  std::string Inputs() const;
+};
+bool MakeBandedForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                        const Series& history, const Series& weather_forecast,
+                        const Series& operation_plan, ForecastRequest request,
+                        const ForecastWindowStats& stats, BandedForecast* out, std::string* error);
+
 // The sample quantile q (0 … 1) of values, linear between order statistics
 // (Hyndman & Fan type 7); NaN for no values. Reorders values.
 double SampleQuantile(std::vector<double>* values, double q);

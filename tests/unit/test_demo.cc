@@ -40,6 +40,16 @@ TEST(Demo, ALiveRunCutShortByItsTimeLimitStillSucceedsAndCountsItsForecasts) {
   EXPECT_NE(run.out.find("performance index (measured / model): "), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("FROM performance_daily"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("FROM event"), std::string::npos) << run.out;
+  // Its forecasts carry bands around the forecast (issue 15), and it ends by
+  // printing the skill of the day-ahead forecasts and the bands' coverage.
+  EXPECT_GE(db.Number("SELECT count(*) FROM forecast_latest WHERE p_el_w_p10 <= p_el_w AND "
+                      "p_el_w <= p_el_w_p90 AND q_th_w_p90 > q_th_w_p10"),
+            60);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM forecast WHERE p_el_w_ref IS NULL"), 0);
+  EXPECT_TRUE(std::regex_search(
+      run.out, m,
+      std::regex(R"(all \d+ days: skill P_el -?[0-9.]+, Q_u -?[0-9.]+; the 10-90 % band covers)")))
+      << run.out;
 }
 
 }  // namespace

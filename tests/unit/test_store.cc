@@ -74,14 +74,17 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
             (std::vector<std::string>{"id", "run_at", "variant", "window_start", "window_end",
                                       "status", "mae_p_el_w", "mae_q_th_w", "runtime_s", "n_evals",
                                       "params_json", "reason", "heldout_mae_w", "accepted"}));
+  // Version 6 appended the bands and the reference (issue 15).
   EXPECT_EQ(db.Columns("forecast"),
             (std::vector<std::string>{"issued_at", "ts", "calibration_id", "p_el_w", "q_th_w",
-                                      "t_pv_c", "t_out_c", "inputs"}));
+                                      "t_pv_c", "t_out_c", "inputs", "p_el_w_p10", "p_el_w_p90",
+                                      "q_th_w_p10", "q_th_w_p90", "p_el_w_ref", "q_th_w_ref"}));
   EXPECT_EQ(db.Columns("forecast_latest"),
-            (std::vector<std::string>{"ts", "issued_at", "p_el_w", "q_th_w", "t_pv_c", "t_out_c"}));
-  EXPECT_EQ(
-      db.Columns("forecast_skill"),
-      (std::vector<std::string>{"day", "mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th"}));
+            (std::vector<std::string>{"ts", "issued_at", "p_el_w", "q_th_w", "t_pv_c", "t_out_c",
+                                      "p_el_w_p10", "p_el_w_p90", "q_th_w_p10", "q_th_w_p90"}));
+  EXPECT_EQ(db.Columns("forecast_skill"),
+            (std::vector<std::string>{"day", "mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th",
+                                      "skill_p_el", "skill_q_th", "coverage_p10_p90", "minutes"}));
   EXPECT_EQ(
       db.Columns("weather_forecast"),
       (std::vector<std::string>{"ts", "g_poa_w_m2", "ghi_w_m2", "dhi_w_m2", "g_poa_diffuse_w_m2",
@@ -137,13 +140,31 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   }
   {
     RawDb db(DbPath());
-    // Back to what version 1 wrote: without the tables and views of 2 to 5.
-    for (const char* sql :
-         {"DROP TABLE measurement_interval", "DROP VIEW parameter_history",
-          "DROP TABLE calibration_param", "DROP VIEW event", "DROP VIEW measurement_qc",
-          "DROP TABLE performance_daily", "DROP TABLE qc_event", "DROP TABLE monitor_event",
-          "DROP TABLE diagnosis", "ALTER TABLE weather_forecast DROP COLUMN source",
-          "DROP TABLE plant_config", "PRAGMA user_version = 1"}) {
+    // Back to what version 1 wrote: without the tables and views of 2 to 6
+    // (version 1's two forecast views stand in as views of those names,
+    // which version 6 replaces).
+    for (const char* sql : {"DROP VIEW forecast_latest",
+                            "DROP VIEW forecast_skill",
+                            "ALTER TABLE forecast DROP COLUMN p_el_w_p10",
+                            "ALTER TABLE forecast DROP COLUMN p_el_w_p90",
+                            "ALTER TABLE forecast DROP COLUMN q_th_w_p10",
+                            "ALTER TABLE forecast DROP COLUMN q_th_w_p90",
+                            "ALTER TABLE forecast DROP COLUMN p_el_w_ref",
+                            "ALTER TABLE forecast DROP COLUMN q_th_w_ref",
+                            "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
+                            "CREATE VIEW forecast_skill(day) AS SELECT ts FROM measurement_1min",
+                            "DROP TABLE measurement_interval",
+                            "DROP VIEW parameter_history",
+                            "DROP TABLE calibration_param",
+                            "DROP VIEW event",
+                            "DROP VIEW measurement_qc",
+                            "DROP TABLE performance_daily",
+                            "DROP TABLE qc_event",
+                            "DROP TABLE monitor_event",
+                            "DROP TABLE diagnosis",
+                            "ALTER TABLE weather_forecast DROP COLUMN source",
+                            "DROP TABLE plant_config",
+                            "PRAGMA user_version = 1"}) {
       ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
     }
   }
@@ -485,6 +506,71 @@ TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements
   EXPECT_NEAR(skill[0].nmae_q_th, 0.4, 1e-12);
   ASSERT_TRUE(store->ReadForecastSkill(kDay0 + 86400, kDay0 + 2 * 86400, &skill, &error));
   EXPECT_TRUE(skill.empty());
+}
+
+// Skill against the reference and the band's coverage, by hand: 400 minutes
+// of day 0 forecast the day before. P_el: forecast 100, reference 110,
+// measured 100 + (k % 4) → |e| = 0,1,2,3 (mean 1.5), |e_ref| = 10,9,8,7
+// (mean 8.5): skill 1 − 1.5/8.5. Q_u: forecast 500, reference 480, measured
+// 510 → skill 1 − 10/30. Bands: P_el [99, 101.5] holds k % 4 ∈ {0, 1} (200
+// of 400), Q_u [490, 520] all 400; the first 40 minutes have a band of no
+// width for Q_u (night-like) and count for neither: coverage (200 + 360) /
+// (400 + 360). A second day with 100 scored minutes keeps its MAE but gets
+// no skill or coverage.
+TEST_F(StoreTest, ForecastSkillScoresAgainstTheReferenceAndCountsTheBandsCoverage) {
+  auto store = OpenStore();
+  std::string error;
+  const std::int64_t day1 = kDay0 + 86400;
+  Series meas;
+  meas.step_s = 60;
+  std::vector<Store::ForecastRow> rows;
+  std::vector<double> p_el, q_th;
+  for (int k = 0; k < 400; ++k) {
+    const std::int64_t t = kDay0 + 60 * k;
+    meas.time_s.push_back(t);
+    p_el.push_back(100.0 + k % 4);
+    q_th.push_back(510.0);
+    Store::ForecastRow r{t, 100.0, 500.0, 0.0, 0.0};
+    r.p_el_w_p10 = 99.0;
+    r.p_el_w_p90 = 101.5;
+    r.q_th_w_p10 = k < 40 ? 500.0 : 490.0;
+    r.q_th_w_p90 = k < 40 ? 500.0 : 520.0;
+    r.p_el_w_ref = 110.0;
+    r.q_th_w_ref = 480.0;
+    rows.push_back(r);
+  }
+  for (int k = 0; k < 100; ++k) {
+    meas.time_s.push_back(day1 + 60 * k);
+    p_el.push_back(50.0);
+    q_th.push_back(50.0);
+    Store::ForecastRow r{day1 + 60 * k, 40.0, 40.0, 0.0, 0.0};
+    r.p_el_w_ref = 50.0;
+    r.q_th_w_ref = 50.0;
+    rows.push_back(r);
+  }
+  meas[Channel::kPElW] = p_el;
+  meas[Channel::kQThW] = q_th;
+  ASSERT_TRUE(store->WriteMinutes(meas, &error)) << error;
+  ASSERT_TRUE(store->InsertForecast(kDay0 - 3600, 1, "", rows, &error)) << error;
+  std::vector<Store::SkillRow> skill;
+  ASSERT_TRUE(store->ReadForecastSkill(kDay0, day1 + 86400, &skill, &error)) << error;
+  ASSERT_EQ(skill.size(), 2u);
+  EXPECT_EQ(skill[0].minutes, 400);
+  EXPECT_DOUBLE_EQ(skill[0].mae_p_el_w, 1.5);
+  EXPECT_NEAR(skill[0].skill_p_el, 1.0 - 1.5 / 8.5, 1e-12);
+  EXPECT_NEAR(skill[0].skill_q_th, 1.0 - 10.0 / 30.0, 1e-12);
+  EXPECT_NEAR(skill[0].coverage_p10_p90, (200.0 + 360.0) / (400.0 + 360.0), 1e-12);
+  EXPECT_EQ(skill[1].minutes, 100);
+  EXPECT_DOUBLE_EQ(skill[1].mae_p_el_w, 10.0);
+  EXPECT_TRUE(std::isnan(skill[1].skill_p_el));
+  EXPECT_TRUE(std::isnan(skill[1].coverage_p10_p90));
+  std::vector<Store::ForecastRow> latest;
+  ASSERT_TRUE(store->ReadLatestForecast(kDay0, kDay0 + 120, &latest, &error)) << error;
+  ASSERT_EQ(latest.size(), 2u);
+  EXPECT_EQ(latest[1].p_el_w_p10, 99.0);
+  EXPECT_EQ(latest[1].q_th_w_p90, 500.0);
+  ASSERT_TRUE(store->ReadLatestForecast(day1, day1 + 60, &latest, &error)) << error;
+  EXPECT_TRUE(std::isnan(latest[0].p_el_w_p10));  // written without a band: NULL
 }
 
 TEST_F(StoreTest, PruningOldForecastsLeavesBothViewsAsTheyWere) {

@@ -186,11 +186,21 @@ void FillWeather(const Series& history, const Series& weather_forecast,
   const std::int64_t history_span_s = history.time_s.back() - history.time_s.front();
   from_table->assign(n_horizon, use_table ? 1 : 0);
   std::vector<std::uint8_t> persisted(n_horizon, 0), missing(n_horizon, 0);
+  // A forecast's irradiance is one set: where the table has irradiance, an
+  // irradiance channel it lacks (the in-plane diffuse of a GTI-only
+  // provider) is left out of the run rather than persisted beside it; the
+  // model then splits the forecast's own irradiance (paper eq. 2.5).
+  bool table_has_irradiance = false;
+  for (Channel c : kWeatherChannels) {
+    table_has_irradiance = table_has_irradiance || (use_table && IsIrradiance(c) &&
+                                                    !Track(weather_forecast, c).time_s.empty());
+  }
   for (Channel c : kWeatherChannels) {
     if (!history.Has(c)) continue;
     const Track measured(history, c);
     if (measured.time_s.empty()) continue;
     const Track predicted(use_table ? weather_forecast : kNoRows, c);
+    if (table_has_irradiance && IsIrradiance(c) && predicted.time_s.empty()) continue;
     ChannelInputUse channel_use{c};
     FillColumn(measured, n_warm, in, c, [&](std::size_t h, std::int64_t t) {
       double v = predicted.Interpolated(t, request.max_interp_gap_s);
@@ -242,7 +252,8 @@ std::vector<double> OperationFallback(const Plant& plant, const Series& history,
                                       const ForecastRequest& request, Channel c, const Series& in,
                                       const PumpRule* rule) {
   const Track measured(history, c);
-  std::vector<double> typical = TypicalDay(measured, request.step_s);
+  std::vector<double> typical = TypicalDay(
+      request.operation_history ? Track(*request.operation_history, c) : measured, request.step_s);
   if (rule != nullptr && c == Channel::kMdotKgS) return PumpFlow(plant, *rule, in, false);
   if (rule != nullptr) typical = ShiftedToLastDay(measured, std::move(typical), request.step_s);
   const std::int64_t step = std::llround(request.step_s);
@@ -394,7 +405,7 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
               &out->weather_from_forecast);
   PumpRule rule;
   if (request.operation == OperationForecast::kLearned) {
-    rule = LearnPumpRule(plant, history);
+    rule = LearnPumpRule(plant, request.operation_history ? *request.operation_history : history);
     use.pump_rule = rule.Describe();
   }
   FillOperation(plant, history, operation_plan, request, n_warm, true, rule.valid ? &rule : nullptr,

@@ -62,6 +62,10 @@ struct ForecastRequest {
   double max_interp_gap_s = 3600.0;  // longest gap in a forecast input bridged linearly
   bool with_reference = true;        // also run the reference forecast (Forecast::reference)
   OperationForecast operation = OperationForecast::kTypicalDay;
+  // Where the typical day and the learned rule are learned from (null: the
+  // history). A replay of a past day passes the window without that day, so
+  // that its operation forecast knows as many days as the real one.
+  const Series* operation_history = nullptr;
 };
 
 // Where one input channel's horizon values came from, counted in rows.

@@ -17,10 +17,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-Series Between(const Series& s, std::int64_t from, std::int64_t to) {
-  return s.Slice(s.RowAtOrAfter(from), s.RowAtOrAfter(to));
-}
-
 // The parameters of the day: identified on the window, or the fixed ones.
 bool DayParams(const Series& window, const Plant& plant, const ForecastBacktestOptions& options,
                ParamVector* params, std::string* failure) {
@@ -85,8 +81,8 @@ void RunDay(const Series& data, const Series& weather_forecast, const Plant& pla
             const ForecastBacktestOptions& options, ForecastBacktestDay* day) {
   const std::int64_t issued = day->issued_at_s;
   const std::int64_t horizon_end = issued + std::llround(options.horizon_s);
-  const Series window = Between(
-      data, issued - static_cast<std::int64_t>(options.window_days) * kSecondsPerDay, issued);
+  const Series window = data.Between(
+      issued - static_cast<std::int64_t>(options.window_days) * kSecondsPerDay, issued);
   if (window.size() == 0) {
     day->failure = "no measured rows in the window before the issue";
     return;
@@ -99,10 +95,10 @@ void RunDay(const Series& data, const Series& weather_forecast, const Plant& pla
   ForecastWindowStats stats;
   BandedForecast banded;
   if (!ReplayWindow(plant, options.spec, params, window,
-                    Between(weather_forecast, window.time_s.front(), issued), request, &stats,
+                    weather_forecast.Between(window.time_s.front(), issued), request, &stats,
                     &day->failure) ||
       !MakeBandedForecast(plant, options.spec, params, window,
-                          Between(weather_forecast, issued, horizon_end), Series{}, request, stats,
+                          weather_forecast.Between(issued, horizon_end), Series{}, request, stats,
                           &banded, &day->failure)) {
     return;
   }
@@ -190,7 +186,9 @@ std::string FormatForecastBacktest(const ForecastBacktestResult& result) {
   }
   char all[32];
   std::snprintf(all, sizeof all, "all %d days", result.days_ok);
-  row(all, "", 0, result.total_p_el, result.total_q_th);
+  std::size_t wf_rows = 0;
+  for (const ForecastBacktestDay& d : result.days) wf_rows += d.ok ? d.weather_forecast_rows : 0;
+  row(all, "", wf_rows, result.total_p_el, result.total_q_th);
   return out;
 }
 

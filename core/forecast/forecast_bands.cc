@@ -166,7 +166,26 @@ std::vector<ForecastRegime> RegimesOf(const Plant& plant, const Series& inputs) 
 
 namespace {
 
-// Calls per_day(request of the day, history before it) for each UTC day of
+// The rows of s outside [from, to).
+Series WithoutRows(const Series& s, std::int64_t from, std::int64_t to) {
+  const std::size_t a = s.RowAtOrAfter(from), b = std::max(a, s.RowAtOrAfter(to));
+  Series out = s.Slice(0, a);
+  const Series tail = s.Slice(b, s.size());
+  out.time_s.insert(out.time_s.end(), tail.time_s.begin(), tail.time_s.end());
+  for (std::size_t c = 0; c < kNumChannels; ++c) {
+    const auto channel = static_cast<Channel>(c);
+    if (!s.Has(channel)) continue;
+    std::vector<double>& col = out.Ensure(channel);
+    col.resize(a, kNaN);
+    const std::vector<double>& t = tail[channel];
+    col.insert(col.end(), t.begin(), t.end());
+    col.resize(out.time_s.size(), kNaN);
+  }
+  return out;
+}
+
+// Calls per_day(request of the day, history before it; its operation
+// learned from the history's other days) for each UTC day of
 // the history with a full day of history before it, until it returns false.
 template <class PerDay>
 void ForEachReplayDay(const Series& history, const ForecastRequest& request, PerDay per_day) {
@@ -184,6 +203,8 @@ void ForEachReplayDay(const Series& history, const ForecastRequest& request, Per
       continue;
     }
     day.issued_at_s = d;
+    const Series others = WithoutRows(history, d, d + kDayS);
+    day.operation_history = &others;
     if (!per_day(day, before)) return;
   }
 }

@@ -3,6 +3,7 @@
 // measured day; without a plan it runs the window's typical day.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/forecast/forecast.h"
@@ -153,6 +154,32 @@ TEST(Forecast, RefusesHistoryShorterThanADay) {
   EXPECT_FALSE(MakeForecast(c.plant, c.spec, c.truth, short_history, Series{}, Series{}, request,
                             &f, &error));
   EXPECT_NE(error.find("less than one day"), std::string::npos);
+}
+
+// A provider that gives the in-plane global irradiance but no in-plane
+// diffuse: yesterday's measured diffuse is not persisted beside today's
+// forecast global (the model splits the forecast's own irradiance), and the
+// rows count as weather-forecast rows for the bands.
+TEST(Forecast, AnIrradianceChannelTheWeatherForecastLacksIsLeftOutNotPersisted) {
+  const Case c;
+  ASSERT_TRUE(c.data.Has(Channel::kGPoaDiffuseWM2));
+  Series weather = c.From(c.t_forecast);
+  weather[Channel::kGPoaDiffuseWM2].clear();
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  Forecast f;
+  std::string error;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), weather, Series{},
+                           request, &f, &error))
+      << error;
+  EXPECT_FALSE(f.inputs_used.Has(Channel::kGPoaDiffuseWM2));
+  EXPECT_EQ(f.inputs.weather_forecast, 1440u);
+  EXPECT_EQ(std::count(f.weather_from_forecast.begin(), f.weather_from_forecast.end(), 1), 1440);
+  EXPECT_EQ(f.inputs.Describe().find("g_poa_diffuse_w_m2="), std::string::npos);
+  // Without a weather forecast the channel is persisted as before.
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), Series{}, Series{},
+                           request, &f, &error));
+  EXPECT_TRUE(f.inputs_used.Has(Channel::kGPoaDiffuseWM2));
 }
 
 }  // namespace

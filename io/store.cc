@@ -505,6 +505,12 @@ double ColumnReal(sqlite3_stmt* stmt, int index) {
                                                          : sqlite3_column_double(stmt, index);
 }
 
+// Columns 1, 2, … of the current row into *fields[0], *fields[1], … (NULL: NaN).
+void ColumnReals(sqlite3_stmt* stmt, std::initializer_list<double*> fields) {
+  int index = 1;
+  for (double* field : fields) *field = ColumnReal(stmt, index++);
+}
+
 std::string ColumnText(sqlite3_stmt* stmt, int index) {
   const unsigned char* text = sqlite3_column_text(stmt, index);
   return text == nullptr ? std::string() : reinterpret_cast<const char*>(text);
@@ -1445,9 +1451,8 @@ bool Store::ReadLatestForecast(std::int64_t from_ts, std::int64_t to_ts,
       [](sqlite3_stmt* stmt) {
         ForecastRow r;
         r.ts = sqlite3_column_int64(stmt, 0);
-        double* fields[] = {&r.p_el_w,     &r.q_th_w,     &r.t_pv_c,     &r.t_out_c,
-                            &r.p_el_w_p10, &r.p_el_w_p90, &r.q_th_w_p10, &r.q_th_w_p90};
-        for (int i = 0; i < 8; ++i) *fields[i] = ColumnReal(stmt, i + 1);
+        ColumnReals(stmt, {&r.p_el_w, &r.q_th_w, &r.t_pv_c, &r.t_out_c, &r.p_el_w_p10,
+                           &r.p_el_w_p90, &r.q_th_w_p10, &r.q_th_w_p90});
         return r;
       },
       out, error);
@@ -1462,9 +1467,8 @@ bool Store::ReadForecastSkill(std::int64_t from_day, std::int64_t to_day,
       [](sqlite3_stmt* stmt) {
         SkillRow r;
         r.day = sqlite3_column_int64(stmt, 0);
-        double* fields[] = {&r.mae_p_el_w, &r.mae_q_th_w, &r.nmae_p_el,       &r.nmae_q_th,
-                            &r.skill_p_el, &r.skill_q_th, &r.coverage_p10_p90};
-        for (int i = 0; i < 7; ++i) *fields[i] = ColumnReal(stmt, i + 1);
+        ColumnReals(stmt, {&r.mae_p_el_w, &r.mae_q_th_w, &r.nmae_p_el, &r.nmae_q_th, &r.skill_p_el,
+                           &r.skill_q_th, &r.coverage_p10_p90});
         r.minutes = sqlite3_column_int64(stmt, 8);
         return r;
       },

@@ -231,7 +231,7 @@ class Service {
   ForecastWindowStats forecast_stats_;
   std::int64_t forecast_stats_day_ = -1;
   std::int64_t forecast_stats_params_id_ = -1;
-  bool UpdateForecastStats(const Series& history, const ForecastRequest& request);
+  void UpdateForecastStats(const Series& history, const ForecastRequest& request);
   double next_retention_s_ = 0.0;
   double next_watchdog_wall_s_ = 0.0;
 };
@@ -667,7 +667,7 @@ void Service::IssueForecast() {
     LogToStderr(kErr, "forecast inputs could not be read: " + error);
     return;
   }
-  if (!UpdateForecastStats(history, request)) return;
+  UpdateForecastStats(history, request);
   BandedForecast banded;
   if (!MakeBandedForecast(config_.plant, spec_, params_, history, weather, plan, request,
                           forecast_stats_, &banded, &error)) {
@@ -706,22 +706,27 @@ void Service::IssueForecast() {
                          std::to_string(params_id_) + "; " + inputs);
 }
 
-bool Service::UpdateForecastStats(const Series& history, const ForecastRequest& request) {
+void Service::UpdateForecastStats(const Series& history, const ForecastRequest& request) {
   const std::int64_t day = request.issued_at_s - ((request.issued_at_s % kDayS) + kDayS) % kDayS;
-  if (day == forecast_stats_day_ && params_id_ == forecast_stats_params_id_) return true;
+  if (day == forecast_stats_day_ && params_id_ == forecast_stats_params_id_) return;
+  forecast_stats_day_ = day;
+  forecast_stats_params_id_ = params_id_;
   Series past_weather;
   std::string error;
   if (!store_->ReadWeatherForecast(history.size() ? history.time_s.front() : day, day + kDayS,
                                    &past_weather, &error) ||
       !ReplayWindow(config_.plant, spec_, params_, history, past_weather, request, &forecast_stats_,
                     &error)) {
-    LogToStderr(kWarning, "the forecast's window could not be replayed: " + error);
-    return false;
+    // Forecasts go on without bands and with the typical day until the
+    // next day or calibration tries again.
+    forecast_stats_ = ForecastWindowStats{};
+    LogToStderr(kWarning,
+                "the forecast's window could not be replayed (forecasts without bands until the "
+                "next day or calibration): " +
+                    error);
+    return;
   }
-  forecast_stats_day_ = day;
-  forecast_stats_params_id_ = params_id_;
   LogToStderr(kInfo, forecast_stats_.operation.Describe());
-  return true;
 }
 
 void Service::StartUpload() {

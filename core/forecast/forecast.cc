@@ -169,8 +169,9 @@ double Persisted(const Track& measured, std::int64_t t, std::int64_t history_spa
                  std::int64_t* back_s) {
   double v = kNaN;
   std::int64_t back = 86400;
-  for (; back <= history_span_s + 86400 && std::isnan(v); back += 86400)
+  for (; back <= history_span_s + 86400 && std::isnan(v); back += 86400) {
     v = measured.Exact(t - back);
+  }
   if (back_s != nullptr) *back_s = back - 86400;
   return v;
 }

@@ -39,10 +39,11 @@ struct Month {
   WeatherOptions weather;
   Series data;
 
-  explicit Month(int days, std::uint64_t seed) {
+  Month(int days, std::uint64_t seed, PumpControl control = PumpControl::kIrradiance) {
     weather.num_days = days;
     weather.seed = seed;
     weather.flow_mode = FlowMode::kVariable;
+    weather.pump_control = control;
     data = MakeSyntheticPlantData(plant, weather, spec, truth, RealisticSensorNoise(seed));
   }
   std::size_t RowOf(std::int64_t t) const {
@@ -163,6 +164,23 @@ TEST(PumpRule, FindsTheIrradianceSwitchOfTheGenerator) {
     }
   }
   EXPECT_NE(rule.Describe().find("pump on at g_poa >="), std::string::npos) << rule.Describe();
+}
+
+// A thermostat on the collector-minus-tank difference (the generator's
+// differential control, a form the rule does not have) is still caught by an
+// irradiance rule on most minutes, and the rule forecasts the heat of the
+// last day better than the typical day.
+TEST(PumpRule, StandsForADifferentialThermostat) {
+  const Month m(15, 6, PumpControl::kDifferential);
+  const PumpRule rule = LearnPumpRule(m.plant, m.data.Slice(0, 14 * 1440));
+  ASSERT_TRUE(rule.valid);
+  EXPECT_GT(rule.accuracy, 0.9) << rule.Describe();
+  OperationChoice choice;
+  ForecastRequest request;
+  std::string error;
+  ASSERT_TRUE(ChooseOperation(m.plant, m.spec, m.truth, m.data, request, &choice, &error));
+  EXPECT_EQ(choice.chosen, OperationForecast::kLearned) << choice.Describe();
+  EXPECT_LT(choice.mae_q_th_learned_w, choice.mae_q_th_typical_w);
 }
 
 // Without enough data there is no rule, and the forecast keeps the typical day.

@@ -10,6 +10,18 @@
 
 namespace pvtwin {
 
+// The broader form the diagnosis also fits ("r+sky_radiation"): the sky the
+// front exchanges with emits Δε_sky·σ·T_a⁴ more than the logged long-wave
+// channel says (another sky model, its cloud correction, a pyrgeometer's
+// offset), i.e. the equivalent sky temperature becomes
+//   T_sky,eff⁴ = T_sky⁴ + Δε_sky·T_a⁴   (K⁴; T_a the air temperature in K),
+// floored at 0. Δε_sky = 0 is the paper's form 2.9.
+inline double SkyK4WithEmissivityOffset(double t_sky_k4, double t_amb_k, double offset) {
+  const double t2 = t_amb_k * t_amb_k;
+  const double v = t_sky_k4 + offset * t2 * t2;
+  return v > 0.0 ? v : 0.0;
+}
+
 // --- Other-form truth: another sky model than the logged long-wave ---
 // (with CloudySkyEmissivity and LongWaveOnPlaneWM2 of core/physics/sky_radiation.h)
 

@@ -42,8 +42,10 @@ const std::array<ParamInfo, kNumParams> kParamTable = {{
     // Dittus–Boelter (h ∝ Re^0.8).
     {Param::kNFlow, "n_flow", "-", "n_flow", 0.4, 0.0, 1.2, kLin, false},
     {Param::kPLimitWM2, "p_limit_w_m2", "W/m²", "P_limit", 100.0, 30.0, 300.0, kLin, false},
+    // The sun's azimuth spans about 50–310° over a year at the plant's
+    // latitudes: the obstacle's centre may lie anywhere from 30° to 330°.
     {Param::kShadeAzimuthRad, "shade_azimuth_rad", "rad", "γ_shade", 3.14159265358979323846,
-     1.5707963267948966, 4.71238898038469, kLin, false},
+     0.5235987755982988, 5.759586531581287, kLin, false},
     // The start window (240° wide, up to 20° elevation) shades the low sun
     // of mornings and evenings in every season, so the fit starts with a
     // gradient in every shading parameter.

@@ -57,11 +57,10 @@ const std::array<ParamInfo, kNumParams> kParamTable = {{
     {Param::kSoilingPerDay, "soiling_per_day", "1/d", "r_soil", 0.002, 0.0, 0.02, kLin, false},
     {Param::kClockOffsetS, "clock_offset_s", "s", "Δt_clock", 0.0, -1800.0, 1800.0, kLin, false},
     {Param::kIrradianceBias, "irradiance_bias", "-", "k_pyr", 0.0, -0.3, 0.3, kLin, false},
-    // Clear-sky emissivity models differ by up to about 0.1 at the same air
-    // temperature and humidity, their cloud corrections by more (Flerchinger
-    // et al. 2009, Water Resour. Res. 45, W03423).
-    {Param::kSkyEmissivityOffset, "sky_emissivity_offset", "-", "Δε_sky", 0.0, -0.3, 0.3, kLin,
-     false},
+    // The sky the front sees may be cloudier (> 0) or clearer (< 0) than the
+    // logged long-wave's: sky models and their cloud corrections differ that
+    // much (Flerchinger et al. 2009, Water Resour. Res. 45, W03423).
+    {Param::kSkyCloudOffset, "sky_cloud_offset", "-", "Δc_sky", 0.0, -0.5, 0.9, kLin, false},
 }};
 
 ParamInfo ResolvedInfo(Param p, const Plant& plant) {

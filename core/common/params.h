@@ -54,17 +54,17 @@ enum class Param : std::size_t {
   // their meaning. Each is a slot of the fixed-size ParamVector, so that the
   // simulation loop never allocates: a new effect's parameter adds a slot
   // here and a row in params.cc.
-  kUPipeWM2K,            // transport_delay: pipe loss to ambient, W/(m²K) of collector
-  kNFlow,                // flow_dependent_u: exponent of the fluid-side resistance on flow
-  kPLimitWM2,            // pv_clipping: inverter AC limit per m² of collector, W/m²
-  kShadeAzimuthRad,      // shading: centre of the obstacle's azimuth window
-  kShadeWidthRad,        // shading: full width of the azimuth window
-  kShadeElevationRad,    // shading: elevation of the obstacle's upper edge
-  kShadeMismatch,        // shading: extra P_el loss per shaded fraction (bypass diodes)
-  kSoilingPerDay,        // soiling: transmittance loss per day since cleaning
-  kClockOffsetS,         // clock_offset: weather clock behind the collector clock
-  kIrradianceBias,       // irradiance_bias: pyranometer scale error k
-  kSkyEmissivityOffset,  // sky_radiation (broader form): sky emissivity beyond the logged sky's
+  kUPipeWM2K,          // transport_delay: pipe loss to ambient, W/(m²K) of collector
+  kNFlow,              // flow_dependent_u: exponent of the fluid-side resistance on flow
+  kPLimitWM2,          // pv_clipping: inverter AC limit per m² of collector, W/m²
+  kShadeAzimuthRad,    // shading: centre of the obstacle's azimuth window
+  kShadeWidthRad,      // shading: full width of the azimuth window
+  kShadeElevationRad,  // shading: elevation of the obstacle's upper edge
+  kShadeMismatch,      // shading: extra P_el loss per shaded fraction (bypass diodes)
+  kSoilingPerDay,      // soiling: transmittance loss per day since cleaning
+  kClockOffsetS,       // clock_offset: weather clock behind the collector clock
+  kIrradianceBias,     // irradiance_bias: pyranometer scale error k
+  kSkyCloudOffset,     // sky_radiation (broader form): cloud fraction beyond the logged sky's
   kCount
 };
 

@@ -7,12 +7,12 @@ namespace pvtwin {
 
 namespace {
 
-// T_sky⁴ per row with the emissivity offset (SkyK4WithEmissivityOffset).
+// T_sky⁴ per row with the cloud offset (SkyK4WithCloudOffset).
 void OffsetTheSky(const Drivers& d, const ParamVector& p, RunInputs* run) {
-  const double offset = ParamOf(p, Param::kSkyEmissivityOffset);
+  const double offset = ParamOf(p, Param::kSkyCloudOffset);
   double* t_sky_k4 = run->Own(&run->t_sky_k4);
   for (std::size_t i = 0; i < run->n; ++i) {
-    t_sky_k4[i] = SkyK4WithEmissivityOffset(t_sky_k4[i], CToK(d.t_amb_c[i]), offset);
+    t_sky_k4[i] = SkyK4WithCloudOffset(t_sky_k4[i], CToK(d.t_amb_c[i]), offset);
   }
 }
 
@@ -23,7 +23,7 @@ const ModelExtension& OffsetExtension() {
     ModelExtension e;
     e.name = "sky_radiation";
     e.variant_order = 8;
-    e.params = {Param::kSkyEmissivityOffset};
+    e.params = {Param::kSkyCloudOffset};
     e.transform_drivers = OffsetTheSky;
     return e;
   }();
@@ -39,7 +39,7 @@ void AddToSpec(ModelSpec* spec) {
   spec->sky = true;
 }
 
-// The diagnosis's second form: 'r' with the emissivity offset.
+// The diagnosis's second form: 'r' with the cloud offset.
 void AddBroaderForm(ModelSpec* spec) {
   spec->sky = true;
   spec->Add(OffsetExtension());
@@ -118,12 +118,13 @@ const EffectModule& SkyRadiationEffect() {
         "Long-wave exchange of the front with the sky: ε·σ·(T_PV⁴ − T_sky⁴) (paper "
         "2.9, 'r'). Clear nights and clear days with a cold sky cool the collector below "
         "ambient; the loss scales with the sky temperature deficit. The diagnosis also "
-        "fits a broader form, a sky that emits Δε_sky·σ·T_a⁴ more than the logged long-wave "
-        "says (another sky model or cloud correction), T_sky,eff⁴ = T_sky⁴ + Δε_sky·T_a⁴.";
+        "fits a broader form, a sky cloudier by Δc_sky than the logged long-wave says "
+        "(another sky model or cloud correction; Crawford & Duchon's ε' = ε + Δc·(1 − ε)): "
+        "T_sky,eff⁴ = T_sky⁴ + Δc_sky·(T_a⁴ − T_sky⁴).";
     m.source =
-        "paper 2.9 (long-wave exchange with the sky); sky models' spread: Flerchinger et al. "
-        "2009, Water Resour. Res. 45";
-    m.params = {Param::kEpsPvt, Param::kSkyEmissivityOffset};
+        "paper 2.9 (long-wave exchange with the sky); cloudy sky: Crawford & Duchon 1999; "
+        "sky models' spread: Flerchinger et al. 2009, Water Resour. Res. 45";
+    m.params = {Param::kEpsPvt, Param::kSkyCloudOffset};
     m.needs = {Channel::kTSkyC};
     m.typical_truth = {{Param::kEpsPvt, 0.12}};
     m.signature = "ambient minus sky temperature, K";

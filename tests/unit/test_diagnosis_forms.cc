@@ -1,6 +1,6 @@
 // The forms the diagnosis fits for an effect (EffectModule::diagnosis_forms)
 // and the broader candidate forms behind them: wind's physical "+wind"
-// besides the paper's 'w', the sky's emissivity offset beyond the logged
+// besides the paper's 'w', the sky's cloud offset beyond the logged
 // long-wave, and the obstacle that stands on some days only.
 #include <gtest/gtest.h>
 
@@ -32,28 +32,32 @@ TEST(DiagnosisForms, WindIsFittedInThePaperAndInThePhysicalForm) {
   EXPECT_EQ(FormNames("1N1Cr", "wind"), (std::vector<std::string>{"1N1Cwr", "1N1Cr+wind"}));
 }
 
-TEST(DiagnosisForms, SkyIsFittedWithAndWithoutTheEmissivityOffset) {
+TEST(DiagnosisForms, SkyIsFittedWithAndWithoutTheCloudOffset) {
   EXPECT_EQ(FormNames("1N1Cw", "sky_radiation"),
             (std::vector<std::string>{"1N1Cwr", "1N1Cwr+sky_radiation"}));
   // The broader form's name parses back to it.
   EXPECT_EQ(testing::SpecOf("1N1Cwr+sky_radiation").Name(), "1N1Cwr+sky_radiation");
   EXPECT_TRUE(UsedParams(testing::SpecOf("1N1Cwr+sky_radiation"))
-                  .test(static_cast<std::size_t>(Param::kSkyEmissivityOffset)));
-  EXPECT_FALSE(UsedParams(testing::SpecOf("1N1Cwr"))
-                   .test(static_cast<std::size_t>(Param::kSkyEmissivityOffset)));
+                  .test(static_cast<std::size_t>(Param::kSkyCloudOffset)));
+  EXPECT_FALSE(
+      UsedParams(testing::SpecOf("1N1Cwr")).test(static_cast<std::size_t>(Param::kSkyCloudOffset)));
 }
 
 TEST(DiagnosisForms, AnEffectWithOneFormHasOnlyIt) {
   EXPECT_EQ(FormNames("1N1Cwr", "shading"), (std::vector<std::string>{"1N1Cwr+shading"}));
 }
 
-TEST(DiagnosisForms, SkyEmissivityOffsetByHand) {
+TEST(DiagnosisForms, SkyCloudOffsetByHand) {
   const double t_sky_k = 270.0, t_amb_k = 290.0;
   const double t4 = std::pow(t_sky_k, 4);
-  EXPECT_DOUBLE_EQ(SkyK4WithEmissivityOffset(t4, t_amb_k, 0.0), t4);
-  // Δε = 0.1: the sky emits 0.1·σ·T_a⁴ more, 0.1·290⁴ = 7.07281e8 K⁴.
-  EXPECT_NEAR(SkyK4WithEmissivityOffset(t4, t_amb_k, 0.1), t4 + 7.07281e8, 1e3);
-  EXPECT_DOUBLE_EQ(SkyK4WithEmissivityOffset(1e8, t_amb_k, -0.3), 0.0);
+  EXPECT_DOUBLE_EQ(SkyK4WithCloudOffset(t4, t_amb_k, 0.0), t4);
+  // Δc = 0.1: a tenth of the way from the sky to the air,
+  // 270⁴ + 0.1·(290⁴ − 270⁴) = 5.31441e9 + 0.1·1.75840e9 K⁴.
+  EXPECT_NEAR(SkyK4WithCloudOffset(t4, t_amb_k, 0.1), 5.31441e9 + 1.75840e8, 1e4);
+  // Δc = 1: the sky at air temperature.
+  EXPECT_NEAR(SkyK4WithCloudOffset(t4, t_amb_k, 1.0), std::pow(t_amb_k, 4), 1e-3);
+  // Floored at 0 for a sky far clearer than logged.
+  EXPECT_DOUBLE_EQ(SkyK4WithCloudOffset(t4, t_amb_k, -5.0), 0.0);
 }
 
 TEST(DiagnosisForms, ObstacleDayFromTheMeasuredYieldDeficit) {

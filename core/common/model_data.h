@@ -55,6 +55,9 @@ struct Drivers {
   // soiling: days since the last cleaning (since the first row when none is
   // known; see SetCleaningTimes).
   std::vector<double> days_since_clean;
+  // shading: the measured P_el per I_gt relative to its solar day's upper
+  // quartile (ShadingRelativeYield), NaN where undefined or without +shading.
+  std::vector<double> relative_yield;
   // irradiance_bias: the pyranometer scale error k estimated from the two
   // sources (EstimateIrradianceBias); g_poa_w_m2, g_abs_w_m2 and a beam from
   // the plane-of-array sensors are already multiplied by (1 + k). 0 without

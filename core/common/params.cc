@@ -42,8 +42,10 @@ const std::array<ParamInfo, kNumParams> kParamTable = {{
     // Dittus–Boelter (h ∝ Re^0.8).
     {Param::kNFlow, "n_flow", "-", "n_flow", 0.4, 0.0, 1.2, kLin, false},
     {Param::kPLimitWM2, "p_limit_w_m2", "W/m²", "P_limit", 100.0, 30.0, 300.0, kLin, false},
+    // The sun's azimuth spans about 50–310° over a year at the plant's
+    // latitudes: the obstacle's centre may lie anywhere from 30° to 330°.
     {Param::kShadeAzimuthRad, "shade_azimuth_rad", "rad", "γ_shade", 3.14159265358979323846,
-     1.5707963267948966, 4.71238898038469, kLin, false},
+     0.5235987755982988, 5.759586531581287, kLin, false},
     // The start window (240° wide, up to 20° elevation) shades the low sun
     // of mornings and evenings in every season, so the fit starts with a
     // gradient in every shading parameter.
@@ -55,6 +57,10 @@ const std::array<ParamInfo, kNumParams> kParamTable = {{
     {Param::kSoilingPerDay, "soiling_per_day", "1/d", "r_soil", 0.002, 0.0, 0.02, kLin, false},
     {Param::kClockOffsetS, "clock_offset_s", "s", "Δt_clock", 0.0, -1800.0, 1800.0, kLin, false},
     {Param::kIrradianceBias, "irradiance_bias", "-", "k_pyr", 0.0, -0.3, 0.3, kLin, false},
+    // The sky the front sees may be cloudier (> 0) or clearer (< 0) than the
+    // logged long-wave's: sky models and their cloud corrections differ that
+    // much (Flerchinger et al. 2009, Water Resour. Res. 45, W03423).
+    {Param::kSkyCloudOffset, "sky_cloud_offset", "-", "Δc_sky", 0.0, -0.5, 0.9, kLin, false},
 }};
 
 ParamInfo ResolvedInfo(Param p, const Plant& plant) {

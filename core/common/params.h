@@ -64,6 +64,7 @@ enum class Param : std::size_t {
   kSoilingPerDay,      // soiling: transmittance loss per day since cleaning
   kClockOffsetS,       // clock_offset: weather clock behind the collector clock
   kIrradianceBias,     // irradiance_bias: pyranometer scale error k
+  kSkyCloudOffset,     // sky_radiation (broader form): cloud fraction beyond the logged sky's
   kCount
 };
 

@@ -53,12 +53,16 @@ void SensorTest(const Series& data, const std::vector<std::int64_t>& day_starts,
 // ended at a bound, "n_flow = 0.079 ± 0.25 (not determined)" for each whose
 // standard error is as large as its value (or that the fit found
 // undetermined); *all set when every one of them is either (the data did
-// not determine the effect).
-std::vector<std::string> AtBounds(const EffectModule& effect, const EffectTrial& t,
-                                  const Plant& plant, bool* all) {
+// not determine the effect). Only the parameters of the fitted form (spec)
+// count: wind's "+wind" leaves the paper form's r_refwind untouched.
+std::vector<std::string> AtBounds(const EffectModule& effect, const ModelSpec& spec,
+                                  const EffectTrial& t, const Plant& plant, bool* all) {
   std::vector<std::string> out;
-  std::size_t unsupported = 0;
+  std::size_t unsupported = 0, used_params = 0;
+  const std::bitset<kNumParams> used = UsedParams(spec);
   for (const Param param : effect.params) {
+    if (!used.test(static_cast<std::size_t>(param))) continue;
+    ++used_params;
     const ParamInfo info = ResolvedInfo(param, plant);
     const double v = ParamOf(t.params, param);
     const double tol = 1e-3 * (info.upper - info.lower);
@@ -85,7 +89,7 @@ std::vector<std::string> AtBounds(const EffectModule& effect, const EffectTrial&
       }
     }
   }
-  *all = !effect.params.empty() && unsupported == effect.params.size();
+  *all = used_params > 0 && unsupported == used_params;
   return out;
 }
 
@@ -123,7 +127,7 @@ void Judge(const TrialInputs& in, const EffectCandidate& c, const Part& ho, cons
   int days = 0;
   t.days_improved = DaysImproved(before, after, ho, in.split->offset_s, &days);
   bool all_at_bounds = false;
-  t.at_bounds = AtBounds(*c.module, t, *in.plant, &all_at_bounds);
+  t.at_bounds = AtBounds(*c.module, c.spec, t, *in.plant, &all_at_bounds);
   t.significant = t.heldout_test.p <= o.alpha && t.shrink_pct >= o.min_shrink_pct;
   if (!t.significant) return;
   std::vector<std::string> why;
@@ -209,87 +213,124 @@ std::vector<EffectCandidate> SelectCandidates(const TrialInputs& in, const Model
   return candidates;
 }
 
+// The fit of one form of a candidate on the training days.
+struct FormFit {
+  Part train;
+  IdentSummary fit;
+  std::string failure;  // the part could not be prepared
+};
+
+// Re-identifies `spec` on the training days from the current model's
+// parameters (and the module's start from the base model's residuals).
+FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectModule& effect,
+                const ModelSpec& spec) {
+  FormFit f;
+  const Plant& plant = *in.plant;
+  if (!PreparePart(in.split->train_series, plant, spec, in.split->data_start_s, &f.train,
+                   &f.failure)) {
+    if (f.failure.empty()) f.failure = "the training days cannot be prepared";
+    return f;
+  }
+  ParamVector start = MergedStart(plant, current.spec, current.params);
+  if (effect.start_from_residuals != nullptr) {
+    EffectResiduals res;
+    res.drivers = &in.base->train.drivers;
+    res.base = &in.base->train_sim;
+    res.rows = &in.base->train.meas.rows;
+    res.p_el_meas_w = &in.base->train.meas.p_el_w;
+    effect.start_from_residuals(res, &start);
+  }
+  f.fit = Identify(f.train.drivers, f.train.meas, start, in.options->ident);
+  return f;
+}
+
 // The decisive test of one candidate: evidence on the base model's residuals
-// (step 1), re-identification from the current model's parameters (and the
-// module's start from the residuals), the held-out score and its tests.
+// (step 1), re-identification of each of its forms (the one that fits the
+// training days best becomes the candidate's spec), the held-out score and
+// its tests.
 void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
-                  const EffectCandidate& c, EffectTrial* trial, Score* score) {
+                  EffectCandidate* candidate, EffectTrial* trial, Score* score) {
+  EffectCandidate& c = *candidate;
   EffectTrial& t = *trial;
   const Plant& plant = *in.plant;
   const DiagnosisOptions& options = *in.options;
-  const Series& train_series = in.split->train_series;
   const Series& heldout_series = in.split->heldout_series;
   const std::int64_t data_start_s = in.split->data_start_s;
   const ModelSpec& current_spec = current.spec;
   const Score& current_score = current.score;
   const Score& base_score = in.base->score;
-  const Part& base_train = in.base->train;
   t.name = c.name;
-  t.variant = c.spec.Name();
   t.tested_against = current_spec.Name();
   t.explanation = c.explanation;
   t.signature = c.signature;
   t.advice = std::string(c.module->advice);
   t.heldout_mae_before_w = MaeSumW(current_score.errors);
-  Part tr, ho;
   std::string why;
-  if (!PreparePart(train_series, plant, c.spec, data_start_s, &tr, &why) ||
+  double fit_runtime_s = 0.0;
+  FormFit best;
+  bool have_best = false;
+  for (const ModelSpec& form : c.forms.empty() ? std::vector<ModelSpec>{c.spec} : c.forms) {
+    FormFit f = FitForm(in, current, *c.module, form);
+    fit_runtime_s += f.fit.runtime_s;
+    const bool better =
+        f.failure.empty() && f.fit.ok &&
+        (!have_best || !best.fit.ok || f.fit.final_cost_w_m2 < best.fit.final_cost_w_m2);
+    if (!have_best || better) {
+      best = std::move(f);
+      c.spec = form;
+      have_best = true;
+    }
+  }
+  t.variant = c.spec.Name();
+  t.fit_runtime_s = fit_runtime_s;
+  Part ho;
+  if (!best.failure.empty() ||
       !PreparePart(heldout_series, plant, c.spec, data_start_s, &ho, &why)) {
-    t.failure = why;
-  } else {
-    // Evidence on the base model's residuals (the gap being explained).
-    if (step == 1) {
-      const std::vector<double> sig = CandidateSignature(c, ho.drivers, base_score.sim);
-      std::vector<std::vector<double>> ctl = in.controls;
-      const PartialCorrelation cp = [&] {
-        ctl.push_back(base_score.sim.p_el_w);
-        return PartialCorrelate(in.residuals->p_el_w, sig, ctl);
-      }();
-      ctl.back() = base_score.sim.q_th_w;
-      const PartialCorrelation cq = PartialCorrelate(in.residuals->q_th_w, sig, ctl);
-      const bool use_q = std::fabs(cq.z) >= std::fabs(cp.z);
-      t.evidence_corr = use_q ? cq : cp;
-      t.evidence_output = use_q ? "q_th" : "p_el";
+    t.failure = best.failure.empty() ? why : best.failure;
+    return;
+  }
+  // Evidence on the base model's residuals (the gap being explained).
+  if (step == 1) {
+    const std::vector<double> sig = CandidateSignature(c, ho.drivers, base_score.sim);
+    std::vector<std::vector<double>> ctl = in.controls;
+    const PartialCorrelation cp = [&] {
+      ctl.push_back(base_score.sim.p_el_w);
+      return PartialCorrelate(in.residuals->p_el_w, sig, ctl);
+    }();
+    ctl.back() = base_score.sim.q_th_w;
+    const PartialCorrelation cq = PartialCorrelate(in.residuals->q_th_w, sig, ctl);
+    const bool use_q = std::fabs(cq.z) >= std::fabs(cp.z);
+    t.evidence_corr = use_q ? cq : cp;
+    t.evidence_output = use_q ? "q_th" : "p_el";
+  }
+  const IdentSummary& fit = best.fit;
+  t.params = fit.params;
+  if (c.module->advice_for != nullptr) t.advice = c.module->advice_for(fit.params, plant);
+  for (const ParamEstimate& e : fit.estimates) {
+    if (std::find(c.module->params.begin(), c.module->params.end(), e.param) !=
+        c.module->params.end()) {
+      t.estimates.push_back(e);
     }
-    ParamVector start = MergedStart(plant, current_spec, current.params);
-    if (c.module->start_from_residuals != nullptr) {
-      EffectResiduals res;
-      res.drivers = &base_train.drivers;
-      res.base = &in.base->train_sim;
-      res.rows = &base_train.meas.rows;
-      res.p_el_meas_w = &base_train.meas.p_el_w;
-      c.module->start_from_residuals(res, &start);
-    }
-    const IdentSummary fit = Identify(tr.drivers, tr.meas, start, options.ident);
-    t.fit_runtime_s = fit.runtime_s;
-    t.params = fit.params;
-    if (c.module->advice_for != nullptr) t.advice = c.module->advice_for(fit.params, plant);
-    for (const ParamEstimate& e : fit.estimates) {
-      if (std::find(c.module->params.begin(), c.module->params.end(), e.param) !=
-          c.module->params.end()) {
-        t.estimates.push_back(e);
-      }
-    }
-    if (!fit.ok) {
-      t.failure = "identification failed: " + fit.failure_reason;
-    } else {
-      *score = ScoreHeldout(ho, fit.params, in.base->units, plant.area_m2);
-      if (!std::isfinite((*score).errors.objective_w_m2())) {
-        t.failure = "non-finite held-out outputs";
-      } else {
-        t.fit_ok = true;
-        t.heldout_mae_after_w = MaeSumW((*score).errors);
-        t.shrink_pct = 100.0 * (1.0 - (*score).errors.objective_w_m2() /
-                                          current_score.errors.objective_w_m2());
-        t.test = CompareUnits(current_score, (*score));
-        Judge(in, c, ho, current_score, *score, &t);
-        if (c.module->sensor_estimate != nullptr) {
-          SensorTest(*in.data, in.split->day_starts, plant, c.spec, *c.module, &t);
-          t.significant = t.sensor_p <= options.alpha &&
-                          std::fabs(t.sensor_estimate) >= options.min_sensor_error;
-        }
-      }
-    }
+  }
+  if (!fit.ok) {
+    t.failure = "identification failed: " + fit.failure_reason;
+    return;
+  }
+  *score = ScoreHeldout(ho, fit.params, in.base->units, plant.area_m2);
+  if (!std::isfinite((*score).errors.objective_w_m2())) {
+    t.failure = "non-finite held-out outputs";
+    return;
+  }
+  t.fit_ok = true;
+  t.heldout_mae_after_w = MaeSumW((*score).errors);
+  t.shrink_pct =
+      100.0 * (1.0 - (*score).errors.objective_w_m2() / current_score.errors.objective_w_m2());
+  t.test = CompareUnits(current_score, (*score));
+  Judge(in, c, ho, current_score, *score, &t);
+  if (c.module->sensor_estimate != nullptr) {
+    SensorTest(*in.data, in.split->day_starts, plant, c.spec, *c.module, &t);
+    t.significant =
+        t.sensor_p <= options.alpha && std::fabs(t.sensor_estimate) >= options.min_sensor_error;
   }
 }
 
@@ -354,7 +395,7 @@ std::vector<std::vector<double>> EvidenceControls(const Drivers& d) {
 StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& current) {
   StepTrials out;
   out.candidates = SelectCandidates(in, current.spec, &out.skipped);
-  const std::vector<EffectCandidate>& candidates = out.candidates;
+  std::vector<EffectCandidate>& candidates = out.candidates;
   if (candidates.empty()) return out;
   out.trials.resize(candidates.size());
   out.scores.resize(candidates.size());
@@ -362,7 +403,7 @@ StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& cur
   std::atomic<int> done{0};
   auto worker = [&] {
     for (std::size_t k = next++; k < candidates.size(); k = next++) {
-      TryCandidate(in, step, current, candidates[k], &out.trials[k], &out.scores[k]);
+      TryCandidate(in, step, current, &candidates[k], &out.trials[k], &out.scores[k]);
       const int finished = ++done;
       in.progress(ProgressLine(step, finished, candidates.size(), out.trials[k], in.test_unit));
     }

@@ -1,6 +1,7 @@
 #include "core/diagnosis/effect_candidates.h"
 
 #include <cmath>
+#include <utility>
 
 #include "core/effects/effects.h"
 
@@ -15,7 +16,8 @@ std::vector<EffectCandidate> CandidateEffects(const ModelSpec& base, const Serie
       if (skipped != nullptr) skipped->push_back({std::string(m->name), why});
       continue;
     }
-    out.push_back({std::string(m->name), WithEffect(base, *m), std::string(m->physics),
+    std::vector<ModelSpec> forms = DiagnosisForms(base, *m);
+    out.push_back({std::string(m->name), forms.front(), std::move(forms), std::string(m->physics),
                    std::string(m->signature), m});
   }
   return out;

@@ -139,6 +139,11 @@ struct EffectModule {
   bool (*in_spec)(const ModelSpec& spec) = nullptr;
   // Adds the effect to spec (WithEffect); null: spec->Add(*extension).
   void (*add_to_spec)(ModelSpec* spec) = nullptr;
+  // Further forms of the effect that the diagnosis fits besides
+  // add_to_spec's, each adding the effect to spec in its own form (wind: the
+  // physical "+wind" besides the paper's 'w'). The form with the lowest
+  // training objective is the one judged on the held-out days.
+  std::vector<void (*)(ModelSpec* spec)> diagnosis_forms;
   // Why it cannot be added to spec ("" = it can); null: present = cannot.
   std::string (*cannot_add)(const ModelSpec& spec) = nullptr;
   // Why the data cannot show it, e.g. a missing channel ("" = they can).

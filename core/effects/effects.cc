@@ -1,5 +1,6 @@
 #include "core/effects/effects.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace pvtwin {
@@ -37,6 +38,20 @@ ModelSpec WithEffect(ModelSpec spec, const EffectModule& e) {
     spec.Add(*e.extension);
   }
   return spec;
+}
+
+std::vector<ModelSpec> DiagnosisForms(const ModelSpec& spec, const EffectModule& e) {
+  std::vector<ModelSpec> forms = {WithEffect(spec, e)};
+  for (void (*add)(ModelSpec*) : e.diagnosis_forms) {
+    ModelSpec form = spec;
+    add(&form);
+    const std::string name = form.Name();
+    if (std::none_of(forms.begin(), forms.end(),
+                     [&name](const ModelSpec& f) { return f.Name() == name; })) {
+      forms.push_back(form);
+    }
+  }
+  return forms;
 }
 
 std::vector<double> EffectSignature(const EffectModule& e, const Drivers& drivers,

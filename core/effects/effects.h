@@ -29,6 +29,10 @@ bool CanAddEffect(const ModelSpec& spec, const EffectModule& effect, const Serie
 // extension). Adding a present effect returns spec unchanged.
 ModelSpec WithEffect(ModelSpec spec, const EffectModule& effect);
 
+// Every form of the effect that the diagnosis fits, added to spec: WithEffect
+// first, then each of EffectModule::diagnosis_forms that differs from it.
+std::vector<ModelSpec> DiagnosisForms(const ModelSpec& spec, const EffectModule& effect);
+
 // Per-row value of the effect's signature (EffectModule::signature), for
 // residual evidence; NaN where undefined.
 std::vector<double> EffectSignature(const EffectModule& effect, const Drivers& drivers,

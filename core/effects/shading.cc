@@ -62,6 +62,55 @@ double HorizonDiffuseShare(const HorizonProfile& p) {
   return integral / (2.0 * kPi);
 }
 
+std::vector<double> ShadingRelativeYield(const std::vector<std::int64_t>& time_s,
+                                         const std::vector<double>& p_el_w,
+                                         const std::vector<double>& g_poa_w_m2,
+                                         const std::vector<double>& sun_elevation_rad,
+                                         std::int64_t solar_offset_s) {
+  const std::size_t n = time_s.size();
+  std::vector<double> out(n, std::nan(""));
+  std::vector<double> y;
+  for (std::size_t lo = 0; lo < n;) {
+    const std::int64_t day = SolarDayStartS(time_s[lo], solar_offset_s);
+    std::size_t hi = lo;
+    y.clear();
+    for (; hi < n && SolarDayStartS(time_s[hi], solar_offset_s) == day; ++hi) {
+      const double r = p_el_w[hi] / g_poa_w_m2[hi];
+      if (g_poa_w_m2[hi] >= 200.0 && sun_elevation_rad[hi] > 0.0 && std::isfinite(r)) {
+        y.push_back(r);
+      }
+    }
+    if (y.size() >= 10) {
+      const auto q = y.begin() + static_cast<std::ptrdiff_t>(3 * y.size() / 4);
+      std::nth_element(y.begin(), q, y.end());
+      const double reference = *q;
+      for (std::size_t i = lo; reference > 0.0 && i < hi; ++i) {
+        const double r = p_el_w[i] / g_poa_w_m2[i];
+        if (g_poa_w_m2[i] >= 100.0 && sun_elevation_rad[i] > 0.0 && std::isfinite(r)) {
+          out[i] = r / reference;
+        }
+      }
+    }
+    lo = hi;
+  }
+  return out;
+}
+
+void ObstacleDayEvidence::Add(double relative_yield, double shaded_fraction, double beam_share,
+                              double mismatch) {
+  if (!(shaded_fraction >= 0.5) || !std::isfinite(relative_yield) || !std::isfinite(beam_share)) {
+    return;
+  }
+  measured_deficit += 1.0 - relative_yield;
+  modelled_deficit += 1.0 - (1.0 - shaded_fraction * std::clamp(beam_share, 0.0, 1.0)) *
+                                (1.0 - mismatch * shaded_fraction);
+  ++rows;
+}
+
+bool ObstacleDayEvidence::Present() const {
+  return rows < 3 || measured_deficit >= 0.5 * modelled_deficit;
+}
+
 const HorizonObstacle& OtherTruthObstacle() {
   static const HorizonObstacle kObstacle = [] {
     HorizonObstacle o;
@@ -120,24 +169,56 @@ const OtherFormTruth& OtherTruth() {
 }
 
 // I_at loses s·I_beam; P_el is multiplied by (1 − f_mismatch·s), the power
-// not converted staying as heat (RunInputs::electric_effects).
+// not converted staying as heat (RunInputs::electric_effects). On the solar
+// days whose measured yield does not show the obstacle (ObstacleDayEvidence)
+// it does not stand: s = 0 there.
 void ShadeTheBeam(const Drivers& d, const ParamVector& p, RunInputs* run) {
   const double centre = ParamOf(p, Param::kShadeAzimuthRad);
   const double width = ParamOf(p, Param::kShadeWidthRad);
   const double edge = ParamOf(p, Param::kShadeElevationRad);
   const double mismatch = ParamOf(p, Param::kShadeMismatch);
+  const std::int64_t solar_offset_s = SolarDayOffsetS(d.plant);
+  const bool has_yield = d.relative_yield.size() == run->n;
   double* g_abs = run->Own(&run->g_abs_w_m2);
+  std::vector<double>& shaded = run->Scratch();
+  shaded.resize(run->n);
   std::vector<double>& factor = run->Scratch();
   factor.resize(run->n);
-  for (std::size_t i = 0; i < run->n; ++i) {
-    const double s =
-        ShadedFraction(d.sun_azimuth_rad[i], d.sun_elevation_rad[i], centre, width, edge);
-    const double beam = std::isfinite(run->g_beam_w_m2[i]) ? run->g_beam_w_m2[i] : 0.0;
-    g_abs[i] -= s * beam;
-    factor[i] = 1.0 - mismatch * s;
+  for (std::size_t lo = 0; lo < run->n;) {
+    const std::int64_t day = SolarDayStartS(d.time_s[lo], solar_offset_s);
+    ObstacleDayEvidence evidence;
+    std::size_t hi = lo;
+    for (; hi < run->n && SolarDayStartS(d.time_s[hi], solar_offset_s) == day; ++hi) {
+      shaded[hi] =
+          ShadedFraction(d.sun_azimuth_rad[hi], d.sun_elevation_rad[hi], centre, width, edge);
+      if (has_yield) {
+        evidence.Add(d.relative_yield[hi], shaded[hi], run->g_beam_w_m2[hi] / run->g_poa_w_m2[hi],
+                     mismatch);
+      }
+    }
+    const bool present = evidence.Present();
+    for (std::size_t i = lo; i < hi; ++i) {
+      const double s = present ? shaded[i] : 0.0;
+      const double beam = std::isfinite(run->g_beam_w_m2[i]) ? run->g_beam_w_m2[i] : 0.0;
+      g_abs[i] -= s * beam;
+      factor[i] = 1.0 - mismatch * s;
+    }
+    lo = hi;
   }
   run->pv_factor = factor.data();
   run->electric_effects = true;
+}
+
+// The measured relative yield of every row (ShadingRelativeYield), for the
+// days on which the obstacle stands.
+bool PrepareRelativeYield(const Series& s, Drivers* d, std::string*) {
+  if (!s.Has(Channel::kPElW)) {
+    d->relative_yield.clear();
+    return true;
+  }
+  d->relative_yield = ShadingRelativeYield(d->time_s, s[Channel::kPElW], d->g_poa_w_m2,
+                                           d->sun_elevation_rad, SolarDayOffsetS(d->plant));
+  return true;
 }
 
 const ModelExtension& Extension() {
@@ -150,6 +231,7 @@ const ModelExtension& Extension() {
     e.inputs = {
         {"beam/diffuse irradiance (shading)",
          {{Channel::kGPoaWM2, Channel::kGPoaDiffuseWM2}, {Channel::kGhiWM2, Channel::kDhiWM2}}}};
+    e.prepare_drivers = PrepareRelativeYield;
     e.transform_drivers = ShadeTheBeam;
     return e;
   }();
@@ -211,30 +293,39 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) { return d.g_
 // A start for the shading parameters from where the base model over-predicts
 // P_el under beam light: cells of sun azimuth (10°) × elevation (5°) whose
 // mean relative P_el residual (predicted − measured)/predicted exceeds 15 %
-// on rows with at least 200 W/m² in the plane. The obstacle's azimuth window
-// spans those cells, its edge is the highest of them. A local fit started at
-// the default (a shade due south) does not find an obstacle elsewhere.
-// Returns false when no cell qualifies.
+// on at least two solar days (at least 3 rows a day, with at least 200 W/m²
+// in the plane): an obstacle recurs at the same sun positions, if not on
+// every day. The obstacle's azimuth window spans those cells, its edge is
+// the highest of them. A local fit started at the default (a shade due
+// south) does not find an obstacle elsewhere. Returns false when no cell
+// qualifies.
 bool StartFromResiduals(const EffectResiduals& res, ParamVector* start) {
   const Drivers& d = *res.drivers;
   const SimOutputs& sim = *res.base;
   const std::vector<double>& p_el_meas_w = *res.p_el_meas_w;
   constexpr int kAz = 36, kEl = 18;
-  std::vector<double> sum(kAz * kEl, 0.0), count(kAz * kEl, 0.0);
+  const std::int64_t solar_offset_s = SolarDayOffsetS(d.plant);
+  // (cell, solar day) → sum and count of the relative residual.
+  std::map<std::pair<int, std::int64_t>, std::pair<double, int>> cell_days;
   for (std::uint32_t i : *res.rows) {
     const double azimuth_rad = d.sun_azimuth_rad[i];
     const double elevation_rad = d.sun_elevation_rad[i];
     if (elevation_rad <= 0.0 || d.g_poa_w_m2[i] < 200.0 || !(sim.p_el_w[i] > 0.0)) continue;
     const int a = std::clamp(static_cast<int>(RadToDeg(azimuth_rad) / 10.0), 0, kAz - 1);
     const int e = std::clamp(static_cast<int>(RadToDeg(elevation_rad) / 5.0), 0, kEl - 1);
-    sum[a * kEl + e] += (sim.p_el_w[i] - p_el_meas_w[i]) / sim.p_el_w[i];
-    count[a * kEl + e] += 1.0;
+    auto& [sum, count] = cell_days[{a * kEl + e, SolarDayStartS(d.time_s[i], solar_offset_s)}];
+    sum += (sim.p_el_w[i] - p_el_meas_w[i]) / sim.p_el_w[i];
+    ++count;
+  }
+  std::vector<int> days_over(kAz * kEl, 0);
+  for (const auto& [key, sum_count] : cell_days) {
+    const auto& [sum, count] = sum_count;
+    if (count >= 3 && sum / count >= 0.15) ++days_over[static_cast<std::size_t>(key.first)];
   }
   int az_lo = kAz, az_hi = -1, el_hi = -1;
   for (int a = 0; a < kAz; ++a) {
     for (int e = 0; e < kEl; ++e) {
-      const int k = a * kEl + e;
-      if (count[k] < 5 || sum[k] / count[k] < 0.15) continue;
+      if (days_over[static_cast<std::size_t>(a * kEl + e)] < 2) continue;
       az_lo = std::min(az_lo, a);
       az_hi = std::max(az_hi, a);
       el_hi = std::max(el_hi, e);
@@ -270,7 +361,10 @@ const EffectModule& ShadingEffect() {
         "e = 2° so that the fit has a gradient. The absorbed irradiance loses s·I_beam, "
         "and partial shade of a string makes the bypass diodes drop whole substrings: "
         "P_el is further multiplied by (1 − f_mismatch·s), the power not converted "
-        "staying as heat. P_el therefore drops much more than Q_u.";
+        "staying as heat. P_el therefore drops much more than Q_u. An obstacle may stand "
+        "on some days only (scaffolding, a vehicle, a crown in leaf): it is taken to stand "
+        "on a solar day when the measured yield P_el/I_gt on the rows it shades falls by "
+        "at least half of what it would remove (every day where P_el is not measured).";
     m.source =
         "Deline et al. 2013, A simplified model of uniform shading in large photovoltaic arrays, "
         "Solar Energy 96";

@@ -19,6 +19,30 @@ namespace pvtwin {
 double ShadedFraction(double sun_azimuth_rad, double sun_elevation_rad, double centre_rad,
                       double width_rad, double edge_elevation_rad);
 
+// An obstacle that stands on some days only (scaffolding, a parked vehicle,
+// a crown in leaf) shows in the measured yield y = P_el/I_gt, relative to the
+// upper quartile of y on the same solar day (rows with I_gt ≥ 200 W/m² and
+// the sun up; y of rows with I_gt ≥ 100 W/m², NaN elsewhere, and on days
+// with fewer than 10 such rows). Per row of the series, in its order.
+std::vector<double> ShadingRelativeYield(const std::vector<std::int64_t>& time_s,
+                                         const std::vector<double>& p_el_w,
+                                         const std::vector<double>& g_poa_w_m2,
+                                         const std::vector<double>& sun_elevation_rad,
+                                         std::int64_t solar_offset_s);
+
+// Whether the obstacle stands on a day: the measured relative-yield deficit
+// on the rows it shades is nearer the modelled one than none,
+//   Σ (1 − y_i) ≥ ½·Σ (1 − (1 − s_i·b_i)·(1 − f_mismatch·s_i)),
+// over the day's rows with s_i ≥ 0.5 and a relative yield y_i (b_i =
+// I_beam/I_gt). A day with fewer than 3 such rows keeps the obstacle.
+struct ObstacleDayEvidence {
+  double measured_deficit = 0.0;
+  double modelled_deficit = 0.0;
+  int rows = 0;
+  void Add(double relative_yield, double shaded_fraction, double beam_share, double mismatch);
+  bool Present() const;
+};
+
 // --- Other-form truth: an obstacle's horizon profile, on some days ---
 
 // The upper edge of an obstacle seen from the collector: vertices (γ_k, h_k),

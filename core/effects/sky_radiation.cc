@@ -7,9 +7,43 @@ namespace pvtwin {
 
 namespace {
 
+// T_sky⁴ per row with the cloud offset (SkyK4WithCloudOffset).
+void OffsetTheSky(const Drivers& d, const ParamVector& p, RunInputs* run) {
+  const double offset = ParamOf(p, Param::kSkyCloudOffset);
+  double* t_sky_k4 = run->Own(&run->t_sky_k4);
+  for (std::size_t i = 0; i < run->n; ++i) {
+    t_sky_k4[i] = SkyK4WithCloudOffset(t_sky_k4[i], CToK(d.t_amb_c[i]), offset);
+  }
+}
+
+// The broader form's part beyond the letter 'r' (its name is the module's,
+// so that "…r+sky_radiation" names and parses to it).
+const ModelExtension& OffsetExtension() {
+  static const ModelExtension kExtension = [] {
+    ModelExtension e;
+    e.name = "sky_radiation";
+    e.variant_order = 8;
+    e.params = {Param::kSkyCloudOffset};
+    e.transform_drivers = OffsetTheSky;
+    return e;
+  }();
+  return kExtension;
+}
+
 bool InSpec(const ModelSpec& spec) { return spec.sky; }
 
-void AddToSpec(ModelSpec* spec) { spec->sky = true; }
+// 'r'; on a spec that has it, the broader form (so that "1N1Cwr+sky_radiation"
+// parses to the form the diagnosis names so).
+void AddToSpec(ModelSpec* spec) {
+  if (spec->sky) spec->Add(OffsetExtension());
+  spec->sky = true;
+}
+
+// The diagnosis's second form: 'r' with the cloud offset.
+void AddBroaderForm(ModelSpec* spec) {
+  spec->sky = true;
+  spec->Add(OffsetExtension());
+}
 
 std::string DataLacks(const Series& data) {
   return !data.Has(Channel::kTSkyC) && !data.Has(Channel::kLwDownWM2)
@@ -83,9 +117,14 @@ const EffectModule& SkyRadiationEffect() {
     m.physics =
         "Long-wave exchange of the front with the sky: ε·σ·(T_PV⁴ − T_sky⁴) (paper "
         "2.9, 'r'). Clear nights and clear days with a cold sky cool the collector below "
-        "ambient; the loss scales with the sky temperature deficit.";
-    m.source = "paper 2.9 (long-wave exchange with the sky)";
-    m.params = {Param::kEpsPvt};
+        "ambient; the loss scales with the sky temperature deficit. The diagnosis also "
+        "fits a broader form, a sky cloudier by Δc_sky than the logged long-wave says "
+        "(another sky model or cloud correction; Crawford & Duchon's ε' = ε + Δc·(1 − ε)): "
+        "T_sky,eff⁴ = T_sky⁴ + Δc_sky·(T_a⁴ − T_sky⁴).";
+    m.source =
+        "paper 2.9 (long-wave exchange with the sky); cloudy sky: Crawford & Duchon 1999; "
+        "sky models' spread: Flerchinger et al. 2009, Water Resour. Res. 45";
+    m.params = {Param::kEpsPvt, Param::kSkyCloudOffset};
     m.needs = {Channel::kTSkyC};
     m.typical_truth = {{Param::kEpsPvt, 0.12}};
     m.signature = "ambient minus sky temperature, K";
@@ -94,6 +133,7 @@ const EffectModule& SkyRadiationEffect() {
         "sky temperature; clear nights then cool the model as they cool the collector.";
     m.in_spec = InSpec;
     m.add_to_spec = AddToSpec;
+    m.diagnosis_forms = {AddBroaderForm};
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
     m.other_truth = &OtherTruth();

@@ -10,6 +10,20 @@
 
 namespace pvtwin {
 
+// The broader form the diagnosis also fits ("r+sky_radiation"): the sky the
+// front exchanges with is cloudier by Δc_sky than the logged long-wave
+// channel says (another sky model or cloud correction, a pyrgeometer that
+// sees another sky). Crawford & Duchon's cloudy sky, ε = c + (1 − c)·ε_clr,
+// applied to the logged sky's emissivity gives ε' = ε + Δc·(1 − ε), i.e. the
+// equivalent sky temperature
+//   T_sky,eff⁴ = T_sky⁴ + Δc_sky·(T_a⁴ − T_sky⁴)   (K⁴; T_a the air in K),
+// floored at 0 (Δc_sky < 0: a clearer sky). Δc_sky = 0 is the paper's 2.9.
+inline double SkyK4WithCloudOffset(double t_sky_k4, double t_amb_k, double offset) {
+  const double t2 = t_amb_k * t_amb_k;
+  const double v = t_sky_k4 + offset * (t2 * t2 - t_sky_k4);
+  return v > 0.0 ? v : 0.0;
+}
+
 // --- Other-form truth: another sky model than the logged long-wave ---
 // (with CloudySkyEmissivity and LongWaveOnPlaneWM2 of core/physics/sky_radiation.h)
 

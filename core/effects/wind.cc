@@ -45,6 +45,14 @@ void AddToSpec(ModelSpec* spec) {
   if (!spec->Has(Extension())) spec->wind_paper = true;
 }
 
+// The physical form "+wind" in place of the paper's 'w' (the diagnosis
+// fits both: the printed form can only lower the front loss as the wind
+// rises, forced convection raises it).
+void AddPhysicalForm(ModelSpec* spec) {
+  spec->wind_paper = false;
+  spec->Add(Extension());
+}
+
 std::string DataLacks(const Series& data) {
   return data.Has(Channel::kWindMS) ? "" : "needs wind_m_s";
 }
@@ -91,8 +99,11 @@ const EffectModule& WindEffect() {
     EffectModule m;
     m.name = "wind";
     m.physics =
-        "Forced convection on the uncovered front: the front loss conductance grows with "
-        "wind speed, U_front(v) with 1/U = 1/U_front + r_refwind/v^n (paper 2.8, 'w').";
+        "Forced convection on the uncovered front: the front loss conductance depends on "
+        "the wind speed, in the paper's printed form 1/U = 1/U_front + r_refwind·v^n "
+        "(paper 2.8, 'w') or in the physical form U = U_front + c_wind·v^n ('+wind', rising "
+        "with the wind as forced convection does); the diagnosis fits both and keeps the "
+        "one that fits the training days better.";
     m.source =
         "paper 2.8 ('w'); ISO 9806:2017 quasi-dynamic model, wind term (c6, c3·u) for '+wind'";
     // The paper's form ('w') first, then the physical form's coefficient.
@@ -101,11 +112,12 @@ const EffectModule& WindEffect() {
     m.typical_truth = {{Param::kRRefWind, 0.02}, {Param::kNWind, 0.8}};
     m.signature = "wind speed, m/s";
     m.advice =
-        "Use a variant with wind ('w') and keep the anemometer near the collector plane; "
-        "forecasts then need a wind forecast.";
+        "Use a variant with wind (the form the report's variant names: 'w' or '+wind') and "
+        "keep the anemometer near the collector plane; forecasts then need a wind forecast.";
     m.extension = &Extension();
     m.in_spec = InSpec;
     m.add_to_spec = AddToSpec;
+    m.diagnosis_forms = {AddPhysicalForm};
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
     m.other_truth = &OtherTruth();

@@ -81,9 +81,6 @@ struct SimOutputs {
   // Work space of the effects' hooks (RunInputs::Scratch), kept here so that
   // repeated runs do not allocate.
   std::array<std::vector<double>, kRunWorkVectors> work;
-  // The model's per-row coefficients of one run (core/model/thermal_model.cc:
-  // conductances, absorbed sun, PV efficiency), kept for the same reason.
-  std::vector<double> row_terms;
 };
 
 struct SimOptions {

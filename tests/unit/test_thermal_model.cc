@@ -365,9 +365,10 @@ bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
 }
 
 // Simulate picks its row loop per run (network shape, sky term, electric
-// effects) and keeps its per-row coefficient arrays in SimOutputs: outputs
-// that runs of other variants and of more rows used before give the same
-// run as fresh ones, and a rerun of the same variant reallocates nothing.
+// effects) and the effects' hooks keep their arrays in SimOutputs' work
+// space: outputs that runs of other variants and of more rows used before
+// give the same run as fresh ones, and a rerun of the same variant
+// reallocates nothing.
 TEST(ThermalModel, ReusedOutputsGiveTheSameRunAndDoNotReallocate) {
   const Plant plant = DesignExamplePlant();
   WeatherOptions weather;
@@ -402,11 +403,11 @@ TEST(ThermalModel, ReusedOutputsGiveTheSameRunAndDoNotReallocate) {
                               [](double t) { return std::isfinite(t); }),
                 static_cast<std::ptrdiff_t>(s->size() / 2));
 
-      const double* row_terms = reused.row_terms.data();
       const double* t_pv = reused.t_pv_c.data();
+      const double* work = reused.work[0].data();
       Simulate(d, params, &reused, options);
-      EXPECT_EQ(reused.row_terms.data(), row_terms);
       EXPECT_EQ(reused.t_pv_c.data(), t_pv);
+      EXPECT_EQ(reused.work[0].data(), work);
       EXPECT_TRUE(SameBits(fresh.t_out_c, reused.t_out_c));
     }
   }

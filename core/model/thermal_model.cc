@@ -24,7 +24,6 @@ double P(const ParamVector& p, Param name) { return p[static_cast<std::size_t>(n
 // Parameter-dependent constants of one run (W/K and J/K for the whole field).
 struct RunConstants {
   int nodes;
-  int fluid_node;  // node that carries the back and fluid links
   double area_m2;
   double f_th;
   double c_pv_j_k;
@@ -47,7 +46,6 @@ RunConstants MakeConstants(const Drivers& d, const ParamVector& p) {
   const ModelSpec& spec = d.spec;
   RunConstants k{};
   k.nodes = spec.nodes;
-  k.fluid_node = spec.nodes == 2 ? 1 : 0;
   k.area_m2 = P(p, Param::kAreaM2);
   k.f_th = P(p, Param::kFTh);
   k.c_pv_j_k = spec.c_pv ? P(p, Param::kCPvJM2K) * k.area_m2 : 0.0;
@@ -187,12 +185,15 @@ constexpr bool TwoNodes(RcShape shape) {
   return shape != RcShape::kOneAlgebraic && shape != RcShape::kOneCapacitive;
 }
 
+// The node that carries the back and fluid links (paper 2.10: the PV node
+// in the one-node model).
+constexpr int FluidNode(RcShape shape) { return TwoNodes(shape) ? 1 : 0; }
+
 // Fills *out (in place: no struct copies in the row loop) from the fluxes
 // `at` the linearisation point.
 template <RcShape kShape, bool kSky>
 [[gnu::always_inline]] inline void Linearise(const RunConstants& k, const RowTerms& r,
                                              double t_lin_c, const PvFluxes& at, Linearised* out) {
-  constexpr int kFluidNode = TwoNodes(kShape) ? 1 : 0;
   Linearised& l = *out;
   l.net = RcNetwork{};
   l.t_lin_c = t_lin_c;
@@ -209,7 +210,7 @@ template <RcShape kShape, bool kSky>
     pv.conductance_w_k += at.dq_rad_w_k;
     pv.source_w += at.dq_rad_w_k * t_lin_c - at.q_rad_w;
   }
-  RcNode& fluid = l.net.node[kFluidNode];
+  RcNode& fluid = l.net.node[FluidNode(kShape)];
   fluid.conductance_w_k += k.g_back_w_k + r.g_fluid_w_k;
   fluid.source_w += k.g_back_w_k * r.t_back_c + r.g_fluid_w_k * r.t_in_c;
 
@@ -286,13 +287,12 @@ template <RcShape kShape, bool kElectric>
 [[gnu::always_inline]] inline void WriteRow(const RunContext& run, const RowTerms& r, std::size_t i,
                                             const double start[2], const RcStepResult& res,
                                             const Linearised& l, SimOutputs* out) {
-  constexpr int kFluidNode = TwoNodes(kShape) ? 1 : 0;
   const RunConstants& k = run.k;
   const double t_pv = res.t_mean_c[0];
-  const double t_fluid_node = res.t_mean_c[kFluidNode];
+  const double t_fluid_node = res.t_mean_c[FluidNode(kShape)];
   const double q_u = r.g_fluid_w_k * (t_fluid_node - r.t_in_c);
   out->t_pv_c[i] = t_pv;
-  out->t_coll_c[i] = res.t_mean_c[kFluidNode];
+  out->t_coll_c[i] = res.t_mean_c[FluidNode(kShape)];
   out->q_th_w[i] = q_u;
   if constexpr (kElectric) {
     double unused_slope;

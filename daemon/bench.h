@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace pvtwin::cli {
@@ -10,7 +11,8 @@ namespace pvtwin::cli {
 double Median(std::vector<double> v);
 double SecondsSince(std::chrono::steady_clock::time_point start);
 
-void BenchIdentification(int repeats, std::uint64_t seed);
+// data_dir: where to write the 1-min training and held-out CSVs ("" = nowhere).
+void BenchIdentification(int repeats, std::uint64_t seed, const std::string& data_dir);
 void BenchTable6(std::uint64_t seed);
 void BenchStore(int repeats, std::uint64_t seed);
 // Real processes, real time: CPU and memory of `pvtwin run` over `seconds`.

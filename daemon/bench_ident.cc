@@ -12,12 +12,18 @@
 //      per m², the paper's objective), also relative to the reference;
 //   3. the reference: a long multi-start BOBYQA run;
 //   4. the speed targets of the default (lad_lm) at 1 min and at 5 s;
-//   5. the paper's MATLAB figures.
+//   5. the paper's MATLAB figures;
+//   6. the time split of the default at 1 min: parse (the training CSV from
+//      text), fit coarse / fine with their model runs, write (params.json).
+// With a data directory, the 1-min training and held-out days are written
+// there as train.csv and held_out.csv (config/examples/plant.toml is their
+// plant), so that `pvtwin calibrate` can be timed on them as a process.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,6 +32,8 @@
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
+#include "io/csv.h"
+#include "io/params_json.h"
 
 namespace pvtwin::cli {
 
@@ -39,6 +47,7 @@ constexpr const char* kVariant = "2N1Ccolwr";
 struct SplitData {
   double step_s = 0.0;
   std::size_t rows = 0;
+  Series train, held_out;
   Drivers train_drivers, held_out_drivers;
   Measurements train_meas, held_out_meas;
 };
@@ -60,15 +69,76 @@ bool MakeSplitData(const Plant& plant, const ModelSpec& spec, double step_s, std
   }
   out->step_s = step_s;
   out->rows = data.size();
-  const Series train = data.Slice(0, train_rows);
-  const Series held_out = data.Slice(train_rows, data.size());
-  if (!PrepareDrivers(train, plant, spec, &out->train_drivers, error) ||
-      !PrepareDrivers(held_out, plant, spec, &out->held_out_drivers, error)) {
+  out->train = data.Slice(0, train_rows);
+  out->held_out = data.Slice(train_rows, data.size());
+  if (!PrepareDrivers(out->train, plant, spec, &out->train_drivers, error) ||
+      !PrepareDrivers(out->held_out, plant, spec, &out->held_out_drivers, error)) {
     return false;
   }
-  out->train_meas = MakeMeasurements(train, out->train_drivers);
-  out->held_out_meas = MakeMeasurements(held_out, out->held_out_drivers);
+  out->train_meas = MakeMeasurements(out->train, out->train_drivers);
+  out->held_out_meas = MakeMeasurements(out->held_out, out->held_out_drivers);
   return true;
+}
+
+std::vector<Channel> ChannelsOf(const Series& s) {
+  std::vector<Channel> channels;
+  for (const ChannelInfo& info : kChannels) {
+    if (s.Has(info.channel)) channels.push_back(info.channel);
+  }
+  return channels;
+}
+
+// Writes train.csv and held_out.csv of `data` into dir.
+void WriteSplitData(const SplitData& data, const std::string& dir) {
+  std::string error;
+  for (const auto& [name, series] :
+       {std::pair{"train.csv", &data.train}, std::pair{"held_out.csv", &data.held_out}}) {
+    const std::string path = dir + "/" + name;
+    if (!WriteCsv(path, *series, ChannelsOf(*series), &error)) {
+      std::printf("ident: %s\n", error.c_str());
+      return;
+    }
+    std::printf("ident: wrote %s (%zu rows)\n", path.c_str(), series->size());
+  }
+}
+
+// The time split of the default at 1 min: median parse time of the training
+// CSV from text (as `calibrate` reads it), the fit's stages from its summary,
+// and the median time to format and write params.json.
+void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, int runs) {
+  std::ostringstream text;
+  WriteCsv(text, data.train, ChannelsOf(data.train));
+  const std::string csv = text.str();
+  std::vector<double> parse, write;
+  const std::string out_path = "/tmp/pvtwin-bench-ident-params.json";
+  for (int r = 0; r < runs; ++r) {
+    std::istringstream in(csv);
+    Series s;
+    Diagnostics errors, warnings;
+    CsvReadOptions options;
+    options.area_m2 = data.train_drivers.plant.area_m2;
+    const auto t0 = std::chrono::steady_clock::now();
+    ParseCanonicalCsv(in, "train.csv", options, &s, &errors, &warnings);
+    parse.push_back(SecondsSince(t0));
+    const auto t1 = std::chrono::steady_clock::now();
+    std::string error;
+    WriteTextFileAtomically(
+        out_path,
+        FormatParamsJson(fit.variant, fit.params, UsedParams(data.train_drivers.spec), "{}"),
+        &error);
+    write.push_back(SecondsSince(t1));
+  }
+  std::remove(out_path.c_str());
+  std::printf(
+      "\ntime split of the default (lad_lm) at 1 min, ms (parse and write: median of %d runs; "
+      "fit: the last run)\n",
+      runs);
+  std::printf(
+      "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs) + fine %.1f "
+      "(%d model runs) | write %.2f\n",
+      1e3 * Median(parse), csv.size() / 1024, 1e3 * fit.runtime_s, 1e3 * fit.coarse_runtime_s,
+      fit.coarse_evaluations, 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
+      fit.evaluations - fit.coarse_evaluations, 1e3 * Median(write));
 }
 
 // The paper's objective (MAE of P_el + MAE of Q_u, W/m²) of `params` on
@@ -146,7 +216,7 @@ void PrintFitRow(const FitFigures& f, double reference_held_out_w_m2) {
 
 }  // namespace
 
-void BenchIdentification(int repeats, std::uint64_t seed) {
+void BenchIdentification(int repeats, std::uint64_t seed, const std::string& data_dir) {
   const auto bench_start = std::chrono::steady_clock::now();
   const Plant plant = DesignExamplePlant();
   ModelSpec spec;
@@ -184,6 +254,7 @@ void BenchIdentification(int repeats, std::uint64_t seed) {
       kTrainDays + kHeldOutDays, d1.rows, kTrainDays, d1.train_meas.size(),
       d1.train_meas.rows.size(), kHeldOutDays, d1.held_out_meas.size(),
       d1.held_out_meas.rows.size());
+  if (!data_dir.empty()) WriteSplitData(d1, data_dir);
   std::printf("objective (MAE P_el + MAE Q_u, W/m2)   %10s %10s\n", "train", "held-out");
   std::printf("  true parameters (noise floor)        %10.4f %10.4f\n",
               ObjectiveWM2(d1.train_drivers, d1.train_meas, truth),
@@ -297,6 +368,7 @@ void BenchIdentification(int repeats, std::uint64_t seed) {
     }
     std::printf(" faster (different machines)");
   }
+  if (fit_1min.summary.ok) PrintTimeSplit(d1, fit_1min.summary, repeats);
   std::printf("\nident: done in %.1f s\n", SecondsSince(bench_start));
 }
 

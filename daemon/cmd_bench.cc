@@ -31,6 +31,7 @@ struct BenchArgs {
   int repeats = 21;
   std::uint64_t seed = 1;
   double daemon_seconds = 60.0;
+  std::string data_dir;
 };
 
 // One 14-day, 1-min simulation (20 160 rows) of each variant.
@@ -99,12 +100,15 @@ void RegisterBench(CLI::App& app) {
   cmd->add_option("--repeats", args->repeats, "runs per figure (median)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
+  cmd->add_option("--data-dir", args->data_dir,
+                  "ident: write its 1-min training and held-out days there (train.csv, "
+                  "held_out.csv; plant: config/examples/plant.toml)");
   cmd->add_option("--daemon-seconds", args->daemon_seconds, "measuring time of `bench daemon`")
       ->check(CLI::PositiveNumber);
   cmd->callback([args] {
     for (const std::string& w : args->what) {
       if (w == "sim") BenchSimulation(*args);
-      if (w == "ident") BenchIdentification(args->repeats, args->seed);
+      if (w == "ident") BenchIdentification(args->repeats, args->seed, args->data_dir);
       if (w == "table6") BenchTable6(args->seed);
       if (w == "store") BenchStore(args->repeats, args->seed);
       if (w == "daemon") BenchDaemon(args->daemon_seconds);

@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -37,8 +38,37 @@ struct CalibrateArgs {
   int max_evaluations = 0;
   double ftol_rel = 0.0;
   bool use_t_pv = false;
+  bool timing = false;
   int parent_pid = 0;
 };
+
+// Wall time of the stages of one calibrate run, for --timing.
+struct StageTimes {
+  std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+  double parse_s = 0.0;    // reading the CSVs
+  double prepare_s = 0.0;  // window, resampling, drivers, measurements
+  double held_out_s = 0.0;
+  double write_s = 0.0;
+
+  // Seconds since the previous call.
+  double Lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - last).count();
+    last = now;
+    return s;
+  }
+};
+
+// One line on standard error: parse / prepare / fit (coarse, fine) /
+// held-out / write, in ms, and the model runs of each fit stage.
+void PrintTiming(const StageTimes& t, const IdentSummary& s) {
+  std::fprintf(stderr,
+               "timing: parse %.1f ms, prepare %.1f ms, fit %.1f ms (coarse %.1f ms, %d model "
+               "runs; fine %.1f ms, %d model runs), held-out %.1f ms, write %.1f ms\n",
+               1e3 * t.parse_s, 1e3 * t.prepare_s, 1e3 * s.runtime_s, 1e3 * s.coarse_runtime_s,
+               s.coarse_evaluations, 1e3 * (s.runtime_s - s.coarse_runtime_s),
+               s.evaluations - s.coarse_evaluations, 1e3 * t.held_out_s, 1e3 * t.write_s);
+}
 
 bool ResampleOrReport(const std::string& path, double step_s, Series* s) {
   if (step_s <= 0.0 || step_s == s->step_s) return true;
@@ -195,8 +225,10 @@ int RunCalibrate(const CalibrateArgs& a) {
     start = file.values;
   }
 
+  StageTimes times;
   Series series;
   if (!LoadCsvOrReport(a.csv, config, &series)) return kExitBadInput;
+  times.parse_s += times.Lap();
   std::int64_t t_begin = series.time_s.empty() ? 0 : series.time_s.front();
   std::int64_t t_end = series.time_s.empty() ? 0 : series.time_s.back() + 1;
   if (!a.train_start.empty() && !ParseTimeOrReport("--train-start", a.train_start, &t_begin)) {
@@ -210,6 +242,7 @@ int RunCalibrate(const CalibrateArgs& a) {
   Drivers drivers;
   if (!PrepareDriversOrReport(train, a.csv, config, spec, &drivers)) return kExitBadInput;
   const Measurements meas = MakeMeasurements(train, drivers);
+  times.prepare_s += times.Lap();
   if (static_cast<int>(meas.rows.size()) < options.min_rows) {
     std::cerr << a.csv << ": training window " << FormatIsoUtc(t_begin) << " .. "
               << FormatIsoUtc(t_end) << " has " << meas.rows.size()
@@ -224,15 +257,19 @@ int RunCalibrate(const CalibrateArgs& a) {
   Drivers test_drivers;
   if (!a.test_csv.empty()) {
     if (!LoadCsvOrReport(a.test_csv, config, &test)) return kExitBadInput;
+    times.parse_s += times.Lap();
     if (!ResampleOrReport(a.test_csv, a.step_s, &test)) return kExitBadInput;
     if (!PrepareDriversOrReport(test, a.test_csv, config, spec, &test_drivers)) {
       return kExitBadInput;
     }
+    times.prepare_s += times.Lap();
   }
 
   std::fprintf(stderr, "calibrating %s on %zu rows (%zu in the objective) of %s ...\n",
                spec.Name().c_str(), train.size(), meas.rows.size(), a.csv.c_str());
+  times.Lap();
   const IdentSummary summary = Identify(drivers, meas, start, options);
+  times.Lap();
   std::printf("%s\n", summary.BriefReport().c_str());
   std::printf("training data: %s, %s .. %s, step %.0f s\n", a.csv.c_str(),
               FormatIsoUtc(train.time_s.front()).c_str(), FormatIsoUtc(train.time_s.back()).c_str(),
@@ -244,6 +281,7 @@ int RunCalibrate(const CalibrateArgs& a) {
     Simulate(test_drivers, summary.params, &sim);
     held_out = ComputeErrors(MakeMeasurements(test, test_drivers), sim, config.plant.area_m2);
     PrintErrors("errors (held out):", held_out, config.plant.area_m2);
+    times.held_out_s = times.Lap();
   }
   std::printf("parameters:\n  %-22s %12s %-11s %-16s %12s  %-22s %s\n", "name", "value",
               "std. error", "unit", "start", "range", "status");
@@ -258,9 +296,11 @@ int RunCalibrate(const CalibrateArgs& a) {
   if (summary.ok) PrintIsoEquivalents(config.plant, spec, summary.params, train);
   for (const std::string& note : summary.notes) std::printf("note: %s\n", note.c_str());
   if (!summary.ok) {
+    if (a.timing) PrintTiming(times, summary);
     std::fprintf(stderr, "calibration failed: %s\n", summary.failure_reason.c_str());
     return kExitRuntime;
   }
+  times.Lap();
   if (!a.out.empty()) {
     std::string error;
     const std::string text =
@@ -270,8 +310,10 @@ int RunCalibrate(const CalibrateArgs& a) {
       std::cerr << error << "\n";
       return kExitRuntime;
     }
+    times.write_s = times.Lap();
     std::fprintf(stderr, "wrote %s\n", a.out.c_str());
   }
+  if (a.timing) PrintTiming(times, summary);
   return kExitOk;
 }
 
@@ -317,6 +359,9 @@ void RegisterCalibrate(CLI::App& app) {
   cmd->add_option("--parent-pid", args->parent_pid,
                   "exit when the process with this pid ends (used by pvtwin run for its "
                   "calibration child)");
+  cmd->add_flag("--timing", args->timing,
+                "print the time split (parse, prepare, fit coarse/fine with their model runs, "
+                "held-out, write) on standard error");
   cmd->add_flag("--use-t-pv", args->use_t_pv,
                 "add the measured PV temperature (t_pv_c) to the objective");
   cmd->callback([args] { SetExitCode(RunCalibrate(*args)); });

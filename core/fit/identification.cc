@@ -875,7 +875,11 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
     return finish(false, "the model gives non-finite outputs at the start values");
   }
   ParamVector best = fs.base;
+  const auto t_coarse = std::chrono::steady_clock::now();
   const int coarse_simulations = CoarseStart(drivers, meas, options, fs, obj, initial_cost, &best);
+  summary.coarse_runtime_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_coarse).count();
+  summary.coarse_evaluations = coarse_simulations;
   FineFit fine(obj, fs, meas, options, drivers.plant, coarse_simulations, best);
   fine.FitAll();
   fine.FixUnidentifiable(&summary.notes);

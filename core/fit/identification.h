@@ -140,6 +140,11 @@ struct IdentSummary {
   double final_cost_w_m2 = 0.0;    // objective at the result (without the prior)
   int evaluations = 0;             // model simulations, all stages
   double runtime_s = 0.0;
+  // Time split: the coarse stage's share of runtime_s and of evaluations
+  // (0 without a coarse stage); the fine stage (fit, identifiability,
+  // polish) is the rest.
+  double coarse_runtime_s = 0.0;
+  int coarse_evaluations = 0;
   ParamVector params{};
   std::vector<ParamEstimate> estimates;  // the parameters the variant uses
   std::vector<std::string> notes;        // identifiability findings, in words

@@ -13,7 +13,7 @@ struct Phi {
 
 // Both φ functions from one expm1; Taylor series near 0 where the closed
 // forms cancel.
-Phi ExpPhis(double x) {
+[[gnu::always_inline]] inline Phi ExpPhis(double x) {
   if (std::fabs(x) < 1e-3) {
     return {1.0 - x / 2.0 + x * x / 6.0 - x * x * x / 24.0,
             0.5 - x / 6.0 + x * x / 24.0 - x * x * x / 120.0};
@@ -29,8 +29,8 @@ namespace {
 
 // One capacitive node: C·dT/dt = S − G·T. End value and mean over dt:
 //   T(dt) = T0 + (S − G·T0)·dt/C·φ1(G·dt/C),   mean = T0 + (S − G·T0)·dt/C·φ2(·)
-void AdvanceOne(double c, double g, double s, double t0, double dt_s, double* t_end,
-                double* t_mean) {
+[[gnu::always_inline]] inline void AdvanceOne(double c, double g, double s, double t0, double dt_s,
+                                              double* t_end, double* t_mean) {
   const double dt_over_c = dt_s / c;
   const double rate = (s - g * t0) * dt_over_c;
   const Phi phi = ExpPhis(g * dt_over_c);
@@ -77,40 +77,77 @@ void AdvanceTwo(const RcNetwork& net, const double t0[2], double dt_s, RcStepRes
 
 }  // namespace
 
-RcStepResult AdvanceRc(const RcNetwork& net, const double t_start_c[2], double dt_s) {
+RcShape ShapeOf(const RcNetwork& net) {
+  const bool cap0 = net.node[0].capacitance_j_k > 0.0;
+  if (net.nodes == 1) return cap0 ? RcShape::kOneCapacitive : RcShape::kOneAlgebraic;
+  const bool cap1 = net.node[1].capacitance_j_k > 0.0;
+  if (cap0 && cap1) return RcShape::kTwoCapacitiveBoth;
+  if (cap0) return RcShape::kTwoCapacitive0;
+  return cap1 ? RcShape::kTwoCapacitive1 : RcShape::kTwoAlgebraic;
+}
+
+template <RcShape kShape>
+[[gnu::always_inline]] inline RcStepResult AdvanceRcShaped(const RcNetwork& net,
+                                                           const double t_start_c[2], double dt_s) {
   RcStepResult r;
   const RcNode& n0 = net.node[0];
-  if (net.nodes == 1) {
-    if (n0.capacitance_j_k > 0.0) {
-      AdvanceOne(n0.capacitance_j_k, n0.conductance_w_k, n0.source_w, t_start_c[0], dt_s,
-                 &r.t_end_c[0], &r.t_mean_c[0]);
-    } else {
-      r.t_end_c[0] = r.t_mean_c[0] = n0.source_w / n0.conductance_w_k;
-    }
-    return r;
-  }
-  const RcNode& n1 = net.node[1];
-  const bool cap0 = n0.capacitance_j_k > 0.0;
-  const bool cap1 = n1.capacitance_j_k > 0.0;
-  if (!cap0 && !cap1) return SteadyRc(net);
-  if (cap0 && cap1) {
+  if constexpr (kShape == RcShape::kOneAlgebraic) {
+    r.t_end_c[0] = r.t_mean_c[0] = n0.source_w / n0.conductance_w_k;
+  } else if constexpr (kShape == RcShape::kOneCapacitive) {
+    AdvanceOne(n0.capacitance_j_k, n0.conductance_w_k, n0.source_w, t_start_c[0], dt_s,
+               &r.t_end_c[0], &r.t_mean_c[0]);
+  } else if constexpr (kShape == RcShape::kTwoAlgebraic) {
+    r = SteadyRc(net);
+  } else if constexpr (kShape == RcShape::kTwoCapacitiveBoth) {
     AdvanceTwo(net, t_start_c, dt_s, &r);
-    return r;
+  } else {
+    // One algebraic node a, one capacitive node b. Eliminating a:
+    //   T_a = (S_a + g·T_b)/(G_a + g)
+    //   C_b·dT_b/dt = S_b + g·S_a/(G_a + g) − (G_b + g·G_a/(G_a + g))·T_b
+    constexpr int a = kShape == RcShape::kTwoCapacitive0 ? 1 : 0;
+    constexpr int b = 1 - a;
+    const double g = net.coupling_w_k;
+    const double inv_denom_a = 1.0 / (net.node[a].conductance_w_k + g);
+    const double s_red = net.node[b].source_w + g * net.node[a].source_w * inv_denom_a;
+    const double g_red =
+        net.node[b].conductance_w_k + g * net.node[a].conductance_w_k * inv_denom_a;
+    AdvanceOne(net.node[b].capacitance_j_k, g_red, s_red, t_start_c[b], dt_s, &r.t_end_c[b],
+               &r.t_mean_c[b]);
+    r.t_end_c[a] = (net.node[a].source_w + g * r.t_end_c[b]) * inv_denom_a;
+    r.t_mean_c[a] = (net.node[a].source_w + g * r.t_mean_c[b]) * inv_denom_a;
   }
-  // One algebraic node a, one capacitive node b. Eliminating a:
-  //   T_a = (S_a + g·T_b)/(G_a + g)
-  //   C_b·dT_b/dt = S_b + g·S_a/(G_a + g) − (G_b + g·G_a/(G_a + g))·T_b
-  const int a = cap0 ? 1 : 0;
-  const int b = 1 - a;
-  const double g = net.coupling_w_k;
-  const double inv_denom_a = 1.0 / (net.node[a].conductance_w_k + g);
-  const double s_red = net.node[b].source_w + g * net.node[a].source_w * inv_denom_a;
-  const double g_red = net.node[b].conductance_w_k + g * net.node[a].conductance_w_k * inv_denom_a;
-  AdvanceOne(net.node[b].capacitance_j_k, g_red, s_red, t_start_c[b], dt_s, &r.t_end_c[b],
-             &r.t_mean_c[b]);
-  r.t_end_c[a] = (net.node[a].source_w + g * r.t_end_c[b]) * inv_denom_a;
-  r.t_mean_c[a] = (net.node[a].source_w + g * r.t_mean_c[b]) * inv_denom_a;
   return r;
+}
+
+template RcStepResult AdvanceRcShaped<RcShape::kOneAlgebraic>(const RcNetwork&, const double[2],
+                                                              double);
+template RcStepResult AdvanceRcShaped<RcShape::kOneCapacitive>(const RcNetwork&, const double[2],
+                                                               double);
+template RcStepResult AdvanceRcShaped<RcShape::kTwoAlgebraic>(const RcNetwork&, const double[2],
+                                                              double);
+template RcStepResult AdvanceRcShaped<RcShape::kTwoCapacitive0>(const RcNetwork&, const double[2],
+                                                                double);
+template RcStepResult AdvanceRcShaped<RcShape::kTwoCapacitive1>(const RcNetwork&, const double[2],
+                                                                double);
+template RcStepResult AdvanceRcShaped<RcShape::kTwoCapacitiveBoth>(const RcNetwork&,
+                                                                   const double[2], double);
+
+RcStepResult AdvanceRc(const RcNetwork& net, const double t_start_c[2], double dt_s) {
+  switch (ShapeOf(net)) {
+    case RcShape::kOneAlgebraic:
+      return AdvanceRcShaped<RcShape::kOneAlgebraic>(net, t_start_c, dt_s);
+    case RcShape::kOneCapacitive:
+      return AdvanceRcShaped<RcShape::kOneCapacitive>(net, t_start_c, dt_s);
+    case RcShape::kTwoAlgebraic:
+      return AdvanceRcShaped<RcShape::kTwoAlgebraic>(net, t_start_c, dt_s);
+    case RcShape::kTwoCapacitive0:
+      return AdvanceRcShaped<RcShape::kTwoCapacitive0>(net, t_start_c, dt_s);
+    case RcShape::kTwoCapacitive1:
+      return AdvanceRcShaped<RcShape::kTwoCapacitive1>(net, t_start_c, dt_s);
+    case RcShape::kTwoCapacitiveBoth:
+      break;
+  }
+  return AdvanceRcShaped<RcShape::kTwoCapacitiveBoth>(net, t_start_c, dt_s);
 }
 
 RcStepResult SteadyRc(const RcNetwork& net) {

@@ -40,6 +40,24 @@ struct RcStepResult {
 // connected group.
 RcStepResult AdvanceRc(const RcNetwork& net, const double t_start_c[2], double dt_s);
 
+// Which nodes of a network hold a capacitance (C > 0): the case AdvanceRc
+// solves. A caller that steps one network shape many times (the model's row
+// loop) picks it once and calls AdvanceRcShaped, which does the same
+// arithmetic as AdvanceRc without testing the shape at every step.
+enum class RcShape {
+  kOneAlgebraic,      // one node, C = 0
+  kOneCapacitive,     // one node, C > 0
+  kTwoAlgebraic,      // two nodes, no capacitance
+  kTwoCapacitive0,    // two nodes, capacitance on node 0 only
+  kTwoCapacitive1,    // two nodes, capacitance on node 1 only
+  kTwoCapacitiveBoth  // two nodes, both capacitive
+};
+RcShape ShapeOf(const RcNetwork& net);
+
+// AdvanceRc for a network of shape kShape (ShapeOf(net) == kShape).
+template <RcShape kShape>
+RcStepResult AdvanceRcShaped(const RcNetwork& net, const double t_start_c[2], double dt_s);
+
 // Steady state of the network (all capacitances ignored): paper 2.2's
 // initial node temperatures.
 RcStepResult SteadyRc(const RcNetwork& net);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "core/common/units.h"
@@ -10,6 +11,7 @@
 #include "core/model/thermal_model.h"
 #include "core/physics/rc_network.h"
 #include "core/synth/synthetic_plant.h"
+#include "core/synth/weather_generator.h"
 #include "tests/support/effect_named.h"
 #include "tests/support/synthetic_series.h"
 
@@ -33,31 +35,85 @@ double ExpMean(double t_eq, double t0, double tau, double a, double dt) {
   return t_eq + (t0 - t_eq) * std::exp(-a / tau) * (1.0 - std::exp(-dt / tau)) * tau / dt;
 }
 
-TEST(RcNetwork, TwoCapacitiveNodesMatchFineEulerIntegration) {
+// Reference for one step of any network: explicit Euler with n tiny steps;
+// after each step the algebraic nodes (C = 0) are brought to their balance
+// by Gauss–Seidel sweeps. Means are trapezoidal over the sub-steps.
+RcStepResult FineEulerStep(const RcNetwork& net, const double t0[2], double dt, int n) {
+  double t[2] = {t0[0], net.nodes == 2 ? t0[1] : 0.0};
+  const double g = net.nodes == 2 ? net.coupling_w_k : 0.0;
+  auto balance = [&]() {
+    for (int sweep = 0; sweep < 200; ++sweep) {
+      for (int i = 0; i < net.nodes; ++i) {
+        const RcNode& node = net.node[i];
+        if (node.capacitance_j_k > 0.0) continue;
+        t[i] = (node.source_w + g * t[1 - i]) / (node.conductance_w_k + g);
+      }
+    }
+  };
+  balance();
+  RcStepResult r;
+  const double h = dt / n;
+  for (int step = 0; step < n; ++step) {
+    const double before[2] = {t[0], t[1]};
+    double rate[2] = {0.0, 0.0};
+    for (int i = 0; i < net.nodes; ++i) {
+      const RcNode& node = net.node[i];
+      if (node.capacitance_j_k > 0.0) {
+        rate[i] = (node.source_w - node.conductance_w_k * t[i] + g * (t[1 - i] - t[i])) /
+                  node.capacitance_j_k;
+      }
+    }
+    for (int i = 0; i < net.nodes; ++i) t[i] += h * rate[i];
+    balance();
+    for (int i = 0; i < 2; ++i) r.t_mean_c[i] += 0.5 * (before[i] + t[i]) / n;
+  }
+  r.t_end_c[0] = t[0];
+  r.t_end_c[1] = t[1];
+  return r;
+}
+
+// The network a shape names: the node values of the reference's two-node
+// case (τ_min ≈ 2e4/8 s) with the capacitances the shape has.
+RcNetwork NetworkOfShape(RcShape shape) {
   RcNetwork net;
-  net.nodes = 2;
-  net.node[0] = {2.0e4, 3.0, 3.0 * 10.0 + 500.0};
-  net.node[1] = {9.0e4, 8.0, 8.0 * 30.0};
+  net.nodes = shape == RcShape::kOneAlgebraic || shape == RcShape::kOneCapacitive ? 1 : 2;
+  const bool cap0 = shape == RcShape::kOneCapacitive || shape == RcShape::kTwoCapacitive0 ||
+                    shape == RcShape::kTwoCapacitiveBoth;
+  const bool cap1 = shape == RcShape::kTwoCapacitive1 || shape == RcShape::kTwoCapacitiveBoth;
+  net.node[0] = {cap0 ? 2.0e4 : 0.0, 3.0, 3.0 * 10.0 + 500.0};
+  net.node[1] = {cap1 ? 9.0e4 : 0.0, 8.0, 8.0 * 30.0};
   net.coupling_w_k = 5.0;
+  return net;
+}
+
+template <RcShape kShape>
+void ExpectShapeMatchesFineEuler(const char* what) {
+  SCOPED_TRACE(what);
+  const RcNetwork net = NetworkOfShape(kShape);
+  ASSERT_EQ(ShapeOf(net), kShape);
   const double t0[2] = {15.0, 25.0};
   const double dt = 1800.0;
-  const RcStepResult r = AdvanceRc(net, t0, dt);
-  // Reference: explicit Euler with a tiny step (stable: τ_min ≈ 2e4/8 s).
-  double a = t0[0], b = t0[1], mean_a = 0.0, mean_b = 0.0;
-  const int n = 1'800'000;
-  const double h = dt / n;
-  for (int i = 0; i < n; ++i) {
-    const double da = (net.node[0].source_w - net.node[0].conductance_w_k * a + 5.0 * (b - a));
-    const double db = (net.node[1].source_w - net.node[1].conductance_w_k * b + 5.0 * (a - b));
-    mean_a += (a + 0.5 * h * da / 2.0e4) / n;
-    mean_b += (b + 0.5 * h * db / 9.0e4) / n;
-    a += h * da / 2.0e4;
-    b += h * db / 9.0e4;
+  const RcStepResult r = AdvanceRcShaped<kShape>(net, t0, dt);
+  const RcStepResult ref = FineEulerStep(net, t0, dt, 400'000);
+  for (int i = 0; i < net.nodes; ++i) {
+    EXPECT_NEAR(r.t_end_c[i], ref.t_end_c[i], 1e-4) << "node " << i;
+    EXPECT_NEAR(r.t_mean_c[i], ref.t_mean_c[i], 1e-4) << "node " << i;
   }
-  EXPECT_NEAR(r.t_end_c[0], a, 1e-4);
-  EXPECT_NEAR(r.t_end_c[1], b, 1e-4);
-  EXPECT_NEAR(r.t_mean_c[0], mean_a, 1e-4);
-  EXPECT_NEAR(r.t_mean_c[1], mean_b, 1e-4);
+  // AdvanceRc picks the same arithmetic for this shape.
+  const RcStepResult general = AdvanceRc(net, t0, dt);
+  EXPECT_EQ(general.t_end_c[0], r.t_end_c[0]);
+  EXPECT_EQ(general.t_mean_c[0], r.t_mean_c[0]);
+}
+
+// Each shape's step (the model's row loops call AdvanceRcShaped for their
+// network's shape) against an independent fine integration.
+TEST(RcNetwork, EveryShapeMatchesFineEulerIntegration) {
+  ExpectShapeMatchesFineEuler<RcShape::kOneAlgebraic>("one algebraic node");
+  ExpectShapeMatchesFineEuler<RcShape::kOneCapacitive>("one capacitive node");
+  ExpectShapeMatchesFineEuler<RcShape::kTwoAlgebraic>("two algebraic nodes");
+  ExpectShapeMatchesFineEuler<RcShape::kTwoCapacitive0>("capacitance on node 0");
+  ExpectShapeMatchesFineEuler<RcShape::kTwoCapacitive1>("capacitance on node 1");
+  ExpectShapeMatchesFineEuler<RcShape::kTwoCapacitiveBoth>("two capacitive nodes");
 }
 
 // No sun, no flow: a one-node model with capacitance relaxes to the
@@ -300,6 +356,56 @@ TEST(ThermalModel, ResultIndependentOfStepForConstantInputs) {
     for (std::size_t i = 1; i <= 180; ++i) mean_fine += a.t_pv_c[i] / 180.0;
     // 'r' variants linearise the sky term within a step: equal to ~1 mK.
     EXPECT_NEAR(b.t_pv_c[1], mean_fine, 2e-3) << v;
+  }
+}
+
+// Equal to the bit, NaN where the other is NaN.
+bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+// Simulate picks its row loop per run (network shape, sky term, electric
+// effects) and the effects' hooks keep their arrays in SimOutputs' work
+// space: outputs that runs of other variants and of more rows used before
+// give the same run as fresh ones, and a rerun of the same variant
+// reallocates nothing.
+TEST(ThermalModel, ReusedOutputsGiveTheSameRunAndDoNotReallocate) {
+  const Plant plant = DesignExamplePlant();
+  WeatherOptions weather;  // 7 days at 1 min, varying flow
+  weather.flow_mode = FlowMode::kVariable;
+  const Series week = GenerateWeather(plant, weather);
+  const Series one_day = week.Between(week.time_s.front(), week.time_s.front() + 86400);
+  SimOptions options;
+  options.energy_terms = true;
+  SimOutputs reused;
+  for (const char* v : {"2N2Cr+pv_clipping+shading", "1N", "2N1Ccolwr", "1N1Cr+flow_dependent_u",
+                        "2Nwr", "2N1Cpvr+wind+soiling", "1Nwr+pv_clipping"}) {
+    for (const Series* s : {&week, &one_day}) {
+      SCOPED_TRACE(std::string(v) + (s == &one_day ? ", one day" : ", a week"));
+      const ModelSpec spec = testing::SpecOf(v);
+      const Drivers d = MakeDrivers(*s, v, plant);
+      const ParamVector params = TruthParamsFor(plant, spec);
+      SimOutputs fresh;
+      Simulate(d, params, &fresh, options);
+      Simulate(d, params, &reused, options);
+      const std::vector<double>* outputs[][2] = {
+          {&fresh.p_el_w, &reused.p_el_w},       {&fresh.q_th_w, &reused.q_th_w},
+          {&fresh.t_pv_c, &reused.t_pv_c},       {&fresh.t_coll_c, &reused.t_coll_c},
+          {&fresh.t_out_c, &reused.t_out_c},     {&fresh.q_abs_w, &reused.q_abs_w},
+          {&fresh.q_rad_w, &reused.q_rad_w},     {&fresh.q_store_w, &reused.q_store_w},
+          {&fresh.q_front_w, &reused.q_front_w}, {&fresh.q_back_w, &reused.q_back_w}};
+      for (const auto& pair : outputs) EXPECT_TRUE(SameBits(*pair[0], *pair[1]));
+      EXPECT_GT(std::count_if(reused.t_pv_c.begin(), reused.t_pv_c.end(),
+                              [](double t) { return std::isfinite(t); }),
+                static_cast<std::ptrdiff_t>(s->size() / 2));
+
+      const double* t_pv = reused.t_pv_c.data();
+      const double* work = reused.work[0].data();
+      Simulate(d, params, &reused, options);
+      EXPECT_EQ(reused.t_pv_c.data(), t_pv);
+      EXPECT_EQ(reused.work[0].data(), work);
+      EXPECT_TRUE(SameBits(fresh.t_out_c, reused.t_out_c));
+    }
   }
 }
 

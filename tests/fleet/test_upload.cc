@@ -324,9 +324,13 @@ TEST_F(Upload, ReaggregatedMinutesCalibrationStatusAndForecastsUpdateTheirCentra
     for (const std::int64_t at : {issue - 5 * 86400, issue - 3600, issue}) {
       for (int k = 0; k < 120; ++k) {
         const std::int64_t ts = at + 60 * k;
-        ASSERT_EQ(db.Exec("INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w) VALUES(" +
+        // With the bands and the reference of schema 6: central columns
+        // follow the store's (ExpectPlantEqual compares every column).
+        ASSERT_EQ(db.Exec("INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w, p_el_w_p10, "
+                          "p_el_w_p90, q_th_w_p10, q_th_w_p90, p_el_w_ref, q_th_w_ref) VALUES(" +
                           std::to_string(at) + ", " + std::to_string(ts) + ", " +
-                          std::to_string(at % 1000 + k) + ".25, 1.5)"),
+                          std::to_string(at % 1000 + k) + ".25, 1.5, " + std::to_string(k) +
+                          ".5, 300.5, -2.5, 4.5, 7.25, NULL)"),
                   SQLITE_OK);
       }
     }
@@ -344,6 +348,9 @@ TEST_F(Upload, ReaggregatedMinutesCalibrationStatusAndForecastsUpdateTheirCentra
   EXPECT_EQ(Central("SELECT count(*) FROM forecast"), 120 + 60);
   EXPECT_EQ(Central("SELECT count(*) FROM forecast WHERE issued_at = " + std::to_string(issue)),
             120);
+  EXPECT_EQ(Central("SELECT count(*) FROM forecast WHERE p_el_w_p90 = 300.5 AND q_th_w_ref IS "
+                    "NULL"),
+            120 + 60);
 
   // Samples of another weather seed for 10 minutes at 12:00: the import
   // re-aggregates (replaces) those minutes in a new process.

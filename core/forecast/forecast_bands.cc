@@ -211,28 +211,84 @@ void ForEachReplayDay(const Series& history, const ForecastRequest& request, Per
 
 }  // namespace
 
+namespace {
+
+// The replayed errors of one weather source (the history's days on which
+// that source has rows) into out->by_source[source] and out->days[source].
+bool ReplaySource(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                  const Series& history, const Series& past_weather_forecast,
+                  const ForecastRequest& request, WeatherSource source, ForecastErrors* out,
+                  std::string* error) {
+  const auto s = static_cast<std::size_t>(source);
+  const bool table = source == WeatherSource::kWeatherForecast;
+  bool ok = true;
+  ForEachReplayDay(history, request, [&](const ForecastRequest& day, const Series& before) {
+    const std::int64_t d = day.issued_at_s;
+    if (table && (past_weather_forecast.size() == 0 || past_weather_forecast.time_s.back() < d ||
+                  past_weather_forecast.time_s.front() >= d + kDayS)) {
+      return true;
+    }
+    Forecast f;
+    ok = MakeForecast(plant, spec, params, before, table ? past_weather_forecast : Series{},
+                      Series{}, day, &f, error);
+    if (!ok) return false;
+    const std::size_t n_before = out->by_source[s].size();
+    Score(f, RegimesOf(plant, f.inputs_used), history, table, &out->by_source[s]);
+    if (out->by_source[s].size() > n_before) ++out->days[s];
+    return true;
+  });
+  return ok;
+}
+
+// ChooseOperation, keeping the persistence errors of each operation forecast
+// (as ReplaySource gives them) in *by_operation.
+bool CompareOperations(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                       const Series& history, const ForecastRequest& request, OperationChoice* out,
+                       std::array<ForecastErrors, 2>* by_operation, std::string* error) {
+  *out = OperationChoice{};
+  for (int mode = 0; mode < 2; ++mode) {
+    ForecastRequest r = request;
+    r.operation = mode ? OperationForecast::kLearned : OperationForecast::kTypicalDay;
+    (*by_operation)[mode] = ForecastErrors{};
+    if (!ReplaySource(plant, spec, params, history, Series{}, r, WeatherSource::kPersistence,
+                      &(*by_operation)[mode], error)) {
+      return false;
+    }
+  }
+  out->days = (*by_operation)[0].days[0];
+  // The same minutes for both: those where both forecasts have Q.
+  const std::vector<ForecastError>& typical = (*by_operation)[0].by_source[0];
+  const std::vector<ForecastError>& learned = (*by_operation)[1].by_source[0];
+  double sum[2] = {0.0, 0.0};
+  std::size_t n = 0, j = 0;
+  for (const ForecastError& a : typical) {
+    while (j < learned.size() && learned[j].time_s < a.time_s) ++j;
+    if (j == learned.size() || learned[j].time_s != a.time_s) continue;
+    if (!std::isfinite(a.q_th_w) || !std::isfinite(learned[j].q_th_w)) continue;
+    sum[0] += std::fabs(a.q_th_w);
+    sum[1] += std::fabs(learned[j].q_th_w);
+    ++n;
+  }
+  if (n > 0) {
+    out->mae_q_th_typical_w = sum[0] / static_cast<double>(n);
+    out->mae_q_th_learned_w = sum[1] / static_cast<double>(n);
+    if (out->mae_q_th_learned_w < out->mae_q_th_typical_w) {
+      out->chosen = OperationForecast::kLearned;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 bool ReplayForecastErrors(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
                           const Series& history, const Series& past_weather_forecast,
                           const ForecastRequest& request, ForecastErrors* out, std::string* error) {
   *out = ForecastErrors{};
-  bool ok = true;
-  ForEachReplayDay(history, request, [&](const ForecastRequest& day, const Series& before) {
-    const std::int64_t d = day.issued_at_s;
-    const bool table = past_weather_forecast.size() > 0 &&
-                       past_weather_forecast.time_s.back() >= d &&
-                       past_weather_forecast.time_s.front() < d + kDayS;
-    for (std::size_t s = 0; s < (table ? 2u : 1u); ++s) {
-      Forecast f;
-      ok = MakeForecast(plant, spec, params, before, s == 1 ? past_weather_forecast : Series{},
-                        Series{}, day, &f, error);
-      if (!ok) return false;
-      const std::size_t n_before = out->by_source[s].size();
-      Score(f, RegimesOf(plant, f.inputs_used), history, s == 1, &out->by_source[s]);
-      if (out->by_source[s].size() > n_before) ++out->days[s];
-    }
-    return true;
-  });
-  return ok;
+  return ReplaySource(plant, spec, params, history, past_weather_forecast, request,
+                      WeatherSource::kPersistence, out, error) &&
+         ReplaySource(plant, spec, params, history, past_weather_forecast, request,
+                      WeatherSource::kWeatherForecast, out, error);
 }
 
 std::string OperationChoice::Describe() const {
@@ -248,53 +304,25 @@ std::string OperationChoice::Describe() const {
 bool ChooseOperation(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
                      const Series& history, const ForecastRequest& request, OperationChoice* out,
                      std::string* error) {
-  *out = OperationChoice{};
-  double sum[2] = {0.0, 0.0};
-  std::size_t n = 0;
-  bool ok = true;
-  ForEachReplayDay(history, request, [&](ForecastRequest day, const Series& before) {
-    std::vector<ForecastError> errors[2];
-    for (int mode = 0; mode < 2 && ok; ++mode) {
-      day.operation = mode ? OperationForecast::kLearned : OperationForecast::kTypicalDay;
-      Forecast f;
-      ok = MakeForecast(plant, spec, params, before, Series{}, Series{}, day, &f, error);
-      if (ok) Score(f, std::vector<ForecastRegime>(f.rows.size()), history, false, &errors[mode]);
-    }
-    if (!ok) return false;
-    // The same minutes for both: those where both forecasts have Q.
-    std::size_t j = 0;
-    for (const ForecastError& a : errors[0]) {
-      while (j < errors[1].size() && errors[1][j].time_s < a.time_s) ++j;
-      if (j == errors[1].size() || errors[1][j].time_s != a.time_s) continue;
-      if (!std::isfinite(a.q_th_w) || !std::isfinite(errors[1][j].q_th_w)) continue;
-      sum[0] += std::fabs(a.q_th_w);
-      sum[1] += std::fabs(errors[1][j].q_th_w);
-      ++n;
-    }
-    ++out->days;
-    return true;
-  });
-  if (!ok) return false;
-  if (n > 0) {
-    out->mae_q_th_typical_w = sum[0] / static_cast<double>(n);
-    out->mae_q_th_learned_w = sum[1] / static_cast<double>(n);
-    if (out->mae_q_th_learned_w < out->mae_q_th_typical_w) {
-      out->chosen = OperationForecast::kLearned;
-    }
-  }
-  return true;
+  std::array<ForecastErrors, 2> by_operation;
+  return CompareOperations(plant, spec, params, history, request, out, &by_operation, error);
 }
 
+// The persistence errors come from the comparison of the operation
+// forecasts (the chosen one's), not from a third replay of the same days.
 bool ReplayWindow(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
                   const Series& history, const Series& past_weather_forecast,
                   const ForecastRequest& request, ForecastWindowStats* out, std::string* error) {
-  if (!ChooseOperation(plant, spec, params, history, request, &out->operation, error)) {
+  std::array<ForecastErrors, 2> by_operation;
+  if (!CompareOperations(plant, spec, params, history, request, &out->operation, &by_operation,
+                         error)) {
     return false;
   }
+  out->errors = std::move(by_operation[out->operation.chosen == OperationForecast::kLearned]);
   ForecastRequest replay = request;
   replay.operation = out->operation.chosen;
-  return ReplayForecastErrors(plant, spec, params, history, past_weather_forecast, replay,
-                              &out->errors, error);
+  return ReplaySource(plant, spec, params, history, past_weather_forecast, replay,
+                      WeatherSource::kWeatherForecast, &out->errors, error);
 }
 
 std::string BandedForecast::Inputs() const {

@@ -265,13 +265,8 @@ ClearSkyGrid MakeClearSkyGrid(const Plant& plant, std::int64_t begin, std::int64
     g.time_s.push_back(t);
     middles.push_back(static_cast<double>(t) + 30.0);
   }
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  site.pressure_hpa = 1013.25 * std::exp(-plant.elevation_m / 8434.5);  // scale height 8.4 km
   std::vector<SolarPosition> sun;
-  ComputeSolarPositions(middles, site, &sun);
+  ComputeSolarPositions(middles, SiteAtStandardPressure(plant), &sun);
   const std::size_t n = middles.size();
   g.zenith_rad.resize(n);
   g.aoi_rad.resize(n);

@@ -562,4 +562,13 @@ double AngleOfIncidenceRad(double zenith_rad, double azimuth_rad, double tilt_ra
   return std::acos(std::clamp(cos_aoi, -1.0, 1.0));
 }
 
+SolarPositionInput SiteAtStandardPressure(const Plant& plant) {
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  site.elevation_m = plant.elevation_m;
+  site.pressure_hpa = 1013.25 * std::exp(-plant.elevation_m / 8434.5);
+  return site;
+}
+
 }  // namespace pvtwin

@@ -17,6 +17,8 @@
 #include <span>
 #include <vector>
 
+#include "core/common/plant.h"
+
 namespace pvtwin {
 
 struct SolarPositionInput {
@@ -99,6 +101,11 @@ SolarPosition ComputeSolarPosition(const SolarPositionInput& in);
 // rows cost about as much as 3 full SPA evaluations plus 1440 cheap ones.
 void ComputeSolarPositions(std::span<const double> times_s, const SolarPositionInput& site,
                            std::vector<SolarPosition>* out);
+
+// The plant's site with the standard-atmosphere pressure of its elevation,
+// P = 1013.25 hPa · exp(−h / 8434.5 m) (scale height 8.4 km), for the
+// refraction of the synthetic weather and the clear-sky grid.
+SolarPositionInput SiteAtStandardPressure(const Plant& plant);
 
 // Angle of incidence θ_inc between the sun direction and the normal of a
 // plane tilted by β from horizontal whose normal points, in plan view, to

@@ -566,13 +566,8 @@ Series GenerateWeather(const Plant& plant, const WeatherOptions& options) {
   const std::size_t rows = series.size();
 
   // Sun positions for all rows at once.
-  SolarPositionInput site;
-  site.latitude_rad = plant.latitude_rad;
-  site.longitude_rad = plant.longitude_rad;
-  site.elevation_m = plant.elevation_m;
-  site.pressure_hpa = 1013.25 * std::exp(-plant.elevation_m / 8434.5);  // scale height 8.4 km
   std::vector<SolarPosition> sun;
-  ComputeSolarPositions(times_s, site, &sun);
+  ComputeSolarPositions(times_s, SiteAtStandardPressure(plant), &sun);
 
   const std::vector<DayType> day_types = DayTypesFor(options);
   const double first_day =

@@ -63,6 +63,14 @@ struct Drivers {
   // the plane-of-array sensors are already multiplied by (1 + k). 0 without
   // the effect.
   double irradiance_bias = 0.0;
+  // 'I' variants: the in-plane irradiance's parts before the IAM (paper
+  // 2.5's split, W/m²), the beam's 1/cos θ − 1 (+inf at θ ≥ 90°) and the
+  // paper's τα(θ) of the beam at [plant] iam_b0: what a fitted IAM form
+  // (iam's "+iam") re-weights g_abs_w_m2 and g_beam_w_m2 from. Empty without
+  // 'I'.
+  struct IamParts {
+    std::vector<double> beam_w_m2, sky_w_m2, ground_w_m2, beam_excess, paper_k_beam;
+  } iam_parts;
   // Non-empty when the sky temperature is not the measured channel's: why
   // (an implausible long-wave channel, or [plant] sky = "estimated").
   std::string sky_note;

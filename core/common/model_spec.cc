@@ -11,7 +11,10 @@ bool ModelSpec::Has(const ModelExtension& e) const {
 void ModelSpec::Add(const ModelExtension& e) {
   if (Has(e)) return;
   const auto at = std::find_if(extensions.begin(), extensions.end(), [&e](const ModelExtension* x) {
-    return x->variant_order > e.variant_order;
+    // Two forms of one effect share a place: then by name, so that the
+    // canonical name does not depend on the order of adding.
+    return x->variant_order > e.variant_order ||
+           (x->variant_order == e.variant_order && x->name > e.name);
   });
   extensions.insert(at, &e);
 }

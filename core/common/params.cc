@@ -61,6 +61,15 @@ const std::array<ParamInfo, kNumParams> kParamTable = {{
     // logged long-wave's: sky models and their cloud corrections differ that
     // much (Flerchinger et al. 2009, Water Resour. Res. 45, W03423).
     {Param::kSkyCloudOffset, "sky_cloud_offset", "-", "Δc_sky", 0.0, -0.5, 0.9, kLin, false},
+    // Fluid between the collector outlet and its sensor, per m² of collector:
+    // the part that moves as a plug (a dead time ∝ 1/flow) and the part that
+    // is mixed (bends, a sensor well, a manifold: a first-order lag ∝ 1/flow).
+    // 10 kg/m² is 18 L for a 1.8 m² collector, 60 m of DN 20 pipe.
+    {Param::kPipePlugKgM2, "pipe_plug_kg_m2", "kg/m²", "M_plug", 0.5, 0.0, 10.0, kLin, false},
+    {Param::kPipeMixKgM2, "pipe_mix_kg_m2", "kg/m²", "M_mix", 0.5, 0.0, 10.0, kLin, false},
+    // ASHRAE's b0 of a glazed collector: 0.04–0.2 (Duffie & Beckman 5.6;
+    // ISO 9806 test reports); 0.05 is the paper's Table 3 value.
+    {Param::kIamB0Fit, "iam_b0_fit", "-", "b0", 0.05, 0.0, 0.3, kLin, false},
 }};
 
 ParamInfo ResolvedInfo(Param p, const Plant& plant) {

@@ -65,6 +65,9 @@ enum class Param : std::size_t {
   kClockOffsetS,       // clock_offset: weather clock behind the collector clock
   kIrradianceBias,     // irradiance_bias: pyranometer scale error k
   kSkyCloudOffset,     // sky_radiation (broader form): cloud fraction beyond the logged sky's
+  kPipePlugKgM2,       // transport_delay (pipe_volume form): plug-flow fluid mass per m²
+  kPipeMixKgM2,        // transport_delay (pipe_volume form): mixed fluid mass per m²
+  kIamB0Fit,           // iam (fitted form "+iam"): ASHRAE coefficient b0
   kCount
 };
 

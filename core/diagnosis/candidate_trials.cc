@@ -305,7 +305,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   }
   const IdentSummary& fit = best.fit;
   t.params = fit.params;
-  if (c.module->advice_for != nullptr) t.advice = c.module->advice_for(fit.params, plant);
+  if (c.module->advice_for != nullptr) t.advice = c.module->advice_for(c.spec, fit.params, plant);
   for (const ParamEstimate& e : fit.estimates) {
     if (std::find(c.module->params.begin(), c.module->params.end(), e.param) !=
         c.module->params.end()) {

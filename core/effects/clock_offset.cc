@@ -161,7 +161,7 @@ SignatureCheck ElectricityLeadsOrLags(const SignatureData& d) {
 }
 
 // "The weather logger's clock is 97 s off: …".
-std::string OffsetAdvice(const ParamVector& p, const Plant&) {
+std::string OffsetAdvice(const ModelSpec&, const ParamVector& p, const Plant&) {
   return "The weather logger's clock is " +
          FixedDecimals(std::fabs(ParamOf(p, Param::kClockOffsetS)), 0) +
          " s off the collector logger's: synchronise both (NTP) and check their time zones.";

@@ -125,8 +125,10 @@ struct EffectModule {
   // One sentence for the site when the diagnosis finds the effect.
   std::string_view advice;
   // The same with the fitted parameters in physical units ("Inverter limit ≈
-  // 260 W: …"); null: `advice` as it is.
-  std::string (*advice_for)(const ParamVector& fitted, const Plant& plant) = nullptr;
+  // 260 W: …"); spec is the fitted form's (an effect with several forms
+  // reads its own parameters); null: `advice` as it is.
+  std::string (*advice_for)(const ModelSpec& spec, const ParamVector& fitted,
+                            const Plant& plant) = nullptr;
   // A realistic magnitude for synthetic truth data (applied on top of
   // ReferenceTruthParams, core/synth/synthetic_plant.h).
   std::vector<std::pair<Param, double>> typical_truth;
@@ -144,6 +146,9 @@ struct EffectModule {
   // physical "+wind" besides the paper's 'w'). The form with the lowest
   // training objective is the one judged on the held-out days.
   std::vector<void (*)(ModelSpec* spec)> diagnosis_forms;
+  // The extensions those forms add besides `extension` ("+pipe_volume" of
+  // transport_delay), so that a variant naming one parses.
+  std::vector<const ModelExtension*> form_extensions;
   // Why it cannot be added to spec ("" = it can); null: present = cannot.
   std::string (*cannot_add)(const ModelSpec& spec) = nullptr;
   // Why the data cannot show it, e.g. a missing channel ("" = they can).

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/common/text.h"
 #include "core/common/units.h"
+#include "core/physics/iam.h"
 #include "core/physics/irradiance.h"
 
 namespace pvtwin {
@@ -29,7 +31,60 @@ double FresnelIam(double aoi_rad, const FresnelCover& c) {
   return FresnelCoverTransmittance(aoi_rad, c) / FresnelCoverTransmittance(0.0, c);
 }
 
+double IamAshraeFromExcess(double excess, double b0) {
+  if (std::isnan(excess)) return excess;
+  return std::max(0.0, 1.0 - b0 * excess);
+}
+
 namespace {
+
+// "+iam": g_abs and g_beam re-weighted from the paper's τα at [plant]
+// iam_b0 to ASHRAE's at the fitted b0, part by part (beam at its angle, sky
+// and ground diffuse at Brandemuehl & Beckman's): g_abs is multiplied by
+// Σ K_fit·part / Σ K_paper·part, so that any factor already applied to it
+// (a pyranometer's scale error) stays.
+void RefitIam(const Drivers& d, const ParamVector& p, RunInputs* run) {
+  const Drivers::IamParts& parts = d.iam_parts;
+  if (parts.beam_w_m2.size() != run->n) return;
+  const double b0 = ParamOf(p, Param::kIamB0Fit);
+  const EffectiveDiffuseAngles angles = BrandemuehlBeckmanAngles(d.plant.tilt_rad);
+  auto excess = [](double theta) { return 1.0 / std::cos(theta) - 1.0; };
+  const double k_sky = IamAshraeFromExcess(excess(angles.sky_rad), b0);
+  const double k_gnd = IamAshraeFromExcess(excess(angles.ground_rad), b0);
+  const double k_sky_paper = IamSoukaSafwat(angles.sky_rad, d.plant.iam_b0);
+  const double k_gnd_paper = IamSoukaSafwat(angles.ground_rad, d.plant.iam_b0);
+  double* g_abs = run->Own(&run->g_abs_w_m2);
+  double* g_beam = run->Own(&run->g_beam_w_m2);
+  for (std::size_t i = 0; i < run->n; ++i) {
+    const double beam = parts.beam_w_m2[i] > 0.0 ? parts.beam_w_m2[i] : 0.0;
+    const double k_paper = parts.paper_k_beam[i];
+    const double k_fit = beam > 0.0 ? IamAshraeFromExcess(parts.beam_excess[i], b0) : 0.0;
+    const double paper = (beam > 0.0 ? k_paper * beam : 0.0) + k_sky_paper * parts.sky_w_m2[i] +
+                         k_gnd_paper * parts.ground_w_m2[i];
+    const double fit = k_fit * beam + k_sky * parts.sky_w_m2[i] + k_gnd * parts.ground_w_m2[i];
+    if (paper > 0.0) g_abs[i] *= fit / paper;
+    if (k_paper > 0.0 && std::isfinite(g_beam[i])) g_beam[i] *= k_fit / k_paper;
+  }
+}
+
+// The fitted form's part beyond the letter 'I' (its name is the module's, so
+// that "…I+iam" names and parses to it).
+const ModelExtension& FittedExtension() {
+  static const ModelExtension kExtension = [] {
+    ModelExtension e;
+    e.name = "iam";
+    e.variant_order = 0;  // before shading and soiling, which take the beam as it is
+    e.params = {Param::kIamB0Fit};
+    e.transform_drivers = RefitIam;
+    return e;
+  }();
+  return kExtension;
+}
+
+void RemoveSameForm(ModelSpec* spec) {
+  spec->iam = false;
+  spec->Remove(FittedExtension());
+}
 
 // Other-form truth: I_at = K(θ)·beam + K(θ_sky)·I_dsky + K(θ_gnd)·I_dgd with the
 // Fresnel cover's K, the parts from the plant's irradiance (paper 2.5's split)
@@ -58,8 +113,6 @@ void FresnelCoverIam(const OtherTruthContext& ctx, Drivers* d) {
   }
 }
 
-void RemoveSameForm(ModelSpec* spec) { spec->iam = false; }
-
 const OtherFormTruth& OtherTruth() {
   static const OtherFormTruth kTruth = [] {
     OtherFormTruth t;
@@ -78,7 +131,35 @@ const OtherFormTruth& OtherTruth() {
 
 bool InSpec(const ModelSpec& spec) { return spec.iam; }
 
-void AddToSpec(ModelSpec* spec) { spec->iam = true; }
+// 'I'; on a spec that has it, the fitted form (so that "2N1CcolwrI+iam"
+// parses to the form the diagnosis names so).
+void AddToSpec(ModelSpec* spec) {
+  if (spec->iam) spec->Add(FittedExtension());
+  spec->iam = true;
+}
+
+// The diagnosis's second form: 'I' with ASHRAE's b0 fitted.
+void AddFittedForm(ModelSpec* spec) {
+  spec->iam = true;
+  spec->Add(FittedExtension());
+}
+
+// "The cover's incidence-angle loss fits b0 ≈ 0.07 …" for the fitted form.
+std::string IamAdvice(const ModelSpec& spec, const ParamVector& p, const Plant&) {
+  const char* kLog =
+      "log diffuse irradiance (g_poa_diffuse_w_m2, or GHI and DHI) so that beam and diffuse "
+      "are weighted apart.";
+  if (!spec.Has(FittedExtension())) {
+    return std::string("Use a variant with the incidence-angle modifier ('I') and ") + kLog;
+  }
+  const double b0 = ParamOf(p, Param::kIamB0Fit);
+  auto k_at = [b0](double deg) {
+    return IamAshraeFromExcess(1.0 / std::cos(DegToRad(deg)) - 1.0, b0);
+  };
+  return "The cover reflects more at grazing sun: ASHRAE's b0 ≈ " + FixedDecimals(b0, 3) +
+         " (τα/τα_n " + FixedDecimals(k_at(60.0), 2) + " at 60°, " + FixedDecimals(k_at(75.0), 2) +
+         " at 75°); use a variant with 'I+iam' and " + kLog;
+}
 
 std::vector<double> Signature(const Drivers& d, const SimOutputs&) { return d.aoi_rad; }
 
@@ -92,14 +173,19 @@ const EffectModule& IamEffect() {
         "Incidence-angle modifier: reflection at the glass rises at grazing angles, so "
         "the absorbed irradiance is the beam weighted by K(θ) = 1 − b0·(1/cos θ − 1) "
         "plus sky and ground diffuse at their effective angles (Souka & Safwat; "
-        "Brandemuehl & Beckman; paper 2.5, 'I').";
+        "Brandemuehl & Beckman; paper 2.5, 'I'). The diagnosis also fits ASHRAE's form "
+        "K(θ) = max(0, 1 − b0·(1/cos θ − 1)) over the whole range with b0 free ('I+iam'): "
+        "the paper's linear segment above 60° loses more than a glass cover does.";
     m.source = "Souka & Safwat (IAM); Brandemuehl & Beckman (effective diffuse angles); paper 2.5";
     m.signature = "beam angle of incidence, rad";
     m.advice =
         "Use a variant with the incidence-angle modifier ('I') and log diffuse irradiance "
         "(g_poa_diffuse_w_m2, or GHI and DHI) so that beam and diffuse can be weighted.";
+    m.params = {Param::kIamB0Fit};
     m.in_spec = InSpec;
     m.add_to_spec = AddToSpec;
+    m.diagnosis_forms = {AddFittedForm};
+    m.advice_for = IamAdvice;
     m.signature_values = Signature;
     m.other_truth = &OtherTruth();
     return m;

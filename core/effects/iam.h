@@ -31,6 +31,14 @@ double FresnelCoverTransmittance(double aoi_rad, const FresnelCover& cover);
 // The incidence-angle modifier K(θ) = τ(θ)/τ(0) of that cover.
 double FresnelIam(double aoi_rad, const FresnelCover& cover);
 
+// --- The diagnosis's fitted form "+iam" ---
+
+// ASHRAE's incidence-angle modifier over the whole range, from the beam's
+// excess e = 1/cos θ − 1 (Souka & Safwat's form without the paper's linear
+// segment above 60°): K = max(0, 1 − b0·e); +inf (θ ≥ 90°) gives 0.
+// ASHRAE Standard 93; Duffie & Beckman 5.6; pvlib iam.ashrae.
+double IamAshraeFromExcess(double excess, double b0);
+
 const EffectModule& IamEffect();
 
 }  // namespace pvtwin

@@ -142,7 +142,7 @@ const OtherFormTruth& OtherTruth() {
 }
 
 // "The in-plane pyranometer reads 6 % high: …".
-std::string PyranometerAdvice(const ParamVector& p, const Plant&) {
+std::string PyranometerAdvice(const ModelSpec&, const ParamVector& p, const Plant&) {
   const double k = ParamOf(p, Param::kIrradianceBias);
   return "The in-plane pyranometer reads " + FixedDecimals(100.0 * std::fabs(k), 1) + " % " +
          (k >= 0.0 ? "high" : "low") + " against GHI/DHI: clean, level and recalibrate it.";

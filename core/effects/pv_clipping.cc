@@ -116,7 +116,7 @@ SignatureCheck Plateau(const SignatureData& d) {
 }
 
 // "Inverter limit ≈ 216 W (120 W/m²): …".
-std::string LimitAdvice(const ParamVector& p, const Plant& plant) {
+std::string LimitAdvice(const ModelSpec&, const ParamVector& p, const Plant& plant) {
   const double limit_w_m2 = ParamOf(p, Param::kPLimitWM2);
   return "Inverter limit ≈ " + FixedDecimals(limit_w_m2 * plant.area_m2, 0) + " W (" +
          FixedDecimals(limit_w_m2, 0) + " W/m²): check the inverter's AC rating against the array.";

@@ -340,7 +340,7 @@ bool StartFromResiduals(const EffectResiduals& res, ParamVector* start) {
 }
 
 // "Obstacle at azimuth 230–270°, up to 25° elevation: …".
-std::string ObstacleAdvice(const ParamVector& p, const Plant&) {
+std::string ObstacleAdvice(const ModelSpec&, const ParamVector& p, const Plant&) {
   const double centre = RadToDeg(ParamOf(p, Param::kShadeAzimuthRad));
   const double half = RadToDeg(0.5 * ParamOf(p, Param::kShadeWidthRad));
   return "Obstacle at azimuth " + FixedDecimals(centre - half, 0) + "–" +

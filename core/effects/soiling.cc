@@ -86,7 +86,7 @@ const ModelExtension& Extension() {
 std::vector<double> Signature(const Drivers& d, const SimOutputs&) { return d.days_since_clean; }
 
 // "The front loses 0.4 % of its transmittance per day: …".
-std::string SoilingAdvice(const ParamVector& p, const Plant&) {
+std::string SoilingAdvice(const ModelSpec&, const ParamVector& p, const Plant&) {
   return "The front loses " + FixedDecimals(100.0 * ParamOf(p, Param::kSoilingPerDay), 2) +
          " % of its transmittance per day: clean it, and log cleanings and heavy rain.";
 }

@@ -1,6 +1,7 @@
 #include "core/effects/transport_delay.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -22,41 +23,54 @@ TankStep MixedTankStep(double t0_c, double t_in_c, double t_amb_c, double mdot_k
 
 namespace {
 
-// Other-form truth: the sensor sees the collector's outlet after the plug
-// (the fluid that left when the cumulative mass was M_plug less, taken at the
-// row's middle) and the tanks; the measured heat is ṁ·c_p·(T_sensor − T_in).
-// A restart (gap) refills the pipe with the row's outlet temperature.
-void MixedPipeToSensor(const OtherTruthContext&, const Drivers& d, SimOutputs* out) {
-  const MixedPipe& pipe = kOtherTruthPipe;
+// The sensor behind a MixedPipe: it sees the collector's outlet after the
+// plug (the fluid that left when the cumulative mass was M_plug less, taken
+// at the row's middle) and the tanks; where the pump runs, the measured heat
+// is ṁ·c_p·(T_sensor − T_in). A restart (gap) refills the pipe with the
+// row's outlet temperature; a standing pump leaves the pipe's fluid where it
+// is (it only loses heat). t_out is the collector's outlet (a copy: out's is
+// overwritten), mass_end work space of n rows.
+void PipeToSensor(const Drivers& d, const MixedPipe& pipe, const double* t_amb_c,
+                  const std::vector<double>& t_out, std::vector<double>* mass_end,
+                  SimOutputs* out) {
+  constexpr int kMaxTanks = 8;
+  const int tanks = std::clamp(pipe.tanks, 1, kMaxTanks);
   const double cp = d.plant.fluid_cp_j_kgk;
   const std::size_t n = d.size();
-  const std::vector<double> t_out = out->t_out_c;  // at the collector
-  std::vector<double> mass_end(n, 0.0);            // cumulative mass at row ends
-  std::vector<double> tank(static_cast<std::size_t>(pipe.tanks), 0.0);
+  mass_end->assign(n, 0.0);
+  std::array<double, kMaxTanks> tank{};
   std::size_t first = 0, j = 0;  // this segment's first row; the plug's exit row
   for (std::size_t i = 0; i < n; ++i) {
     const double mdot = d.usable[i] && d.mdot_kg_s[i] > 0.0 ? d.mdot_kg_s[i] : 0.0;
     if (i == 0 || d.restart[i]) {
       first = j = i;
-      std::fill(tank.begin(), tank.end(), t_out[i]);
+      tank.fill(t_out[i]);
     }
-    const double mass_start = i > first ? mass_end[i - 1] : 0.0;
-    mass_end[i] = mass_start + mdot * d.dt_s[i];
+    const double mass_start = i > first ? (*mass_end)[i - 1] : 0.0;
+    (*mass_end)[i] = mass_start + mdot * d.dt_s[i];
     if (!d.usable[i] || !std::isfinite(t_out[i])) continue;
-    const double exit_mass = 0.5 * (mass_start + mass_end[i]) - pipe.plug_mass_kg;
-    while (j < i && mass_end[j] <= exit_mass) ++j;
+    const double exit_mass = 0.5 * (mass_start + (*mass_end)[i]) - pipe.plug_mass_kg;
+    while (j < i && (*mass_end)[j] <= exit_mass) ++j;
     double t_c = exit_mass < 0.0 ? t_out[first] : t_out[j];
     if (!std::isfinite(t_c)) t_c = t_out[i];
-    for (double& t_tank : tank) {
+    for (int k = 0; k < tanks; ++k) {
+      double& t_tank = tank[static_cast<std::size_t>(k)];
       if (!std::isfinite(t_tank)) t_tank = t_c;
-      const TankStep step = MixedTankStep(t_tank, t_c, d.t_amb_c[i], mdot, cp, pipe.tank_mass_kg,
-                                          pipe.loss_w_k / pipe.tanks, d.dt_s[i]);
+      const TankStep step = MixedTankStep(t_tank, t_c, t_amb_c[i], mdot, cp, pipe.tank_mass_kg,
+                                          pipe.loss_w_k / tanks, d.dt_s[i]);
       t_tank = step.t_end_c;
       t_c = step.t_mean_c;
     }
     out->t_out_c[i] = t_c;
     if (mdot > 0.0) out->q_th_w[i] = mdot * cp * (t_c - d.t_in_c[i]);
   }
+}
+
+// Other-form truth: the sensor sees the outlet through kOtherTruthPipe.
+void MixedPipeToSensor(const OtherTruthContext&, const Drivers& d, SimOutputs* out) {
+  const std::vector<double> t_out = out->t_out_c;  // at the collector
+  std::vector<double> mass_end;
+  PipeToSensor(d, kOtherTruthPipe, d.t_amb_c.data(), t_out, &mass_end, out);
 }
 
 const OtherFormTruth& OtherTruth() {
@@ -120,6 +134,52 @@ const ModelExtension& Extension() {
   return kExtension;
 }
 
+// The broader form "+pipe_volume": the pipe as a volume, not a number of
+// seconds. Plug flow of M_plug·A then one mixed tank of M_mix·A losing
+// U_pipe·A to ambient (PipeToSensor with one tank): the dead time M_plug·A/ṁ
+// and the lag M_mix·A/ṁ both scale with 1/flow, as a pipe's do, where the
+// fixed τ of "+transport_delay" fits one flow only.
+void SensorBehindPipeVolume(const Drivers& d, const ParamVector& p, RunInputs* run,
+                            SimOutputs* out) {
+  const double area_m2 = ParamOf(p, Param::kAreaM2);
+  MixedPipe pipe;
+  pipe.plug_mass_kg = ParamOf(p, Param::kPipePlugKgM2) * area_m2;
+  pipe.tank_mass_kg = ParamOf(p, Param::kPipeMixKgM2) * area_m2;
+  pipe.tanks = 1;
+  pipe.loss_w_k = ParamOf(p, Param::kUPipeWM2K) * area_m2;
+  if (d.size() == 0) return;
+  std::vector<double>& t_out = run->Scratch();
+  t_out = out->t_out_c;
+  PipeToSensor(d, pipe, run->t_amb_c, t_out, &run->Scratch(), out);
+}
+
+const ModelExtension& VolumeExtension() {
+  static const ModelExtension kExtension = [] {
+    ModelExtension e;
+    e.name = "pipe_volume";
+    e.variant_order = 1;  // transport_delay's place
+    e.params = {Param::kPipePlugKgM2, Param::kPipeMixKgM2, Param::kUPipeWM2K};
+    e.transform_outputs = SensorBehindPipeVolume;
+    return e;
+  }();
+  return kExtension;
+}
+
+bool InSpec(const ModelSpec& spec) { return spec.Has(Extension()) || spec.Has(VolumeExtension()); }
+
+void AddVolumeForm(ModelSpec* spec) { spec->Add(VolumeExtension()); }
+
+// The median flow of the rows where the pump runs, kg/s (0: it never runs).
+double MedianRunningFlow(const Drivers& d, const std::vector<std::uint32_t>& rows) {
+  std::vector<double> flows;
+  for (std::uint32_t r : rows) {
+    if (d.mdot_kg_s[r] > 0.0) flows.push_back(d.mdot_kg_s[r]);
+  }
+  if (flows.empty()) return 0.0;
+  std::nth_element(flows.begin(), flows.begin() + flows.size() / 2, flows.end());
+  return flows[flows.size() / 2];
+}
+
 // Rate of change of the base model's outlet temperature, K per minute.
 std::vector<double> Signature(const Drivers& d, const SimOutputs& base) {
   if (base.t_out_c.size() == d.size()) return RatePerMinute(d, base.t_out_c);
@@ -134,16 +194,31 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs& base) {
 // 0.965, 0.027 at r = 0.5; a dispersed delay, plug flow with mixing, shows
 // this as well as a pure one). A pipe loss alone, or a fit that shifts a bias,
 // leaves the changes as they were. A τ below half the row step cannot show
-// in the timing: the check then has nothing to say.
+// in the timing: the effect is then the pipe's loss alone, shown when the
+// fit gives the pipe one (U_pipe > 0; a τ of a few seconds with no loss only
+// smooths the outlet between rows).
 constexpr double kMinFisherZRise = 0.1;
 
 SignatureCheck ChangesFollowTheDelay(const SignatureData& d) {
   const double step_s = RowStepS(*d.drivers);
-  const double tau_s = ParamOf(*d.params, Param::kTransportDelayS);
+  double tau_s = ParamOf(*d.params, Param::kTransportDelayS);
+  if (d.drivers->spec.Has(VolumeExtension())) {  // the residence time at the median flow
+    const double flow = MedianRunningFlow(*d.drivers, *d.rows);
+    const double mass_kg =
+        (ParamOf(*d.params, Param::kPipePlugKgM2) + ParamOf(*d.params, Param::kPipeMixKgM2)) *
+        ParamOf(*d.params, Param::kAreaM2);
+    tau_s = flow > 0.0 ? mass_kg / flow : 0.0;
+  }
   SignatureCheck c;
   if (tau_s / step_s < 0.5) {
+    // No lag the data can show: what is left of the effect is the pipe's
+    // loss, which must then be there.
+    const double u_pipe = ParamOf(*d.params, Param::kUPipeWM2K);
+    c.shown = u_pipe > 0.0;
     c.sentence = "the fitted τ = " + FixedDecimals(tau_s, 0) + " s is below half the " +
-                 FixedDecimals(step_s, 0) + " s row step: no lag the data can show";
+                 FixedDecimals(step_s, 0) + " s row step: no lag the data can show" +
+                 (c.shown ? ", the pipe loses U_pipe = " + FixedDecimals(u_pipe, 2) + " W/(m²K)"
+                          : ", and the pipe loses nothing (U_pipe = 0)");
     return c;
   }
   const LagFit before = BestLag(*d.drivers, *d.rows, *d.q_th_meas_w, d.before->q_th_w, 0, 0);
@@ -157,18 +232,33 @@ SignatureCheck ChangesFollowTheDelay(const SignatureData& d) {
   c.shown = fisher_z(after.corr_at_zero) - fisher_z(before.corr_at_zero) >= kMinFisherZRise;
   c.sentence = "the measured Q_u's row-to-row changes correlate " +
                FixedDecimals(after.corr_at_zero, 3) +
-               " with the model with τ = " + FixedDecimals(tau_s, 0) + " s, " +
+               " with the model with τ = " + FixedDecimals(tau_s, 0) + " s" +
+               (d.drivers->spec.Has(VolumeExtension()) ? " at the median flow" : "") + ", " +
                FixedDecimals(before.corr_at_zero, 3) + " without it" +
                (c.shown ? "" : ": the delay does not improve the timing");
   return c;
 }
 
-// "Outlet sensor sees the fluid 95 s late: …".
-std::string DelayAdvice(const ParamVector& p, const Plant&) {
+// "The outlet sensor sees the fluid 146 s late …", or for the pipe volume
+// "… 3.2 L of fluid between the collector and the outlet sensor …".
+std::string DelayAdvice(const ModelSpec& spec, const ParamVector& p, const Plant& plant) {
+  const std::string loss =
+      "pipe loss U_pipe = " + FixedDecimals(ParamOf(p, Param::kUPipeWM2K), 2) + " W/(m²K)";
+  if (spec.Has(VolumeExtension())) {
+    const double area_m2 = ParamOf(p, Param::kAreaM2);
+    const double plug_kg = ParamOf(p, Param::kPipePlugKgM2) * area_m2;
+    const double mix_kg = ParamOf(p, Param::kPipeMixKgM2) * area_m2;
+    const double litres = (plug_kg + mix_kg) / plant.fluid_density_kg_m3 * 1000.0;
+    return "The outlet sensor sees the fluid through " + FixedDecimals(litres, 1) + " L of pipe (" +
+           FixedDecimals(plug_kg, 1) + " kg in plug flow, " + FixedDecimals(mix_kg, 1) +
+           " kg mixed; " + loss + "): it lags the collector by " +
+           FixedDecimals(plug_kg + mix_kg, 1) +
+           " kg over the flow, longer the slower the pump; move the sensor to the collector "
+           "outlet or model the pipe.";
+  }
   return "The outlet sensor sees the fluid " +
-         FixedDecimals(ParamOf(p, Param::kTransportDelayS), 0) +
-         " s late (pipe loss U_pipe = " + FixedDecimals(ParamOf(p, Param::kUPipeWM2K), 2) +
-         " W/(m²K)): move the sensor to the collector outlet or model the pipe.";
+         FixedDecimals(ParamOf(p, Param::kTransportDelayS), 0) + " s late (" + loss +
+         "): move the sensor to the collector outlet or model the pipe.";
 }
 }  // namespace
 
@@ -182,15 +272,22 @@ const EffectModule& TransportDelayEffect() {
         "T_sensor = T_amb + (T_out(t − τ) − T_amb)·exp(−U_pipe·A/(ṁ·c_p)) "
         "(exponential decay of a plug in a pipe of loss UA, Duffie & Beckman 10.3). "
         "Q_u is then ṁ·c_p·(T_sensor − T_in): lagging at pump starts and irradiance "
-        "steps, lower than the collector's output at low flow.";
+        "steps, lower than the collector's output at low flow. The diagnosis also fits "
+        "the pipe as a volume ('+pipe_volume'): plug flow of M_plug then one mixed tank "
+        "of M_mix losing U_pipe·A, so that the dead time M_plug/ṁ and the lag M_mix/ṁ "
+        "scale with 1/flow as a pipe's do.";
     m.source = "Duffie & Beckman, Solar Engineering of Thermal Processes, 10.3 (pipe losses)";
-    m.params = {Param::kTransportDelayS, Param::kUPipeWM2K};
+    m.params = {Param::kTransportDelayS, Param::kUPipeWM2K, Param::kPipePlugKgM2,
+                Param::kPipeMixKgM2};
     m.typical_truth = {{Param::kTransportDelayS, 120.0}, {Param::kUPipeWM2K, 1.0}};
     m.signature = "rate of change of the base model's outlet temperature, K per minute";
     m.advice =
         "Model the pipe to the outlet sensor (+transport_delay), or move the sensor to "
         "the collector outlet and insulate the pipe.";
     m.extension = &Extension();
+    m.form_extensions = {&VolumeExtension()};
+    m.in_spec = InSpec;
+    m.diagnosis_forms = {AddVolumeForm};
     m.advice_for = DelayAdvice;
     m.signature_values = Signature;
     m.shows_signature = ChangesFollowTheDelay;

@@ -94,6 +94,14 @@ void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t 
   coarse->g_ref_w_m2.push_back(mean(d.g_ref_w_m2));
   coarse->days_since_clean.push_back(mean(d.days_since_clean));
   coarse->irradiance_bias = d.irradiance_bias;
+  Drivers::IamParts& parts = coarse->iam_parts;
+  if (d.iam_parts.beam_w_m2.size() == d.size()) {
+    parts.beam_w_m2.push_back(mean(d.iam_parts.beam_w_m2));
+    parts.sky_w_m2.push_back(mean(d.iam_parts.sky_w_m2));
+    parts.ground_w_m2.push_back(mean(d.iam_parts.ground_w_m2));
+    parts.beam_excess.push_back(d.iam_parts.beam_excess[mid]);
+    parts.paper_k_beam.push_back(d.iam_parts.paper_k_beam[mid]);
+  }
 }
 
 void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers* d) {
@@ -172,7 +180,7 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
     out.capacity_flow_w_k[i] = out.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
   }
 
-  ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2);
+  ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2, &out.iam_parts);
   FillEffectDrivers(s, plant, spec, &out);
   for (const ModelExtension* e : spec.extensions) {
     if (e->prepare_drivers != nullptr && !e->prepare_drivers(s, &out, error)) return false;

@@ -1,7 +1,9 @@
 #include "core/model/irradiance_drivers.h"
 
 #include <cmath>
+#include <limits>
 
+#include "core/common/units.h"
 #include "core/physics/iam.h"
 #include "core/physics/irradiance.h"
 #include "core/physics/solar_position.h"
@@ -23,7 +25,8 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) 
 }
 
 void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
-                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2) {
+                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2,
+                              Drivers::IamParts* parts) {
   const std::size_t n = s.size();
   const bool measured_poa = s.Has(Channel::kGPoaWM2);
   const bool measured_aoi = s.Has(Channel::kAoiRad);
@@ -36,6 +39,13 @@ void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSp
   const EffectiveDiffuseAngles diffuse_angles = BrandemuehlBeckmanAngles(plant.tilt_rad);
   g_poa_w_m2->assign(n, std::nan(""));
   g_abs_w_m2->assign(n, std::nan(""));
+  if (parts != nullptr) *parts = {};
+  if (parts != nullptr && spec.iam) {
+    for (std::vector<double>* v : {&parts->beam_w_m2, &parts->sky_w_m2, &parts->ground_w_m2,
+                                   &parts->beam_excess, &parts->paper_k_beam}) {
+      v->assign(n, std::nan(""));
+    }
+  }
   for (std::size_t i = 0; i < n; ++i) {
     double aoi_rad = measured_aoi ? s[Channel::kAoiRad][i] : std::nan("");
     if (std::isnan(aoi_rad) && !sun.empty()) {
@@ -69,6 +79,15 @@ void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSp
     }
     (*g_abs_w_m2)[i] = spec.iam ? AbsorbedIrradianceWM2(poa, aoi_rad, diffuse_angles, plant.iam_b0)
                                 : (*g_poa_w_m2)[i];
+    if (parts != nullptr && spec.iam) {
+      parts->beam_w_m2[i] = poa.beam_w_m2;
+      parts->sky_w_m2[i] = poa.sky_diffuse_w_m2;
+      parts->ground_w_m2[i] = poa.ground_diffuse_w_m2;
+      const double theta = std::fabs(aoi_rad);
+      parts->beam_excess[i] =
+          theta < 0.5 * kPi ? 1.0 / std::cos(theta) - 1.0 : std::numeric_limits<double>::infinity();
+      parts->paper_k_beam[i] = IamSoukaSafwat(aoi_rad, plant.iam_b0);
+    }
   }
 }
 

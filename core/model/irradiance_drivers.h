@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "core/common/model_data.h"
 #include "core/common/plant.h"
 #include "core/common/series.h"
 #include "core/model/variant.h"
@@ -23,8 +24,10 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant);
 //    when measured, else from the transposition; each part weighted with the
 //    Souka & Safwat IAM at its angle (aoi_deg when measured, else computed;
 //    Brandemuehl & Beckman angles for sky and ground diffuse).
-// Rows whose inputs are missing get NaN.
+// Rows whose inputs are missing get NaN. With 'I' and parts non-null, also
+// the parts before the IAM (Drivers::IamParts).
 void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
-                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2);
+                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2,
+                              Drivers::IamParts* parts = nullptr);
 
 }  // namespace pvtwin

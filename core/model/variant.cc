@@ -66,8 +66,18 @@ bool ParseBase(std::string_view base, ModelSpec* spec, std::string* error) {
 bool ParseEffect(std::string_view effect, ModelSpec* spec, std::string* error) {
   const EffectModule* m = FindEffect(effect);
   if (m == nullptr) {
+    for (const EffectModule* e : EffectRegistry()) {
+      for (const ModelExtension* form : e->form_extensions) {
+        if (form->name != effect) continue;
+        spec->Add(*form);
+        return true;
+      }
+    }
     std::string known;
-    for (const EffectModule* e : ExtensionsInVariantOrder()) known += std::string(e->name) + ", ";
+    for (const EffectModule* e : ExtensionsInVariantOrder()) {
+      known += std::string(e->name) + ", ";
+      for (const ModelExtension* form : e->form_extensions) known += std::string(form->name) + ", ";
+    }
     std::string letters;
     for (const EffectModule* e : EffectRegistry()) {
       if (e->extension == nullptr) letters += (letters.empty() ? "" : ", ") + std::string(e->name);

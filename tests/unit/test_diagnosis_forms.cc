@@ -6,11 +6,13 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "core/common/units.h"
 #include "core/effects/effects.h"
+#include "core/effects/iam.h"
 #include "core/effects/shading.h"
 #include "core/effects/sky_radiation.h"
 #include "core/model/variant.h"
@@ -41,6 +43,41 @@ TEST(DiagnosisForms, SkyIsFittedWithAndWithoutTheCloudOffset) {
                   .test(static_cast<std::size_t>(Param::kSkyCloudOffset)));
   EXPECT_FALSE(
       UsedParams(testing::SpecOf("1N1Cwr")).test(static_cast<std::size_t>(Param::kSkyCloudOffset)));
+}
+
+TEST(DiagnosisForms, IamIsFittedAsThePaperWritesItAndWithAshraesB0Free) {
+  EXPECT_EQ(FormNames("2N1Ccolwr", "iam"),
+            (std::vector<std::string>{"2N1CcolwrI", "2N1CcolwrI+iam"}));
+  EXPECT_EQ(testing::SpecOf("2N1CcolwrI+iam").Name(), "2N1CcolwrI+iam");
+  EXPECT_EQ(testing::SpecOf("2N1Ccolwr+iam").Name(), "2N1CcolwrI");  // '+iam' adds 'I' first
+  EXPECT_TRUE(UsedParams(testing::SpecOf("2N1CcolwrI+iam"))
+                  .test(static_cast<std::size_t>(Param::kIamB0Fit)));
+  EXPECT_FALSE(
+      UsedParams(testing::SpecOf("2N1CcolwrI")).test(static_cast<std::size_t>(Param::kIamB0Fit)));
+}
+
+TEST(DiagnosisForms, TransportDelayIsAlsoFittedAsAPipeVolume) {
+  EXPECT_EQ(FormNames("1N1Cwr", "transport_delay"),
+            (std::vector<std::string>{"1N1Cwr+transport_delay", "1N1Cwr+pipe_volume"}));
+  EXPECT_EQ(testing::SpecOf("1N1Cwr+pipe_volume").Name(), "1N1Cwr+pipe_volume");
+  EXPECT_TRUE(
+      HasEffect(testing::SpecOf("1N1Cwr+pipe_volume"), testing::EffectNamed("transport_delay")));
+  // Two forms at one place of the name: the same canonical order whichever
+  // is added first.
+  EXPECT_EQ(testing::SpecOf("1N1Cwr+transport_delay+pipe_volume").Name(),
+            testing::SpecOf("1N1Cwr+pipe_volume+transport_delay").Name());
+}
+
+// ASHRAE's modifier over the whole range, by hand: b0 = 0.05, K(60°) =
+// 1 − 0.05·(2 − 1) = 0.95; K(80°) = 1 − 0.05·(5.758770 − 1) = 0.762061;
+// at 88° 1/cos θ = 28.65 puts 1 − b0·e below 0: K = 0.
+TEST(DiagnosisForms, AshraeIamByHand) {
+  auto e = [](double deg) { return 1.0 / std::cos(deg * kPi / 180.0) - 1.0; };
+  EXPECT_NEAR(IamAshraeFromExcess(e(60.0), 0.05), 0.95, 1e-12);
+  EXPECT_NEAR(IamAshraeFromExcess(e(80.0), 0.05), 0.762061, 1e-6);
+  EXPECT_EQ(IamAshraeFromExcess(e(88.0), 0.05), 0.0);
+  EXPECT_EQ(IamAshraeFromExcess(std::numeric_limits<double>::infinity(), 0.05), 0.0);
+  EXPECT_TRUE(std::isnan(IamAshraeFromExcess(std::nan(""), 0.05)));
 }
 
 TEST(DiagnosisForms, AnEffectWithOneFormHasOnlyIt) {

@@ -12,6 +12,8 @@
 #include "core/effects/effect_module.h"
 #include "core/effects/pv_clipping.h"
 #include "core/effects/shading.h"
+#include "core/effects/transport_delay.h"
+#include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
@@ -88,6 +90,33 @@ TEST(PvClippingSignature, APlateauAtTheFittedLimitIsShownAndMissingWithoutOne) {
   EXPECT_FALSE(missing.shown) << missing.sentence;
 }
 
+// A τ below half the row step cannot show as a lag: transport_delay is then
+// only shown by a pipe that loses heat; a τ of a few seconds with U_pipe = 0
+// merely smooths the outlet between rows.
+TEST(TransportDelaySignature, ASubStepDelayNeedsAPipeLoss) {
+  std::vector<std::uint32_t> rows;
+  Drivers d = Rows(100, &rows);
+  d.spec = testing::SpecOf("1N1Cwr+transport_delay");
+  SimOutputs out;
+  out.q_th_w.assign(100, 0.0);
+  std::vector<double> q(100, 0.0);
+  ParamVector params{};
+  params[static_cast<std::size_t>(Param::kTransportDelayS)] = 2.0;
+  params[static_cast<std::size_t>(Param::kUPipeWM2K)] = 0.0;
+  SignatureData s;
+  s.drivers = &d;
+  s.rows = &rows;
+  s.q_th_meas_w = s.p_el_meas_w = &q;
+  s.before = s.after = &out;
+  s.params = &params;
+  const SignatureCheck none = TransportDelayEffect().shows_signature(s);
+  EXPECT_FALSE(none.shown) << none.sentence;
+  EXPECT_NE(none.sentence.find("U_pipe = 0"), std::string::npos) << none.sentence;
+  params[static_cast<std::size_t>(Param::kUPipeWM2K)] = 0.4;
+  const SignatureCheck loss = TransportDelayEffect().shows_signature(s);
+  EXPECT_TRUE(loss.shown) << loss.sentence;
+}
+
 // Advice in the site's units from the fitted parameters: 120 W/m² on 1.8 m²
 // is 216 W; an obstacle centred at 250° with a 40° width reaches 230–270°.
 TEST(EffectAdvice, SaysTheFittedValuesInPhysicalUnits) {
@@ -95,14 +124,32 @@ TEST(EffectAdvice, SaysTheFittedValuesInPhysicalUnits) {
   plant.area_m2 = 1.8;
   ParamVector p{};
   p[static_cast<std::size_t>(Param::kPLimitWM2)] = 120.0;
-  EXPECT_EQ(PvClippingEffect().advice_for(p, plant).rfind("Inverter limit ≈ 216 W (120 W/m²)", 0),
+  EXPECT_EQ(PvClippingEffect()
+                .advice_for(ModelSpec{}, p, plant)
+                .rfind("Inverter limit ≈ 216 W (120 W/m²)", 0),
             0u);
   p[static_cast<std::size_t>(Param::kShadeAzimuthRad)] = 250.0 * kPi / 180.0;
   p[static_cast<std::size_t>(Param::kShadeWidthRad)] = 40.0 * kPi / 180.0;
   p[static_cast<std::size_t>(Param::kShadeElevationRad)] = 25.0 * kPi / 180.0;
-  EXPECT_NE(ShadingEffect().advice_for(p, plant).find("azimuth 230–270°, up to 25° elevation"),
+  EXPECT_NE(ShadingEffect()
+                .advice_for(ModelSpec{}, p, plant)
+                .find("azimuth 230–270°, up to 25° elevation"),
             std::string::npos)
-      << ShadingEffect().advice_for(p, plant);
+      << ShadingEffect().advice_for(ModelSpec{}, p, plant);
+  // The pipe as a volume: 1.0 + 0.5 kg/m² on 1.8 m² is 2.7 kg, 2.6 L at
+  // 1040 kg/m³.
+  p[static_cast<std::size_t>(Param::kAreaM2)] = 1.8;
+  p[static_cast<std::size_t>(Param::kPipePlugKgM2)] = 1.0;
+  p[static_cast<std::size_t>(Param::kPipeMixKgM2)] = 0.5;
+  const std::string pipe =
+      TransportDelayEffect().advice_for(testing::SpecOf("1N1Cwr+pipe_volume"), p, plant);
+  EXPECT_NE(pipe.find("2.6 L of pipe (1.8 kg in plug flow, 0.9 kg mixed"), std::string::npos)
+      << pipe;
+  p[static_cast<std::size_t>(Param::kTransportDelayS)] = 95.0;
+  EXPECT_NE(TransportDelayEffect()
+                .advice_for(testing::SpecOf("1N1Cwr+transport_delay"), p, plant)
+                .find("95 s late"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -8,7 +8,10 @@
 #include "core/common/units.h"
 #include "core/effects/effects.h"
 #include "core/effects/flow_dependent_u.h"
+#include "core/effects/iam.h"
 #include "core/model/thermal_model.h"
+#include "core/physics/iam.h"
+#include "core/physics/irradiance.h"
 #include "core/synth/synthetic_plant.h"
 #include "core/synth/weather_generator.h"
 #include "tests/support/effect_named.h"
@@ -267,6 +270,98 @@ TEST(EffectModel, TransportDelayCoolsTheOutletInThePipeAndDelaysSteps) {
   for (std::size_t i = 30; i < 33; ++i) {
     EXPECT_NEAR(pipe.t_out_c[i], in.t_amb_c + (base.t_out_c[29] - in.t_amb_c) * decay, 1e-9);
   }
+}
+
+// transport_delay's second form, the pipe as a volume ("+pipe_volume"). A
+// plug of 3.6 kg at 0.02 kg/s: a row of 60 s moves 1.2 kg, the row's middle
+// leaves the plug 3 rows later; at 0.04 kg/s (2.4 kg a row) 1 row later:
+// the lag scales with 1/flow. A mixed 2.4 kg at 0.02 kg/s is a first-order
+// lag of 120 s: after an inlet step the sensor's row means follow
+// T_new + (T_end,prev − T_new)·(1 − e^(−1/2))/(1/2). With a loss UA and no
+// mass, steady state: (ṁ·c_p·T_out + UA·T_amb)/(ṁ·c_p + UA).
+TEST(EffectModel, PipeVolumeDelaysByMassOverFlowAndMixesAsATank) {
+  const Plant plant;
+  testing::ConstantInputs in;
+  in.g_poa_w_m2 = 700.0;
+  for (double mdot : {0.02, 0.04}) {
+    in.mdot_kg_s = mdot;
+    Series s = testing::MakeConstantSeries(60, 60.0, in);
+    for (std::size_t i = 30; i < 60; ++i) s[Channel::kTInC][i] = 35.0;  // inlet step at row 30
+    ParamVector p = ReferenceTruthParams(plant);
+    const double area = At(p, Param::kAreaM2);
+    At(p, Param::kUPipeWM2K) = 0.0;
+    At(p, Param::kPipePlugKgM2) = 3.6 / area;
+    At(p, Param::kPipeMixKgM2) = 0.0;
+    const SimOutputs base = SimulateWith(DriversOf(s, plant, "1N"), p);
+    const Drivers pipe_d = DriversOf(s, plant, "1N+pipe_volume");
+    const SimOutputs plug = SimulateWith(pipe_d, p);
+    const std::size_t lag = mdot == 0.02 ? 3 : 1;
+    for (std::size_t i = 25; i < 40; ++i) {
+      EXPECT_NEAR(plug.t_out_c[i], base.t_out_c[i - lag], 1e-9) << mdot << " row " << i;
+      EXPECT_NEAR(plug.q_th_w[i],
+                  mdot * plant.fluid_cp_j_kgk * (plug.t_out_c[i] - s[Channel::kTInC][i]), 1e-6);
+    }
+    if (mdot != 0.02) continue;
+    At(p, Param::kPipePlugKgM2) = 0.0;
+    At(p, Param::kPipeMixKgM2) = 2.4 / area;
+    const SimOutputs mixed = SimulateWith(pipe_d, p);
+    const double a = base.t_out_c[29], b = base.t_out_c[30];
+    const double decay = std::exp(-0.5), mean_factor = (1.0 - decay) / 0.5;
+    double t_end = a;
+    for (std::size_t i = 30; i < 40; ++i) {
+      EXPECT_NEAR(mixed.t_out_c[i], b + (t_end - b) * mean_factor, 1e-9) << "row " << i;
+      t_end = b + (t_end - b) * decay;
+    }
+    At(p, Param::kPipeMixKgM2) = 0.0;
+    At(p, Param::kUPipeWM2K) = 2.0;
+    const SimOutputs lossy = SimulateWith(pipe_d, p);
+    const double flow_w_k = mdot * plant.fluid_cp_j_kgk, ua = 2.0 * area;
+    EXPECT_NEAR(lossy.t_out_c[50],
+                (flow_w_k * base.t_out_c[50] + ua * in.t_amb_c) / (flow_w_k + ua), 1e-9);
+  }
+}
+
+// iam's fitted form "+iam": the absorbed irradiance is each part of the
+// in-plane irradiance (paper 2.5's split of the measured g_poa and its
+// diffuse) weighted with ASHRAE's K = 1 − b0·(1/cos θ − 1) at its angle
+// instead of the paper's τα; with a constant efficiency P_el = η·A·I_at, so
+// the ratio of P_el is the ratio of the weighted sums, by hand per row.
+TEST(EffectModel, FittedIamReweightsEachPartWithAshraesModifier) {
+  const Plant plant = DesignExamplePlant();
+  const Series s = SummerDay();
+  const Drivers paper_d = DriversOf(s, plant, "1NI");
+  const Drivers fit_d = DriversOf(s, plant, "1NI+iam");
+  ParamVector p = ConstantEta(plant);
+  const double b0 = 0.12;
+  At(p, Param::kIamB0Fit) = b0;
+  const SimOutputs paper = SimulateWith(paper_d, p);
+  const SimOutputs fit = SimulateWith(fit_d, p);
+  const EffectiveDiffuseAngles angles = BrandemuehlBeckmanAngles(plant.tilt_rad);
+  auto ashrae = [b0](double theta) {
+    return std::max(0.0, 1.0 - b0 * (1.0 / std::cos(theta) - 1.0));
+  };
+  int rows = 0, grazing = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (!(s[Channel::kGPoaWM2][i] > 20.0)) continue;
+    MeasuredPoaInput m;
+    m.g_poa_w_m2 = s[Channel::kGPoaWM2][i];
+    m.g_poa_diffuse_w_m2 = s[Channel::kGPoaDiffuseWM2][i];
+    m.ghi_w_m2 = s.At(Channel::kGhiWM2, i);
+    m.dhi_w_m2 = s.At(Channel::kDhiWM2, i);
+    m.tilt_rad = plant.tilt_rad;
+    m.ground_albedo = plant.ground_albedo;
+    const PoaComponents poa = SplitMeasuredPoa(m);
+    const double theta = paper_d.aoi_rad[i];
+    const double by_hand = (theta < 0.5 * kPi ? ashrae(theta) * poa.beam_w_m2 : 0.0) +
+                           ashrae(angles.sky_rad) * poa.sky_diffuse_w_m2 +
+                           ashrae(angles.ground_rad) * poa.ground_diffuse_w_m2;
+    const double paper_sum = AbsorbedIrradianceWM2(poa, theta, angles, plant.iam_b0);
+    EXPECT_NEAR(fit.p_el_w[i] / paper.p_el_w[i], by_hand / paper_sum, 1e-9) << "row " << i;
+    ++rows;
+    if (theta > DegToRad(60.0) && poa.beam_w_m2 > 10.0) ++grazing;
+  }
+  EXPECT_GE(rows, 40);
+  EXPECT_GE(grazing, 3);  // rows where the paper's linear segment and ASHRAE differ
 }
 
 // irradiance_bias: the scale error of a plane-of-array sensor that reads 6 %

@@ -55,6 +55,10 @@ struct Drivers {
   // soiling: days since the last cleaning (since the first row when none is
   // known; see SetCleaningTimes).
   std::vector<double> days_since_clean;
+  // soiling: the recoveries of the performance at the cleanings the data
+  // show (DetectCleanings, core/model/thermal_model.h), summed up to the row;
+  // the loss r·d drops by it. 0 where there is none.
+  std::vector<double> soiling_recovered;
   // shading: the measured P_el per I_gt relative to its solar day's upper
   // quartile (ShadingRelativeYield), NaN where undefined or without +shading.
   std::vector<double> relative_yield;

@@ -19,8 +19,9 @@ bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
   Part& base_train = fit->train;
   Part& base_heldout = fit->heldout;
   Units& units = fit->units;
-  if (!PreparePart(train_series, plant, base, data_start_s, &base_train, error) ||
-      !PreparePart(heldout_series, plant, base, data_start_s, &base_heldout, error)) {
+  if (!PreparePart(train_series, plant, base, data_start_s, split.cleanings, &base_train, error) ||
+      !PreparePart(heldout_series, plant, base, data_start_s, split.cleanings, &base_heldout,
+                   error)) {
     return false;
   }
   const std::size_t min_rows = static_cast<std::size_t>(std::max(options.ident.min_rows, 1));

@@ -147,19 +147,36 @@ void Judge(const TrialInputs& in, const EffectCandidate& c, const Part& ho, cons
   }
   // On held-out days outside the training range the base model's error is
   // mostly a bias that any extra freedom can shift; a gain that is nothing
-  // but that shift is not the effect.
+  // but that shift is not the effect. An effect gains where the drivers stay
+  // inside the training range too (where the base model is determined): a
+  // gain there of at least half the gain outside, per row, clears it.
   if (in.extrapolation != nullptr && !in.extrapolation->empty()) {
     const double mae_drop =
         (t.mae_p_el_before_w - t.mae_p_el_after_w) + (t.mae_q_th_before_w - t.mae_q_th_after_w);
     const double bias_drop = (std::fabs(before.bias_p_el_w) - std::fabs(after.bias_p_el_w)) +
                              (std::fabs(before.bias_q_th_w) - std::fabs(after.bias_q_th_w));
-    if (mae_drop > 0.0 && bias_drop >= 0.8 * mae_drop) {
+    const std::vector<std::uint8_t> inside = RowsInsideTrainingRange(ho.drivers, *in.extrapolation);
+    double gain_w[2] = {0.0, 0.0};  // outside, inside
+    double rows[2] = {0.0, 0.0};
+    for (std::uint32_t i : ho.meas.rows) {
+      const double g = before.loss_w[i] - after.loss_w[i];
+      if (!std::isfinite(g)) continue;
+      gain_w[inside[i]] += g;
+      rows[inside[i]] += 1.0;
+    }
+    const double gain_out = rows[0] > 0.0 ? gain_w[0] / rows[0] : 0.0;
+    const double gain_in = rows[1] > 0.0 ? gain_w[1] / rows[1] : 0.0;
+    const bool gains_inside =
+        rows[1] >= 0.1 * (rows[0] + rows[1]) && gain_in > 0.0 && gain_in >= 0.5 * gain_out;
+    if (mae_drop > 0.0 && bias_drop >= 0.8 * mae_drop && !gains_inside) {
       why.push_back(
           "its gain is a shift of the bias on held-out days outside the training "
           "range (bias P_el " +
           FixedDecimals(before.bias_p_el_w, 2) + " → " + FixedDecimals(after.bias_p_el_w, 2) +
           " W, Q_u " + FixedDecimals(before.bias_q_th_w, 2) + " → " +
-          FixedDecimals(after.bias_q_th_w, 2) + " W)");
+          FixedDecimals(after.bias_q_th_w, 2) + " W; " + FixedDecimals(gain_out, 2) +
+          " W per row outside the range, " +
+          (rows[1] > 0.0 ? FixedDecimals(gain_in, 2) + " W inside)" : "no row inside)"));
     }
   }
   if (all_at_bounds) {
@@ -226,8 +243,8 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
                 const ModelSpec& spec) {
   FormFit f;
   const Plant& plant = *in.plant;
-  if (!PreparePart(in.split->train_series, plant, spec, in.split->data_start_s, &f.train,
-                   &f.failure)) {
+  if (!PreparePart(in.split->train_series, plant, spec, in.split->data_start_s, in.split->cleanings,
+                   &f.train, &f.failure)) {
     if (f.failure.empty()) f.failure = "the training days cannot be prepared";
     return f;
   }
@@ -285,7 +302,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   t.fit_runtime_s = fit_runtime_s;
   Part ho;
   if (!best.failure.empty() ||
-      !PreparePart(heldout_series, plant, c.spec, data_start_s, &ho, &why)) {
+      !PreparePart(heldout_series, plant, c.spec, data_start_s, in.split->cleanings, &ho, &why)) {
     t.failure = best.failure.empty() ? why : best.failure;
     return;
   }

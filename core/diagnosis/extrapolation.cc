@@ -40,6 +40,18 @@ const DriverOfModel kDrivers[] = {
     {"flow_kg_s", [](const Drivers& d, std::size_t i) { return d.mdot_kg_s[i]; }},
 };
 
+// A margin of 10 % of the training span (at least a hundredth of its
+// scale) keeps the percentiles' own noise from counting.
+double Margin(const Extrapolation& e) {
+  return std::max(0.1 * (e.train_high - e.train_low),
+                  0.01 * std::max(std::fabs(e.train_low), std::fabs(e.train_high)));
+}
+
+bool Outside(const Extrapolation& e, double x) {
+  const double margin = Margin(e);
+  return x < e.train_low - margin || x > e.train_high + margin;
+}
+
 }  // namespace
 
 std::vector<Extrapolation> FindExtrapolation(const BaseFit& base, const DiagnosisOptions& options) {
@@ -54,22 +66,32 @@ std::vector<Extrapolation> FindExtrapolation(const BaseFit& base, const Diagnosi
     e.heldout_low = Quantile(heldout, 0.01);
     e.heldout_high = Quantile(heldout, 0.99);
     if (!std::isfinite(e.train_low) || !std::isfinite(e.heldout_low)) continue;
-    // A margin of 10 % of the training span (at least a hundredth of its
-    // scale) keeps the percentiles' own noise from counting.
-    const double margin =
-        std::max(0.1 * (e.train_high - e.train_low),
-                 0.01 * std::max(std::fabs(e.train_low), std::fabs(e.train_high)));
     std::size_t outside = 0, n = 0;
     for (const double x : heldout) {
       if (!std::isfinite(x)) continue;
       ++n;
-      if (x < e.train_low - margin || x > e.train_high + margin) ++outside;
+      if (Outside(e, x)) ++outside;
     }
     if (n == 0) continue;
     e.share_outside = static_cast<double>(outside) / static_cast<double>(n);
     if (e.share_outside > options.extrapolation_share) out.push_back(e);
   }
   return out;
+}
+
+std::vector<std::uint8_t> RowsInsideTrainingRange(const Drivers& d,
+                                                  const std::vector<Extrapolation>& extrapolation) {
+  std::vector<std::uint8_t> inside(d.size(), 1);
+  for (const Extrapolation& e : extrapolation) {
+    const auto driver = std::find_if(std::begin(kDrivers), std::end(kDrivers),
+                                     [&e](const DriverOfModel& k) { return e.driver == k.name; });
+    if (driver == std::end(kDrivers)) continue;
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      const double x = driver->value(d, i);
+      if (std::isfinite(x) && Outside(e, x)) inside[i] = 0;
+    }
+  }
+  return inside;
 }
 
 }  // namespace pvtwin::diagnosis_stages

@@ -15,8 +15,8 @@ bool EstimateNoiseFloor(const Split& split, const Plant& plant, const LadderMode
   const double area_m2 = plant.area_m2;
   Part final_heldout;
   std::string why;
-  if (!PreparePart(heldout_series, plant, final_model.spec, split.data_start_s, &final_heldout,
-                   &why)) {
+  if (!PreparePart(heldout_series, plant, final_model.spec, split.data_start_s, split.cleanings,
+                   &final_heldout, &why)) {
     *error = "internal: final model " + r.final_variant + ": " + why;
     return false;
   }

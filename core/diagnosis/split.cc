@@ -44,6 +44,7 @@ bool SplitDays(const Series& data, const Plant& plant, const DiagnosisOptions& o
   split->data_start_s = data_start_s;
   split->train_series = train_series;
   split->heldout_series = heldout_series;
+  split->cleanings = DetectCleanings(data, plant);
   return true;
 }
 

@@ -12,9 +12,11 @@ std::string PValue(double p) {
 }
 
 bool PreparePart(const Series& s, const Plant& plant, const ModelSpec& spec,
-                 std::int64_t data_start_s, Part* part, std::string* error) {
+                 std::int64_t data_start_s, const std::vector<Cleaning>& cleanings, Part* part,
+                 std::string* error) {
   if (!PrepareDrivers(s, plant, spec, &part->drivers, error)) return false;
   Drivers& d = part->drivers;
+  SetCleanings(cleanings, &d);
   if (d.days_since_clean.size() == d.size()) {
     for (std::size_t i = 0; i < d.size(); ++i) {
       d.days_since_clean[i] = static_cast<double>(d.time_s[i] - data_start_s) / 86400.0;

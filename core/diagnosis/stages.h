@@ -45,9 +45,11 @@ struct Part {
 // data_start_s: the first row of the whole data set. The days-since-cleaning
 // clock counts, with no cleaning known, from the start of the data, not from
 // the start of each part (SetCleaningTimes ignores cleanings before a part's
-// first row, so the count is set here).
+// first row, so the count is set here); the recoveries are those of the
+// cleanings the whole data show (Split::cleanings), not the part alone.
 bool PreparePart(const Series& s, const Plant& plant, const ModelSpec& spec,
-                 std::int64_t data_start_s, Part* part, std::string* error);
+                 std::int64_t data_start_s, const std::vector<Cleaning>& cleanings, Part* part,
+                 std::string* error);
 
 // The test units (held-out days, or hours) of the held-out rows.
 struct Units {
@@ -90,6 +92,8 @@ struct Split {
   int heldout_days = 0;
   std::int64_t data_start_s = 0;  // first row of the data
   Series train_series, heldout_series;
+  // Cleanings the whole data show (DetectCleanings), for both parts.
+  std::vector<Cleaning> cleanings;
 };
 bool SplitDays(const Series& data, const Plant& plant, const DiagnosisOptions& options,
                Split* split, std::string* error);
@@ -120,6 +124,11 @@ BaseResiduals LocaliseBaseGap(const Split& split, const BaseFit& base, const Pla
 // range leaves the training range on more than options.extrapolation_share
 // of the held-out objective rows.
 std::vector<Extrapolation> FindExtrapolation(const BaseFit& base, const DiagnosisOptions& options);
+// Per row of d: whether every driver of `extrapolation` lies inside its
+// training range there (with FindExtrapolation's margin); NaN counts as
+// inside.
+std::vector<std::uint8_t> RowsInsideTrainingRange(const Drivers& d,
+                                                  const std::vector<Extrapolation>& extrapolation);
 
 // The sensor checks of the monitor (FindSensorFaults) over the whole data,
 // one finding per channel and kind, most rows first (sensors.cc).

@@ -66,8 +66,10 @@ const OtherFormTruth& OtherTruth() {
 void SoilTheCover(const Drivers& d, const ParamVector& p, RunInputs* run) {
   const double rate_per_day = ParamOf(p, Param::kSoilingPerDay);
   double* g_abs = run->Own(&run->g_abs_w_m2);
+  const bool recovered = d.soiling_recovered.size() == run->n;
   for (std::size_t i = 0; i < run->n; ++i) {
-    g_abs[i] *= SoilingTransmittance(rate_per_day, d.days_since_clean[i]);
+    g_abs[i] *= SoilingTransmittance(rate_per_day, d.days_since_clean[i],
+                                     recovered ? d.soiling_recovered[i] : 0.0);
   }
 }
 
@@ -101,10 +103,15 @@ const EffectModule& SoilingEffect() {
         "with the days since the last rain or cleaning: τ_soil = max(0, 1 − r_soil·d) "
         "multiplies the absorbed irradiance, so P_el and Q_u both drift down over the "
         "weeks (Kimber et al. 2006, linear soiling rate). Cleanings reset d "
-        "(SetCleaningTimes); without a known cleaning d counts from the first row.";
+        "(SetCleaningTimes); without a known cleaning d counts from the first row. A rain "
+        "or a washing that the data show (the daily performance index P_el/I_gt at the "
+        "measured module temperature recovers by more than 2 % and four robust standard "
+        "deviations of its day-to-day changes, and stays up) lowers the loss by the "
+        "recovery measured: τ_soil = 1 − max(0, r_soil·d − Σ recoveries).";
     m.source =
         "Kimber et al. 2006, the effects of soiling on large grid-connected PV systems (linear "
-        "soiling rate)";
+        "soiling rate); Deceglie et al. 2018, IEEE J. Photovolt. 8 (stochastic rate and "
+        "recovery: cleanings from the performance index)";
     m.params = {Param::kSoilingPerDay};
     m.typical_truth = {{Param::kSoilingPerDay, 0.004}};
     m.signature = "days since the last cleaning";

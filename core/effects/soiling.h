@@ -15,8 +15,12 @@ namespace pvtwin {
 // Transmittance of the soiled cover, τ_soil = max(0, 1 − r_soil·d): r_soil
 // per day, d days since the last cleaning (Kimber et al. 2006, linear
 // soiling rate).
-inline double SoilingTransmittance(double rate_per_day, double days_since_clean) {
-  return std::max(0.0, 1.0 - rate_per_day * days_since_clean);
+// With recovered = the recoveries measured at the cleanings the data show
+// (Drivers::soiling_recovered): the loss r·d drops by them,
+// τ = 1 − max(0, r·d − recovered).
+inline double SoilingTransmittance(double rate_per_day, double days_since_clean,
+                                   double recovered = 0.0) {
+  return std::max(0.0, 1.0 - std::max(0.0, rate_per_day * days_since_clean - recovered));
 }
 
 // --- Other-form truth: saturating soiling, partly washed off by rain ---

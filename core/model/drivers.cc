@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/common/calendar.h"
 #include "core/common/units.h"
 #include "core/model/irradiance_drivers.h"
 #include "core/model/thermal_model.h"
@@ -93,6 +94,9 @@ void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t 
   coarse->g_beam_w_m2.push_back(mean(d.g_beam_w_m2));
   coarse->g_ref_w_m2.push_back(mean(d.g_ref_w_m2));
   coarse->days_since_clean.push_back(mean(d.days_since_clean));
+  if (d.soiling_recovered.size() == d.size()) {
+    coarse->soiling_recovered.push_back(mean(d.soiling_recovered));
+  }
   coarse->irradiance_bias = d.irradiance_bias;
   Drivers::IamParts& parts = coarse->iam_parts;
   if (d.iam_parts.beam_w_m2.size() == d.size()) {
@@ -101,6 +105,76 @@ void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t 
     parts.ground_w_m2.push_back(mean(d.iam_parts.ground_w_m2));
     parts.beam_excess.push_back(d.iam_parts.beam_excess[mid]);
     parts.paper_k_beam.push_back(d.iam_parts.paper_k_beam[mid]);
+  }
+}
+
+std::vector<Cleaning> DetectCleanings(const Series& s, const Plant& plant) {
+  if (!s.Has(Channel::kPElW) || !s.Has(Channel::kGPoaWM2) || !s.Has(Channel::kTAmbC) ||
+      s.size() == 0) {
+    return {};
+  }
+  constexpr double kBrightWM2 = 500.0;
+  constexpr std::size_t kMinRows = 20;
+  const std::int64_t offset_s = SolarDayOffsetS(plant);
+  const std::vector<double>& p_el = s[Channel::kPElW];
+  const std::vector<double>& g_poa = s[Channel::kGPoaWM2];
+  const std::vector<double>& t_amb = s[Channel::kTAmbC];
+  std::vector<std::int64_t> day_start;
+  std::vector<double> index;  // PI per day with enough bright rows
+  std::vector<double> ratios;
+  auto close_day = [&](std::int64_t start) {
+    if (ratios.size() >= kMinRows) {
+      std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+      day_start.push_back(start);
+      index.push_back(ratios[ratios.size() / 2]);
+    }
+    ratios.clear();
+  };
+  std::int64_t current = SolarDayStartS(s.time_s[0], offset_s);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const std::int64_t day = SolarDayStartS(s.time_s[i], offset_s);
+    if (day != current) {
+      close_day(current);
+      current = day;
+    }
+    const double g = g_poa[i];
+    if (!(g >= kBrightWM2) || !(p_el[i] > 0.0) || !std::isfinite(t_amb[i]) ||
+        s.At(Channel::kValid, i) == 0.0) {
+      continue;
+    }
+    const double t_pv_c = s.At(Channel::kTPvC, i);
+    const double t_module_c = std::isfinite(t_pv_c) ? t_pv_c : t_amb[i] + 0.025 * g;
+    ratios.push_back(p_el[i] /
+                     (g * (1.0 + plant.pv_temp_coeff_per_k * (t_module_c - plant.pv_t_ref_c))));
+  }
+  close_day(current);
+  if (index.size() < 6) return {};
+  std::vector<double> change(index.size() - 1);
+  for (std::size_t k = 1; k < index.size(); ++k) change[k - 1] = std::log(index[k] / index[k - 1]);
+  std::vector<double> sorted = change;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  for (double& x : sorted) x = std::fabs(x - median);
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double sigma = 1.4826 * sorted[sorted.size() / 2];
+  const double threshold = std::max(std::log(1.02), 4.0 * sigma);
+  std::vector<Cleaning> out;
+  for (std::size_t k = 1; k < index.size(); ++k) {
+    if (change[k - 1] <= threshold) continue;
+    if (k + 1 < index.size() && std::log(index[k + 1] / index[k - 1]) < 0.5 * change[k - 1]) {
+      continue;  // undone the next day: a good day, not a cleaning
+    }
+    out.push_back({day_start[k], index[k] / index[k - 1] - 1.0});
+  }
+  return out;
+}
+
+void SetCleanings(const std::vector<Cleaning>& cleanings, Drivers* d) {
+  d->soiling_recovered.assign(d->size(), 0.0);
+  for (const Cleaning& c : cleanings) {
+    for (std::size_t i = 0; i < d->size(); ++i) {
+      if (d->time_s[i] >= c.time_s) d->soiling_recovered[i] += c.recovered;
+    }
   }
 }
 
@@ -182,6 +256,7 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
 
   ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2, &out.iam_parts);
   FillEffectDrivers(s, plant, spec, &out);
+  SetCleanings(DetectCleanings(s, plant), &out);
   for (const ModelExtension* e : spec.extensions) {
     if (e->prepare_drivers != nullptr && !e->prepare_drivers(s, &out, error)) return false;
   }

@@ -69,6 +69,29 @@ std::vector<double> SkyTemperaturesC(const Series& series, const Plant& plant, s
 // loss; recomputes drivers->days_since_clean. Times need not be sorted.
 void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers* drivers);
 
+// A cleaning the measured data show: the start of the solar day on which
+// the performance index recovered, and by how much (a fraction).
+struct Cleaning {
+  std::int64_t time_s = 0;
+  double recovered = 0.0;
+};
+
+// Cleanings (rain, washing) seen in the data, the way a soiling analysis
+// finds them (Deceglie et al. 2018, stochastic rate and recovery, RdTools):
+// a daily performance index PI = median over the rows with g_poa ≥ 500 W/m²
+// (at least 20) of P_el / (g_poa·(1 + f_corr_T·(T_amb + 0.025·g_poa −
+// T_PVref))) (the module heated 25 K per kW/m² above the air; its error is
+// much the same from one day to the next); a day whose PI rises over the
+// previous PI day's by more than max(2 %, 4 robust standard deviations of
+// the day-to-day changes), and that the next PI day does not undo (it keeps
+// at least half of the rise), is a cleaning that recovered PI_d/PI_prev − 1.
+// None without P_el or g_poa, or with fewer than 6 PI days.
+std::vector<Cleaning> DetectCleanings(const Series& series, const Plant& plant);
+
+// drivers->soiling_recovered from the cleanings: their recoveries summed up
+// to each row.
+void SetCleanings(const std::vector<Cleaning>& cleanings, Drivers* drivers);
+
 // Appends to *coarse the effect modules' raw drivers of rows [begin, end) of d
 // averaged to one row (time-weighted means; sun angles of the middle row),
 // for a coarsened copy of d such as identification's coarse stage builds.

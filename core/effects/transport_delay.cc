@@ -29,9 +29,12 @@ namespace {
 // is ṁ·c_p·(T_sensor − T_in). A restart (gap) refills the pipe with the
 // row's outlet temperature; a standing pump leaves the pipe's fluid where it
 // is (it only loses heat). t_out is the collector's outlet (a copy: out's is
-// overwritten), mass_end work space of n rows.
+// overwritten), mass_end work space of n rows. With `interpolate` the plug's
+// exit takes the outlet linearly between the rows' middles (by cumulative
+// mass), so that the output moves smoothly with M_plug (a fit needs its
+// slope); without, the row the exit falls in.
 void PipeToSensor(const Drivers& d, const MixedPipe& pipe, const double* t_amb_c,
-                  const std::vector<double>& t_out, std::vector<double>* mass_end,
+                  const std::vector<double>& t_out, std::vector<double>* mass_end, bool interpolate,
                   SimOutputs* out) {
   constexpr int kMaxTanks = 8;
   const int tanks = std::clamp(pipe.tanks, 1, kMaxTanks);
@@ -52,6 +55,18 @@ void PipeToSensor(const Drivers& d, const MixedPipe& pipe, const double* t_amb_c
     const double exit_mass = 0.5 * (mass_start + (*mass_end)[i]) - pipe.plug_mass_kg;
     while (j < i && (*mass_end)[j] <= exit_mass) ++j;
     double t_c = exit_mass < 0.0 ? t_out[first] : t_out[j];
+    if (interpolate && exit_mass >= 0.0) {
+      // Cumulative mass at the middle of row k.
+      auto middle = [&](std::size_t k) {
+        return 0.5 * ((k > first ? (*mass_end)[k - 1] : 0.0) + (*mass_end)[k]);
+      };
+      const double m_j = middle(j);
+      const std::size_t k = exit_mass >= m_j ? (j < i ? j + 1 : j) : (j > first ? j - 1 : j);
+      const double m_k = middle(k);
+      if (k != j && m_k != m_j && std::isfinite(t_out[k]) && std::isfinite(t_c)) {
+        t_c += (exit_mass - m_j) / (m_k - m_j) * (t_out[k] - t_c);
+      }
+    }
     if (!std::isfinite(t_c)) t_c = t_out[i];
     for (int k = 0; k < tanks; ++k) {
       double& t_tank = tank[static_cast<std::size_t>(k)];
@@ -70,7 +85,7 @@ void PipeToSensor(const Drivers& d, const MixedPipe& pipe, const double* t_amb_c
 void MixedPipeToSensor(const OtherTruthContext&, const Drivers& d, SimOutputs* out) {
   const std::vector<double> t_out = out->t_out_c;  // at the collector
   std::vector<double> mass_end;
-  PipeToSensor(d, kOtherTruthPipe, d.t_amb_c.data(), t_out, &mass_end, out);
+  PipeToSensor(d, kOtherTruthPipe, d.t_amb_c.data(), t_out, &mass_end, false, out);
 }
 
 const OtherFormTruth& OtherTruth() {
@@ -150,7 +165,7 @@ void SensorBehindPipeVolume(const Drivers& d, const ParamVector& p, RunInputs* r
   if (d.size() == 0) return;
   std::vector<double>& t_out = run->Scratch();
   t_out = out->t_out_c;
-  PipeToSensor(d, pipe, run->t_amb_c, t_out, &run->Scratch(), out);
+  PipeToSensor(d, pipe, run->t_amb_c, t_out, &run->Scratch(), true, out);
 }
 
 const ModelExtension& VolumeExtension() {
@@ -195,10 +210,10 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs& base) {
 // this as well as a pure one), or the measured changes follow those of the
 // model without the effect best k ≥ 1 rows late (a lag that maximises the
 // cross-correlation, by the same rise in z). A pipe loss alone, or a fit
-// that shifts a bias, leaves the changes as they were. A τ below half the row step cannot show
-// in the timing: the effect is then the pipe's loss alone, shown when the
-// fit gives the pipe one (U_pipe > 0; a τ of a few seconds with no loss only
-// smooths the outlet between rows).
+// that shifts a bias, leaves the changes as they were. A τ below half the
+// row step cannot show in the timing: the effect is then the pipe's loss
+// alone, shown when the fit gives the pipe one (U_pipe > 0; a τ of a few
+// seconds with no loss only smooths the outlet between rows).
 constexpr double kMinFisherZRise = 0.1;
 
 SignatureCheck ChangesFollowTheDelay(const SignatureData& d) {

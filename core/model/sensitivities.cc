@@ -37,8 +37,9 @@ struct RowTermTangents {
   Column g_back_w_k, g_coll_w_k, c_pv_j_k, c_coll_j_k;
 };
 
-// The partial derivatives of row i's terms by parameter, then scattered to
-// the columns. Paper 2.8 ('w'): U = 1/(1/U_front + r_refwind·v^n), so
+// The partial derivatives of row i's terms by parameter, scattered to the
+// columns. A column's parameter writes the same entries at every row (zero
+// where the row has none), so *t is zeroed once per run, not per row. Paper 2.8 ('w'): U = 1/(1/U_front + r_refwind·v^n), so
 // dU/dU_front = U²/U_front², dU/dr_refwind = −U²·v^n, dU/dn = −U²·r_refwind·
 // v^n·ln v. Eq. 2.7 per field: G_fluid = 2w/(r1 + 2w·r0/A), so dG/dr1 =
 // −G²/(2w), dG/dr0 = −G²/A, dG/dA = G²·r0/A².
@@ -62,11 +63,6 @@ void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i,
   const double irr_dev = run.w.g_poa_w_m2[i] - k.pv.pv_g_ref_w_m2;
   const bool two = k.nodes == 2;
   for (int j = 0; j < run.cols; ++j) {
-    for (double* c : {t->g_front_w_k, t->g_fluid_w_k, t->q_sun_w, t->eta_at_ref_temp,
-                      t->temp_coeff_per_k, t->eps_pvt, t->area_m2, t->g_back_w_k, t->g_coll_w_k,
-                      t->c_pv_j_k, t->c_coll_j_k}) {
-      c[j] = 0.0;
-    }
     switch (run.wrt[static_cast<std::size_t>(j)]) {
       case Param::kAreaM2:
         t->area_m2[j] = 1.0;
@@ -210,16 +206,18 @@ void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
 }
 
 // One row solved as SolveRow (thermal_model.cc) does, keeping each pass's
-// linearisation; returns the number of passes.
+// linearisation and step; returns the number of passes (the row's result
+// is the last pass's).
 template <RcShape kShape, bool kSky>
 int SolveRowPasses(const RunConstants& k, const RowTerms& r, const double start[2], double dt_s,
                    bool steady, double t_guess_c, Linearised lins[kMaxNodeIterations],
-                   RcStepResult* result) {
+                   RcStepResult results[kMaxNodeIterations]) {
   double t_lin = t_guess_c;
   PvFluxes at = FluxesAt<kSky, false>(k, r, t_lin);
   int passes = 0;
   for (int it = 0; it < kMaxNodeIterations; ++it) {
-    Linearised* l = &lins[passes++];
+    Linearised* l = &lins[passes];
+    RcStepResult* result = &results[passes++];
     Linearise<kShape, kSky>(k, r, t_lin, at, l);
     *result = steady ? SteadyRc(l->net) : AdvanceRcShaped<kShape>(l->net, start, dt_s);
     const double t_pv = result->t_mean_c[0];
@@ -236,7 +234,8 @@ int SolveRowPasses(const RunConstants& k, const RowTerms& r, const double start[
 // each next one the previous pass's step-mean T_PV derivatives.
 template <RcShape kShape, bool kSky>
 void RowTangent(const SensRun& run, const RowTerms& r, const RowTermTangents& t,
-                const Linearised lins[], int passes, const double start[2], double dt_s,
+                const Linearised lins[], const RcStepResult results[], int passes,
+                const double start[2], double dt_s,
                 bool steady, const double* d_guess, const double* d_start0,
                 const double* d_start1, RcStepTangent* out) {
   RcNetworkTangent dn;
@@ -245,13 +244,10 @@ void RowTangent(const SensRun& run, const RowTerms& r, const RowTermTangents& t,
   for (int pass = 0; pass < passes; ++pass) {
     const Linearised& l = lins[pass];
     NetworkTangent<kShape, kSky>(run, r, l, t, d_lin, d_start0, d_start1, &dn);
-    RcStepResult value;
     if (steady) {
-      value = SteadyRc(l.net);
-      SteadyRcTangent(l.net, value, dn, out);
+      SteadyRcTangent(l.net, results[pass], dn, out);
     } else {
-      value = AdvanceRcShaped<kShape>(l.net, start, dt_s);
-      AdvanceRcTangent<kShape>(l.net, start, dt_s, value, dn, out);
+      AdvanceRcTangent<kShape>(l.net, start, dt_s, results[pass], dn, out);
     }
     std::copy(out->t_mean_c[0], out->t_mean_c[0] + run.cols, d_lin);
   }
@@ -319,8 +315,9 @@ void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
   bool need_restart = true;
   RcStepResult res;
   RcStepTangent dres;
-  RowTermTangents t;
+  RowTermTangents t{};
   Linearised lins[kMaxNodeIterations];
+  RcStepResult pass_results[kMaxNodeIterations];
   Column d_guess, zero{};
   for (std::size_t i = 0; i < d.size(); ++i) {
     const RowTerms r = MakeRowTerms<false>(run.k, d, run.w, i);
@@ -333,9 +330,10 @@ void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
     if (need_restart || d.restart[i]) {
       // Paper 2.2: the steady state of this row's inputs, from T_amb (data).
       const int passes = SolveRowPasses<kShape, kSky>(run.k, r, s.t_c, 0.0, true, r.t_amb_c,
-                                                      lins, &res);
-      RowTangent<kShape, kSky>(run, r, t, lins, passes, s.t_c, 0.0, true, zero, zero, zero,
-                               &dres);
+                                                      lins, pass_results);
+      res = pass_results[passes - 1];
+      RowTangent<kShape, kSky>(run, r, t, lins, pass_results, passes, s.t_c, 0.0, true, zero,
+                               zero, zero, &dres);
       s.TakeEnd(res, dres, cols);
       s.t_pv_prev = s.t_pv_prev2 = res.t_mean_c[0];
       std::copy(dres.t_mean_c[0], dres.t_mean_c[0] + cols, s.d_prev);
@@ -345,10 +343,11 @@ void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
     const double start[2] = {s.t_c[0], s.t_c[1]};
     const double guess = 2.0 * s.t_pv_prev - s.t_pv_prev2;
     for (int j = 0; j < cols; ++j) d_guess[j] = 2.0 * s.d_prev[j] - s.d_prev2[j];
-    const int passes =
-        SolveRowPasses<kShape, kSky>(run.k, r, start, d.dt_s[i], false, guess, lins, &res);
-    RowTangent<kShape, kSky>(run, r, t, lins, passes, start, d.dt_s[i], false, d_guess, s.d_t0,
-                             s.d_t1, &dres);
+    const int passes = SolveRowPasses<kShape, kSky>(run.k, r, start, d.dt_s[i], false, guess,
+                                                    lins, pass_results);
+    res = pass_results[passes - 1];
+    RowTangent<kShape, kSky>(run, r, t, lins, pass_results, passes, start, d.dt_s[i], false,
+                             d_guess, s.d_t0, s.d_t1, &dres);
     s.TakeEnd(res, dres, cols);
     s.t_pv_prev2 = s.t_pv_prev;
     s.t_pv_prev = res.t_mean_c[0];

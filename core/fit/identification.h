@@ -166,9 +166,10 @@ struct IdentSummary {
 };
 
 // What one model run with sensitivities is charged against the simulation
-// budget (IdentOptions::optimizer.max_evaluations), in simulations: about
-// its cost in time for the default variant's free parameters.
-inline constexpr int kSensitivityRunCost = 2;
+// budget (IdentOptions::optimizer.max_evaluations), in simulations: its
+// cost in time for the bench variant's 11 free parameters (`bench sim`:
+// 2N1Ccolwr 4.7–4.8 plain runs).
+inline constexpr int kSensitivityRunCost = 5;
 
 // Identifies the parameters of drivers.spec from the measurements, starting
 // at `start` (typically StartParams(plant), or yesterday's parameters).

@@ -389,7 +389,7 @@ SensLoop PickSensLoop(const ModelSpec& spec) {
     case RcShape::kTwoCapacitiveBoth:
       break;
   }
-  return nullptr;
+  return PickSensLoop<RcShape::kTwoCapacitiveBoth>(spec.sky);
 }
 
 }  // namespace
@@ -403,9 +403,6 @@ bool SensitivitiesSupported(const ModelSpec& spec, std::span<const Param> wrt, s
   };
   if (!spec.extensions.empty()) {
     return fail(spec.Name() + ": effect extensions have no sensitivities (finite differences)");
-  }
-  if (SpecShape(spec) == RcShape::kTwoCapacitiveBoth) {
-    return fail(spec.Name() + ": two capacitive nodes have no sensitivities (finite differences)");
   }
   if (wrt.size() > MaxSensitivityParams()) {
     return fail(std::to_string(wrt.size()) + " parameters: at most " +

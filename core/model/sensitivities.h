@@ -25,8 +25,7 @@
 // Simulate jumps (far below kNodeToleranceK) and has no derivative.
 //
 // Supported: the variants without extensions (so without electric effects),
-// every network shape but two capacitive nodes (2N2C). Parameters the
-// variant does not use get zero columns.
+// every network shape. Parameters the variant does not use get zero columns.
 #pragma once
 
 #include <cstddef>

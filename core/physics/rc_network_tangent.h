@@ -15,8 +15,11 @@
 //   T_a = (S_a + g·T_b)/(G_a + g), and b sees S_b + g·S_a/(G_a + g) and
 //   G_b + g·G_a/(G_a + g). Steady state: K·T = S with K = [G0+g, −g; −g,
 //   G1+g], so K·dT = dS − dK·T.
-// The shape with both nodes capacitive (the eigen-decomposition of
-// AdvanceTwo) has no tangent here.
+// Two capacitive nodes (AdvanceTwo): with P = C^(−1/2) and the symmetric
+// M = P·K·P = V·diag(λa, λb)·Vᵀ, T_end = T0 + P·g1(M)·P·(S − K·T0) with
+// g1(λ) = dt·φ1(λ·dt) (g2, φ2 for the mean); the derivative of g(M) along
+// dM is V·(Γ ∘ Vᵀ·dM·V)·Vᵀ with Γ_ab = (g(λa) − g(λb))/(λa − λb) and Γ_aa
+// = g'(λa) (Daleckii–Krein; the mean of the slopes where λa ≈ λb).
 #pragma once
 
 #include <cmath>
@@ -89,6 +92,86 @@ inline void AlgebraicTangent(const RcNode& node, double t_c, const double* dg, c
   for (int j = 0; j < n; ++j) d_t[j] = (ds[j] - t_c * dg[j]) * inv_g;
 }
 
+// Γ_ab of g(λ) = dt·φ(λ·dt) from its values and slopes at λa ≥ λb.
+inline double DividedDifference(double ga, double gb, double slope_a, double slope_b,
+                                double lambda_a, double lambda_b) {
+  const double gap = lambda_a - lambda_b;
+  if (gap > 1e-6 * (std::fabs(lambda_a) + std::fabs(lambda_b))) return (ga - gb) / gap;
+  return 0.5 * (slope_a + slope_b);
+}
+
+// Tangent of AdvanceTwo (rc_network.cc): both nodes capacitive.
+inline void AdvanceTwoTangent(const RcNetwork& net, const double t0[2], double dt_s,
+                              const RcNetworkTangent& d, RcStepTangent* out) {
+  const double g = net.coupling_w_k;
+  const double k00 = net.node[0].conductance_w_k + g;
+  const double k11 = net.node[1].conductance_w_k + g;
+  const double c0 = net.node[0].capacitance_j_k;
+  const double c1 = net.node[1].capacitance_j_k;
+  const double p0 = 1.0 / std::sqrt(c0);
+  const double p1 = 1.0 / std::sqrt(c1);
+  const double m00 = k00 * p0 * p0;
+  const double m11 = k11 * p1 * p1;
+  const double m01 = -g * p0 * p1;
+  const double radius = std::hypot(0.5 * (m00 - m11), m01);
+  const double theta = 0.5 * std::atan2(2.0 * m01, m00 - m11);
+  const double c = std::cos(theta);
+  const double s = std::sin(theta);
+  const double lambda_a = 0.5 * (m00 + m11) + radius;
+  const double lambda_b = 0.5 * (m00 + m11) - radius;
+  const PhiSlopes pa = ExpPhisWithSlopes(lambda_a * dt_s);
+  const PhiSlopes pb = ExpPhisWithSlopes(lambda_b * dt_s);
+  const double dt2 = dt_s * dt_s;
+  // g(λ) = dt·φ(λ·dt), g'(λ) = dt²·φ'(λ·dt); [0]: end (φ1), [1]: mean (φ2).
+  const double ga[2] = {dt_s * pa.phi1, dt_s * pa.phi2};
+  const double gb[2] = {dt_s * pb.phi1, dt_s * pb.phi2};
+  const double sa[2] = {dt2 * pa.dphi1, dt2 * pa.dphi2};
+  const double sb[2] = {dt2 * pb.dphi1, dt2 * pb.dphi2};
+  double dd[2];
+  for (int f = 0; f < 2; ++f) {
+    dd[f] = DividedDifference(ga[f], gb[f], sa[f], sb[f], lambda_a, lambda_b);
+  }
+  const double r0 = net.node[0].source_w - k00 * t0[0] + g * t0[1];  // S − K·T0
+  const double r1 = net.node[1].source_w - k11 * t0[1] + g * t0[0];
+  const double fa = c * p0 * r0 + s * p1 * r1;  // Vᵀ·P·(S − K·T0)
+  const double fb = -s * p0 * r0 + c * p1 * r1;
+  double w0[2], w1[2];  // g(M)·P·(S − K·T0)
+  for (int f = 0; f < 2; ++f) {
+    w0[f] = c * ga[f] * fa - s * gb[f] * fb;
+    w1[f] = s * ga[f] * fa + c * gb[f] * fb;
+  }
+  for (int j = 0; j < d.directions; ++j) {
+    const double dg = d.coupling_w_k[j];
+    const double dk00 = d.conductance_w_k[0][j] + dg;
+    const double dk11 = d.conductance_w_k[1][j] + dg;
+    const double dp0 = -0.5 * p0 * d.capacitance_j_k[0][j] / c0;
+    const double dp1 = -0.5 * p1 * d.capacitance_j_k[1][j] / c1;
+    const double dt00 = d.t_start_c[0][j];
+    const double dt01 = d.t_start_c[1][j];
+    const double dr0 = d.source_w[0][j] - dk00 * t0[0] - k00 * dt00 + dg * t0[1] + g * dt01;
+    const double dr1 = d.source_w[1][j] - dk11 * t0[1] - k11 * dt01 + dg * t0[0] + g * dt00;
+    const double dq0 = dp0 * r0 + p0 * dr0;
+    const double dq1 = dp1 * r1 + p1 * dr1;
+    const double dm00 = dk00 * p0 * p0 + 2.0 * k00 * p0 * dp0;
+    const double dm11 = dk11 * p1 * p1 + 2.0 * k11 * p1 * dp1;
+    const double dm01 = -dg * p0 * p1 - g * (dp0 * p1 + p0 * dp1);
+    // Vᵀ·dM·V with V = [(c, s), (−s, c)].
+    const double e_aa = c * c * dm00 + 2.0 * c * s * dm01 + s * s * dm11;
+    const double e_bb = s * s * dm00 - 2.0 * c * s * dm01 + c * c * dm11;
+    const double e_ab = c * s * (dm11 - dm00) + (c * c - s * s) * dm01;
+    const double dfa = c * dq0 + s * dq1;
+    const double dfb = -s * dq0 + c * dq1;
+    double* d_end_mean[2][2] = {{&out->t_end_c[0][j], &out->t_end_c[1][j]},
+                                {&out->t_mean_c[0][j], &out->t_mean_c[1][j]}};
+    for (int f = 0; f < 2; ++f) {
+      const double ua = sa[f] * e_aa * fa + dd[f] * e_ab * fb + ga[f] * dfa;
+      const double ub = dd[f] * e_ab * fa + sb[f] * e_bb * fb + gb[f] * dfb;
+      *d_end_mean[f][0] = dt00 + dp0 * w0[f] + p0 * (c * ua - s * ub);
+      *d_end_mean[f][1] = dt01 + dp1 * w1[f] + p1 * (s * ua + c * ub);
+    }
+  }
+}
+
 }  // namespace rc_tangent
 
 // Tangent of SteadyRc(net) whose value is `value`.
@@ -121,7 +204,6 @@ template <RcShape kShape>
 inline void AdvanceRcTangent(const RcNetwork& net, const double t_start_c[2], double dt_s,
                              const RcStepResult& value, const RcNetworkTangent& d,
                              RcStepTangent* out) {
-  static_assert(kShape != RcShape::kTwoCapacitiveBoth, "no tangent for two capacitive nodes");
   const int n = d.directions;
   const RcNode& n0 = net.node[0];
   if constexpr (kShape == RcShape::kOneAlgebraic) {
@@ -135,6 +217,8 @@ inline void AdvanceRcTangent(const RcNetwork& net, const double t_start_c[2], do
                                   out->t_mean_c[0]);
   } else if constexpr (kShape == RcShape::kTwoAlgebraic) {
     SteadyRcTangent(net, value, d, out);
+  } else if constexpr (kShape == RcShape::kTwoCapacitiveBoth) {
+    rc_tangent::AdvanceTwoTangent(net, t_start_c, dt_s, d, out);
   } else {
     // a algebraic, b capacitive (see AdvanceRcShaped).
     constexpr int a = kShape == RcShape::kTwoCapacitive0 ? 1 : 0;

@@ -86,7 +86,7 @@ TEST(IdentifySynthetic, NoisyDataReachTheNoiseFloor) {
 // (IdentOptions::analytic_jacobian) reaches the fit of the forward
 // differences on noisy data (within 0.5 % of the training MAE) and recovers
 // the identifiable parameters of noise-free data within 1 %; a variant
-// without sensitivities (2N2C) falls back to differences.
+// without sensitivities (an effect extension) falls back to differences.
 TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   const Plant plant = DesignExamplePlant();
   const Case noisy = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
@@ -119,7 +119,8 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   }
   EXPECT_GE(checked, 8) << c.BriefReport();
 
-  const Case both = MakeCase(plant, "2N2Cwr", 3, 300.0, /*seed=*/15, SensorNoise{});
+  const Case both =
+      MakeCase(plant, "1N1Cwr+transport_delay", 3, 300.0, /*seed=*/15, SensorNoise{});
   const IdentSummary f = Identify(both.drivers, both.meas, StartParams(plant), sensitivities);
   EXPECT_TRUE(f.ok) << f.BriefReport();
   EXPECT_EQ(f.sensitivity_runs, 0);

@@ -299,6 +299,13 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
     f.algorithm = "lad_lm ftol 1e-4";
     table.push_back(f);
   }
+  {  // The default method with the other Jacobian (IdentOptions::analytic_jacobian).
+    IdentOptions options;
+    options.analytic_jacobian = !options.analytic_jacobian;
+    FitFigures f = RunFits(d1, start, options, repeats);
+    f.algorithm = options.analytic_jacobian ? "lad_lm sens. J" : "lad_lm diff. J";
+    table.push_back(f);
+  }
   std::printf(
       "\nalgorithms: %d days at 1 min from StartParams, default IdentOptions; NLopt methods with "
       "max_evaluations 6000, ftol_rel 1e-6; median runtime over %d (lad_lm) or %d runs\n",

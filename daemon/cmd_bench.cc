@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/common/units.h"
+#include "core/model/sensitivities.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
@@ -34,7 +35,23 @@ struct BenchArgs {
   std::string data_dir;
 };
 
-// One 14-day, 1-min simulation (20 160 rows) of each variant.
+// Median time of `repeats` calls of run(), after one warm-up call.
+template <typename Run>
+double MedianTime(int repeats, const Run& run) {
+  run();
+  std::vector<double> times;
+  for (int r = 0; r < repeats; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    run();
+    times.push_back(SecondsSince(start));
+  }
+  return Median(times);
+}
+
+// One 14-day, 1-min simulation (20 160 rows) of each variant, and where the
+// variant has them the run with sensitivities to its default free
+// parameters (what identification's Jacobian takes), with its cost in plain
+// runs.
 void BenchSimulation(const BenchArgs& a) {
   const Plant plant = DesignExamplePlant();
   WeatherOptions weather;
@@ -44,7 +61,8 @@ void BenchSimulation(const BenchArgs& a) {
   const Series series = GenerateWeather(plant, weather);
   std::printf("simulation: 14 days at 1 min (%zu rows), weather seed %llu, median of %d runs\n",
               series.size(), static_cast<unsigned long long>(a.seed), a.repeats);
-  std::printf("  %-24s %12s %14s\n", "variant", "median (ms)", "per row (ns)");
+  std::printf("  %-24s %12s %14s %18s %9s\n", "variant", "median (ms)", "per row (ns)",
+              "sensitivities (ms)", "/plain");
   std::vector<std::string> variants = PaperVariants();
   variants.push_back("1N1Cwr+transport_delay");
   variants.push_back("1N1Cwr+pv_clipping+shading+soiling+clock_offset");
@@ -59,16 +77,21 @@ void BenchSimulation(const BenchArgs& a) {
     }
     const ParamVector params = ReferenceTruthParams(plant);
     SimOutputs out;
-    Simulate(drivers, params, &out);  // warm-up, sizes the buffers
-    std::vector<double> times;
-    for (int r = 0; r < a.repeats; ++r) {
-      const auto start = std::chrono::steady_clock::now();
-      Simulate(drivers, params, &out);
-      times.push_back(SecondsSince(start));
-    }
-    const double median = Median(times);
-    std::printf("  %-24s %12.3f %14.1f\n", name.c_str(), median * 1e3,
+    const double median = MedianTime(a.repeats, [&] { Simulate(drivers, params, &out); });
+    std::printf("  %-24s %12.3f %14.1f", name.c_str(), median * 1e3,
                 median * 1e9 / static_cast<double>(series.size()));
+    std::vector<Param> wrt;
+    const auto free = DefaultFreeParams(spec);
+    for (std::size_t i = 0; i < kNumParams; ++i) {
+      if (free.test(i)) wrt.push_back(static_cast<Param>(i));
+    }
+    if (SensitivitiesSupported(spec, wrt, nullptr)) {
+      SimSensitivities sens;
+      const double sens_s =
+          MedianTime(a.repeats, [&] { SimulateSensitivities(drivers, params, wrt, &sens); });
+      std::printf(" %12.3f (%2zu) %9.2f", sens_s * 1e3, wrt.size(), sens_s / median);
+    }
+    std::printf("\n");
   }
 }
 

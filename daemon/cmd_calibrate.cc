@@ -32,6 +32,7 @@ struct CalibrateArgs {
   std::string start_params;
   std::string test_csv;
   std::string algorithm = "lad_lm";
+  std::string jacobian;  // "", "differences" or "sensitivities"
   std::vector<std::string> free;
   std::vector<std::string> fix;
   double step_s = 0.0;
@@ -64,10 +65,12 @@ struct StageTimes {
 void PrintTiming(const StageTimes& t, const IdentSummary& s) {
   std::fprintf(stderr,
                "timing: parse %.1f ms, prepare %.1f ms, fit %.1f ms (coarse %.1f ms, %d model "
-               "runs; fine %.1f ms, %d model runs), held-out %.1f ms, write %.1f ms\n",
+               "runs; fine %.1f ms, %d model runs), held-out %.1f ms, write %.1f ms; "
+               "%d of the model runs with sensitivities (each counted as %d)\n",
                1e3 * t.parse_s, 1e3 * t.prepare_s, 1e3 * s.runtime_s, 1e3 * s.coarse_runtime_s,
                s.coarse_evaluations, 1e3 * (s.runtime_s - s.coarse_runtime_s),
-               s.evaluations - s.coarse_evaluations, 1e3 * t.held_out_s, 1e3 * t.write_s);
+               s.evaluations - s.coarse_evaluations, 1e3 * t.held_out_s, 1e3 * t.write_s,
+               s.sensitivity_runs, kSensitivityRunCost);
 }
 
 bool ResampleOrReport(const std::string& path, double step_s, Series* s) {
@@ -203,6 +206,7 @@ int RunCalibrate(const CalibrateArgs& a) {
                  "multistart_bobyqa, mlsl_bobyqa)\n";
     return kExitBadInput;
   }
+  if (!a.jacobian.empty()) options.analytic_jacobian = a.jacobian == "sensitivities";
   if (a.max_evaluations > 0) options.optimizer.max_evaluations = a.max_evaluations;
   if (a.ftol_rel > 0.0) options.optimizer.ftol_rel = a.ftol_rel;
   options.use_t_pv = a.use_t_pv;
@@ -346,6 +350,11 @@ void RegisterCalibrate(CLI::App& app) {
                   "lad_lm (default: Levenberg-Marquardt on IRLS) or an NLopt method: bobyqa, "
                   "sbplx, nelder_mead, cobyla, lbfgs, mma, crs2_bobyqa, multistart_bobyqa, "
                   "mlsl_bobyqa");
+  cmd->add_option("--jacobian", args->jacobian,
+                  "how lad_lm gets its Jacobian: sensitivities (the model run with exact "
+                  "derivatives, where the variant supports it) or differences (forward "
+                  "differences); default: IdentOptions::analytic_jacobian")
+      ->check(CLI::IsMember({"sensitivities", "differences"}));
   cmd->add_option("--free", args->free,
                   "parameters to identify (default: all the variant uses except area_m2 and the "
                   "PV correction coefficients)")

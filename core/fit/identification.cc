@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/fit/lad_fit.h"
+#include "core/model/sensitivities.h"
 
 namespace pvtwin {
 
@@ -117,8 +118,46 @@ class Objective {
     }
   }
 
+  // True when Jacobian() serves the active parameters.
+  bool HasSensitivities() const {
+    return options_.analytic_jacobian && SensitivitiesSupported(drivers_.spec, free_, nullptr);
+  }
+
+  // The Jacobian of Residuals at p in the active parameters' unit
+  // coordinates (infos: their scales; dx/dz = upper − lower, or x·ln(upper /
+  // lower) on a log scale), from one run with sensitivities. A column with a
+  // non-finite entry is left zero. False when not supported.
+  bool Jacobian(const ParamVector& p, const std::vector<ParamInfo>& infos, Eigen::MatrixXd* jac) {
+    if (!HasSensitivities() || !SimulateSensitivities(drivers_, p, free_, &sens_)) return false;
+    simulations_ += kSensitivityRunCost;
+    ++sensitivity_runs_;
+    const auto m = static_cast<Eigen::Index>(meas_.rows.size());
+    const auto cols = static_cast<Eigen::Index>(free_.size());
+    jac->resize((use_t_pv_ ? 3 : 2) * m, cols);
+    const double inv_area = 1.0 / drivers_.plant.area_m2;
+    for (Eigen::Index j = 0; j < cols; ++j) {
+      const auto uj = static_cast<std::size_t>(j);
+      const ParamInfo& info = infos[uj];
+      const double x = p[static_cast<std::size_t>(free_[uj])];
+      const double dx_dz = info.scale == ParamScale::kLog ? x * std::log(info.upper / info.lower)
+                                                          : info.upper - info.lower;
+      const double* dp = sens_.DPEl(uj);
+      const double* dq = sens_.DQTh(uj);
+      const double* dt = sens_.DTPv(uj);
+      for (Eigen::Index k = 0; k < m; ++k) {
+        const std::uint32_t i = meas_.rows[static_cast<std::size_t>(k)];
+        (*jac)(k, j) = dp[i] * inv_area * dx_dz;
+        (*jac)(m + k, j) = dq[i] * inv_area * dx_dz;
+        if (use_t_pv_) (*jac)(2 * m + k, j) = options_.t_pv_weight_w_m2k * dt[i] * dx_dz;
+      }
+      if (!jac->col(j).allFinite()) jac->col(j).setZero();
+    }
+    return true;
+  }
+
   const SimOutputs& last() const { return sim_; }
   int simulations() const { return simulations_; }
+  int sensitivity_runs() const { return sensitivity_runs_; }
 
  private:
   const Drivers& drivers_;
@@ -129,9 +168,11 @@ class Objective {
   std::vector<ParamInfo> infos_;
   std::vector<double> z_ref_;
   SimOutputs sim_;
+  SimSensitivities sens_;
   double inv_rows_area_ = 0.0;
   bool use_t_pv_ = false;
   int simulations_ = 0;
+  int sensitivity_runs_ = 0;
 };
 
 // Standard errors of the free parameters (unit coordinates) from the
@@ -340,7 +381,16 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
       obj.Residuals(obj.Params(x), r);
       return r->allFinite();
     };
-    const LadFitResult fit = LadFit(residuals, z0, zr, lo);
+    JacobianFunction jacobian = nullptr;
+    if (obj.HasSensitivities()) {
+      lo.jacobian_cost = kSensitivityRunCost;
+      jacobian = [&](const Eigen::VectorXd& z, const Eigen::VectorXd&, Eigen::MatrixXd* jac) {
+        for (std::size_t j = 0; j < n; ++j)
+          x[j] = FromUnit(infos[j], z(static_cast<Eigen::Index>(j)));
+        return obj.Jacobian(obj.Params(x), infos, jac);
+      };
+    }
+    const LadFitResult fit = LadFit(residuals, z0, zr, lo, jacobian);
     for (std::size_t j = 0; j < n; ++j)
       x[j] = FromUnit(infos[j], fit.z(static_cast<Eigen::Index>(j)));
     out.params = obj.Params(x);
@@ -387,12 +437,14 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
 }
 
 // Sensitivity matrix of the residuals to the active parameters (unit
-// coordinates) at p, by forward differences; r0 gets the residuals at p.
+// coordinates) at p, from the run with sensitivities when the objective has
+// it, else by forward differences; r0 gets the residuals at p.
 Eigen::MatrixXd SensitivityMatrix(Objective& obj, const std::vector<ParamInfo>& infos,
                                   const ParamVector& p, Eigen::VectorXd* r0) {
   const std::vector<Param>& active = obj.free();
   obj.Residuals(p, r0);
   Eigen::MatrixXd jac(r0->size(), static_cast<Eigen::Index>(active.size()));
+  if (obj.Jacobian(p, infos, &jac)) return jac;
   Eigen::VectorXd r1;
   constexpr double kStep = 1e-4;
   for (std::size_t j = 0; j < active.size(); ++j) {
@@ -494,7 +546,8 @@ FreeSet SelectFree(const Drivers& drivers, const ParamVector& start, const Ident
 // optimum close to the fine one.) Replaces *best when the coarse optimum
 // also beats the start on the data as given; returns its simulations.
 int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOptions& options,
-                const FreeSet& fs, Objective& obj, double initial_cost, ParamVector* best) {
+                const FreeSet& fs, Objective& obj, double initial_cost, ParamVector* best,
+                int* sensitivity_runs) {
   const double data_step_s = drivers.dt_s.empty() ? 0.0 : drivers.dt_s[0];
   const double coarse_step_s =
       data_step_s < 30.0 && options.coarse_step_s > 60.0 ? 60.0 : options.coarse_step_s;
@@ -518,6 +571,7 @@ int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOpt
   // A misspecified model can have its coarse optimum far from the fine one:
   // keep it only if it also beats the start on the data as given.
   if (cs.ok && obj.DataCost(cs.params) < initial_cost) *best = cs.params;
+  *sensitivity_runs = cs.sensitivity_runs;
   return cs.evaluations;
 }
 
@@ -876,7 +930,9 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   }
   ParamVector best = fs.base;
   const auto t_coarse = std::chrono::steady_clock::now();
-  const int coarse_simulations = CoarseStart(drivers, meas, options, fs, obj, initial_cost, &best);
+  int coarse_sensitivity_runs = 0;
+  const int coarse_simulations = CoarseStart(drivers, meas, options, fs, obj, initial_cost, &best,
+                                             &coarse_sensitivity_runs);
   summary.coarse_runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_coarse).count();
   summary.coarse_evaluations = coarse_simulations;
@@ -891,6 +947,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   summary.final_cost_w_m2 = final_cost;
   summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
   summary.evaluations = obj.simulations() + coarse_simulations;
+  summary.sensitivity_runs = obj.sensitivity_runs() + coarse_sensitivity_runs;
   summary.estimates = Estimates(drivers, fs, fine, options);
   if (!fit.ok) {
     return finish(false, "optimiser stopped with " + std::string(ToString(fit.termination)) +

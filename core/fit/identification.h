@@ -100,6 +100,11 @@ struct IdentOptions {
   double coarse_step_s = 300.0;
   // Fewest objective rows accepted.
   int min_rows = 30;
+  // kLadLm: take the Jacobian (and the identifiability analysis's
+  // sensitivity matrix) from the model run with sensitivities
+  // (core/model/sensitivities.h) where it supports the variant, instead of
+  // forward differences of one simulation per free parameter.
+  bool analytic_jacobian = false;
 
   static OptimizerOptions DefaultOptimizerOptions();
   // False if a field is out of range; *why names field, value and rule.
@@ -139,6 +144,9 @@ struct IdentSummary {
   double initial_cost_w_m2 = 0.0;  // objective at the start values
   double final_cost_w_m2 = 0.0;    // objective at the result (without the prior)
   int evaluations = 0;             // model simulations, all stages
+  // Runs with sensitivities among them (analytic_jacobian), each counted in
+  // `evaluations` as kSensitivityRunCost simulations.
+  int sensitivity_runs = 0;
   double runtime_s = 0.0;
   // Time split: the coarse stage's share of runtime_s and of evaluations
   // (0 without a coarse stage); the fine stage (fit, identifiability,
@@ -156,6 +164,12 @@ struct IdentSummary {
   // runtime; "ok, but N parameters at bounds (names)" when any are.
   std::string BriefReport() const;
 };
+
+// What one model run with sensitivities is charged against the simulation
+// budget (IdentOptions::optimizer.max_evaluations), in simulations: its
+// cost in time for the bench variant's 11 free parameters (`bench sim`:
+// 2N1Ccolwr 4.7–4.8 plain runs).
+inline constexpr int kSensitivityRunCost = 5;
 
 // Identifies the parameters of drivers.spec from the measurements, starting
 // at `start` (typically StartParams(plant), or yesterday's parameters).

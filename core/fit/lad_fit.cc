@@ -15,7 +15,8 @@ double Objective(const Eigen::VectorXd& r, const Eigen::VectorXd& z, const Eigen
 }  // namespace
 
 LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0,
-                    const Eigen::VectorXd& z_ref, const LadFitOptions& o) {
+                    const Eigen::VectorXd& z_ref, const LadFitOptions& o,
+                    const JacobianFunction& jacobian) {
   LadFitResult res;
   const Eigen::Index n = z0.size();
   Eigen::VectorXd z = z0.cwiseMax(0.0).cwiseMin(1.0);
@@ -37,8 +38,9 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   Eigen::VectorXd w;
   bool jac_at_z = false;  // jac was computed at the current z
   double floor_rel = o.weight_floor_rel;
+  const Eigen::Index jacobian_cost = jacobian ? o.jacobian_cost : n;
   for (int it = 0; it < o.max_iterations; ++it) {
-    if (res.evaluations + n + 1 > o.max_evaluations) {
+    if (res.evaluations + jacobian_cost + 1 > o.max_evaluations) {
       res.message = "evaluation budget reached";
       break;
     }
@@ -46,13 +48,17 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     // IRLS weights at the current residuals.
     const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
     w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
-    // Forward-difference Jacobian, stepping inwards at the upper bound.
-    for (Eigen::Index j = 0; j < n; ++j) {
-      Eigen::VectorXd zp = z;
-      const double h = z(j) + o.jacobian_step <= 1.0 ? o.jacobian_step : -o.jacobian_step;
-      zp(j) += h;
-      if (!eval(zp, &r_step)) r_step = r;  // a non-finite column gives no direction
-      jac.col(j) = (r_step - r) / h;
+    if (jacobian && jacobian(z, r, &jac)) {
+      res.evaluations += static_cast<int>(jacobian_cost);
+    } else {
+      // Forward-difference Jacobian, stepping inwards at the upper bound.
+      for (Eigen::Index j = 0; j < n; ++j) {
+        Eigen::VectorXd zp = z;
+        const double h = z(j) + o.jacobian_step <= 1.0 ? o.jacobian_step : -o.jacobian_step;
+        zp(j) += h;
+        if (!eval(zp, &r_step)) r_step = r;  // a non-finite column gives no direction
+        jac.col(j) = (r_step - r) / h;
+      }
     }
     jac_at_z = true;
     // Majoriser: H = JᵀWJ / N + 2p·I, g = JᵀW r / N + 2p (z − z_ref).

@@ -6,9 +6,11 @@
 // few parameters — the paper's MAE objective (3.2.2) in the identification's
 // unit coordinates. Each iteration replaces |r_i| by its quadratic majoriser
 // r_i²/(2|r̂_i|) + |r̂_i|/2 at the current residuals r̂ (IRLS weights
-// 1/max(|r̂_i|, δ)), builds the forward-difference Jacobian (one residual
-// evaluation per free parameter) and takes damped Gauss–Newton steps
-// (Levenberg–Marquardt, projected onto the box) that must lower O itself.
+// 1/max(|r̂_i|, δ)), gets the Jacobian — from the caller's JacobianFunction
+// when given (identification: the model's sensitivities), else by forward
+// differences, one residual evaluation per free parameter — and takes damped
+// Gauss–Newton steps (Levenberg–Marquardt, projected onto the box) that must
+// lower O itself.
 // This uses the residual structure that a derivative-free method cannot see,
 // the same idea as the paper's lsqnonlin on √|r_i|, without the singularity
 // of √|r| at zero.
@@ -37,6 +39,10 @@ struct LadFitOptions {
   double weight_floor_rel = 0.3;
   double prior_weight = 0.0;  // see O(z)
   double n_scale = 1.0;       // N_scale in O(z)
+  // Residual evaluations one Jacobian of the JacobianFunction is charged,
+  // for the budget; ignored without one (forward differences: one per
+  // parameter).
+  int jacobian_cost = 1;
 };
 
 struct LadFitResult {
@@ -58,7 +64,16 @@ struct LadFitResult {
 // residuals are not finite.
 using ResidualFunction = std::function<bool(const Eigen::VectorXd& z, Eigen::VectorXd* r)>;
 
+// jacobian(z, r, jac) fills jac (rows of r × parameters) at z, where the
+// residuals are r; false when it cannot (LadFit then takes forward
+// differences for that iteration). A column it cannot give (non-finite) it
+// leaves zero: no direction.
+using JacobianFunction =
+    std::function<bool(const Eigen::VectorXd& z, const Eigen::VectorXd& r, Eigen::MatrixXd* jac)>;
+
+// jacobian empty: forward differences of `residuals`.
 LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0,
-                    const Eigen::VectorXd& z_ref, const LadFitOptions& options);
+                    const Eigen::VectorXd& z_ref, const LadFitOptions& options,
+                    const JacobianFunction& jacobian = nullptr);
 
 }  // namespace pvtwin

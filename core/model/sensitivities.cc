@@ -1,0 +1,431 @@
+#include "core/model/sensitivities.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/model/model_row.h"
+#include "core/model/thermal_model.h"
+#include "core/physics/rc_network_tangent.h"
+
+namespace pvtwin {
+
+namespace {
+
+using namespace model_row;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kMaxCols = kMaxRcTangents;
+using Column = double[kMaxCols];
+
+// What one sensitivity run reads besides the row.
+struct SensRun {
+  const Drivers& d;
+  const RunConstants& k;
+  const RunInputs& w;
+  std::span<const Param> wrt;
+  int cols;
+};
+
+// Derivatives of one row's terms (RowTerms, the parameters' products)
+// with respect to each parameter of wrt: d(term)/d(wrt[j]) at [j].
+struct RowTermTangents {
+  Column g_front_w_k, g_fluid_w_k, q_sun_w;
+  Column eta_at_ref_temp;  // η_PVref·(1 + f_corr_I·(I_gt − I_gtref))
+  Column temp_coeff_per_k;  // f_corr_T
+  Column eps_pvt, area_m2;
+  Column g_back_w_k, g_coll_w_k, c_pv_j_k, c_coll_j_k;
+};
+
+// The partial derivatives of row i's terms by parameter, scattered to the
+// columns. A column's parameter writes the same entries at every row (zero
+// where the row has none), so *t is zeroed once per run, not per row. Paper 2.8 ('w'): U = 1/(1/U_front + r_refwind·v^n), so
+// dU/dU_front = U²/U_front², dU/dr_refwind = −U²·v^n, dU/dn = −U²·r_refwind·
+// v^n·ln v. Eq. 2.7 per field: G_fluid = 2w/(r1 + 2w·r0/A), so dG/dr1 =
+// −G²/(2w), dG/dr0 = −G²/A, dG/dA = G²·r0/A².
+void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i,
+                         RowTermTangents* t) {
+  const RunConstants& k = run.k;
+  const double area = k.area_m2;
+  const double u_front = r.g_front_w_k / area;
+  double du_dufront = 1.0, du_drref = 0.0, du_dn = 0.0;
+  if (k.wind_paper) {
+    const double wind_pow = WindPower(run.w.ln_wind[i], k.n_wind);
+    const double u2 = u_front * u_front;
+    du_dufront = u2 * k.r_front_m2k_w * k.r_front_m2k_w;
+    du_drref = -u2 * wind_pow;
+    du_dn = wind_pow > 0.0 ? -u2 * k.r_refwind * wind_pow * run.w.ln_wind[i] : 0.0;
+  }
+  const double cap_w_k = run.d.capacity_flow_w_k[i];
+  const double g_fl = r.g_fluid_w_k;
+  const bool flow = cap_w_k > 0.0;
+  const double g_abs = run.w.g_abs_w_m2[i];
+  const double irr_dev = run.w.g_poa_w_m2[i] - k.pv.pv_g_ref_w_m2;
+  const bool two = k.nodes == 2;
+  for (int j = 0; j < run.cols; ++j) {
+    switch (run.wrt[static_cast<std::size_t>(j)]) {
+      case Param::kAreaM2:
+        t->area_m2[j] = 1.0;
+        t->g_front_w_k[j] = u_front;
+        t->g_fluid_w_k[j] = flow ? g_fl * g_fl * k.r0_fluid_per_area / area : 0.0;
+        t->q_sun_w[j] = k.f_th * g_abs;
+        t->g_back_w_k[j] = k.g_back_w_k / area;
+        t->g_coll_w_k[j] = two ? k.g_coll_w_k / area : 0.0;
+        t->c_pv_j_k[j] = k.c_pv_j_k / area;
+        t->c_coll_j_k[j] = k.c_coll_j_k / area;
+        break;
+      case Param::kEpsPvt:
+        t->eps_pvt[j] = k.sky ? 1.0 : 0.0;
+        break;
+      case Param::kEtaPvRef:
+        t->eta_at_ref_temp[j] = 1.0 + k.pv.pv_irr_coeff_m2_w * irr_dev;
+        break;
+      case Param::kFTh:
+        t->q_sun_w[j] = area * g_abs;
+        break;
+      case Param::kUFrontWM2K:
+        t->g_front_w_k[j] = area * du_dufront;
+        break;
+      case Param::kUBackWM2K:
+        t->g_back_w_k[j] = area;
+        break;
+      case Param::kUCollWM2K:
+        t->g_coll_w_k[j] = two ? area : 0.0;
+        break;
+      case Param::kR0FluidM2KW:
+        t->g_fluid_w_k[j] = flow ? -g_fl * g_fl / area : 0.0;
+        break;
+      case Param::kR1Fluid:
+        t->g_fluid_w_k[j] = flow ? -g_fl * g_fl / (2.0 * cap_w_k) : 0.0;
+        break;
+      case Param::kCPvJM2K:
+        t->c_pv_j_k[j] = k.c_pv_j_k > 0.0 ? area : 0.0;
+        break;
+      case Param::kCCollJM2K:
+        t->c_coll_j_k[j] = k.c_coll_j_k > 0.0 ? area : 0.0;
+        break;
+      case Param::kRRefWind:
+        t->g_front_w_k[j] = area * du_drref;
+        break;
+      case Param::kNWind:
+        t->g_front_w_k[j] = area * du_dn;
+        break;
+      case Param::kPvTempCoeffPerK:
+        t->temp_coeff_per_k[j] = 1.0;
+        break;
+      case Param::kPvIrrCoeffM2W:
+        t->eta_at_ref_temp[j] = k.pv.eta_pv_ref * irr_dev;
+        break;
+      default:  // not used by a variant without extensions
+        break;
+    }
+  }
+}
+
+// η_PV at t_c (eq. 2.4) with its slope and, per column, the derivatives of
+// both at fixed t_c; all zero where the efficiency is clamped to [0, 1].
+struct EfficiencyTangent {
+  double eta, slope_per_k;
+  Column d_eta, d_slope;
+};
+
+void EfficiencyAt(const RunConstants& k, const RowTerms& r, const RowTermTangents& t, double t_c,
+                  int cols, EfficiencyTangent* e) {
+  e->eta = r.eta.At(t_c);
+  e->slope_per_k = r.eta.SlopeAt(t_c);
+  const double dev = t_c - r.eta.t_ref_c;
+  const double coeff = k.pv.pv_temp_coeff_per_k;
+  const double eta0 = r.eta.eta_at_ref_temp;
+  const bool free = e->eta > 0.0 && e->eta < 1.0;  // else clamped: constant
+  for (int j = 0; j < cols; ++j) {
+    // η = η0 + η0·f_corr_T·(T − T_ref), slope = η0·f_corr_T.
+    const double d_eta0 = t.eta_at_ref_temp[j];
+    const double d_coeff = t.temp_coeff_per_k[j];
+    e->d_eta[j] = free ? d_eta0 * (1.0 + coeff * dev) + eta0 * d_coeff * dev : 0.0;
+    e->d_slope[j] = free ? d_eta0 * coeff + eta0 * d_coeff : 0.0;
+  }
+}
+
+// The derivatives of the network that `l` linearised about t_lin (see
+// Linearise), per column: of the row terms `t` at fixed t_lin, plus the
+// linearisation point's own derivative d_lin times its effect (d G_PV/d t_lin
+// = q_rad'', d S_PV/d t_lin = q_rad''·t_lin, and q_abs' when the Q_abs slope
+// stays explicit). d_start: the derivatives of the start temperatures.
+template <RcShape kShape, bool kSky>
+void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
+                    const RowTermTangents& t, const double* d_lin, const double* d_start0,
+                    const double* d_start1, RcNetworkTangent* dn) {
+  const RunConstants& k = run.k;
+  const int cols = run.cols;
+  const double x = l.t_lin_c;
+  EfficiencyTangent e;
+  EfficiencyAt(k, r, t, x, cols, &e);
+  const bool slope_in_g = l.lin.dq_abs_w_k != 0.0;
+  double kappa_g = 0.0, kappa_s = 0.0, r1 = 0.0, r0 = 0.0;
+  if constexpr (kSky) {
+    const double xk = CToK(x);
+    r1 = 4.0 * kStefanBoltzmannW_m2k4 * xk * xk * xk;                  // q_rad'/(ε·A)
+    r0 = kStefanBoltzmannW_m2k4 * (xk * xk * xk * xk - r.t_sky_k4);   // q_rad/(ε·A)
+    kappa_g = 12.0 * k.eps_pvt * kStefanBoltzmannW_m2k4 * k.area_m2 * xk * xk;
+    kappa_s = kappa_g * x;
+  }
+  if (!slope_in_g) kappa_s -= r.q_sun_w * e.slope_per_k;
+  constexpr int f = FluidNode(kShape);
+  dn->directions = cols;
+  for (int j = 0; j < cols; ++j) {
+    double g0 = t.g_front_w_k[j];
+    double s0 = t.g_front_w_k[j] * r.t_amb_c;
+    if constexpr (kSky) {
+      const double d_eps_area = k.area_m2 * t.eps_pvt[j] + k.eps_pvt * t.area_m2[j];
+      g0 += r1 * d_eps_area;
+      s0 += (r1 * x - r0) * d_eps_area;
+    }
+    g0 += kappa_g * d_lin[j];
+    s0 += kappa_s * d_lin[j];
+    const double dq = t.q_sun_w[j];
+    if (slope_in_g) {  // G += q_sun·η', S += q_sun·(1 − η + η'·x)
+      g0 += dq * e.slope_per_k + r.q_sun_w * e.d_slope[j];
+      s0 += dq * (1.0 - e.eta + e.slope_per_k * x) + r.q_sun_w * (e.d_slope[j] * x - e.d_eta[j]);
+    } else {  // S += q_sun·(1 − η)
+      s0 += dq * (1.0 - e.eta) - r.q_sun_w * e.d_eta[j];
+    }
+    dn->conductance_w_k[0][j] = g0;
+    dn->source_w[0][j] = s0;
+    if constexpr (f == 1) {
+      dn->conductance_w_k[1][j] = 0.0;
+      dn->source_w[1][j] = 0.0;
+    }
+    dn->conductance_w_k[f][j] += t.g_back_w_k[j] + t.g_fluid_w_k[j];
+    dn->source_w[f][j] += t.g_back_w_k[j] * r.t_back_c + t.g_fluid_w_k[j] * r.t_in_c;
+    dn->coupling_w_k[j] = t.g_coll_w_k[j];
+    dn->capacitance_j_k[0][j] = t.c_pv_j_k[j];
+    dn->capacitance_j_k[1][j] = t.c_coll_j_k[j];
+    dn->t_start_c[0][j] = d_start0[j];
+    dn->t_start_c[1][j] = d_start1[j];
+  }
+}
+
+// One row solved as SolveRow (thermal_model.cc) does, keeping each pass's
+// linearisation and step; returns the number of passes (the row's result
+// is the last pass's).
+template <RcShape kShape, bool kSky>
+int SolveRowPasses(const RunConstants& k, const RowTerms& r, const double start[2], double dt_s,
+                   bool steady, double t_guess_c, Linearised lins[kMaxNodeIterations],
+                   RcStepResult results[kMaxNodeIterations]) {
+  double t_lin = t_guess_c;
+  PvFluxes at = FluxesAt<kSky, false>(k, r, t_lin);
+  int passes = 0;
+  for (int it = 0; it < kMaxNodeIterations; ++it) {
+    Linearised* l = &lins[passes];
+    RcStepResult* result = &results[passes++];
+    Linearise<kShape, kSky>(k, r, t_lin, at, l);
+    *result = steady ? SteadyRc(l->net) : AdvanceRcShaped<kShape>(l->net, start, dt_s);
+    const double t_pv = result->t_mean_c[0];
+    if (!std::isfinite(t_pv)) break;
+    at = FluxesAt<kSky, false>(k, r, t_pv);
+    if (LinearisationConverged<kSky>(*l, at, t_pv)) break;
+    t_lin = t_pv;
+  }
+  return passes;
+}
+
+// The derivatives of one solved row (steady or a step from `start`) through
+// its passes: the first pass's linearisation point has derivatives d_guess,
+// each next one the previous pass's step-mean T_PV derivatives.
+template <RcShape kShape, bool kSky>
+void RowTangent(const SensRun& run, const RowTerms& r, const RowTermTangents& t,
+                const Linearised lins[], const RcStepResult results[], int passes,
+                const double start[2], double dt_s,
+                bool steady, const double* d_guess, const double* d_start0,
+                const double* d_start1, RcStepTangent* out) {
+  RcNetworkTangent dn;
+  Column d_lin;
+  std::copy(d_guess, d_guess + run.cols, d_lin);
+  for (int pass = 0; pass < passes; ++pass) {
+    const Linearised& l = lins[pass];
+    NetworkTangent<kShape, kSky>(run, r, l, t, d_lin, d_start0, d_start1, &dn);
+    if (steady) {
+      SteadyRcTangent(l.net, results[pass], dn, out);
+    } else {
+      AdvanceRcTangent<kShape>(l.net, start, dt_s, results[pass], dn, out);
+    }
+    std::copy(out->t_mean_c[0], out->t_mean_c[0] + run.cols, d_lin);
+  }
+  if constexpr (!TwoNodes(kShape)) {
+    std::fill(out->t_end_c[1], out->t_end_c[1] + run.cols, 0.0);
+    std::fill(out->t_mean_c[1], out->t_mean_c[1] + run.cols, 0.0);
+  }
+}
+
+// Row i's outputs and their derivatives from its step `res`, `dres`.
+template <RcShape kShape>
+void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& t, std::size_t i,
+                  const RcStepResult& res, const RcStepTangent& dres, SimSensitivities* out) {
+  const RunConstants& k = run.k;
+  const std::size_t n = out->rows;
+  const double t_pv = res.t_mean_c[0];
+  const double t_fluid = res.t_mean_c[FluidNode(kShape)];
+  const double g_abs = run.w.g_abs_w_m2[i];
+  EfficiencyTangent e;
+  EfficiencyAt(k, r, t, t_pv, run.cols, &e);
+  out->t_pv_c[i] = t_pv;
+  out->q_th_w[i] = r.g_fluid_w_k * (t_fluid - r.t_in_c);
+  out->p_el_w[i] = e.eta * k.area_m2 * g_abs;
+  for (int j = 0; j < run.cols; ++j) {
+    const auto col = static_cast<std::size_t>(j) * n;
+    const double d_pv = dres.t_mean_c[0][j];
+    const double d_fluid = dres.t_mean_c[FluidNode(kShape)][j];
+    out->dt_pv_c[col + i] = d_pv;
+    out->dq_th_w[col + i] = t.g_fluid_w_k[j] * (t_fluid - r.t_in_c) + r.g_fluid_w_k * d_fluid;
+    out->dp_el_w[col + i] = (e.d_eta[j] + e.slope_per_k * d_pv) * k.area_m2 * g_abs +
+                            e.eta * t.area_m2[j] * g_abs;
+  }
+}
+
+void SetSensRowNaN(SimSensitivities* out, std::size_t i, int cols) {
+  out->p_el_w[i] = out->q_th_w[i] = out->t_pv_c[i] = kNaN;
+  for (int j = 0; j < cols; ++j) {
+    const std::size_t at = static_cast<std::size_t>(j) * out->rows + i;
+    out->dp_el_w[at] = out->dq_th_w[at] = out->dt_pv_c[at] = kNaN;
+  }
+}
+
+// The state a row hands to the next: node temperatures at its end, the
+// last two step-mean T_PV (the next linearisation guess), and their
+// derivatives.
+struct SensState {
+  double t_c[2] = {0.0, 0.0};
+  double t_pv_prev = kNaN, t_pv_prev2 = kNaN;
+  Column d_t0{}, d_t1{}, d_prev{}, d_prev2{};
+
+  void TakeEnd(const RcStepResult& res, const RcStepTangent& d, int cols) {
+    t_c[0] = res.t_end_c[0];
+    t_c[1] = res.t_end_c[1];
+    std::copy(d.t_end_c[0], d.t_end_c[0] + cols, d_t0);
+    std::copy(d.t_end_c[1], d.t_end_c[1] + cols, d_t1);
+  }
+};
+
+// The row loop of Simulate (IntegrateRows) with the derivatives.
+template <RcShape kShape, bool kSky>
+void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
+  const Drivers& d = run.d;
+  const int cols = run.cols;
+  SensState s;
+  bool need_restart = true;
+  RcStepResult res;
+  RcStepTangent dres;
+  RowTermTangents t{};
+  Linearised lins[kMaxNodeIterations];
+  RcStepResult pass_results[kMaxNodeIterations];
+  Column d_guess, zero{};
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const RowTerms r = MakeRowTerms<false>(run.k, d, run.w, i);
+    if (!d.usable[i] || !RowInputsFinite(r)) {
+      SetSensRowNaN(out, i, cols);
+      need_restart = true;
+      continue;
+    }
+    MakeRowTermTangents(run, r, i, &t);
+    if (need_restart || d.restart[i]) {
+      // Paper 2.2: the steady state of this row's inputs, from T_amb (data).
+      const int passes = SolveRowPasses<kShape, kSky>(run.k, r, s.t_c, 0.0, true, r.t_amb_c,
+                                                      lins, pass_results);
+      res = pass_results[passes - 1];
+      RowTangent<kShape, kSky>(run, r, t, lins, pass_results, passes, s.t_c, 0.0, true, zero,
+                               zero, zero, &dres);
+      s.TakeEnd(res, dres, cols);
+      s.t_pv_prev = s.t_pv_prev2 = res.t_mean_c[0];
+      std::copy(dres.t_mean_c[0], dres.t_mean_c[0] + cols, s.d_prev);
+      std::copy(dres.t_mean_c[0], dres.t_mean_c[0] + cols, s.d_prev2);
+      need_restart = false;
+    }
+    const double start[2] = {s.t_c[0], s.t_c[1]};
+    const double guess = 2.0 * s.t_pv_prev - s.t_pv_prev2;
+    for (int j = 0; j < cols; ++j) d_guess[j] = 2.0 * s.d_prev[j] - s.d_prev2[j];
+    const int passes = SolveRowPasses<kShape, kSky>(run.k, r, start, d.dt_s[i], false, guess,
+                                                    lins, pass_results);
+    res = pass_results[passes - 1];
+    RowTangent<kShape, kSky>(run, r, t, lins, pass_results, passes, start, d.dt_s[i], false,
+                             d_guess, s.d_t0, s.d_t1, &dres);
+    s.TakeEnd(res, dres, cols);
+    s.t_pv_prev2 = s.t_pv_prev;
+    s.t_pv_prev = res.t_mean_c[0];
+    std::copy(s.d_prev, s.d_prev + cols, s.d_prev2);
+    std::copy(dres.t_mean_c[0], dres.t_mean_c[0] + cols, s.d_prev);
+    WriteSensRow<kShape>(run, r, t, i, res, dres, out);
+  }
+}
+
+using SensLoop = void (*)(const SensRun& run, SimSensitivities* out);
+
+template <RcShape kShape>
+SensLoop PickSensLoop(bool sky) {
+  return sky ? &IntegrateRowsSens<kShape, true> : &IntegrateRowsSens<kShape, false>;
+}
+
+// The network shape of a spec (every capacitance parameter is positive
+// within its bounds).
+RcShape SpecShape(const ModelSpec& spec) {
+  RcNetwork net;
+  net.nodes = spec.nodes;
+  net.node[0].capacitance_j_k = spec.c_pv ? 1.0 : 0.0;
+  net.node[1].capacitance_j_k = spec.nodes == 2 && spec.c_coll ? 1.0 : 0.0;
+  return ShapeOf(net);
+}
+
+SensLoop PickSensLoop(const ModelSpec& spec) {
+  switch (SpecShape(spec)) {
+    case RcShape::kOneAlgebraic:
+      return PickSensLoop<RcShape::kOneAlgebraic>(spec.sky);
+    case RcShape::kOneCapacitive:
+      return PickSensLoop<RcShape::kOneCapacitive>(spec.sky);
+    case RcShape::kTwoAlgebraic:
+      return PickSensLoop<RcShape::kTwoAlgebraic>(spec.sky);
+    case RcShape::kTwoCapacitive0:
+      return PickSensLoop<RcShape::kTwoCapacitive0>(spec.sky);
+    case RcShape::kTwoCapacitive1:
+      return PickSensLoop<RcShape::kTwoCapacitive1>(spec.sky);
+    case RcShape::kTwoCapacitiveBoth:
+      break;
+  }
+  return PickSensLoop<RcShape::kTwoCapacitiveBoth>(spec.sky);
+}
+
+}  // namespace
+
+std::size_t MaxSensitivityParams() { return kMaxCols; }
+
+bool SensitivitiesSupported(const ModelSpec& spec, std::span<const Param> wrt, std::string* why) {
+  auto fail = [why](const std::string& reason) {
+    if (why != nullptr) *why = reason;
+    return false;
+  };
+  if (!spec.extensions.empty()) {
+    return fail(spec.Name() + ": effect extensions have no sensitivities (finite differences)");
+  }
+  if (wrt.size() > MaxSensitivityParams()) {
+    return fail(std::to_string(wrt.size()) + " parameters: at most " +
+                std::to_string(MaxSensitivityParams()) + " per sensitivity run");
+  }
+  return true;
+}
+
+bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::span<const Param> wrt,
+                           SimSensitivities* out, std::string* why) {
+  if (!SensitivitiesSupported(d.spec, wrt, why)) return false;
+  const std::size_t n = d.size();
+  out->wrt.assign(wrt.begin(), wrt.end());
+  out->rows = n;
+  for (auto* v : {&out->p_el_w, &out->q_th_w, &out->t_pv_c}) v->resize(n);
+  for (auto* v : {&out->dp_el_w, &out->dq_th_w, &out->dt_pv_c}) v->resize(n * wrt.size());
+  const RunConstants k = MakeConstants(d, params);
+  RunInputs w;
+  SimOutputs unused_work;  // no extension: the hooks' work space stays empty
+  MakeRunInputs(d, params, &unused_work, &w);
+  const SensRun run{d, k, w, wrt, static_cast<int>(wrt.size())};
+  PickSensLoop(d.spec)(run, out);
+  return true;
+}
+
+}  // namespace pvtwin

@@ -1,0 +1,70 @@
+// The model run with forward sensitivities: Simulate's outputs P_el, Q_u and
+// T_PV per row together with their exact derivatives with respect to a list
+// of parameters, for identification's Jacobian (core/fit/identification.h).
+//
+// Hand-chained through each row (forward mode): the derivatives of the row
+// terms (g_front with the paper's wind form 'w', g_fluid of eq. 2.7, q_sun,
+// η_PV of eq. 2.4, the sky loss of eq. 2.6), of the network linearised about
+// T_PV, and of the exact step (core/physics/rc_network_tangent.h), started
+// from the derivatives of the previous row's end state, or at a restart row
+// from those of the steady state of its inputs (paper 2.2).
+//
+// The linearisation point is differentiated as the run computes it, pass by
+// pass: the first pass linearises about the extrapolation of the previous
+// two rows' T_PV (whose derivatives are carried along), each further pass
+// about the previous pass's step-mean T_PV (d G_PV/d T_lin = q_rad'',
+// d S_PV/d T_lin = q_rad''·T_lin, plus q_abs' where the Q_abs slope stays
+// explicit, see Linearise). These are the derivatives of Simulate's own
+// arithmetic for its number of passes, which central differences of
+// Simulate confirm to about 1e-9 of a column's scale
+// (tests/unit/test_model_sensitivities.cc). The linearisation point's own
+// dependence is not negligible: left out, the same tests find errors of
+// 1e-4 to 5e-2 of a column's scale (the step-mean of a capacitive node
+// depends on the point, and an explicit Q_abs slope depends on it to first
+// order). The pass count changes with the parameters in steps; there
+// Simulate jumps (far below kNodeToleranceK) and has no derivative.
+//
+// Supported: the variants without extensions (so without electric effects),
+// every network shape. Parameters the variant does not use get zero columns.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/common/model_data.h"
+#include "core/common/params.h"
+
+namespace pvtwin {
+
+struct SimSensitivities {
+  std::vector<Param> wrt;
+  std::size_t rows = 0;
+  // Simulate's outputs (NaN where Simulate's are).
+  std::vector<double> p_el_w, q_th_w, t_pv_c;
+  // d output[i] / d wrt[j] at index j·rows + i (one column per parameter,
+  // column-major): W (or K) per unit of the parameter (params.h).
+  std::vector<double> dp_el_w, dq_th_w, dt_pv_c;
+
+  const double* DPEl(std::size_t j) const { return dp_el_w.data() + j * rows; }
+  const double* DQTh(std::size_t j) const { return dq_th_w.data() + j * rows; }
+  const double* DTPv(std::size_t j) const { return dt_pv_c.data() + j * rows; }
+};
+
+// Most parameters one sensitivity run differentiates for.
+std::size_t MaxSensitivityParams();
+
+// True when SimulateSensitivities handles `spec` with these parameters;
+// otherwise *why (may be null) says why (the caller then takes finite
+// differences of Simulate).
+bool SensitivitiesSupported(const ModelSpec& spec, std::span<const Param> wrt, std::string* why);
+
+// Runs the model at `params` with the derivatives of its outputs with
+// respect to `wrt`. False (and *why) when not supported; *out is then
+// unchanged. Reusing *out between calls avoids any allocation.
+bool SimulateSensitivities(const Drivers& drivers, const ParamVector& params,
+                           std::span<const Param> wrt, SimSensitivities* out,
+                           std::string* why = nullptr);
+
+}  // namespace pvtwin

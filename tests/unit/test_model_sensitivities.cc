@@ -1,0 +1,227 @@
+// The model run with sensitivities (core/model/sensitivities.h) against
+// central differences of Simulate, for every Table 6 variant it supports, at
+// random parameter points inside the bounds (recorded seed) on three days of
+// synthetic weather with the pump going on and off; and the RC step's
+// tangent against the analytic step response. Where the central
+// differences are not limited by rounding the two agree to about 1e-9 of
+// the column's scale; the tests hold 1e-6. Leaving out the derivatives of
+// the linearisation point (sensitivities.h) fails them (errors 1e-4 … 5e-2).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/model/sensitivities.h"
+#include "core/model/thermal_model.h"
+#include "core/physics/rc_network_tangent.h"
+#include "core/synth/synthetic_plant.h"
+#include "core/synth/weather_generator.h"
+
+namespace pvtwin {
+namespace {
+
+// Every used parameter with a search range at a uniform position in the
+// middle 60 % of its unit coordinate (log where the range spans decades).
+ParamVector RandomPoint(const Plant& plant, const ModelSpec& spec, std::mt19937_64* rng) {
+  ParamVector p = TruthParamsFor(plant, spec);
+  std::uniform_real_distribution<double> u(0.2, 0.8);
+  const auto used = UsedParams(spec);
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), plant);
+    if (!used.test(i) || !(info.upper > info.lower)) continue;
+    const double z = u(*rng);
+    p[i] = info.scale == ParamScale::kLog ? info.lower * std::pow(info.upper / info.lower, z)
+                                          : info.lower + z * (info.upper - info.lower);
+  }
+  return p;
+}
+
+// The used parameters with a search range, A_PVT and the PV coefficients
+// included (identification may free them).
+std::vector<Param> UsedWithRange(const Plant& plant, const ModelSpec& spec) {
+  std::vector<Param> wrt;
+  const auto used = UsedParams(spec);
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), plant);
+    if (used.test(i) && info.upper > info.lower) wrt.push_back(static_cast<Param>(i));
+  }
+  return wrt;
+}
+
+struct Comparison {
+  double worst = 0.0;  // largest relative error over columns and outputs
+  std::string where;
+  int kinks = 0;       // rows × columns × outputs left out as not smooth
+  double worst_value_rel = 0.0;  // outputs against Simulate's
+};
+
+// max_i |exact − central| / max_i |central| per column and output, beyond
+// the rounding floor of the central differences (100·ε·max|output|/h). The
+// central step is h = 1e-5 of the parameter (truncation ~1e-10 relative).
+// A row where the central differences with steps h and h/2 disagree by more
+// than 0.5e-6 is not smooth within ±h (the linearisation's pass count
+// changes there: a jump that grows like 1/h in the difference quotient, and
+// travels on with the node states) and is counted in `kinks` instead.
+Comparison Compare(const Drivers& d, const ParamVector& p, const std::vector<Param>& wrt) {
+  Comparison c;
+  SimSensitivities sens;
+  EXPECT_TRUE(SimulateSensitivities(d, p, wrt, &sens));
+  SimOutputs plain;
+  Simulate(d, p, &plain);
+  const std::size_t n = d.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double pairs[3][2] = {{sens.p_el_w[i], plain.p_el_w[i]},
+                                {sens.q_th_w[i], plain.q_th_w[i]},
+                                {sens.t_pv_c[i], plain.t_pv_c[i]}};
+    for (const auto& v : pairs) {
+      if (std::isnan(v[0]) && std::isnan(v[1])) continue;
+      const double rel = std::fabs(v[0] - v[1]) / std::max(std::fabs(v[1]), 1.0);
+      c.worst_value_rel = std::isnan(rel) ? INFINITY : std::max(c.worst_value_rel, rel);
+    }
+  }
+  const std::vector<double> SimOutputs::*fields[] = {&SimOutputs::p_el_w, &SimOutputs::q_th_w,
+                                                     &SimOutputs::t_pv_c};
+  const std::vector<double>* exact[] = {&sens.dp_el_w, &sens.dq_th_w, &sens.dt_pv_c};
+  const char* names[] = {"p_el_w", "q_th_w", "t_pv_c"};
+  for (std::size_t j = 0; j < wrt.size(); ++j) {
+    const auto idx = static_cast<std::size_t>(wrt[j]);
+    const double h = 1e-5 * std::fabs(p[idx]);
+    SimOutputs runs[4];  // p + h, p − h, p + h/2, p − h/2
+    const double steps[4] = {h, -h, 0.5 * h, -0.5 * h};
+    for (int k = 0; k < 4; ++k) {
+      ParamVector q = p;
+      q[idx] += steps[k];
+      Simulate(d, q, &runs[k]);
+    }
+    for (int o = 0; o < 3; ++o) {
+      const auto& f = fields[o];
+      double scale = 0.0, magnitude = 0.0;
+      std::vector<double> d1(n), d2(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        d1[i] = ((runs[0].*f)[i] - (runs[1].*f)[i]) / (2.0 * h);
+        d2[i] = ((runs[2].*f)[i] - (runs[3].*f)[i]) / h;
+        if (std::isnan(d2[i])) continue;
+        scale = std::max(scale, std::fabs(d2[i]));
+        magnitude = std::max(magnitude, std::fabs((plain.*f)[i]));
+      }
+      const double floor = 100.0 * 2.2e-16 * magnitude / h;
+      double diff = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double ad = (*exact[o])[j * n + i];
+        if (std::isnan(d2[i]) && std::isnan(ad)) continue;
+        if (std::fabs(d1[i] - d2[i]) > 0.5e-6 * scale + floor) {
+          ++c.kinks;
+          continue;
+        }
+        diff = std::max(diff, std::fabs(ad - d1[i]) - floor);
+        if (std::isnan(ad)) diff = INFINITY;
+      }
+      const double rel = scale > 0.0 ? std::max(diff, 0.0) / scale : diff;
+      if (!(rel <= c.worst)) {
+        c.worst = rel;
+        c.where = std::string(Info(wrt[j]).name) + " on " + names[o];
+      }
+    }
+  }
+  return c;
+}
+
+Series TestWeather(const Plant& plant) {
+  WeatherOptions w;
+  w.num_days = 3;
+  w.step_s = 300.0;
+  w.seed = 11;
+  w.flow_mode = FlowMode::kVariable;  // pump on and off
+  return GenerateWeather(plant, w);
+}
+
+Drivers TestDrivers(const std::string& variant, const Series& s, const Plant& plant) {
+  ModelSpec spec;
+  std::string error;
+  EXPECT_TRUE(ParseVariant(variant, &spec, &error)) << error;
+  Drivers d;
+  EXPECT_TRUE(PrepareDrivers(s, plant, spec, &d, &error)) << error;
+  return d;
+}
+
+TEST(ModelSensitivities, Table6VariantsMatchCentralDifferences) {
+  const Plant plant = DesignExamplePlant();
+  const Series s = TestWeather(plant);
+  int tested = 0;
+  for (const std::string& variant : PaperVariants()) {
+    const Drivers d = TestDrivers(variant, s, plant);
+    const std::vector<Param> wrt = UsedWithRange(plant, d.spec);
+    if (!SensitivitiesSupported(d.spec, wrt, nullptr)) continue;
+    ++tested;
+    std::mt19937_64 rng(2026);
+    for (int point = 0; point < 4; ++point) {
+      const ParamVector p = RandomPoint(plant, d.spec, &rng);
+      const Comparison c = Compare(d, p, wrt);
+      EXPECT_LE(c.worst_value_rel, 1e-12) << variant << ", point " << point;
+      EXPECT_LE(c.worst, 1e-6) << variant << ", point " << point << ": " << c.where;
+      // Non-smooth rows are rare: at most 1 % of rows × columns × outputs.
+      EXPECT_LE(c.kinks, static_cast<int>(3 * wrt.size() * d.size() / 100))
+          << variant << ", point " << point;
+    }
+  }
+  EXPECT_EQ(tested, 9);  // all of Table 6
+}
+
+// At 1 min, the step of the identification's fine stage.
+TEST(ModelSensitivities, OneMinuteStepMatchesCentralDifferences) {
+  const Plant plant = DesignExamplePlant();
+  WeatherOptions w;
+  w.num_days = 2;
+  w.step_s = 60.0;
+  w.seed = 5;
+  w.flow_mode = FlowMode::kVariable;
+  const Series s = GenerateWeather(plant, w);
+  for (const std::string variant : {"1N1Cwr", "2N1Ccolwr", "2N1Cpvwr", "2N2Cwr"}) {
+    const Drivers d = TestDrivers(variant, s, plant);
+    const std::vector<Param> wrt = UsedWithRange(plant, d.spec);
+    std::mt19937_64 rng(7);
+    const Comparison c = Compare(d, RandomPoint(plant, d.spec, &rng), wrt);
+    EXPECT_LE(c.worst_value_rel, 1e-12) << variant;
+    EXPECT_LE(c.worst, 1e-6) << variant << ": " << c.where;
+  }
+}
+
+TEST(ModelSensitivities, UnsupportedSpecsSayWhy) {
+  const Plant plant = DesignExamplePlant();
+  for (const std::string variant : {"1N1Cr+wind", "2N2Cwr+transport_delay"}) {
+    ModelSpec spec;
+    std::string error;
+    ASSERT_TRUE(ParseVariant(variant, &spec, &error)) << error;
+    const std::vector<Param> wrt = UsedWithRange(plant, spec);
+    std::string why;
+    EXPECT_FALSE(SensitivitiesSupported(spec, wrt, &why)) << variant;
+    EXPECT_NE(why.find("finite differences"), std::string::npos) << why;
+  }
+}
+
+// One capacitive node from T0 towards T∞ = S/G: T(dt) = T∞ + (T0 − T∞)·e^(−G·dt/C),
+// so dT/dC = (T0 − T∞)·e^(−G·dt/C)·G·dt/C² and dT/dS = (1 − e^(−G·dt/C))/G.
+TEST(RcNetworkTangent, OneNodeStepResponse) {
+  RcNetwork net;
+  net.node[0] = {2.0e4, 15.0, 15.0 * 40.0};  // C, G, S: T∞ = 40 °C
+  const double t0[2] = {10.0, 0.0};
+  const double dt = 300.0;
+  const RcStepResult value = AdvanceRcShaped<RcShape::kOneCapacitive>(net, t0, dt);
+  RcNetworkTangent d{};
+  d.directions = 2;
+  d.capacitance_j_k[0][0] = 1.0;  // direction 0: C
+  d.source_w[0][1] = 1.0;         // direction 1: S
+  RcStepTangent out;
+  AdvanceRcTangent<RcShape::kOneCapacitive>(net, t0, dt, value, d, &out);
+  const double decay = std::exp(-15.0 * dt / 2.0e4);
+  EXPECT_NEAR(value.t_end_c[0], 40.0 + (10.0 - 40.0) * decay, 1e-12);
+  EXPECT_NEAR(out.t_end_c[0][0], (10.0 - 40.0) * decay * 15.0 * dt / (2.0e4 * 2.0e4), 1e-15);
+  EXPECT_NEAR(out.t_end_c[0][1], (1.0 - decay) / 15.0, 1e-15);
+}
+
+}  // namespace
+}  // namespace pvtwin

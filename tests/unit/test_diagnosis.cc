@@ -15,6 +15,7 @@
 #include "core/data/qc.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/diagnosis/diagnosis_stats.h"
+#include "core/diagnosis/stages.h"
 #include "core/diagnosis/gap_localisation.h"
 #include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
@@ -496,6 +497,25 @@ TEST_F(DiagnoseCli, OnRealDataAnAblationIsNeverBlamedOnAnotherEffect) {
           << variant << " +" << e.at("name");
     }
   }
+}
+
+// The rows where every extrapolated driver stays inside its training range
+// (with FindExtrapolation's margin, 10 % of the span): T_in − T_amb trained
+// on [10, 20] K keeps 9 and 21 K inside, puts 8 and 22 K outside; a driver
+// the list does not name is not looked at.
+TEST(Extrapolation, RowsInsideTheTrainingRangeOfEveryExtrapolatedDriver) {
+  Drivers d;
+  d.t_amb_c = {10.0, 10.0, 10.0, 10.0, 10.0, 10.0};
+  d.t_in_c = {25.0, 19.0, 18.0, 31.0, 32.0, std::nan("")};
+  d.time_s = {0, 60, 120, 180, 240, 300};
+  d.mdot_kg_s.assign(6, 0.0);
+  Extrapolation e;
+  e.driver = "t_in_minus_t_amb_k";
+  e.train_low = 10.0;
+  e.train_high = 20.0;
+  const std::vector<std::uint8_t> inside = diagnosis_stages::RowsInsideTrainingRange(d, {e});
+  EXPECT_EQ(inside, (std::vector<std::uint8_t>{1, 1, 0, 1, 0, 1}));
+  EXPECT_EQ(diagnosis_stages::RowsInsideTrainingRange(d, {}), std::vector<std::uint8_t>(6, 1));
 }
 
 }  // namespace

@@ -350,10 +350,12 @@ void RegisterCalibrate(CLI::App& app) {
                   "lad_lm (default: Levenberg-Marquardt on IRLS) or an NLopt method: bobyqa, "
                   "sbplx, nelder_mead, cobyla, lbfgs, mma, crs2_bobyqa, multistart_bobyqa, "
                   "mlsl_bobyqa");
-  cmd->add_option("--jacobian", args->jacobian,
-                  "how lad_lm gets its Jacobian: sensitivities (the model run with exact "
-                  "derivatives, where the variant supports it) or differences (forward "
-                  "differences); default: IdentOptions::analytic_jacobian")
+  cmd->add_option(
+         "--jacobian", args->jacobian,
+         "how lad_lm gets its Jacobian: sensitivities (the model run with exact "
+         "derivatives, where the variant supports it) or differences (forward "
+         "differences, the default: the sensitivities are faster but can stop earlier at the "
+         "default --ftol)")
       ->check(CLI::IsMember({"sensitivities", "differences"}));
   cmd->add_option("--free", args->free,
                   "parameters to identify (default: all the variant uses except area_m2 and the "

@@ -211,9 +211,9 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs& base) {
 // model without the effect best k ≥ 1 rows late (a lag that maximises the
 // cross-correlation, by the same rise in z). A pipe loss alone, or a fit
 // that shifts a bias, leaves the changes as they were. A τ below half the
-// row step cannot show in the timing: the effect is then the pipe's loss
-// alone, shown when the fit gives the pipe one (U_pipe > 0; a τ of a few
-// seconds with no loss only smooths the outlet between rows).
+// row step cannot show in the timing: the effect is then not shown (a τ of a
+// few seconds only smooths the outlet between rows, and a pipe loss alone
+// acts like one more thermal loss of the collector).
 constexpr double kMinFisherZRise = 0.1;
 
 SignatureCheck ChangesFollowTheDelay(const SignatureData& d) {
@@ -228,14 +228,14 @@ SignatureCheck ChangesFollowTheDelay(const SignatureData& d) {
   }
   SignatureCheck c;
   if (tau_s / step_s < 0.5) {
-    // No lag the data can show: what is left of the effect is the pipe's
-    // loss, which must then be there.
-    const double u_pipe = ParamOf(*d.params, Param::kUPipeWM2K);
-    c.shown = u_pipe > 0.0;
+    // No lag the data can show: what is left is a loss of the pipe, which
+    // the data cannot tell from the collector's own losses.
+    c.shown = false;
     c.sentence = "the fitted τ = " + FixedDecimals(tau_s, 0) + " s is below half the " +
-                 FixedDecimals(step_s, 0) + " s row step: no lag the data can show" +
-                 (c.shown ? ", the pipe loses U_pipe = " + FixedDecimals(u_pipe, 2) + " W/(m²K)"
-                          : ", and the pipe loses nothing (U_pipe = 0)");
+                 FixedDecimals(step_s, 0) +
+                 " s row step: no lag the data can show, and a pipe loss alone (U_pipe = " +
+                 FixedDecimals(ParamOf(*d.params, Param::kUPipeWM2K), 2) +
+                 " W/(m²K)) is not told from the collector's own losses";
     return c;
   }
   const LagFit before = BestLag(*d.drivers, *d.rows, *d.q_th_meas_w, d.before->q_th_w, 0, 0);

@@ -229,7 +229,7 @@ inline void AdvanceRcTangent(const RcNetwork& net, const double t_start_c[2], do
     const double inv_denom_a = 1.0 / (g_a + g);
     const double s_red = net.node[b].source_w + g * s_a * inv_denom_a;
     const double g_red = net.node[b].conductance_w_k + g * g_a * inv_denom_a;
-    double ds_red[kMaxRcTangents], dg_red[kMaxRcTangents];
+    double ds_red[kMaxRcTangents] = {}, dg_red[kMaxRcTangents] = {};
     for (int j = 0; j < n; ++j) {
       const double dg = d.coupling_w_k[j];
       const double d_inv = -inv_denom_a * inv_denom_a * (d.conductance_w_k[a][j] + dg);

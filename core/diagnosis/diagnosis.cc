@@ -7,6 +7,8 @@
 #include <sstream>
 #include <thread>
 
+#include "core/common/calendar.h"
+#include "core/common/text.h"
 #include "core/data/resample.h"
 #include "core/diagnosis/stages.h"
 
@@ -92,6 +94,17 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   r.extrapolation = st::FindExtrapolation(base_fit, options);
   r.sensors = st::CheckSensors(data, plant);
   if (!base_fit.train.drivers.sky_note.empty()) r.notes.push_back(base_fit.train.drivers.sky_note);
+  if (!split.cleanings.empty()) {
+    std::string days;
+    for (const Cleaning& c : split.cleanings) {
+      days += (days.empty() ? "" : ", ") + SolarDate(c.time_s, split.offset_s) + " (+" +
+              FixedDecimals(100.0 * c.recovered, 1) + " %)";
+    }
+    r.notes.push_back(
+        "cleanings the data show (the daily performance index recovers and stays "
+        "up; soiling's loss drops by the recovery): " +
+        days);
+  }
 
   st::TrialInputs trials;
   trials.data = &data;

@@ -79,9 +79,10 @@ struct Cleaning {
 // Cleanings (rain, washing) seen in the data, the way a soiling analysis
 // finds them (Deceglie et al. 2018, stochastic rate and recovery, RdTools):
 // a daily performance index PI = median over the rows with g_poa ≥ 500 W/m²
-// (at least 20) of P_el / (g_poa·(1 + f_corr_T·(T_amb + 0.025·g_poa −
-// T_PVref))) (the module heated 25 K per kW/m² above the air; its error is
-// much the same from one day to the next); a day whose PI rises over the
+// (at least 20) of P_el / (g_poa·(1 + f_corr_T·(T_PV − T_PVref))), T_PV the
+// measured t_pv_c, else T_amb + 0.025·g_poa (the module 25 K per kW/m² above
+// the air; a PVT module's fluid makes that rough, but much the same from one
+// day to the next); a day whose PI rises over the
 // previous PI day's by more than max(2 %, 4 robust standard deviations of
 // the day-to-day changes), and that the next PI day does not undo (it keeps
 // at least half of the rise), is a cleaning that recovered PI_d/PI_prev − 1.

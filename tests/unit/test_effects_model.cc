@@ -142,19 +142,36 @@ TEST(EffectModel, ShadingRemovesBeamOnlyInsideTheWindowAndHitsPelHarder) {
   }
 }
 
+// Ten days, hourly, at 800 W/m², a constant efficiency and a soiling rate
+// of 1 % a day: the soiling tests' plant.
+struct SoilingCase {
+  static constexpr std::size_t rows = 10 * 24;
+  static constexpr double rate = 0.01;
+  Plant plant;
+  Series s;
+  ParamVector p;
+  Drivers d;
+  double area;
+  SoilingCase() {
+    testing::ConstantInputs in;
+    in.g_poa_w_m2 = 800.0;
+    s = testing::MakeConstantSeries(rows, 3600.0, in);
+    p = ConstantEta(plant);
+    At(p, Param::kSoilingPerDay) = rate;
+    d = DriversOf(s, plant, "1N+soiling");
+    area = At(p, Param::kAreaM2);
+  }
+};
+
 // soiling: P_el = η·A·I·(1 − r·d), d the days since the last cleaning; a
 // cleaning resets d.
 TEST(EffectModel, SoilingGrowsLinearlyAndCleaningResetsIt) {
-  const Plant plant;
-  testing::ConstantInputs in;
-  in.g_poa_w_m2 = 800.0;
-  const std::size_t rows = 10 * 24;  // ten days, hourly
-  const Series s = testing::MakeConstantSeries(rows, 3600.0, in);
-  ParamVector p = ConstantEta(plant);
-  const double rate = 0.01;
-  At(p, Param::kSoilingPerDay) = rate;
-  Drivers d = DriversOf(s, plant, "1N+soiling");
-  const double area = At(p, Param::kAreaM2);
+  SoilingCase c;
+  const std::size_t rows = c.rows;
+  const double rate = c.rate, area = c.area;
+  const Series& s = c.s;
+  const ParamVector& p = c.p;
+  Drivers& d = c.d;
   SimOutputs out = SimulateWith(d, p);
   for (std::size_t i = 0; i < rows; ++i) {
     const double days = static_cast<double>(i) / 24.0;
@@ -175,16 +192,12 @@ TEST(EffectModel, SoilingGrowsLinearlyAndCleaningResetsIt) {
 // A cleaning the data show lowers the loss by its recovery from then on:
 // τ = 1 − max(0, r·d − recovered), never above 1.
 TEST(EffectModel, SoilingDropsByTheRecoveryOfACleaningSeenInTheData) {
-  const Plant plant;
-  testing::ConstantInputs in;
-  in.g_poa_w_m2 = 800.0;
-  const std::size_t rows = 10 * 24;
-  const Series s = testing::MakeConstantSeries(rows, 3600.0, in);
-  ParamVector p = ConstantEta(plant);
-  const double rate = 0.01;
-  At(p, Param::kSoilingPerDay) = rate;
-  Drivers d = DriversOf(s, plant, "1N+soiling");
-  const double area = At(p, Param::kAreaM2);
+  SoilingCase c;
+  const std::size_t rows = c.rows;
+  const double rate = c.rate, area = c.area;
+  const Series& s = c.s;
+  const ParamVector& p = c.p;
+  Drivers& d = c.d;
   const std::int64_t wash_s = s.time_s[0] + 4 * 86400;
   SetCleanings({{wash_s, 0.03}}, &d);
   const SimOutputs out = SimulateWith(d, p);

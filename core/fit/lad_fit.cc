@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace pvtwin {
 
@@ -10,6 +11,29 @@ namespace {
 double Objective(const Eigen::VectorXd& r, const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref,
                  const LadFitOptions& o) {
   return r.cwiseAbs().sum() / o.n_scale + o.prior_weight * (z - z_ref).squaredNorm();
+}
+
+// ½·gᵀH⁻¹g over the parameters free to move: a parameter at a bound of the
+// unit box whose gradient points out of it is left out.
+double PromisedDecrease(const Eigen::MatrixXd& h, const Eigen::VectorXd& g,
+                        const Eigen::VectorXd& z) {
+  std::vector<Eigen::Index> movable;
+  for (Eigen::Index j = 0; j < z.size(); ++j) {
+    const bool pinned = (z(j) <= 0.0 && g(j) > 0.0) || (z(j) >= 1.0 && g(j) < 0.0);
+    if (!pinned) movable.push_back(j);
+  }
+  const auto m = static_cast<Eigen::Index>(movable.size());
+  if (m == 0) return 0.0;
+  Eigen::MatrixXd hm(m, m);
+  Eigen::VectorXd gm(m);
+  for (Eigen::Index a = 0; a < m; ++a) {
+    gm(a) = g(movable[static_cast<std::size_t>(a)]);
+    for (Eigen::Index b = 0; b < m; ++b) {
+      hm(a, b) = h(movable[static_cast<std::size_t>(a)], movable[static_cast<std::size_t>(b)]);
+    }
+  }
+  hm.diagonal().array() += 1e-12 * hm.diagonal().maxCoeff() + 1e-300;
+  return 0.5 * gm.dot(hm.ldlt().solve(gm));
 }
 
 }  // namespace
@@ -38,6 +62,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   Eigen::VectorXd w;
   bool jac_at_z = false;  // jac was computed at the current z
   double floor_rel = o.weight_floor_rel;
+  int small_in_a_row = 0;  // accepted steps in a row that lowered O by less than ftol
   const Eigen::Index jacobian_cost = jacobian ? o.jacobian_cost : n;
   for (int it = 0; it < o.max_iterations; ++it) {
     if (res.evaluations + jacobian_cost + 1 > o.max_evaluations) {
@@ -67,6 +92,10 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     Eigen::VectorXd g = (wj.transpose() * r) / o.n_scale;
     h.diagonal().array() += 2.0 * o.prior_weight;
     g += 2.0 * o.prior_weight * (z - z_ref);
+    // What the undamped step of this majoriser promises, ½·gᵀH⁻¹g, over
+    // the parameters the box lets move (not those at a bound that the
+    // gradient pushes against).
+    const double promised = PromisedDecrease(h, g, z);
     bool accepted = false;
     double step_norm = 0.0;
     double new_cost = cost;
@@ -113,10 +142,18 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
       lambda = 1e-3;
       continue;
     }
-    if (decrease <= o.ftol_rel * cost || step_norm <= o.xtol) {
+    // A small decrease ends the fit if the undamped step of this iteration's
+    // majoriser promised little too, or if it is the third small one in a
+    // row: one short, damped step of a fit still making its way along a
+    // valley does not stop it, and a promise the steps do not keep (a flat
+    // direction) does not hold it for long.
+    const bool small = decrease <= o.ftol_rel * cost;
+    small_in_a_row = small ? small_in_a_row + 1 : 0;
+    const bool small_decrease = small && (o.stop_promise_factor <= 0.0 || small_in_a_row >= 3 ||
+                                          promised <= o.stop_promise_factor * o.ftol_rel * cost);
+    if (small_decrease || step_norm <= o.xtol) {
       res.converged = true;
-      res.message =
-          decrease <= o.ftol_rel * cost ? "relative decrease below ftol" : "step below xtol";
+      res.message = small_decrease ? "relative decrease below ftol" : "step below xtol";
       break;
     }
   }

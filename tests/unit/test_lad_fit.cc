@@ -73,6 +73,37 @@ TEST(LadFit, BoundsAndPrior) {
   EXPECT_NEAR(pulled.z(0), 0.405, 1e-4);
 }
 
+// A curved valley (Rosenbrock's in L1 form): |a·(z1 − z0²)| + |b − z0|,
+// each term over many rows with offsets symmetric about zero so that the
+// optimum is z = (b, b²) = (0.8, 0.64). The iterations walk along the
+// valley with steps the damping holds back; a stop on one small decrease
+// ends far from the optimum, the stop that also asks the undamped step's
+// promise does not.
+TEST(LadFit, StopWaitsForTheUndampedPromiseInACurvedValley) {
+  const double a = 300.0, b = 0.8;
+  std::vector<double> offsets;
+  for (int k = -20; k <= 20; ++k) offsets.push_back(1e-3 * k);
+  ResidualFunction f = [&](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
+    const auto n = static_cast<Eigen::Index>(offsets.size());
+    r->resize(2 * n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      (*r)(k) = a * (z(1) - z(0) * z(0)) + offsets[static_cast<std::size_t>(k)];
+      (*r)(n + k) = b - z(0) + offsets[static_cast<std::size_t>(k)];
+    }
+    return true;
+  };
+  LadFitOptions o;
+  o.ftol_rel = 1e-3;
+  const Eigen::Vector2d start(0.05, 0.0), optimum(b, b * b);
+  const LadFitResult guarded = LadFit(f, start, Eigen::Vector2d::Zero(), o);
+  o.stop_promise_factor = 0.0;
+  const LadFitResult plain = LadFit(f, start, Eigen::Vector2d::Zero(), o);
+  EXPECT_TRUE(guarded.converged) << guarded.message;
+  EXPECT_LT((guarded.z - optimum).cwiseAbs().maxCoeff(), 0.002);
+  EXPECT_GT((plain.z - optimum).cwiseAbs().maxCoeff(), 0.1);  // what the guard prevents
+  EXPECT_LT(guarded.final_cost, plain.final_cost);
+}
+
 TEST(LadFit, NonFiniteStartIsReported) {
   ResidualFunction f = [](const Eigen::VectorXd&, Eigen::VectorXd* r) {
     *r = Eigen::VectorXd::Constant(3, std::nan(""));

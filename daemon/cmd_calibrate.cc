@@ -350,12 +350,11 @@ void RegisterCalibrate(CLI::App& app) {
                   "lad_lm (default: Levenberg-Marquardt on IRLS) or an NLopt method: bobyqa, "
                   "sbplx, nelder_mead, cobyla, lbfgs, mma, crs2_bobyqa, multistart_bobyqa, "
                   "mlsl_bobyqa");
-  cmd->add_option(
-         "--jacobian", args->jacobian,
-         "how lad_lm gets its Jacobian: sensitivities (the model run with exact "
-         "derivatives, where the variant supports it) or differences (forward "
-         "differences, the default: the sensitivities are faster but can stop earlier at the "
-         "default --ftol)")
+  cmd->add_option("--jacobian", args->jacobian,
+                  "how lad_lm (and the gradient methods lbfgs, mma) get their derivatives: "
+                  "sensitivities (default: the model run with exact derivatives, where the variant "
+                  "supports it; variants with effect extensions fall back to differences) or "
+                  "differences (forward differences, one model run per free parameter)")
       ->check(CLI::IsMember({"sensitivities", "differences"}));
   cmd->add_option("--free", args->free,
                   "parameters to identify (default: all the variant uses except area_m2 and the "
@@ -364,8 +363,9 @@ void RegisterCalibrate(CLI::App& app) {
   cmd->add_option("--fix", args->fix, "parameters to keep at their start values")->delimiter(',');
   cmd->add_option("--max-evaluations", args->max_evaluations, "simulation budget of the fit");
   cmd->add_option("--ftol", args->ftol_rel,
-                  "stop when an iteration lowers the MAE by less than this fraction (default "
-                  "1e-3; 1e-4 reaches the noise floor on synthetic data at about twice the time)")
+                  "stop when an iteration lowers the MAE by less than this fraction and lad_lm's "
+                  "next step promises little more (default 1e-4; 1e-3 stops about a third "
+                  "sooner, a little above the noise floor on synthetic data)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--parent-pid", args->parent_pid,
                   "exit when the process with this pid ends (used by pvtwin run for its "

@@ -58,7 +58,7 @@ ErrorMetrics ComputeErrors(const Measurements& meas, const SimOutputs& sim, doub
 
 enum class IdentMethod {
   // Levenberg–Marquardt on IRLS for the MAE (core/fit/lad_fit.h): uses the
-  // residual structure, a forward-difference Jacobian per iteration.
+  // residual structure, one Jacobian per iteration (see analytic_jacobian).
   kLadLm,
   // A method of NLopt (core/fit/optimizer.h), IdentOptions::optimizer.algorithm.
   kNlopt,
@@ -103,8 +103,9 @@ struct IdentOptions {
   // kLadLm: take the Jacobian (and the identifiability analysis's
   // sensitivity matrix) from the model run with sensitivities
   // (core/model/sensitivities.h) where it supports the variant, instead of
-  // forward differences of one simulation per free parameter.
-  bool analytic_jacobian = false;
+  // forward differences of one simulation per free parameter. Gradient
+  // methods of NLopt (kLbfgs, kMma) take their gradient from it too.
+  bool analytic_jacobian = true;
 
   static OptimizerOptions DefaultOptimizerOptions();
   // False if a field is out of range; *why names field, value and rule.

@@ -98,8 +98,7 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   ASSERT_TRUE(d.ok && s.ok) << d.BriefReport() << "\n" << s.BriefReport();
   EXPECT_EQ(d.sensitivity_runs, 0);
   EXPECT_GT(s.sensitivity_runs, 0);
-  EXPECT_NEAR(s.train.objective_w_m2(), d.train.objective_w_m2(),
-              0.005 * d.train.objective_w_m2());
+  EXPECT_NEAR(s.train.objective_w_m2(), d.train.objective_w_m2(), 0.005 * d.train.objective_w_m2());
 
   const ParamVector truth = ReferenceTruthParams(plant);
   const Case clean = MakeCase(plant, "2N1Ccolwr", 7, 120.0, /*seed=*/11, SensorNoise{});
@@ -119,11 +118,33 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   }
   EXPECT_GE(checked, 8) << c.BriefReport();
 
-  const Case both =
-      MakeCase(plant, "1N1Cwr+transport_delay", 3, 300.0, /*seed=*/15, SensorNoise{});
+  const Case both = MakeCase(plant, "1N1Cwr+transport_delay", 3, 300.0, /*seed=*/15, SensorNoise{});
   const IdentSummary f = Identify(both.drivers, both.meas, StartParams(plant), sensitivities);
   EXPECT_TRUE(f.ok) << f.BriefReport();
   EXPECT_EQ(f.sensitivity_runs, 0);
+}
+
+// NLopt's gradient methods take the gradient of the smoothed MAE from the
+// run with sensitivities: L-BFGS reaches the fit it reaches with
+// forward-difference gradients (within 1 % of the training MAE) with
+// fewer simulations. A wrong gradient would leave L-BFGS far off.
+TEST(IdentifySynthetic, GradientMethodsUseTheSensitivities) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 7, 120.0, /*seed=*/12, RealisticSensorNoise(13));
+  IdentOptions differences, sensitivities;
+  ASSERT_TRUE(SetIdentAlgorithm("lbfgs", &differences));
+  ASSERT_TRUE(SetIdentAlgorithm("lbfgs", &sensitivities));
+  differences.analytic_jacobian = false;
+  sensitivities.analytic_jacobian = true;
+  const IdentSummary d = Identify(c.drivers, c.meas, StartParams(plant), differences);
+  const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), sensitivities);
+  ASSERT_TRUE(d.ok && s.ok) << d.BriefReport() << "\n" << s.BriefReport();
+  EXPECT_EQ(d.sensitivity_runs, 0);
+  EXPECT_GT(s.sensitivity_runs, 0);
+  EXPECT_NEAR(s.train.objective_w_m2(), d.train.objective_w_m2(), 0.01 * d.train.objective_w_m2())
+      << d.BriefReport() << "\n"
+      << s.BriefReport();
+  EXPECT_LT(s.evaluations, d.evaluations) << d.BriefReport() << "\n" << s.BriefReport();
 }
 
 // A_PVT multiplies every flux: freed together with the others it spans a flat
@@ -231,26 +252,35 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
   EXPECT_LT(held_out.nmae_p_el, 0.02);
   EXPECT_LT(held_out.nmae_q_th, 0.18);
 
-  // Bounds. Two parameters run to their upper bound on this day; both are
-  // reported as such (IdentSummary::estimates[].at_bound, which `pvtwin
-  // calibrate` prints as "at upper bound": test_cli_model.cc checks the
-  // printout). Any other parameter at a bound fails here.
+  // Bounds. Parameters that run to a bound are reported as such
+  // (IdentSummary::estimates[].at_bound, which `pvtwin calibrate` prints as
+  // "at upper bound": test_cli_model.cc checks the printout). On this day
+  // one always does, two more may, and any other parameter at a bound fails
+  // here.
   //  * u_front_w_m2k → 1e3: in the paper's wind form (2.8) 1/U_front,w =
   //    1/U_front + r_refwind·v^n, U_front → ∞ leaves the front resistance to
   //    the wind term alone. With the blower's near-constant 3.5 m/s the
   //    still-air part cannot be told from the wind part; the paper's own
   //    fits wander the same way (Fig. 8, U_front 2.6e2 … 1e5).
-  //  * f_th → 1.2: F_th > 1 absorbs more than the incident irradiance, which
-  //    is not physical. It pairs with u_back ≈ 25 W/(m²K) on a rear-insulated
-  //    collector: one day at T_m − T_amb ≈ 8 K does not separate gain from
-  //    loss, and the fit trades more of both (see the ISO 9806 equivalents).
-  const std::set<Param> known_at_upper_bound = {Param::kUFrontWM2K, Param::kFTh};
+  //  * f_th → 1.2 or n_wind → 1.2, depending on the path of the fit (forward
+  //    differences end at the first, the exact Jacobian at the second):
+  //    - F_th > 1 absorbs more than the incident irradiance, which is not
+  //      physical. It pairs with u_back ≈ 25 W/(m²K) on a rear-insulated
+  //      collector: one day at T_m − T_amb ≈ 8 K does not separate gain from
+  //      loss, and the fit trades more of both (see the ISO 9806
+  //      equivalents).
+  //    - At a near-constant wind speed v^n is one constant factor that
+  //      r_refwind takes up as well; only the minutes of another speed set n.
+  const std::set<Param> always_at_upper_bound = {Param::kUFrontWM2K};
+  const std::set<Param> may_be_at_upper_bound = {Param::kFTh, Param::kNWind};
   for (const ParamEstimate& e : s.estimates) {
     if (!e.free || e.undetermined) continue;
     const std::string name(Info(e.param).name);
-    if (known_at_upper_bound.count(e.param) > 0) {
+    if (always_at_upper_bound.count(e.param) > 0) {
       EXPECT_TRUE(e.at_bound) << name << " = " << e.value
                               << " left its bound: update the comment above";
+      EXPECT_NEAR(e.value, e.upper, 1e-3 * (e.upper - e.lower)) << name;
+    } else if (may_be_at_upper_bound.count(e.param) > 0 && e.at_bound) {
       EXPECT_NEAR(e.value, e.upper, 1e-3 * (e.upper - e.lower)) << name;
     } else {
       EXPECT_FALSE(e.at_bound) << name << " = " << e.value << " at a bound of [" << e.lower << ", "

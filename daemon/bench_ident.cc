@@ -135,10 +135,11 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, int runs) {
       runs);
   std::printf(
       "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs) + fine %.1f "
-      "(%d model runs) | write %.2f\n",
+      "(%d model runs); %d of the runs with sensitivities, each counted as %d | write %.2f\n",
       1e3 * Median(parse), csv.size() / 1024, 1e3 * fit.runtime_s, 1e3 * fit.coarse_runtime_s,
       fit.coarse_evaluations, 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
-      fit.evaluations - fit.coarse_evaluations, 1e3 * Median(write));
+      fit.evaluations - fit.coarse_evaluations, fit.sensitivity_runs, kSensitivityRunCost,
+      1e3 * Median(write));
 }
 
 // The paper's objective (MAE of P_el + MAE of Q_u, W/m²) of `params` on
@@ -152,11 +153,21 @@ double ObjectiveWM2(const Drivers& drivers, const Measurements& meas, const Para
 // Identifications of one configuration repeated `runs` times.
 struct FitFigures {
   std::string algorithm;
+  std::string jacobian;  // JacobianOf
   int runs = 0;
   double median_runtime_s = 0.0;
   IdentSummary summary;  // of the last run (the fits are deterministic)
   double held_out_w_m2 = std::nan("");
 };
+
+// How the fit got its derivatives: "sens" when runs with sensitivities
+// served it, "diff" for forward differences, "-" for a derivative-free method.
+std::string JacobianOf(const FitFigures& f, const IdentOptions& options) {
+  if (f.summary.sensitivity_runs > 0) return "sens";
+  const bool derivatives =
+      options.method == IdentMethod::kLadLm || NeedsGradient(options.optimizer.algorithm);
+  return derivatives ? "diff" : "-";
+}
 
 FitFigures RunFits(const SplitData& data, const ParamVector& start, const IdentOptions& options,
                    int runs) {
@@ -176,6 +187,7 @@ FitFigures RunFits(const SplitData& data, const ParamVector& start, const IdentO
   }
   f.runs = static_cast<int>(times.size());
   f.median_runtime_s = Median(times);
+  f.jacobian = JacobianOf(f, options);
   if (f.summary.ok) {
     f.held_out_w_m2 = ObjectiveWM2(data.held_out_drivers, data.held_out_meas, f.summary.params);
   }
@@ -202,8 +214,8 @@ std::string FreeCount(const IdentSummary& s) {
 }
 
 void PrintFitRow(const FitFigures& f, double reference_held_out_w_m2) {
-  std::printf("  %-18s %9.3f %5d %7d  ", f.algorithm.c_str(), f.median_runtime_s, f.runs,
-              f.summary.evaluations);
+  std::printf("  %-22s %-4s %9.3f %5d %7d %5d  ", f.algorithm.c_str(), f.jacobian.c_str(),
+              f.median_runtime_s, f.runs, f.summary.evaluations, f.summary.sensitivity_runs);
   if (!f.summary.ok) {
     std::printf("FAILED: %s\n", f.summary.failure_reason.c_str());
     return;
@@ -275,7 +287,8 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
 
   // 2. Algorithm comparison.
   const std::vector<std::string> algorithms = {
-      "lad_lm", "bobyqa", "sbplx", "nelder_mead", "multistart_bobyqa", "crs2_bobyqa", "lbfgs"};
+      "lad_lm",      "bobyqa", "sbplx", "nelder_mead", "multistart_bobyqa",
+      "crs2_bobyqa", "lbfgs",  "mma"};
   std::vector<FitFigures> table;
   for (const std::string& name : algorithms) {
     IdentOptions options;
@@ -292,26 +305,31 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
     }
     table.push_back(RunFits(d1, start, options, name == "lad_lm" ? repeats : slow_runs));
   }
-  {  // The default method with a tighter stop: what the last per mille costs.
+  // The default method with the other Jacobian, and with the looser stop;
+  // the gradient method with differences.
+  auto variation = [&](const char* label, double ftol, bool analytic, const char* algorithm,
+                       int runs) {
     IdentOptions options;
-    options.optimizer.ftol_rel = 1e-4;
-    FitFigures f = RunFits(d1, start, options, slow_runs);
-    f.algorithm = "lad_lm ftol 1e-4";
+    SetIdentAlgorithm(algorithm, &options);
+    if (options.method == IdentMethod::kNlopt) options.optimizer.max_evaluations = 6000;
+    options.optimizer.ftol_rel = ftol;
+    options.analytic_jacobian = analytic;
+    FitFigures f = RunFits(d1, start, options, runs);
+    f.algorithm = label;
     table.push_back(f);
-  }
-  {  // The default method with the other Jacobian (IdentOptions::analytic_jacobian).
-    IdentOptions options;
-    options.analytic_jacobian = !options.analytic_jacobian;
-    FitFigures f = RunFits(d1, start, options, repeats);
-    f.algorithm = options.analytic_jacobian ? "lad_lm sens. J" : "lad_lm diff. J";
-    table.push_back(f);
-  }
+  };
+  variation("lad_lm ftol 1e-3", 1e-3, true, "lad_lm", repeats);
+  variation("lad_lm diff.", IdentOptions{}.optimizer.ftol_rel, false, "lad_lm", slow_runs);
+  variation("lad_lm diff. ftol 1e-3", 1e-3, false, "lad_lm", slow_runs);
+  variation("lbfgs diff.", 1e-6, false, "lbfgs", slow_runs);
   std::printf(
-      "\nalgorithms: %d days at 1 min from StartParams, default IdentOptions; NLopt methods with "
-      "max_evaluations 6000, ftol_rel 1e-6; median runtime over %d (lad_lm) or %d runs\n",
-      kTrainDays, repeats, slow_runs);
-  std::printf("  %-18s %9s %5s %7s  %-18s %5s %9s %9s %7s\n", "algorithm", "median s", "runs",
-              "sims", "status", "free", "train", "held-out", "/ref");
+      "\nalgorithms: %d days at 1 min from StartParams, default IdentOptions (lad_lm: ftol_rel "
+      "%g) unless named; NLopt methods with max_evaluations 6000, ftol_rel 1e-6; median runtime "
+      "over %d (lad_lm) or %d runs; J: derivatives from the runs with sensitivities (sens, each "
+      "counted as %d sims) or forward differences (diff)\n",
+      kTrainDays, IdentOptions{}.optimizer.ftol_rel, repeats, slow_runs, kSensitivityRunCost);
+  std::printf("  %-22s %-4s %9s %5s %7s %5s  %-18s %5s %9s %9s %7s\n", "algorithm", "J", "median s",
+              "runs", "sims", "sens", "status", "free", "train", "held-out", "/ref");
   for (const FitFigures& f : table) PrintFitRow(f, ref_held_out);
 
   // 3. The reference, printed.
@@ -343,7 +361,7 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
   std::printf("  %-28s %9s %5s %9s %9s  %-10s %9s %9s %9s\n", "case", "median s", "runs",
               "target s", "/target", "status", "held-out", "ref", "/ref");
   auto target_row = [](const char* label, const FitFigures& f, double target_s, double ref_w_m2) {
-    std::printf("  %-28s %9.3f %5d %9.1f %9.3f  ", label, f.median_runtime_s, f.runs, target_s,
+    std::printf("  %-28s %9.3f %5d %9.2f %9.3f  ", label, f.median_runtime_s, f.runs, target_s,
                 f.median_runtime_s / target_s);
     if (!f.summary.ok) {
       std::printf("FAILED: %s\n", f.summary.failure_reason.c_str());
@@ -354,10 +372,12 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
   };
   char label[64];
   std::snprintf(label, sizeof(label), "(a) 14 d at 1 min, %zu rows", d1.train_meas.size());
-  target_row(label, fit_1min, 0.5, ref_held_out);
+  // Issue 16's targets: the whole `calibrate` process at 1 min within 50 ms
+  // (timed outside, README), so the fit alone must be below; 5 s within 0.3 s.
+  target_row(label, fit_1min, 0.05, ref_held_out);
   if (have_5s) {
     std::snprintf(label, sizeof(label), "(b) 14 d at 5 s, %zu rows", d5.train_meas.size());
-    target_row(label, fit_5s, 10.0, ref_held_out_5s);
+    target_row(label, fit_5s, 0.3, ref_held_out_5s);
     std::printf("  noise floor on the 5-s held-out days (true parameters): %.4f W/m2\n",
                 floor_held_out_5s);
   } else {

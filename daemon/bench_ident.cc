@@ -160,13 +160,14 @@ struct FitFigures {
   double held_out_w_m2 = std::nan("");
 };
 
-// How the fit got its derivatives: "sens" when runs with sensitivities
-// served it, "diff" for forward differences, "-" for a derivative-free method.
+// How the search got its derivatives: "-" for a derivative-free method (its
+// one run with sensitivities is the identifiability analysis's), "sens" when
+// runs with sensitivities served it, else "diff" (forward differences).
 std::string JacobianOf(const FitFigures& f, const IdentOptions& options) {
-  if (f.summary.sensitivity_runs > 0) return "sens";
   const bool derivatives =
       options.method == IdentMethod::kLadLm || NeedsGradient(options.optimizer.algorithm);
-  return derivatives ? "diff" : "-";
+  if (!derivatives) return "-";
+  return f.summary.sensitivity_runs > 0 ? "sens" : "diff";
 }
 
 FitFigures RunFits(const SplitData& data, const ParamVector& start, const IdentOptions& options,

@@ -28,13 +28,13 @@ struct LadFitOptions {
   int max_evaluations = 2000;  // residual evaluations in total
   double ftol_rel = 1e-7;      // stop when an accepted step lowers O by less than this fraction
   // … and either the majoriser's undamped Gauss–Newton step of that
-  // iteration promised at most this many times ftol_rel·O (½·gᵀH⁻¹g over the
+  // iteration promised at most this fraction of ftol_rel·O (½·gᵀH⁻¹g over the
   // parameters the box lets move), or it is the third such step in a row. A
   // step that happened to gain little (damped after a rejection) then does
   // not stop a fit still walking along a curved valley, as the
   // r0_fluid/r1_fluid one is; a promise the steps keep not keeping (a flat
   // direction) holds it two steps at most. 0 = stop on the decrease alone.
-  double stop_promise_factor = 3.0;
+  double stop_promise_factor = 0.3;
   double xtol = 1e-7;           // … or moves z by less than this (max norm)
   double jacobian_step = 1e-4;  // forward-difference step in unit coordinates
   // δ = this × mean |r|: caps the IRLS weights 1/max(|r̂|, δ). A floor near

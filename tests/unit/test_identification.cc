@@ -254,33 +254,29 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
 
   // Bounds. Parameters that run to a bound are reported as such
   // (IdentSummary::estimates[].at_bound, which `pvtwin calibrate` prints as
-  // "at upper bound": test_cli_model.cc checks the printout). On this day
-  // one always does, two more may, and any other parameter at a bound fails
-  // here.
+  // "at upper bound": test_cli_model.cc checks the printout). Three may run
+  // to their upper bound on this day, depending on the path of the fit;
+  // any other parameter at a bound fails here. (Forward differences end
+  // with u_front_w_m2k and f_th there; the default exact Jacobian ends on a
+  // path where the identifiability analysis fixes u_front_w_m2k, f_th,
+  // n_wind and eps_pvt as not determined by the data.)
   //  * u_front_w_m2k → 1e3: in the paper's wind form (2.8) 1/U_front,w =
   //    1/U_front + r_refwind·v^n, U_front → ∞ leaves the front resistance to
   //    the wind term alone. With the blower's near-constant 3.5 m/s the
   //    still-air part cannot be told from the wind part; the paper's own
   //    fits wander the same way (Fig. 8, U_front 2.6e2 … 1e5).
-  //  * f_th → 1.2 or n_wind → 1.2, depending on the path of the fit (forward
-  //    differences end at the first, the exact Jacobian at the second):
-  //    - F_th > 1 absorbs more than the incident irradiance, which is not
-  //      physical. It pairs with u_back ≈ 25 W/(m²K) on a rear-insulated
-  //      collector: one day at T_m − T_amb ≈ 8 K does not separate gain from
-  //      loss, and the fit trades more of both (see the ISO 9806
-  //      equivalents).
-  //    - At a near-constant wind speed v^n is one constant factor that
-  //      r_refwind takes up as well; only the minutes of another speed set n.
-  const std::set<Param> always_at_upper_bound = {Param::kUFrontWM2K};
-  const std::set<Param> may_be_at_upper_bound = {Param::kFTh, Param::kNWind};
+  //  * f_th → 1.2: F_th > 1 absorbs more than the incident irradiance, which
+  //    is not physical. It pairs with u_back ≈ 25 W/(m²K) on a rear-insulated
+  //    collector: one day at T_m − T_amb ≈ 8 K does not separate gain from
+  //    loss, and the fit trades more of both (see the ISO 9806 equivalents).
+  //  * n_wind → 1.2: at a near-constant wind speed v^n is one constant
+  //    factor that r_refwind takes up as well; only the minutes of another
+  //    speed set n.
+  const std::set<Param> may_be_at_upper_bound = {Param::kUFrontWM2K, Param::kFTh, Param::kNWind};
   for (const ParamEstimate& e : s.estimates) {
     if (!e.free || e.undetermined) continue;
     const std::string name(Info(e.param).name);
-    if (always_at_upper_bound.count(e.param) > 0) {
-      EXPECT_TRUE(e.at_bound) << name << " = " << e.value
-                              << " left its bound: update the comment above";
-      EXPECT_NEAR(e.value, e.upper, 1e-3 * (e.upper - e.lower)) << name;
-    } else if (may_be_at_upper_bound.count(e.param) > 0 && e.at_bound) {
+    if (may_be_at_upper_bound.count(e.param) > 0 && e.at_bound) {
       EXPECT_NEAR(e.value, e.upper, 1e-3 * (e.upper - e.lower)) << name;
     } else {
       EXPECT_FALSE(e.at_bound) << name << " = " << e.value << " at a bound of [" << e.lower << ", "
@@ -291,18 +287,18 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
   // Datasheet (PROVENANCE.md, values quoted by IDEAS for "PVT A").
   auto fitted = [&s](Param p) { return s.params[static_cast<std::size_t>(p)]; };
   // η_PV,ref against the nameplate η_el = 0.1687. 5 %: the module's power
-  // tolerance (a few %) plus the bench's MPP tracking and wiring. Fit: 0.1634.
+  // tolerance (a few %) plus the bench's MPP tracking and wiring. Fit: 0.1657.
   EXPECT_NEAR(fitted(Param::kEtaPvRef), 0.1687, 0.05 * 0.1687);
   // Thermal side through its ISO 9806 equivalents at the bench's wind:
   //   η0(u) = η0·(1 − c6·u) = 0.475·(1 − 0.003·3.5) = 0.4700
   //   c1 + c3·u = 7.411 + 1.7·3.5 = 13.36 W/(m²K)
-  // The fit gives η0 = 0.430 (−8.6 %) and 16.6 W/(m²K) (+24 %). The low η0
+  // The fit gives η0 = 0.429 (−8.7 %) and 16.6 W/(m²K) (+25 %). The low η0
   // is in the data, not the fit: the measured heat of day 1, at T_m ≈ T_amb,
   // is 0.42·G on average (G > 300 W/m², valid rows, IAM losses of the
   // day's angles included), where the datasheet would give ≈ 0.47. The loss coefficient is set by
   // one day at a reduced temperature (T_m − T_amb)/G ≈ 0.011 m²K/W (ISO 9806 tests span ≈ 0 …
-  // 0.08), so it is only loosely determined, and it trades off against the
-  // F_th at its bound above. Bounds: η0 within 10 %, the loss within 50 %.
+  // 0.08), so it is only loosely determined, and it trades off against F_th
+  // (above). Bounds: η0 within 10 %, the loss within 50 %.
   const Iso9806Equivalents iso =
       Iso9806EquivalentsOf(config.plant, spec, s.params, kBenchFlowKgS, kBenchWindMS);
   ASSERT_TRUE(iso.ok);
@@ -310,7 +306,7 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
   EXPECT_NEAR(iso.loss_w_m2k, 13.36, 0.50 * 13.36);
   // Heat capacity: the datasheet's C = 42 200 J/(m²K) is the whole
   // collector's; 2N1Ccol puts one capacitance on the collector node and
-  // none on the PV laminate, and identifies 15 700 J/(m²K) (0.37 × C) here.
+  // none on the PV laminate, and identifies 15 400 J/(m²K) (0.37 × C) here.
   // This is a known disagreement, not asserted as agreement: it is recorded
   // so that a change shows up in the test's XML output.
   ::testing::Test::RecordProperty("c_coll_over_datasheet_c",

@@ -87,18 +87,31 @@ TEST(IdentifySynthetic, NoisyDataReachTheNoiseFloor) {
 // differences on noisy data (within 0.5 % of the training MAE) and recovers
 // the identifiable parameters of noise-free data within 1 %; a variant
 // without sensitivities (an effect extension) falls back to differences.
+// The same fit with forward differences (d) and with the sensitivities (s);
+// each must succeed, and only s may use runs with sensitivities.
+struct BothFits {
+  IdentSummary d, s;
+};
+
+BothFits FitWithBothDerivatives(const Case& c, const Plant& plant, IdentOptions options) {
+  BothFits f;
+  options.analytic_jacobian = false;
+  f.d = Identify(c.drivers, c.meas, StartParams(plant), options);
+  options.analytic_jacobian = true;
+  f.s = Identify(c.drivers, c.meas, StartParams(plant), options);
+  EXPECT_TRUE(f.d.ok && f.s.ok) << f.d.BriefReport() << "\n" << f.s.BriefReport();
+  EXPECT_EQ(f.d.sensitivity_runs, 0);
+  EXPECT_GT(f.s.sensitivity_runs, 0);
+  return f;
+}
+
 TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   const Plant plant = DesignExamplePlant();
   const Case noisy = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
-  IdentOptions differences, sensitivities;
-  differences.analytic_jacobian = false;
-  sensitivities.analytic_jacobian = true;
-  const IdentSummary d = Identify(noisy.drivers, noisy.meas, StartParams(plant), differences);
-  const IdentSummary s = Identify(noisy.drivers, noisy.meas, StartParams(plant), sensitivities);
-  ASSERT_TRUE(d.ok && s.ok) << d.BriefReport() << "\n" << s.BriefReport();
-  EXPECT_EQ(d.sensitivity_runs, 0);
-  EXPECT_GT(s.sensitivity_runs, 0);
+  const auto [d, s] = FitWithBothDerivatives(noisy, plant, IdentOptions{});
   EXPECT_NEAR(s.train.objective_w_m2(), d.train.objective_w_m2(), 0.005 * d.train.objective_w_m2());
+  IdentOptions sensitivities;
+  sensitivities.analytic_jacobian = true;
 
   const ParamVector truth = ReferenceTruthParams(plant);
   const Case clean = MakeCase(plant, "2N1Ccolwr", 7, 120.0, /*seed=*/11, SensorNoise{});
@@ -131,16 +144,9 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
 TEST(IdentifySynthetic, GradientMethodsUseTheSensitivities) {
   const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 7, 120.0, /*seed=*/12, RealisticSensorNoise(13));
-  IdentOptions differences, sensitivities;
-  ASSERT_TRUE(SetIdentAlgorithm("lbfgs", &differences));
-  ASSERT_TRUE(SetIdentAlgorithm("lbfgs", &sensitivities));
-  differences.analytic_jacobian = false;
-  sensitivities.analytic_jacobian = true;
-  const IdentSummary d = Identify(c.drivers, c.meas, StartParams(plant), differences);
-  const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), sensitivities);
-  ASSERT_TRUE(d.ok && s.ok) << d.BriefReport() << "\n" << s.BriefReport();
-  EXPECT_EQ(d.sensitivity_runs, 0);
-  EXPECT_GT(s.sensitivity_runs, 0);
+  IdentOptions lbfgs;
+  ASSERT_TRUE(SetIdentAlgorithm("lbfgs", &lbfgs));
+  const auto [d, s] = FitWithBothDerivatives(c, plant, lbfgs);
   EXPECT_NEAR(s.train.objective_w_m2(), d.train.objective_w_m2(), 0.01 * d.train.objective_w_m2())
       << d.BriefReport() << "\n"
       << s.BriefReport();

@@ -146,10 +146,10 @@ class Objective {
   }
 
   // Gradient of Cost(x, smoothing_w) in the caller's coordinates x from one
-  // run with sensitivities: d/dr of the pseudo-Huber term
-  // of each P_el and Q_u row (|r| for the T_PV rows), times the Jacobian,
-  // divided by dx/dz per parameter, plus the prior's. False when the active
-  // parameters have no sensitivities (the caller differences instead).
+  // run with sensitivities: d/dr of the pseudo-Huber term of each P_el and
+  // Q_u row (of |r| for the T_PV rows) times the Jacobian, divided by dx/dz
+  // per parameter, plus the prior's. False when the active parameters have
+  // no sensitivities (the caller differences instead).
   bool CostGradient(std::span<const double> x, double smoothing_w, std::span<double> grad) {
     if (!HasSensitivities()) return false;
     const ParamVector p = Params(x);
@@ -313,9 +313,9 @@ OptimizerOptions IdentOptions::DefaultOptimizerOptions() {
   OptimizerOptions o;
   o.algorithm = OptAlgorithm::kSbplx;
   o.max_evaluations = 4000;
-  // With lad_lm's stop on the promised decrease, 1e-3 comes within 0.1 % of
-  // the held-out MAE of 1e-4 on the bench data; 1e-4 runs misspecified
-  // variants into the budget (core/fit/README.md).
+  // With lad_lm's stop on the promised decrease, 1e-3 comes within about
+  // 0.1 % of the held-out MAE of 1e-4 on the bench data; 1e-4 runs
+  // misspecified variants into the budget (core/fit/README.md).
   o.ftol_rel = 1e-3;
   o.xtol_rel = 1e-6;
   o.initial_step = 0.1;

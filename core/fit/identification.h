@@ -100,11 +100,11 @@ struct IdentOptions {
   double coarse_step_s = 300.0;
   // Fewest objective rows accepted.
   int min_rows = 30;
-  // kLadLm: take the Jacobian (and the identifiability analysis's
-  // sensitivity matrix) from the model run with sensitivities
-  // (core/model/sensitivities.h) where it supports the variant, instead of
-  // forward differences of one simulation per free parameter. Gradient
-  // methods of NLopt (kLbfgs, kMma) take their gradient from it too.
+  // Take lad_lm's Jacobian, the gradient of NLopt's gradient methods (kLbfgs,
+  // kMma) and the identifiability analysis's sensitivity matrix from the
+  // model run with sensitivities (core/model/sensitivities.h) where it
+  // supports the variant, instead of forward differences of one simulation
+  // per free parameter.
   bool analytic_jacobian = true;
 
   static OptimizerOptions DefaultOptimizerOptions();

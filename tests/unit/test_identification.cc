@@ -82,11 +82,6 @@ TEST(IdentifySynthetic, NoisyDataReachTheNoiseFloor) {
       << "fit " << s.train.objective_w_m2() << " W/m2, noise floor " << floor << " W/m2";
 }
 
-// The LM fit with the Jacobian from the model run with sensitivities
-// (IdentOptions::analytic_jacobian) reaches the fit of the forward
-// differences on noisy data (within 0.5 % of the training MAE) and recovers
-// the identifiable parameters of noise-free data within 1 %; a variant
-// without sensitivities (an effect extension) falls back to differences.
 // The same fit with forward differences (d) and with the sensitivities (s);
 // each must succeed, and only s may use runs with sensitivities.
 struct BothFits {
@@ -105,6 +100,11 @@ BothFits FitWithBothDerivatives(const Case& c, const Plant& plant, IdentOptions 
   return f;
 }
 
+// The LM fit with the Jacobian from the model run with sensitivities
+// (IdentOptions::analytic_jacobian) reaches the fit of the forward
+// differences on noisy data (within 0.5 % of the training MAE) and recovers
+// the identifiable parameters of noise-free data within 1 %; a variant
+// without sensitivities (an effect extension) falls back to differences.
 TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   const Plant plant = DesignExamplePlant();
   const Case noisy = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));

@@ -33,6 +33,12 @@ double FromUnit(const ParamInfo& info, double z) {
   return info.lower + z * (info.upper - info.lower);
 }
 
+// dx/dz of FromUnit at x: upper − lower, or x·ln(upper / lower) on a log scale.
+double DxDz(ParamScale scale, double lower, double upper, double x) {
+  return scale == ParamScale::kLog ? x * std::log(upper / lower) : upper - lower;
+}
+double DxDz(const ParamInfo& info, double x) { return DxDz(info.scale, info.lower, info.upper, x); }
+
 // The objective and its bookkeeping, shared by the optimiser callback and
 // the identifiability analysis. Simulate() reuses `sim`, so an evaluation
 // allocates nothing.
@@ -129,8 +135,7 @@ class Objective {
       const auto uj = static_cast<std::size_t>(j);
       const ParamInfo& info = infos[uj];
       const double x = p[static_cast<std::size_t>(free_[uj])];
-      const double dx_dz = info.scale == ParamScale::kLog ? x * std::log(info.upper / info.lower)
-                                                          : info.upper - info.lower;
+      const double dx_dz = DxDz(info, x);
       const double* dp = sens_.DPEl(uj);
       const double* dq = sens_.DQTh(uj);
       const double* dt = sens_.DTPv(uj);
@@ -173,8 +178,7 @@ class Objective {
     const Eigen::VectorXd grad_z = jac.transpose() * dcost_dr;
     for (std::size_t j = 0; j < free_.size(); ++j) {
       const ParamInfo& info = infos_[j];
-      const double dx_dz = info.scale == ParamScale::kLog ? x[j] * std::log(info.upper / info.lower)
-                                                          : info.upper - info.lower;
+      const double dx_dz = DxDz(info, x[j]);
       const double dz = ToUnit(info, x[j]) - z_ref_[j];
       grad[j] =
           (grad_z(static_cast<Eigen::Index>(j)) + 2.0 * options_.prior_weight_w_m2 * dz) / dx_dz;
@@ -1011,9 +1015,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
 
 double StdErrorInUnit(const ParamEstimate& e) {
   if (!e.free || e.undetermined || !(e.se_unit > 0.0)) return std::nan("");
-  const bool log_scale = Info(e.param).scale == ParamScale::kLog;
-  return log_scale ? e.value * std::log(e.upper / e.lower) * e.se_unit
-                   : (e.upper - e.lower) * e.se_unit;
+  return DxDz(Info(e.param).scale, e.lower, e.upper, e.value) * e.se_unit;
 }
 
 }  // namespace pvtwin

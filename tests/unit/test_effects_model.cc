@@ -161,31 +161,28 @@ struct SoilingCase {
     d = DriversOf(s, plant, "1N+soiling");
     area = At(p, Param::kAreaM2);
   }
+  // P_el = η·A·G·(1 − loss), η = 0.17 (ConstantEta: η_PV,ref of the truth).
+  double PEl(double loss) const { return 0.17 * area * 800.0 * (1.0 - loss); }
 };
 
 // soiling: P_el = η·A·I·(1 − r·d), d the days since the last cleaning; a
 // cleaning resets d.
 TEST(EffectModel, SoilingGrowsLinearlyAndCleaningResetsIt) {
   SoilingCase c;
-  const std::size_t rows = c.rows;
-  const double rate = c.rate, area = c.area;
-  const Series& s = c.s;
-  const ParamVector& p = c.p;
-  Drivers& d = c.d;
-  SimOutputs out = SimulateWith(d, p);
-  for (std::size_t i = 0; i < rows; ++i) {
+  SimOutputs out = SimulateWith(c.d, c.p);
+  for (std::size_t i = 0; i < c.rows; ++i) {
     const double days = static_cast<double>(i) / 24.0;
-    EXPECT_NEAR(out.p_el_w[i], 0.17 * area * 800.0 * (1.0 - rate * days), 1e-9) << i;
+    EXPECT_NEAR(out.p_el_w[i], c.PEl(c.rate * days), 1e-9) << i;
   }
-  const std::int64_t rain_s = s.time_s[0] + 4 * 86400 + 1800;  // mid-row on day 4
-  SetCleaningTimes({rain_s}, &d);
-  out = SimulateWith(d, p);
-  for (std::size_t i = 0; i < rows; ++i) {
-    const double t = static_cast<double>(s.time_s[i]);
+  const std::int64_t rain_s = c.s.time_s[0] + 4 * 86400 + 1800;  // mid-row on day 4
+  SetCleaningTimes({rain_s}, &c.d);
+  out = SimulateWith(c.d, c.p);
+  for (std::size_t i = 0; i < c.rows; ++i) {
+    const double t = static_cast<double>(c.s.time_s[i]);
     const double days = t < static_cast<double>(rain_s)
-                            ? (t - static_cast<double>(s.time_s[0])) / 86400.0
+                            ? (t - static_cast<double>(c.s.time_s[0])) / 86400.0
                             : (t - static_cast<double>(rain_s)) / 86400.0;
-    EXPECT_NEAR(out.p_el_w[i], 0.17 * area * 800.0 * (1.0 - rate * days), 1e-9) << i;
+    EXPECT_NEAR(out.p_el_w[i], c.PEl(c.rate * days), 1e-9) << i;
   }
 }
 
@@ -193,18 +190,13 @@ TEST(EffectModel, SoilingGrowsLinearlyAndCleaningResetsIt) {
 // τ = 1 − max(0, r·d − recovered), never above 1.
 TEST(EffectModel, SoilingDropsByTheRecoveryOfACleaningSeenInTheData) {
   SoilingCase c;
-  const std::size_t rows = c.rows;
-  const double rate = c.rate, area = c.area;
-  const Series& s = c.s;
-  const ParamVector& p = c.p;
-  Drivers& d = c.d;
-  const std::int64_t wash_s = s.time_s[0] + 4 * 86400;
-  SetCleanings({{wash_s, 0.03}}, &d);
-  const SimOutputs out = SimulateWith(d, p);
-  for (std::size_t i = 0; i < rows; ++i) {
+  const std::int64_t wash_s = c.s.time_s[0] + 4 * 86400;
+  SetCleanings({{wash_s, 0.03}}, &c.d);
+  const SimOutputs out = SimulateWith(c.d, c.p);
+  for (std::size_t i = 0; i < c.rows; ++i) {
     const double days = static_cast<double>(i) / 24.0;
-    const double loss = std::max(0.0, rate * days - (s.time_s[i] >= wash_s ? 0.03 : 0.0));
-    EXPECT_NEAR(out.p_el_w[i], 0.17 * area * 800.0 * (1.0 - loss), 1e-9) << i;
+    const double loss = std::max(0.0, c.rate * days - (c.s.time_s[i] >= wash_s ? 0.03 : 0.0));
+    EXPECT_NEAR(out.p_el_w[i], c.PEl(loss), 1e-9) << i;
   }
 }
 

@@ -10,8 +10,8 @@
 //   T_end = T0 + (S − G·T0)·dt/C·φ1(u),   T_mean = T0 + (S − G·T0)·dt/C·φ2(u)
 //   φ1(u) = (1 − e^(−u))/u,   φ1'(u) = (e^(−u) − φ1)/u
 //   φ2(u) = (u − 1 + e^(−u))/u²,   φ2'(u) = (φ1 − 2·φ2)/u
-// (Taylor series below |u| = 1e-3, differentiated term by term, as the
-// values are computed). An algebraic node a coupled to a capacitive node b:
+// (Taylor series below |u| = kPhiSeriesBelow, differentiated term by term,
+// as the values are computed). An algebraic node a coupled to a capacitive node b:
 //   T_a = (S_a + g·T_b)/(G_a + g), and b sees S_b + g·S_a/(G_a + g) and
 //   G_b + g·G_a/(G_a + g). Steady state: K·T = S with K = [G0+g, −g; −g,
 //   G1+g], so K·dT = dS − dK·T.
@@ -50,28 +50,35 @@ struct RcStepTangent {
 namespace rc_tangent {
 
 struct PhiSlopes {
-  double phi1, phi2;    // as rc_network.cc's ExpPhis
+  double phi1, phi2;    // as ExpPhis (rc_network.h)
   double dphi1, dphi2;  // their derivatives in x
 };
 
+// The series' derivative Σ k·c_k·x^(k−1), by Horner.
+inline double PhiSeriesSlope(const PhiSeriesCoefficients& s, double x) {
+  double acc = kPhiSeriesDegree * s.c[kPhiSeriesDegree];
+#pragma GCC unroll 16
+  for (int k = kPhiSeriesDegree - 1; k >= 1; --k) acc = acc * x + k * s.c[k];
+  return acc;
+}
+
 inline PhiSlopes ExpPhisWithSlopes(double x) {
-  if (std::fabs(x) < 1e-3) {
-    return {1.0 - x / 2.0 + x * x / 6.0 - x * x * x / 24.0,
-            0.5 - x / 6.0 + x * x / 24.0 - x * x * x / 120.0, -0.5 + x / 3.0 - x * x / 8.0,
-            -1.0 / 6.0 + x / 12.0 - x * x / 40.0};
+  if (std::fabs(x) < kPhiSeriesBelow) {
+    return {PhiSeries(kPhi1Series, x), PhiSeries(kPhi2Series, x), PhiSeriesSlope(kPhi1Series, x),
+            PhiSeriesSlope(kPhi2Series, x)};
   }
-  const double em1 = std::expm1(-x);
+  const double e = std::exp(-x);
   const double inv_x = 1.0 / x;
-  const double phi1 = -em1 * inv_x;
-  const double phi2 = (x + em1) * inv_x * inv_x;
-  return {phi1, phi2, (1.0 + em1 - phi1) * inv_x, (phi1 - 2.0 * phi2) * inv_x};
+  const double phi1 = (1.0 - e) * inv_x;
+  const double phi2 = (1.0 - phi1) * inv_x;
+  return {phi1, phi2, (e - phi1) * inv_x, (phi1 - 2.0 * phi2) * inv_x};
 }
 
 // Tangent of AdvanceOne (rc_network.cc) for node inputs c, g, s, t0 with
 // derivatives dc, dg, ds, dt0 (arrays over n directions).
-inline void AdvanceOneTangent(double c, double g, double s, double t0, double dt_s, const double* dc,
-                              const double* dg, const double* ds, const double* dt0, int n,
-                              double* d_end, double* d_mean) {
+inline void AdvanceOneTangent(double c, double g, double s, double t0, double dt_s,
+                              const double* dc, const double* dg, const double* ds,
+                              const double* dt0, int n, double* d_end, double* d_mean) {
   const double dt_over_c = dt_s / c;
   const double inv_c = 1.0 / c;
   const double rate = (s - g * t0) * dt_over_c;
@@ -191,8 +198,10 @@ inline void SteadyRcTangent(const RcNetwork& net, const RcStepResult& value,
   const double t0 = value.t_mean_c[0];
   const double t1 = value.t_mean_c[1];
   for (int j = 0; j < n; ++j) {
-    const double rhs0 = d.source_w[0][j] - d.conductance_w_k[0][j] * t0 - d.coupling_w_k[j] * (t0 - t1);
-    const double rhs1 = d.source_w[1][j] - d.conductance_w_k[1][j] * t1 - d.coupling_w_k[j] * (t1 - t0);
+    const double rhs0 =
+        d.source_w[0][j] - d.conductance_w_k[0][j] * t0 - d.coupling_w_k[j] * (t0 - t1);
+    const double rhs1 =
+        d.source_w[1][j] - d.conductance_w_k[1][j] * t1 - d.coupling_w_k[j] * (t1 - t0);
     out->t_end_c[0][j] = out->t_mean_c[0][j] = (k11 * rhs0 + g * rhs1) * inv_det;
     out->t_end_c[1][j] = out->t_mean_c[1][j] = (g * rhs0 + k00 * rhs1) * inv_det;
   }
@@ -211,10 +220,9 @@ inline void AdvanceRcTangent(const RcNetwork& net, const double t_start_c[2], do
                                  out->t_mean_c[0]);
     for (int j = 0; j < n; ++j) out->t_end_c[0][j] = out->t_mean_c[0][j];
   } else if constexpr (kShape == RcShape::kOneCapacitive) {
-    rc_tangent::AdvanceOneTangent(n0.capacitance_j_k, n0.conductance_w_k, n0.source_w,
-                                  t_start_c[0], dt_s, d.capacitance_j_k[0], d.conductance_w_k[0],
-                                  d.source_w[0], d.t_start_c[0], n, out->t_end_c[0],
-                                  out->t_mean_c[0]);
+    rc_tangent::AdvanceOneTangent(n0.capacitance_j_k, n0.conductance_w_k, n0.source_w, t_start_c[0],
+                                  dt_s, d.capacitance_j_k[0], d.conductance_w_k[0], d.source_w[0],
+                                  d.t_start_c[0], n, out->t_end_c[0], out->t_mean_c[0]);
   } else if constexpr (kShape == RcShape::kTwoAlgebraic) {
     SteadyRcTangent(net, value, d, out);
   } else if constexpr (kShape == RcShape::kTwoCapacitiveBoth) {
@@ -233,8 +241,8 @@ inline void AdvanceRcTangent(const RcNetwork& net, const double t_start_c[2], do
     for (int j = 0; j < n; ++j) {
       const double dg = d.coupling_w_k[j];
       const double d_inv = -inv_denom_a * inv_denom_a * (d.conductance_w_k[a][j] + dg);
-      ds_red[j] = d.source_w[b][j] + dg * s_a * inv_denom_a +
-                  g * d.source_w[a][j] * inv_denom_a + g * s_a * d_inv;
+      ds_red[j] = d.source_w[b][j] + dg * s_a * inv_denom_a + g * d.source_w[a][j] * inv_denom_a +
+                  g * s_a * d_inv;
       dg_red[j] = d.conductance_w_k[b][j] + dg * g_a * inv_denom_a +
                   g * d.conductance_w_k[a][j] * inv_denom_a + g * g_a * d_inv;
     }
@@ -248,8 +256,8 @@ inline void AdvanceRcTangent(const RcNetwork& net, const double t_start_c[2], do
       out->t_end_c[a][j] = (d.source_w[a][j] + dg * value.t_end_c[b] + g * out->t_end_c[b][j] -
                             value.t_end_c[a] * dga) *
                            inv_denom_a;
-      out->t_mean_c[a][j] = (d.source_w[a][j] + dg * value.t_mean_c[b] +
-                             g * out->t_mean_c[b][j] - value.t_mean_c[a] * dga) *
+      out->t_mean_c[a][j] = (d.source_w[a][j] + dg * value.t_mean_c[b] + g * out->t_mean_c[b][j] -
+                             value.t_mean_c[a] * dga) *
                             inv_denom_a;
     }
   }

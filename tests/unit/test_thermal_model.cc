@@ -10,6 +10,7 @@
 #include "core/effects/effects.h"
 #include "core/model/thermal_model.h"
 #include "core/physics/rc_network.h"
+#include "core/physics/rc_network_tangent.h"
 #include "core/synth/synthetic_plant.h"
 #include "core/synth/weather_generator.h"
 #include "tests/support/effect_named.h"
@@ -114,6 +115,56 @@ TEST(RcNetwork, EveryShapeMatchesFineEulerIntegration) {
   ExpectShapeMatchesFineEuler<RcShape::kTwoCapacitive0>("capacitance on node 0");
   ExpectShapeMatchesFineEuler<RcShape::kTwoCapacitive1>("capacitance on node 1");
   ExpectShapeMatchesFineEuler<RcShape::kTwoCapacitiveBoth>("two capacitive nodes");
+}
+
+// The step's φ1 = (1 − e^(−x))/x and φ2 = (x − 1 + e^(−x))/x² and their
+// slopes (series below kPhiSeriesBelow, exp above) against long double
+// references, on both sides of the switch and far from it: the closed forms
+// from expm1l for |x| ≥ 1, below it the series summed term by term to x³⁰
+// (the closed forms cancel there even in long double).
+TEST(RcNetwork, ExpPhisMatchALongDoubleReference) {
+  for (double x : {-0.09, -1e-6, 0.0, 1e-9, 1e-4, 0.01, 0.0999999, 0.1, 0.1000001, 0.37, 1.0, 7.5,
+                   60.0, 800.0}) {
+    const long double xl = x;
+    long double phi1 = 0.0L, phi2 = 0.0L, dphi1 = 0.0L, dphi2 = 0.0L;
+    if (std::fabs(x) < 1.0) {
+      // φm = Σ (−x)^k/(k + m)!, φm' = Σ k·(−1)^k·x^(k−1)/(k + m)!.
+      long double pow_k = 1.0L, pow_km1 = 0.0L, f1 = 1.0L, f2 = 2.0L;  // (k+1)!, (k+2)!
+      for (int k = 0; k <= 30; ++k) {
+        const long double sign = k % 2 == 0 ? 1.0L : -1.0L;
+        phi1 += sign * pow_k / f1;
+        phi2 += sign * pow_k / f2;
+        dphi1 += sign * k * pow_km1 / f1;
+        dphi2 += sign * k * pow_km1 / f2;
+        pow_km1 = pow_k;
+        pow_k *= xl;
+        f1 *= k + 2;
+        f2 *= k + 3;
+      }
+    } else {
+      const long double em1 = expm1l(-xl);
+      phi1 = -em1 / xl;
+      phi2 = (xl + em1) / (xl * xl);
+      dphi1 = (1.0L + em1 - phi1) / xl;
+      dphi2 = (phi1 - 2.0L * phi2) / xl;
+    }
+    const ExpPhi got = ExpPhis(x);
+    const rc_tangent::PhiSlopes slopes = rc_tangent::ExpPhisWithSlopes(x);
+    // Relative error bounds: the exp branch's cancellation near the switch
+    // (φ2 ≈ 3e-14, the slopes ≈ 2e-12 there), far less elsewhere.
+    const bool near_switch = std::fabs(x) < 1.0;
+    const double tol = near_switch ? 3e-12 : 1e-14;
+    EXPECT_NEAR(got.phi1, static_cast<double>(phi1), 1e-15 * static_cast<double>(phi1)) << x;
+    EXPECT_NEAR(got.phi2, static_cast<double>(phi2), 1e-13 * static_cast<double>(phi2)) << x;
+    EXPECT_EQ(slopes.phi1, got.phi1) << x;
+    EXPECT_EQ(slopes.phi2, got.phi2) << x;
+    EXPECT_NEAR(slopes.dphi1, static_cast<double>(dphi1),
+                tol * std::fabs(static_cast<double>(dphi1)))
+        << x;
+    EXPECT_NEAR(slopes.dphi2, static_cast<double>(dphi2),
+                tol * std::fabs(static_cast<double>(dphi2)) + 1e-300)
+        << x;
+  }
 }
 
 // No sun, no flow: a one-node model with capacitance relaxes to the

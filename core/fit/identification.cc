@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/effects/registry.h"
 #include "core/fit/lad_fit.h"
 #include "core/model/sensitivities.h"
 
@@ -512,8 +513,13 @@ Eigen::MatrixXd SensitivityMatrix(Objective& obj, const std::vector<ParamInfo>& 
 std::string Name(Param p) { return std::string(kParamTable[static_cast<std::size_t>(p)].name); }
 
 // Averages groups of `factor` consecutive rows of drivers and measurements
-// (never across a restart or an unusable row), as resampling the data to a
-// coarser step would. Used for the coarse first stage of identification.
+// (never across a restart, an unusable row or a pump start or stop), as
+// resampling the data to a coarser step would. Used for the coarse first
+// stage of identification. A group that mixed minutes with and without flow
+// would have a mean flow the collector never saw, and the fluid conductance
+// 2w/(r1 + 2w·r0) is far from linear in w: that bias moved the coarse
+// optimum along the r0_fluid/r1_fluid valley, and the fine stage spent two
+// thirds of its runs walking back.
 void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, Measurements* cm) {
   const std::size_t n = d.size();
   std::vector<std::uint8_t> in_obj(n, 0);
@@ -525,8 +531,9 @@ void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, M
   while (i < n) {
     std::size_t end = i + 1;
     if (d.usable[i]) {
+      const bool flow = d.capacity_flow_w_k[i] > 0.0;
       while (end < n && end - i < static_cast<std::size_t>(factor) && d.usable[end] &&
-             !d.restart[end]) {
+             !d.restart[end] && (d.capacity_flow_w_k[end] > 0.0) == flow) {
         ++end;
       }
     }
@@ -590,6 +597,45 @@ FreeSet SelectFree(const Drivers& drivers, const ParamVector& start, const Ident
   return fs;
 }
 
+// Starts for a second coarse fit, one per effect of the spec whose module
+// reads a start from the residuals of the model without it
+// (EffectModule::start_from_residuals) and whose parameters are free: that
+// start at `at` (the first coarse optimum) with the effect removed. A local
+// fit does not find such an effect's geometry from an arbitrary start (the
+// shading obstacle: it only moves an obstacle whose window the sun already
+// crosses, and where the fit ends depended on its path).
+std::vector<ParamVector> RestartsFromResiduals(const Drivers& drivers, const Measurements& meas,
+                                               const FreeSet& fs, const ParamVector& at) {
+  std::vector<ParamVector> starts;
+  for (const EffectModule* module : EffectRegistry()) {
+    const ModelExtension* ext = module->extension;
+    if (module->start_from_residuals == nullptr || ext == nullptr || !drivers.spec.Has(*ext)) {
+      continue;
+    }
+    const bool frees_one = std::any_of(ext->params.begin(), ext->params.end(), [&](Param p) {
+      return std::find(fs.free.begin(), fs.free.end(), p) != fs.free.end();
+    });
+    if (!frees_one) continue;
+    Drivers without = drivers;
+    without.spec.Remove(*ext);
+    SimOutputs base;
+    Simulate(without, at, &base);
+    EffectResiduals residuals;
+    residuals.drivers = &without;
+    residuals.base = &base;
+    residuals.rows = &meas.rows;
+    residuals.p_el_meas_w = &meas.p_el_w;
+    ParamVector start = at;
+    if (!module->start_from_residuals(residuals, &start)) continue;
+    for (std::size_t j = 0; j < fs.free.size(); ++j) {
+      const auto i = static_cast<std::size_t>(fs.free[j]);
+      start[i] = std::clamp(start[i], fs.infos[j].lower, fs.infos[j].upper);
+    }
+    starts.push_back(start);
+  }
+  return starts;
+}
+
 // Coarse stage: the same fit on the data averaged to about 5 min gets close
 // to the optimum at a fraction of the cost; the fine stage starts from there.
 // (The model at 5 min is the same model: its exact step makes the coarse
@@ -620,9 +666,33 @@ int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOpt
   const IdentSummary cs = Identify(cd, cm, fs.base, coarse);
   // A misspecified model can have its coarse optimum far from the fine one:
   // keep it only if it also beats the start on the data as given.
-  if (cs.ok && obj.DataCost(cs.params) < initial_cost) *best = cs.params;
+  double best_cost = initial_cost;
+  if (cs.ok) {
+    const double cost = obj.DataCost(cs.params);
+    if (cost < best_cost) {
+      *best = cs.params;
+      best_cost = cost;
+    }
+  }
   *sensitivity_runs = cs.sensitivity_runs;
-  return cs.evaluations;
+  int simulations = cs.evaluations;
+  // Restarts from the residuals of that optimum (RestartsFromResiduals), on
+  // the coarsest rung only (a coarse fit with a coarse stage of its own
+  // restarts there).
+  const std::vector<ParamVector> restarts =
+      coarse.coarse_step_s > 0.0 ? std::vector<ParamVector>{}
+                                 : RestartsFromResiduals(drivers, meas, fs, cs.params);
+  for (const ParamVector& restart : restarts) {
+    const IdentSummary rs = Identify(cd, cm, restart, coarse);
+    simulations += rs.evaluations + 1;  // + the run without the effect
+    *sensitivity_runs += rs.sensitivity_runs;
+    const double cost = rs.ok ? obj.DataCost(rs.params) : kNaN;
+    if (cost < best_cost) {
+      *best = rs.params;
+      best_cost = cost;
+    }
+  }
+  return simulations;
 }
 
 // The fine stage: the fit of the active parameters, then identifiability

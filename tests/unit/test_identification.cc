@@ -138,18 +138,19 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
 }
 
 // NLopt's gradient methods take the gradient of the smoothed MAE from the
-// run with sensitivities: L-BFGS reaches the fit it reaches with
-// forward-difference gradients (within 1 % of the training MAE) with
-// fewer simulations. A wrong gradient would leave L-BFGS far off.
+// run with sensitivities: L-BFGS reaches at least the fit it reaches with
+// forward-difference gradients (at most 1 % above its training MAE) with
+// fewer simulations. A wrong gradient would leave L-BFGS far off. (Below is
+// allowed: the differenced gradient's error can stop L-BFGS early; here it
+// ends 2 % above the exact gradient's fit.)
 TEST(IdentifySynthetic, GradientMethodsUseTheSensitivities) {
   const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 7, 120.0, /*seed=*/12, RealisticSensorNoise(13));
   IdentOptions lbfgs;
   ASSERT_TRUE(SetIdentAlgorithm("lbfgs", &lbfgs));
   const auto [d, s] = FitWithBothDerivatives(c, plant, lbfgs);
-  EXPECT_NEAR(s.train.objective_w_m2(), d.train.objective_w_m2(), 0.01 * d.train.objective_w_m2())
-      << d.BriefReport() << "\n"
-      << s.BriefReport();
+  EXPECT_LE(s.train.objective_w_m2(), 1.01 * d.train.objective_w_m2()) << d.BriefReport() << "\n"
+                                                                       << s.BriefReport();
   EXPECT_LT(s.evaluations, d.evaluations) << d.BriefReport() << "\n" << s.BriefReport();
 }
 

@@ -54,12 +54,15 @@ struct PhiSlopes {
   double dphi1, dphi2;  // their derivatives in x
 };
 
-// The series' derivative Σ k·c_k·x^(k−1), by Horner.
+// The series' derivative Σ k·c_k·x^(k−1), by Estrin's scheme as PhiSeries.
 inline double PhiSeriesSlope(const PhiSeriesCoefficients& s, double x) {
-  double acc = kPhiSeriesDegree * s.c[kPhiSeriesDegree];
-#pragma GCC unroll 16
-  for (int k = kPhiSeriesDegree - 1; k >= 1; --k) acc = acc * x + k * s.c[k];
-  return acc;
+  static_assert(kPhiSeriesDegree == 9);
+  const double* c = s.c;
+  const double x2 = x * x;
+  const double x4 = x2 * x2;
+  const double p01 = c[1] + 2.0 * c[2] * x, p23 = 3.0 * c[3] + 4.0 * c[4] * x;
+  const double p45 = 5.0 * c[5] + 6.0 * c[6] * x, p67 = 7.0 * c[7] + 8.0 * c[8] * x;
+  return (p01 + x2 * p23) + x4 * ((p45 + x2 * p67) + x4 * (9.0 * c[9]));
 }
 
 inline PhiSlopes ExpPhisWithSlopes(double x) {

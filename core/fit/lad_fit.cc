@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace pvtwin {
@@ -11,6 +12,27 @@ namespace {
 double Objective(const Eigen::VectorXd& r, const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref,
                  const LadFitOptions& o) {
   return r.cwiseAbs().sum() / o.n_scale + o.prior_weight * (z - z_ref).squaredNorm();
+}
+
+// JᵀWJ and JᵀW·r (W = diag(w)) by blocks of rows through `buffer`, without
+// a weighted copy of the whole Jacobian: at 5-s data that copy was 42 MB,
+// fresh pages from the kernel on every iteration.
+void WeightedNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
+                             const Eigen::VectorXd& r, Eigen::MatrixXd* buffer, Eigen::MatrixXd* h,
+                             Eigen::VectorXd* g) {
+  constexpr Eigen::Index kBlockRows = 2048;
+  const Eigen::Index rows = jac.rows();
+  const Eigen::Index n = jac.cols();
+  h->setZero(n, n);
+  g->setZero(n);
+  for (Eigen::Index start = 0; start < rows; start += kBlockRows) {
+    const Eigen::Index b = std::min(kBlockRows, rows - start);
+    buffer->resize(b, n);
+    buffer->noalias() =
+        (jac.middleRows(start, b).array().colwise() * w.segment(start, b).array()).matrix();
+    h->noalias() += jac.middleRows(start, b).transpose() * *buffer;
+    g->noalias() += buffer->transpose() * r.segment(start, b);
+  }
 }
 
 // ½·gᵀH⁻¹g over the parameters free to move: a parameter at a bound of the
@@ -59,7 +81,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   res.initial_cost = cost;
   double lambda = 1e-3;
   Eigen::MatrixXd jac(r.size(), n);
-  Eigen::VectorXd w;
+  Eigen::MatrixXd weighted_block, h;
+  Eigen::VectorXd w, g;
   bool jac_at_z = false;  // jac was computed at the current z
   double floor_rel = o.weight_floor_rel;
   int small_in_a_row = 0;  // accepted steps in a row that lowered O by less than ftol
@@ -87,9 +110,9 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     }
     jac_at_z = true;
     // Majoriser: H = JᵀWJ / N + 2p·I, g = JᵀW r / N + 2p (z − z_ref).
-    const Eigen::MatrixXd wj = jac.array().colwise() * w.array();
-    Eigen::MatrixXd h = (jac.transpose() * wj) / o.n_scale;
-    Eigen::VectorXd g = (wj.transpose() * r) / o.n_scale;
+    WeightedNormalEquations(jac, w, r, &weighted_block, &h, &g);
+    h /= o.n_scale;
+    g /= o.n_scale;
     h.diagonal().array() += 2.0 * o.prior_weight;
     g += 2.0 * o.prior_weight * (z - z_ref);
     // What the undamped step of this majoriser promises, ½·gᵀH⁻¹g, over
@@ -161,8 +184,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   res.z = z;
   res.final_cost = cost;
   if (jac_at_z) {
-    res.jacobian = jac;
-    res.weights = w;
+    res.jacobian = std::move(jac);
+    res.weights = std::move(w);
   }
   return res;
 }

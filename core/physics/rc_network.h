@@ -23,9 +23,9 @@ namespace pvtwin {
 // The step's exponential factors for x = G·dt/C:
 //   φ1(x) = (1 − e^(−x))/x,   φ2(x) = (x − 1 + e^(−x))/x² = (1 − φ1)/x,
 // (T_end and T_mean of one node: T0 + (S − G·T0)·dt/C·φ1 resp. φ2).
-// From exp (several times cheaper than expm1 here, and the row loop's
-// latency) for |x| ≥ kPhiSeriesBelow, where the cancellation costs at most
-// ~3e-14 of φ2; below, their Taylor series to x⁹ (remainder < 3e-18).
+// For |x| ≥ kPhiSeriesBelow from exp, which costs a fraction of expm1 (the
+// row loop waits for this value), the cancellation costing at most ~3e-14
+// of φ2; below, from their Taylor series to x⁹ (remainder < 3e-18).
 inline constexpr double kPhiSeriesBelow = 0.1;
 inline constexpr int kPhiSeriesDegree = 9;
 

@@ -3,7 +3,7 @@
 // derivatives of the network's inputs (capacitances, conductances, sources,
 // coupling, start temperatures) along each direction, the derivatives of the
 // step's end and mean temperatures. Hand-derived from the closed forms of
-// rc_network.cc; used by the model run with sensitivities
+// rc_network.h; used by the model run with sensitivities
 // (core/model/sensitivities.h).
 //
 // One capacitive node (C·dT/dt = S − G·T over dt, u = G·dt/C):
@@ -77,7 +77,7 @@ inline PhiSlopes ExpPhisWithSlopes(double x) {
   return {phi1, phi2, (e - phi1) * inv_x, (phi1 - 2.0 * phi2) * inv_x};
 }
 
-// Tangent of AdvanceOne (rc_network.cc) for node inputs c, g, s, t0 with
+// Tangent of AdvanceOne (rc_network.h) for node inputs c, g, s, t0 with
 // derivatives dc, dg, ds, dt0 (arrays over n directions).
 inline void AdvanceOneTangent(double c, double g, double s, double t0, double dt_s,
                               const double* dc, const double* dg, const double* ds,
@@ -110,7 +110,7 @@ inline double DividedDifference(double ga, double gb, double slope_a, double slo
   return 0.5 * (slope_a + slope_b);
 }
 
-// Tangent of AdvanceTwo (rc_network.cc): both nodes capacitive.
+// Tangent of AdvanceTwo (rc_network.h): both nodes capacitive.
 inline void AdvanceTwoTangent(const RcNetwork& net, const double t0[2], double dt_s,
                               const RcNetworkTangent& d, RcStepTangent* out) {
   const double g = net.coupling_w_k;

@@ -250,12 +250,8 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
   }
   ParamVector start = MergedStart(plant, current.spec, current.params);
   if (effect.start_from_residuals != nullptr) {
-    EffectResiduals res;
-    res.drivers = &in.base->train.drivers;
-    res.base = &in.base->train_sim;
-    res.rows = &in.base->train.meas.rows;
-    res.p_el_meas_w = &in.base->train.meas.p_el_w;
-    effect.start_from_residuals(res, &start);
+    effect.start_from_residuals(
+        ResidualsForStart(in.base->train.drivers, in.base->train_sim, in.base->train.meas), &start);
   }
   f.fit = Identify(f.train.drivers, f.train.meas, start, in.options->ident);
   return f;

@@ -620,13 +620,8 @@ std::vector<ParamVector> RestartsFromResiduals(const Drivers& drivers, const Mea
     without.spec.Remove(*ext);
     SimOutputs base;
     Simulate(without, at, &base);
-    EffectResiduals residuals;
-    residuals.drivers = &without;
-    residuals.base = &base;
-    residuals.rows = &meas.rows;
-    residuals.p_el_meas_w = &meas.p_el_w;
     ParamVector start = at;
-    if (!module->start_from_residuals(residuals, &start)) continue;
+    if (!module->start_from_residuals(ResidualsForStart(without, base, meas), &start)) continue;
     for (std::size_t j = 0; j < fs.free.size(); ++j) {
       const auto i = static_cast<std::size_t>(fs.free[j]);
       start[i] = std::clamp(start[i], fs.infos[j].lower, fs.infos[j].upper);
@@ -1081,6 +1076,16 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
     return finish(false, buf);
   }
   return finish(true, "");
+}
+
+EffectResiduals ResidualsForStart(const Drivers& drivers, const SimOutputs& base,
+                                  const Measurements& meas) {
+  EffectResiduals residuals;
+  residuals.drivers = &drivers;
+  residuals.base = &base;
+  residuals.rows = &meas.rows;
+  residuals.p_el_meas_w = &meas.p_el_w;
+  return residuals;
 }
 
 double StdErrorInUnit(const ParamEstimate& e) {

@@ -20,6 +20,7 @@
 
 #include "core/common/params.h"
 #include "core/common/series.h"
+#include "core/effects/effect_module.h"
 #include "core/fit/optimizer.h"
 #include "core/model/thermal_model.h"
 
@@ -38,6 +39,12 @@ struct Measurements {
 };
 
 Measurements MakeMeasurements(const Series& series, const Drivers& drivers);
+
+// What an effect's start_from_residuals reads (EffectResiduals): the
+// model's outputs `base` without the effect on `drivers`, the measurements'
+// objective rows and measured P_el. Points into its arguments.
+EffectResiduals ResidualsForStart(const Drivers& drivers, const SimOutputs& base,
+                                  const Measurements& meas);
 
 // Errors of a simulation against measurements (paper 3.2.2).
 struct ErrorMetrics {

@@ -64,7 +64,8 @@ TEST(ModelGolden, OutputsOfTable6VariantsAndEffectsAreBitIdentical) {
   const Series s = GenerateWeather(plant, w);
   // Recorded at commit 856b09b (before core/effects/ modules); re-recorded
   // when the step's φ functions moved from expm1 to exp and a series
-  // (rc_network.h; every output of these runs moved by at most 1.4e-12).
+  // (rc_network.h; every output of these runs moved by at most 1.4e-12 in a
+  // one-off comparison of the two builds).
   const std::map<std::string, std::string> expected = {
 #include "tests/unit/model_golden_hashes.inc"
   };

@@ -175,17 +175,18 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
 }
 
 // The obstacle's geometry from the reference start (a shade due south that
-// the fit can only move where the sun already crosses it) on eight data
+// the fit can only move where the sun already crosses it) on twelve data
 // seeds: identification restarts the coarse stage from the residuals of the
-// model without the obstacle (the module's start_from_residuals). Without
-// that restart the obstacle was found on 4 of these 8 seeds, and on 3 once
-// the coarse stage stopped averaging across pump starts and stops.
+// model without the obstacle (the module's start_from_residuals). It finds
+// the obstacle on 11 of them (the twelfth, 111, ends with none at a training
+// MAE as low as the others'); without that restart it was found on 7, and
+// on 4 once the coarse stage stopped averaging across pump starts and stops.
 TEST(EffectIdentificationShading, FindsTheObstacleFromTheReferenceStart) {
   const Plant plant = DesignExamplePlant();
   const ModelSpec spec = WithEffect(testing::SpecOf("1N1Cwr"), testing::EffectNamed("shading"));
   int found = 0;
   std::string misses;
-  for (std::uint64_t seed = 101; seed <= 108; ++seed) {
+  for (std::uint64_t seed = 101; seed <= 112; ++seed) {
     SyntheticOptions options;
     std::string error;
     ASSERT_TRUE(DefaultSyntheticOptions(plant, spec.Name(), kDays, seed, &options, &error))
@@ -204,7 +205,9 @@ TEST(EffectIdentificationShading, FindsTheObstacleFromTheReferenceStart) {
     found += ok ? 1 : 0;
     if (!ok) misses += "seed " + std::to_string(seed) + ": " + fit.summary.BriefReport() + "\n";
   }
-  EXPECT_GE(found, 7) << misses;
+  std::printf("shading: obstacle found from the reference start on %d of data seeds 101-112\n",
+              found);
+  EXPECT_GE(found, 10) << misses;
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -178,7 +178,11 @@ TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
 TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
   ImportHistory(kJune1, 4);
   WriteConfig(Settings());
-  StartDaemon(kJune1, 60.0, {"--calibration-timeout", "0.01"});
+  // At 3600× the loop looks at the child every 1.4 ms of wall time (one
+  // 5-s poll period), so it sees the 10-ms limit pass long before the
+  // calibration of 4 days, a process of some 50 ms, can finish; at 60× it
+  // looked every 83 ms and a fast child could finish unseen.
+  StartDaemon(kJune1, 3600.0, {"--calibration-timeout", "0.01"});
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(30, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE status = 'timeout'") >= 1;

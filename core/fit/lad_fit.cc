@@ -35,27 +35,45 @@ void WeightedNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& 
   }
 }
 
-// ½·gᵀH⁻¹g over the parameters free to move: a parameter at a bound of the
-// unit box whose gradient points out of it is left out.
-double PromisedDecrease(const Eigen::MatrixXd& h, const Eigen::VectorXd& g,
-                        const Eigen::VectorXd& z) {
+// The parameters free to move: all but those at a bound of the unit box
+// whose gradient points out of it.
+std::vector<Eigen::Index> Movable(const Eigen::VectorXd& g, const Eigen::VectorXd& z) {
   std::vector<Eigen::Index> movable;
   for (Eigen::Index j = 0; j < z.size(); ++j) {
     const bool pinned = (z(j) <= 0.0 && g(j) > 0.0) || (z(j) >= 1.0 && g(j) < 0.0);
     if (!pinned) movable.push_back(j);
   }
+  return movable;
+}
+
+// H and g restricted to the parameters `movable`.
+void Restrict(const Eigen::MatrixXd& h, const Eigen::VectorXd& g,
+              const std::vector<Eigen::Index>& movable, Eigen::MatrixXd* hm, Eigen::VectorXd* gm) {
   const auto m = static_cast<Eigen::Index>(movable.size());
-  if (m == 0) return 0.0;
-  Eigen::MatrixXd hm(m, m);
-  Eigen::VectorXd gm(m);
+  hm->resize(m, m);
+  gm->resize(m);
   for (Eigen::Index a = 0; a < m; ++a) {
-    gm(a) = g(movable[static_cast<std::size_t>(a)]);
+    (*gm)(a) = g(movable[static_cast<std::size_t>(a)]);
     for (Eigen::Index b = 0; b < m; ++b) {
-      hm(a, b) = h(movable[static_cast<std::size_t>(a)], movable[static_cast<std::size_t>(b)]);
+      (*hm)(a, b) = h(movable[static_cast<std::size_t>(a)], movable[static_cast<std::size_t>(b)]);
     }
   }
-  hm.diagonal().array() += 1e-12 * hm.diagonal().maxCoeff() + 1e-300;
-  return 0.5 * gm.dot(hm.ldlt().solve(gm));
+}
+
+// s solving (H + λ·D) s = −g, D the diagonal of H floored so that a
+// direction without curvature is damped too (λ = 0: the undamped step).
+// Not for an empty system.
+Eigen::VectorXd DampedStep(const Eigen::MatrixXd& h, const Eigen::VectorXd& g, double lambda) {
+  const double floor = 1e-12 * h.diagonal().maxCoeff() + 1e-300;
+  Eigen::MatrixXd damped = h;
+  damped.diagonal() += lambda * h.diagonal().cwiseMax(floor);
+  if (lambda == 0.0) damped.diagonal().array() += floor;
+  return -damped.ldlt().solve(g);
+}
+
+// The majoriser's change along s: gᵀs + ½·sᵀHs.
+double ModelChange(const Eigen::MatrixXd& h, const Eigen::VectorXd& g, const Eigen::VectorXd& s) {
+  return g.dot(s) + 0.5 * s.dot(h * s);
 }
 
 }  // namespace
@@ -81,8 +99,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   res.initial_cost = cost;
   double lambda = 1e-3;
   Eigen::MatrixXd jac(r.size(), n);
-  Eigen::MatrixXd weighted_block, h;
-  Eigen::VectorXd w, g;
+  Eigen::MatrixXd weighted_block, h, h_movable;
+  Eigen::VectorXd w, g, g_movable;
   bool jac_at_z = false;  // jac was computed at the current z
   double floor_rel = o.weight_floor_rel;
   int small_in_a_row = 0;  // accepted steps in a row that lowered O by less than ftol
@@ -118,16 +136,34 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     // What the undamped step of this majoriser promises, ½·gᵀH⁻¹g, over
     // the parameters the box lets move (not those at a bound that the
     // gradient pushes against).
-    const double promised = PromisedDecrease(h, g, z);
+    const std::vector<Eigen::Index> movable = Movable(g, z);
+    const bool any_pinned = movable.size() < static_cast<std::size_t>(n);
+    if (any_pinned) Restrict(h, g, movable, &h_movable, &g_movable);
+    const Eigen::MatrixXd& hm = any_pinned ? h_movable : h;
+    const Eigen::VectorXd& gm = any_pinned ? g_movable : g;
+    const double promised = movable.empty() ? 0.0 : -0.5 * gm.dot(DampedStep(hm, gm, 0.0));
     bool accepted = false;
     double step_norm = 0.0;
     double new_cost = cost;
     for (int tries = 0; tries < 12 && res.evaluations < o.max_evaluations; ++tries) {
-      Eigen::MatrixXd damped = h;
-      damped.diagonal() +=
-          lambda * (h.diagonal().cwiseMax(1e-12 * h.diagonal().maxCoeff() + 1e-300));
-      const Eigen::VectorXd step = -damped.ldlt().solve(g);
-      const Eigen::VectorXd z_new = (z + step).cwiseMax(0.0).cwiseMin(1.0);
+      // The damped step of all parameters, clamped to the box. With a
+      // parameter pinned at a bound that step assumes it moves, and the
+      // others' steps, coupled to it, go astray once it does not: the
+      // misspecified fits crawled on tiny accepted steps with a promise many
+      // times what they kept. So the step of the movable parameters alone
+      // (the pinned ones stay) is a second candidate, and the one the
+      // majoriser predicts lower is tried. Neither alone is best: the
+      // second can hold a parameter at the bound an early long step threw
+      // it to, where the first would have pulled it back.
+      Eigen::VectorXd z_new = (z + DampedStep(h, g, lambda)).cwiseMax(0.0).cwiseMin(1.0);
+      if (any_pinned && !movable.empty()) {
+        const Eigen::VectorXd step_movable = DampedStep(h_movable, g_movable, lambda);
+        Eigen::VectorXd z_movable = z;
+        for (std::size_t a = 0; a < movable.size(); ++a)
+          z_movable(movable[a]) += step_movable(static_cast<Eigen::Index>(a));
+        z_movable = z_movable.cwiseMax(0.0).cwiseMin(1.0);
+        if (ModelChange(h, g, z_movable - z) < ModelChange(h, g, z_new - z)) z_new = z_movable;
+      }
       step_norm = (z_new - z).cwiseAbs().maxCoeff();
       if (!(step_norm > 0.0) || !eval(z_new, &r_trial)) {
         lambda *= 4.0;

@@ -263,10 +263,11 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
   // (IdentSummary::estimates[].at_bound, which `pvtwin calibrate` prints as
   // "at upper bound": test_cli_model.cc checks the printout). Three may run
   // to their upper bound on this day, depending on the path of the fit;
-  // any other parameter at a bound fails here. (Forward differences end
-  // with u_front_w_m2k and f_th there; the default exact Jacobian ends on a
-  // path where the identifiability analysis fixes u_front_w_m2k, f_th,
-  // n_wind and eps_pvt as not determined by the data.)
+  // any other parameter at a bound fails here. (The fit ends on a path
+  // where the identifiability analysis fixes u_front_w_m2k, f_th, n_wind
+  // and eps_pvt as not determined by the data, with the exact Jacobian and
+  // with forward differences; forward differences used to leave
+  // u_front_w_m2k and f_th at their upper bounds.)
   //  * u_front_w_m2k → 1e3: in the paper's wind form (2.8) 1/U_front,w =
   //    1/U_front + r_refwind·v^n, U_front → ∞ leaves the front resistance to
   //    the wind term alone. With the blower's near-constant 3.5 m/s the

@@ -397,7 +397,7 @@ struct FitOutcome {
   Termination termination = Termination::kFailure;
   bool ok = false;
   std::string message;
-  Eigen::MatrixXd jacobian;  // at params when the method had it, else empty
+  Eigen::MatrixXd jacobian;  // at or near params when the method had it, else empty
 };
 
 // One fit of the active parameters from `from`.
@@ -438,7 +438,7 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
         return obj.Jacobian(obj.Params(x), infos, jac);
       };
     }
-    const LadFitResult fit = LadFit(residuals, z0, zr, lo, jacobian);
+    LadFitResult fit = LadFit(residuals, z0, zr, lo, jacobian);
     for (std::size_t j = 0; j < n; ++j)
       x[j] = FromUnit(infos[j], fit.z(static_cast<Eigen::Index>(j)));
     out.params = obj.Params(x);
@@ -447,7 +447,13 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
                       : fit.converged                ? Termination::kConverged
                                                      : Termination::kMaxEvaluations;
     out.message = fit.message;
-    out.jacobian = fit.jacobian;
+    // The identifiability analysis takes the last Jacobian when the fit
+    // ended within this distance of where it was computed (unit
+    // coordinates, 0.3 % of each range): the standard errors and the
+    // linear predictions of the fixing rounds hardly notice, and another
+    // run with sensitivities is saved.
+    constexpr double kJacobianReuseDistance = 3e-3;
+    if (fit.jacobian_distance <= kJacobianReuseDistance) out.jacobian = std::move(fit.jacobian);
     return out;
   }
   const bool smooth = NeedsGradient(options.optimizer.algorithm);
@@ -815,7 +821,7 @@ class FineFit {
     const auto m = static_cast<Eigen::Index>(act_index.size());
     if (m <= 1 || Remaining() < static_cast<int>(m) + 10) return false;
     if (jac_.cols() != m) {
-      jac_ = fit_.jacobian.cols() == m ? fit_.jacobian : Eigen::MatrixXd();
+      if (fit_.jacobian.cols() == m) jac_ = std::move(fit_.jacobian);
       if (jac_.cols() == m) {
         obj_.Residuals(best_, &r_);
       } else {

@@ -101,12 +101,14 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   Eigen::MatrixXd jac(r.size(), n);
   Eigen::MatrixXd weighted_block, h, h_movable;
   Eigen::VectorXd w, g, g_movable;
-  bool jac_at_z = false;  // jac was computed at the current z
+  bool have_jac = false;  // jac was computed, at z_jac
+  Eigen::VectorXd z_jac;
   double floor_rel = o.weight_floor_rel;
   int small_in_a_row = 0;  // accepted steps in a row that lowered O by less than ftol
   const Eigen::Index jacobian_cost = jacobian ? o.jacobian_cost : n;
   for (int it = 0; it < o.max_iterations; ++it) {
-    if (res.evaluations + jacobian_cost + 1 > o.max_evaluations) {
+    const bool jacobian_due = !(have_jac && z == z_jac);
+    if (res.evaluations + (jacobian_due ? jacobian_cost : 0) + 1 > o.max_evaluations) {
       res.message = "evaluation budget reached";
       break;
     }
@@ -114,7 +116,10 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     // IRLS weights at the current residuals.
     const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
     w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
-    if (jacobian && jacobian(z, r, &jac)) {
+    if (!jacobian_due) {
+      // Still where the last Jacobian was taken (a sharper weight floor
+      // after a rejected iteration): only the weights change.
+    } else if (jacobian && jacobian(z, r, &jac)) {
       res.evaluations += static_cast<int>(jacobian_cost);
     } else {
       // Forward-difference Jacobian, stepping inwards at the upper bound.
@@ -126,7 +131,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
         jac.col(j) = (r_step - r) / h;
       }
     }
-    jac_at_z = true;
+    have_jac = true;
+    z_jac = z;
     // Majoriser: H = JᵀWJ / N + 2p·I, g = JᵀW r / N + 2p (z − z_ref).
     WeightedNormalEquations(jac, w, r, &weighted_block, &h, &g);
     h /= o.n_scale;
@@ -193,7 +199,6 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
       res.message = "no further descent (damping " + std::to_string(lambda) + ")";
       break;
     }
-    jac_at_z = false;
     const double decrease = cost - new_cost;
     cost = new_cost;
     if (step_norm <= o.xtol && floor_rel > 1e-6) {  // stalled on the smoothing
@@ -219,8 +224,9 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   if (res.message.empty()) res.message = "iteration limit reached";
   res.z = z;
   res.final_cost = cost;
-  if (jac_at_z) {
+  if (have_jac) {
     res.jacobian = std::move(jac);
+    res.jacobian_distance = (z - z_jac).cwiseAbs().maxCoeff();
     res.weights = std::move(w);
   }
   return res;

@@ -61,10 +61,14 @@ struct LadFitResult {
   int evaluations = 0;
   bool converged = false;
   std::string message;
-  // J at the returned point (rows × free parameters), for the caller's
-  // identifiability analysis; empty if the last step moved away from where
-  // it was computed.
+  // The last Jacobian computed (rows × free parameters), for the caller's
+  // identifiability analysis, and how far the returned point is from where
+  // it was computed (max norm in z; 0: at the returned point). A fit
+  // usually ends on an accepted short step, and a run with sensitivities
+  // at 5-s data costs as much as five plain runs: the caller decides
+  // whether the Jacobian one short step back will do.
   Eigen::MatrixXd jacobian;
+  double jacobian_distance = 0.0;
   Eigen::VectorXd weights;  // IRLS weights used with that Jacobian
 };
 

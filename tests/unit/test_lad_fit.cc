@@ -156,6 +156,47 @@ TEST(LadFit, AParameterPinnedAtABoundDoesNotHoldBackTheOthers) {
   EXPECT_LT(res.evaluations, 50) << res.message;
 }
 
+// The Jacobian is taken once per point: an iteration after a rejected one
+// (sharper weight floor, same point) reuses it. The result carries the
+// last Jacobian and how far the returned point is from where it was taken.
+// The median of LocationEstimateIsTheMedian, whose kink rejects steps, on a
+// line z0 + z1·x so that the Jacobian depends on nothing but x.
+TEST(LadFit, TakesEachJacobianOnceAndReturnsTheLast) {
+  const std::vector<double> x = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+  const std::vector<double> y = {0.12, 0.31, 0.35, 0.52, 0.9, 0.93, 0.97};
+  const auto rows = static_cast<Eigen::Index>(y.size());
+  ResidualFunction f = [&](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
+    r->resize(rows);
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      (*r)(i) = z(0) + z(1) * x[static_cast<std::size_t>(i)] - y[static_cast<std::size_t>(i)];
+    }
+    return true;
+  };
+  std::vector<Eigen::VectorXd> points;
+  JacobianFunction jacobian = [&](const Eigen::VectorXd& z, const Eigen::VectorXd&,
+                                  Eigen::MatrixXd* jac) {
+    points.push_back(z);
+    jac->resize(rows, 2);
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      (*jac)(i, 0) = 1.0;
+      (*jac)(i, 1) = x[static_cast<std::size_t>(i)];
+    }
+    (*jac)(0, 0) = 1.0 + static_cast<double>(points.size());  // tells the calls apart
+    return true;
+  };
+  LadFitOptions o;
+  o.ftol_rel = 1e-12;
+  o.xtol = 1e-12;
+  const LadFitResult res =
+      LadFit(f, Eigen::Vector2d(0.05, 0.05), Eigen::Vector2d::Zero(), o, jacobian);
+  ASSERT_GE(points.size(), 2u);
+  EXPECT_LT(static_cast<int>(points.size()), res.iterations) << "no iteration reused a Jacobian";
+  for (std::size_t k = 1; k < points.size(); ++k) EXPECT_NE(points[k], points[k - 1]) << k;
+  EXPECT_DOUBLE_EQ(res.jacobian_distance, (res.z - points.back()).cwiseAbs().maxCoeff());
+  ASSERT_EQ(res.jacobian.rows(), rows);
+  EXPECT_DOUBLE_EQ(res.jacobian(0, 0), 1.0 + static_cast<double>(points.size()));
+}
+
 TEST(LadFit, NonFiniteStartIsReported) {
   ResidualFunction f = [](const Eigen::VectorXd&, Eigen::VectorXd* r) {
     *r = Eigen::VectorXd::Constant(3, std::nan(""));

@@ -35,31 +35,6 @@ void WeightedNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& 
   }
 }
 
-// The parameters free to move: all but those at a bound of the unit box
-// whose gradient points out of it.
-std::vector<Eigen::Index> Movable(const Eigen::VectorXd& g, const Eigen::VectorXd& z) {
-  std::vector<Eigen::Index> movable;
-  for (Eigen::Index j = 0; j < z.size(); ++j) {
-    const bool pinned = (z(j) <= 0.0 && g(j) > 0.0) || (z(j) >= 1.0 && g(j) < 0.0);
-    if (!pinned) movable.push_back(j);
-  }
-  return movable;
-}
-
-// H and g restricted to the parameters `movable`.
-void Restrict(const Eigen::MatrixXd& h, const Eigen::VectorXd& g,
-              const std::vector<Eigen::Index>& movable, Eigen::MatrixXd* hm, Eigen::VectorXd* gm) {
-  const auto m = static_cast<Eigen::Index>(movable.size());
-  hm->resize(m, m);
-  gm->resize(m);
-  for (Eigen::Index a = 0; a < m; ++a) {
-    (*gm)(a) = g(movable[static_cast<std::size_t>(a)]);
-    for (Eigen::Index b = 0; b < m; ++b) {
-      (*hm)(a, b) = h(movable[static_cast<std::size_t>(a)], movable[static_cast<std::size_t>(b)]);
-    }
-  }
-}
-
 // s solving (H + λ·D) s = −g, D the diagonal of H floored so that a
 // direction without curvature is damped too (λ = 0: the undamped step).
 // Not for an empty system.
@@ -75,6 +50,58 @@ Eigen::VectorXd DampedStep(const Eigen::MatrixXd& h, const Eigen::VectorXd& g, d
 double ModelChange(const Eigen::MatrixXd& h, const Eigen::VectorXd& g, const Eigen::VectorXd& s) {
   return g.dot(s) + 0.5 * s.dot(h * s);
 }
+
+// The quadratic majoriser of one iteration: H = JᵀWJ / N + 2p·I and
+// g = JᵀW r / N + 2p (z − z_ref), with both restricted to the parameters
+// free to move from z: all but those at a bound of the unit box whose
+// gradient points out of it.
+struct Majoriser {
+  Eigen::MatrixXd h, h_movable;
+  Eigen::VectorXd g, g_movable;
+  std::vector<Eigen::Index> movable;
+
+  void SetMovable(const Eigen::VectorXd& z) {
+    movable.clear();
+    for (Eigen::Index j = 0; j < z.size(); ++j) {
+      const bool pinned = (z(j) <= 0.0 && g(j) > 0.0) || (z(j) >= 1.0 && g(j) < 0.0);
+      if (!pinned) movable.push_back(j);
+    }
+    const auto m = static_cast<Eigen::Index>(movable.size());
+    h_movable.resize(m, m);
+    g_movable.resize(m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const Eigen::Index ja = movable[static_cast<std::size_t>(a)];
+      g_movable(a) = g(ja);
+      for (Eigen::Index b = 0; b < m; ++b)
+        h_movable(a, b) = h(ja, movable[static_cast<std::size_t>(b)]);
+    }
+  }
+
+  // What the undamped step promises over the movable parameters, ½·gᵀH⁻¹g.
+  double Promised() const {
+    return movable.empty() ? 0.0 : -0.5 * g_movable.dot(DampedStep(h_movable, g_movable, 0.0));
+  }
+
+  // The point tried from z with damping λ. The damped step of all
+  // parameters, clamped to the box: with a parameter pinned at a bound that
+  // step assumes it moves, and the others' steps, coupled to it, go astray
+  // once it does not (the misspecified fits crawled on tiny accepted steps
+  // with a promise many times what they kept). So the step of the movable
+  // parameters alone (the pinned ones stay) is a second candidate, and the
+  // one the majoriser predicts lower is tried. Neither alone is best: the
+  // second can hold a parameter at the bound an early long step threw it
+  // to, where the first would have pulled it back.
+  Eigen::VectorXd TrialPoint(const Eigen::VectorXd& z, double lambda) const {
+    Eigen::VectorXd z_all = (z + DampedStep(h, g, lambda)).cwiseMax(0.0).cwiseMin(1.0);
+    if (movable.empty() || movable.size() == static_cast<std::size_t>(z.size())) return z_all;
+    const Eigen::VectorXd step_movable = DampedStep(h_movable, g_movable, lambda);
+    Eigen::VectorXd z_movable = z;
+    for (std::size_t a = 0; a < movable.size(); ++a)
+      z_movable(movable[a]) += step_movable(static_cast<Eigen::Index>(a));
+    z_movable = z_movable.cwiseMax(0.0).cwiseMin(1.0);
+    return ModelChange(h, g, z_movable - z) < ModelChange(h, g, z_all - z) ? z_movable : z_all;
+  }
+};
 
 }  // namespace
 
@@ -99,8 +126,9 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   res.initial_cost = cost;
   double lambda = 1e-3;
   Eigen::MatrixXd jac(r.size(), n);
-  Eigen::MatrixXd weighted_block, h, h_movable;
-  Eigen::VectorXd w, g, g_movable;
+  Eigen::MatrixXd weighted_block;
+  Eigen::VectorXd w;
+  Majoriser maj;
   bool have_jac = false;  // jac was computed, at z_jac
   Eigen::VectorXd z_jac;
   double floor_rel = o.weight_floor_rel;
@@ -133,43 +161,18 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     }
     have_jac = true;
     z_jac = z;
-    // Majoriser: H = JᵀWJ / N + 2p·I, g = JᵀW r / N + 2p (z − z_ref).
-    WeightedNormalEquations(jac, w, r, &weighted_block, &h, &g);
-    h /= o.n_scale;
-    g /= o.n_scale;
-    h.diagonal().array() += 2.0 * o.prior_weight;
-    g += 2.0 * o.prior_weight * (z - z_ref);
-    // What the undamped step of this majoriser promises, ½·gᵀH⁻¹g, over
-    // the parameters the box lets move (not those at a bound that the
-    // gradient pushes against).
-    const std::vector<Eigen::Index> movable = Movable(g, z);
-    const bool any_pinned = movable.size() < static_cast<std::size_t>(n);
-    if (any_pinned) Restrict(h, g, movable, &h_movable, &g_movable);
-    const Eigen::MatrixXd& hm = any_pinned ? h_movable : h;
-    const Eigen::VectorXd& gm = any_pinned ? g_movable : g;
-    const double promised = movable.empty() ? 0.0 : -0.5 * gm.dot(DampedStep(hm, gm, 0.0));
+    WeightedNormalEquations(jac, w, r, &weighted_block, &maj.h, &maj.g);
+    maj.h /= o.n_scale;
+    maj.g /= o.n_scale;
+    maj.h.diagonal().array() += 2.0 * o.prior_weight;
+    maj.g += 2.0 * o.prior_weight * (z - z_ref);
+    maj.SetMovable(z);
+    const double promised = maj.Promised();
     bool accepted = false;
     double step_norm = 0.0;
     double new_cost = cost;
     for (int tries = 0; tries < 12 && res.evaluations < o.max_evaluations; ++tries) {
-      // The damped step of all parameters, clamped to the box. With a
-      // parameter pinned at a bound that step assumes it moves, and the
-      // others' steps, coupled to it, go astray once it does not: the
-      // misspecified fits crawled on tiny accepted steps with a promise many
-      // times what they kept. So the step of the movable parameters alone
-      // (the pinned ones stay) is a second candidate, and the one the
-      // majoriser predicts lower is tried. Neither alone is best: the
-      // second can hold a parameter at the bound an early long step threw
-      // it to, where the first would have pulled it back.
-      Eigen::VectorXd z_new = (z + DampedStep(h, g, lambda)).cwiseMax(0.0).cwiseMin(1.0);
-      if (any_pinned && !movable.empty()) {
-        const Eigen::VectorXd step_movable = DampedStep(h_movable, g_movable, lambda);
-        Eigen::VectorXd z_movable = z;
-        for (std::size_t a = 0; a < movable.size(); ++a)
-          z_movable(movable[a]) += step_movable(static_cast<Eigen::Index>(a));
-        z_movable = z_movable.cwiseMax(0.0).cwiseMin(1.0);
-        if (ModelChange(h, g, z_movable - z) < ModelChange(h, g, z_new - z)) z_new = z_movable;
-      }
+      const Eigen::VectorXd z_new = maj.TrialPoint(z, lambda);
       step_norm = (z_new - z).cwiseAbs().maxCoeff();
       if (!(step_norm > 0.0) || !eval(z_new, &r_trial)) {
         lambda *= 4.0;

@@ -80,10 +80,14 @@ void BenchSimulation(const BenchArgs& a) {
     const double median = MedianTime(a.repeats, [&] { Simulate(drivers, params, &out); });
     std::printf("  %-24s %12.3f %14.1f", name.c_str(), median * 1e3,
                 median * 1e9 / static_cast<double>(series.size()));
+    // The default free parameters that no effect hook reads: the columns
+    // of the run with sensitivities (identification differences the rest).
     std::vector<Param> wrt;
     const auto free = DefaultFreeParams(spec);
+    const std::vector<Param> hook = HookParams(spec);
     for (std::size_t i = 0; i < kNumParams; ++i) {
-      if (free.test(i)) wrt.push_back(static_cast<Param>(i));
+      const auto p = static_cast<Param>(i);
+      if (free.test(i) && std::find(hook.begin(), hook.end(), p) == hook.end()) wrt.push_back(p);
     }
     if (SensitivitiesSupported(spec, wrt, nullptr)) {
       SimSensitivities sens;

@@ -47,6 +47,17 @@ struct ModelExtension {
   int variant_order = 0;  // position among the "+name" parts of a canonical name
   // Parameters its equations use; identification frees them by default.
   std::vector<Param> params;
+  // Parameters of the base model that its hooks read as well (the "+wind"
+  // front loss reads U_front). A run with sensitivities differentiates the
+  // base model's arithmetic only, so the columns of these and of `params`
+  // come from differences (core/model/sensitivities.h). The sensitivity
+  // tests of every registered effect catch a read left out here.
+  std::vector<Param> reads_base_params;
+  // True when transform_outputs is affine in the outputs it reads and writes
+  // (parameters and drivers fixed), as a sensor behind a pipe is: a run with
+  // sensitivities then pushes its derivatives through the hook. False: no
+  // sensitivities for a spec with this extension.
+  bool outputs_affine = false;
   // Inputs it needs beyond the base variant's.
   std::vector<InputRequirement> inputs;
   // True when the front loss reads the wind (drivers' ln_wind is filled).

@@ -38,6 +38,7 @@ const ModelExtension& Extension() {
     e.name = "flow_dependent_u";
     e.variant_order = 2;
     e.params = {Param::kNFlow};
+    e.reads_base_params = {Param::kAreaM2, Param::kR0FluidM2KW, Param::kR1Fluid};
     e.transform_drivers = FluidCouplingPerRow;
     return e;
   }();

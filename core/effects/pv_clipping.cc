@@ -24,6 +24,7 @@ const ModelExtension& Extension() {
     e.name = "pv_clipping";
     e.variant_order = 3;
     e.params = {Param::kPLimitWM2};
+    e.reads_base_params = {Param::kAreaM2};
     e.transform_drivers = InverterLimit;
     return e;
   }();

@@ -143,7 +143,9 @@ const ModelExtension& Extension() {
     e.name = "transport_delay";
     e.variant_order = 1;
     e.params = {Param::kTransportDelayS, Param::kUPipeWM2K};
+    e.reads_base_params = {Param::kAreaM2};
     e.transform_outputs = SensorBehindPipe;
+    e.outputs_affine = true;  // interpolation and the pipe's loss towards T_amb
     return e;
   }();
   return kExtension;
@@ -174,7 +176,9 @@ const ModelExtension& VolumeExtension() {
     e.name = "pipe_volume";
     e.variant_order = 1;  // transport_delay's place
     e.params = {Param::kPipePlugKgM2, Param::kPipeMixKgM2, Param::kUPipeWM2K};
+    e.reads_base_params = {Param::kAreaM2};
     e.transform_outputs = SensorBehindPipeVolume;
+    e.outputs_affine = true;  // plug flow and mixed tanks losing to T_amb
     return e;
   }();
   return kExtension;

@@ -31,6 +31,7 @@ const ModelExtension& Extension() {
     e.name = "wind";
     e.variant_order = 0;
     e.params = {Param::kUWindWM2K, Param::kNWind};
+    e.reads_base_params = {Param::kUFrontWM2K};
     e.reads_wind = true;
     e.transform_drivers = FrontLossPerRow;
     return e;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <span>
 
 #include "core/effects/registry.h"
 #include "core/fit/lad_fit.h"
@@ -57,6 +58,20 @@ class Objective {
     free_ = free;
     infos_ = infos;
     z_ref_ = z_ref;
+    // The run with sensitivities gives the columns of the parameters no
+    // effect hook reads; the hooks' parameters take differences.
+    const std::vector<Param> hook = HookParams(drivers_.spec);
+    sens_free_.clear();
+    sens_cols_.clear();
+    diff_cols_.clear();
+    for (std::size_t j = 0; j < free.size(); ++j) {
+      if (std::find(hook.begin(), hook.end(), free[j]) != hook.end()) {
+        diff_cols_.push_back(j);
+      } else {
+        sens_cols_.push_back(j);
+        sens_free_.push_back(free[j]);
+      }
+    }
   }
   const std::vector<Param>& free() const { return free_; }
   void SetBase(const ParamVector& base) { base_ = base; }
@@ -117,29 +132,38 @@ class Objective {
 
   // True when Jacobian() serves the active parameters.
   bool HasSensitivities() const {
-    return options_.analytic_jacobian && SensitivitiesSupported(drivers_.spec, free_, nullptr);
+    return options_.analytic_jacobian && !sens_free_.empty() &&
+           SensitivitiesSupported(drivers_.spec, sens_free_, nullptr);
   }
+
+  // Simulations one Jacobian() is charged: the run with sensitivities and
+  // one run per column taken by differences.
+  int JacobianCost() const { return kSensitivityRunCost + static_cast<int>(diff_cols_.size()); }
 
   // The Jacobian of Residuals at p in the active parameters' unit
   // coordinates (infos: their scales; dx/dz = upper − lower, or x·ln(upper /
-  // lower) on a log scale), from one run with sensitivities. A column with a
-  // non-finite entry is left zero. False when not supported.
+  // lower) on a log scale), from one run with sensitivities; the columns of
+  // the parameters an effect hook reads by forward differences from its
+  // outputs (DifferenceColumns). A column with a non-finite entry is left
+  // zero. False when not supported.
   bool Jacobian(const ParamVector& p, const std::vector<ParamInfo>& infos, Eigen::MatrixXd* jac) {
-    if (!HasSensitivities() || !SimulateSensitivities(drivers_, p, free_, &sens_)) return false;
+    if (!HasSensitivities() || !SimulateSensitivities(drivers_, p, sens_free_, &sens_)) {
+      return false;
+    }
     simulations_ += kSensitivityRunCost;
     ++sensitivity_runs_;
     const auto m = static_cast<Eigen::Index>(meas_.rows.size());
-    const auto cols = static_cast<Eigen::Index>(free_.size());
-    jac->resize((use_t_pv_ ? 3 : 2) * m, cols);
+    jac->resize((use_t_pv_ ? 3 : 2) * m, static_cast<Eigen::Index>(free_.size()));
     const double inv_area = 1.0 / drivers_.plant.area_m2;
-    for (Eigen::Index j = 0; j < cols; ++j) {
-      const auto uj = static_cast<std::size_t>(j);
+    for (std::size_t a = 0; a < sens_cols_.size(); ++a) {
+      const std::size_t uj = sens_cols_[a];
+      const auto j = static_cast<Eigen::Index>(uj);
       const ParamInfo& info = infos[uj];
       const double x = p[static_cast<std::size_t>(free_[uj])];
       const double dx_dz = DxDz(info, x);
-      const double* dp = sens_.DPEl(uj);
-      const double* dq = sens_.DQTh(uj);
-      const double* dt = sens_.DTPv(uj);
+      const double* dp = sens_.DPEl(a);
+      const double* dq = sens_.DQTh(a);
+      const double* dt = sens_.DTPv(a);
       for (Eigen::Index k = 0; k < m; ++k) {
         const std::uint32_t i = meas_.rows[static_cast<std::size_t>(k)];
         (*jac)(k, j) = dp[i] * inv_area * dx_dz;
@@ -148,7 +172,32 @@ class Objective {
       }
       if (!jac->col(j).allFinite()) jac->col(j).setZero();
     }
+    if (!diff_cols_.empty()) {
+      Eigen::VectorXd r0;
+      FillResiduals(sens_.p_el_w, sens_.q_th_w, sens_.t_pv_c, &r0);
+      DifferenceColumns(p, infos, r0, diff_cols_, jac);
+    }
     return true;
+  }
+
+  // Columns `cols` of the Jacobian at p (residuals r0) by forward
+  // differences, a step of kDifferenceStep in unit coordinates (inwards at
+  // the upper bound); a non-finite column is left zero.
+  void DifferenceColumns(const ParamVector& p, const std::vector<ParamInfo>& infos,
+                         const Eigen::VectorXd& r0, std::span<const std::size_t> cols,
+                         Eigen::MatrixXd* jac) {
+    constexpr double kDifferenceStep = 1e-4;
+    for (std::size_t uj : cols) {
+      ParamVector q = p;
+      const auto idx = static_cast<std::size_t>(free_[uj]);
+      const double z = ToUnit(infos[uj], p[idx]);
+      const double h = z + kDifferenceStep <= 1.0 ? kDifferenceStep : -kDifferenceStep;
+      q[idx] = FromUnit(infos[uj], z + h);
+      Residuals(q, &diff_r_);
+      const auto j = static_cast<Eigen::Index>(uj);
+      jac->col(j) = (diff_r_ - r0) / h;
+      if (!jac->col(j).allFinite()) jac->col(j).setZero();
+    }
   }
 
   // Gradient of Cost(x, smoothing_w) in the caller's coordinates x from one
@@ -210,6 +259,9 @@ class Objective {
   const IdentOptions& options_;
   ParamVector base_;
   std::vector<Param> free_;
+  std::vector<Param> sens_free_;                    // free_ without the hooks' parameters
+  std::vector<std::size_t> sens_cols_, diff_cols_;  // their columns, the others'
+  Eigen::VectorXd diff_r_;
   std::vector<ParamInfo> infos_;
   std::vector<double> z_ref_;
   SimOutputs sim_;
@@ -431,7 +483,7 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
     };
     JacobianFunction jacobian = nullptr;
     if (obj.HasSensitivities()) {
-      lo.jacobian_cost = kSensitivityRunCost;
+      lo.jacobian_cost = obj.JacobianCost();
       jacobian = [&](const Eigen::VectorXd& z, const Eigen::VectorXd&, Eigen::MatrixXd* jac) {
         for (std::size_t j = 0; j < n; ++j)
           x[j] = FromUnit(infos[j], z(static_cast<Eigen::Index>(j)));
@@ -482,8 +534,9 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
   };
   OptimizerOptions opt = options.optimizer;
   // A gradient method's cost call runs n + 1 simulations, or one plain run
-  // and one with sensitivities.
-  const int call_cost = obj.HasSensitivities() ? 1 + kSensitivityRunCost : static_cast<int>(n + 1);
+  // and one with sensitivities (plus one per column an effect hook's
+  // parameter takes by differences).
+  const int call_cost = obj.HasSensitivities() ? 1 + obj.JacobianCost() : static_cast<int>(n + 1);
   opt.max_evaluations = std::max(smooth ? budget / call_cost : budget, 1);
   const OptimizerResult result = Minimize(cost, x0, Bounds{lower, upper, log_scale}, opt);
   if (!result.x.empty()) out.params = obj.Params(result.x);
@@ -502,17 +555,9 @@ Eigen::MatrixXd SensitivityMatrix(Objective& obj, const std::vector<ParamInfo>& 
   obj.Residuals(p, r0);
   Eigen::MatrixXd jac(r0->size(), static_cast<Eigen::Index>(active.size()));
   if (obj.Jacobian(p, infos, &jac)) return jac;
-  Eigen::VectorXd r1;
-  constexpr double kStep = 1e-4;
-  for (std::size_t j = 0; j < active.size(); ++j) {
-    ParamVector q = p;
-    const auto idx = static_cast<std::size_t>(active[j]);
-    const double z = ToUnit(infos[j], p[idx]);
-    const double h = z + kStep <= 1.0 ? kStep : -kStep;
-    q[idx] = FromUnit(infos[j], z + h);
-    obj.Residuals(q, &r1);
-    jac.col(static_cast<Eigen::Index>(j)) = (r1 - *r0) / h;
-  }
+  std::vector<std::size_t> all(active.size());
+  for (std::size_t j = 0; j < all.size(); ++j) all[j] = j;
+  obj.DifferenceColumns(p, infos, *r0, all, &jac);
   return jac;
 }
 

@@ -25,6 +25,7 @@ struct SensRun {
   const RunInputs& w;
   std::span<const Param> wrt;
   int cols;
+  bool outlet;  // also the collector node's and the outlet's temperature (SimSensitivities)
 };
 
 // Derivatives of one row's terms (RowTerms, the parameters' products)
@@ -35,6 +36,7 @@ struct RowTermTangents {
   Column temp_coeff_per_k;  // f_corr_T
   Column eps_pvt, area_m2;
   Column g_back_w_k, g_coll_w_k, c_pv_j_k, c_coll_j_k;
+  Column f_th, p_per_eta_w;  // F_th and, with electric effects, RowTerms::p_per_eta_w
 };
 
 // The partial derivatives of row i's terms by parameter, scattered to the
@@ -60,6 +62,7 @@ void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i,
   const double g_fl = r.g_fluid_w_k;
   const bool flow = cap_w_k > 0.0;
   const double g_abs = run.w.g_abs_w_m2[i];
+  const double pv_factor = run.w.pv_factor != nullptr ? run.w.pv_factor[i] : 1.0;
   const double irr_dev = run.w.g_poa_w_m2[i] - k.pv.pv_g_ref_w_m2;
   const bool two = k.nodes == 2;
   for (int j = 0; j < run.cols; ++j) {
@@ -69,6 +72,7 @@ void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i,
         t->g_front_w_k[j] = u_front;
         t->g_fluid_w_k[j] = flow ? g_fl * g_fl * k.r0_fluid_per_area / area : 0.0;
         t->q_sun_w[j] = k.f_th * g_abs;
+        t->p_per_eta_w[j] = g_abs * pv_factor;
         t->g_back_w_k[j] = k.g_back_w_k / area;
         t->g_coll_w_k[j] = two ? k.g_coll_w_k / area : 0.0;
         t->c_pv_j_k[j] = k.c_pv_j_k / area;
@@ -82,6 +86,7 @@ void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i,
         break;
       case Param::kFTh:
         t->q_sun_w[j] = area * g_abs;
+        t->f_th[j] = 1.0;
         break;
       case Param::kUFrontWM2K:
         t->g_front_w_k[j] = area * du_dufront;
@@ -116,7 +121,7 @@ void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i,
       case Param::kPvIrrCoeffM2W:
         t->eta_at_ref_temp[j] = k.pv.eta_pv_ref * irr_dev;
         break;
-      default:  // not used by a variant without extensions
+      default:  // not used by the base model, or read by a hook (HookParams)
         break;
     }
   }
@@ -146,12 +151,46 @@ void EfficiencyAt(const RunConstants& k, const RowTerms& r, const RowTermTangent
   }
 }
 
+// The sun's power that leaves the PV node as electricity, as its heat
+// balance counts it (FluxesAt: Q_abs = q_sun − conversion): q_sun·η without
+// electric effects; F_th·P_el with them, P_el = min(η·p_per_eta, P_limit),
+// constant where clipped. With its slope in T_PV and, per column, the
+// derivatives of both at fixed T_PV (`e` at the same T_PV). The limit's own
+// dependence on A_PVT is the clipping hook's (HookParams): not a column.
+struct ConversionTangent {
+  double slope_per_k;
+  Column d_value, d_slope;
+};
+
+template <bool kElectric>
+void ConversionAt(const RunConstants& k, const RowTerms& r, const RowTermTangents& t,
+                  const EfficiencyTangent& e, int cols, ConversionTangent* c) {
+  if constexpr (kElectric) {
+    if (e.eta * r.p_per_eta_w >= r.p_limit_w) {  // RowTerms::PElW's test
+      c->slope_per_k = 0.0;
+      for (int j = 0; j < cols; ++j) {
+        c->d_value[j] = t.f_th[j] * r.p_limit_w;
+        c->d_slope[j] = 0.0;
+      }
+      return;
+    }
+  }
+  const double scale = kElectric ? k.f_th * r.p_per_eta_w : r.q_sun_w;
+  c->slope_per_k = scale * e.slope_per_k;
+  for (int j = 0; j < cols; ++j) {
+    const double d_scale =
+        kElectric ? t.f_th[j] * r.p_per_eta_w + k.f_th * t.p_per_eta_w[j] : t.q_sun_w[j];
+    c->d_value[j] = d_scale * e.eta + scale * e.d_eta[j];
+    c->d_slope[j] = d_scale * e.slope_per_k + scale * e.d_slope[j];
+  }
+}
+
 // The derivatives of the network that `l` linearised about t_lin (see
 // Linearise), per column: of the row terms `t` at fixed t_lin, plus the
 // linearisation point's own derivative d_lin times its effect (d G_PV/d t_lin
 // = q_rad'', d S_PV/d t_lin = q_rad''·t_lin, and q_abs' when the Q_abs slope
 // stays explicit). d_start: the derivatives of the start temperatures.
-template <RcShape kShape, bool kSky>
+template <RcShape kShape, bool kSky, bool kElectric>
 void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
                     const RowTermTangents& t, const double* d_lin, const double* d_start0,
                     const double* d_start1, RcNetworkTangent* dn) {
@@ -160,6 +199,8 @@ void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
   const double x = l.t_lin_c;
   EfficiencyTangent e;
   EfficiencyAt(k, r, t, x, cols, &e);
+  ConversionTangent c;
+  ConversionAt<kElectric>(k, r, t, e, cols, &c);
   const bool slope_in_g = l.lin.dq_abs_w_k != 0.0;
   double kappa_g = 0.0, kappa_s = 0.0, r1 = 0.0, r0 = 0.0;
   if constexpr (kSky) {
@@ -169,7 +210,7 @@ void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
     kappa_g = 12.0 * k.eps_pvt * kStefanBoltzmannW_m2k4 * k.area_m2 * xk * xk;
     kappa_s = kappa_g * x;
   }
-  if (!slope_in_g) kappa_s -= r.q_sun_w * e.slope_per_k;
+  if (!slope_in_g) kappa_s -= c.slope_per_k;
   constexpr int f = FluidNode(kShape);
   dn->directions = cols;
   for (int j = 0; j < cols; ++j) {
@@ -183,11 +224,11 @@ void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
     g0 += kappa_g * d_lin[j];
     s0 += kappa_s * d_lin[j];
     const double dq = t.q_sun_w[j];
-    if (slope_in_g) {  // G += q_sun·η', S += q_sun·(1 − η + η'·x)
-      g0 += dq * e.slope_per_k + r.q_sun_w * e.d_slope[j];
-      s0 += dq * (1.0 - e.eta + e.slope_per_k * x) + r.q_sun_w * (e.d_slope[j] * x - e.d_eta[j]);
-    } else {  // S += q_sun·(1 − η)
-      s0 += dq * (1.0 - e.eta) - r.q_sun_w * e.d_eta[j];
+    if (slope_in_g) {  // G += conversion', S += q_sun − conversion + conversion'·x
+      g0 += c.d_slope[j];
+      s0 += dq - c.d_value[j] + c.d_slope[j] * x;
+    } else {  // S += q_sun − conversion
+      s0 += dq - c.d_value[j];
     }
     dn->conductance_w_k[0][j] = g0;
     dn->source_w[0][j] = s0;
@@ -208,12 +249,12 @@ void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
 // One row solved as SolveRow (thermal_model.cc) does, keeping each pass's
 // linearisation and step; returns the number of passes (the row's result
 // is the last pass's).
-template <RcShape kShape, bool kSky>
+template <RcShape kShape, bool kSky, bool kElectric>
 int SolveRowPasses(const RunConstants& k, const RowTerms& r, const double start[2], double dt_s,
                    bool steady, double t_guess_c, Linearised lins[kMaxNodeIterations],
                    RcStepResult results[kMaxNodeIterations]) {
   double t_lin = t_guess_c;
-  PvFluxes at = FluxesAt<kSky, false>(k, r, t_lin);
+  PvFluxes at = FluxesAt<kSky, kElectric>(k, r, t_lin);
   int passes = 0;
   for (int it = 0; it < kMaxNodeIterations; ++it) {
     Linearised* l = &lins[passes];
@@ -222,7 +263,7 @@ int SolveRowPasses(const RunConstants& k, const RowTerms& r, const double start[
     *result = steady ? SteadyRc(l->net) : AdvanceRcShaped<kShape>(l->net, start, dt_s);
     const double t_pv = result->t_mean_c[0];
     if (!std::isfinite(t_pv)) break;
-    at = FluxesAt<kSky, false>(k, r, t_pv);
+    at = FluxesAt<kSky, kElectric>(k, r, t_pv);
     if (LinearisationConverged<kSky>(*l, at, t_pv)) break;
     t_lin = t_pv;
   }
@@ -232,18 +273,17 @@ int SolveRowPasses(const RunConstants& k, const RowTerms& r, const double start[
 // The derivatives of one solved row (steady or a step from `start`) through
 // its passes: the first pass's linearisation point has derivatives d_guess,
 // each next one the previous pass's step-mean T_PV derivatives.
-template <RcShape kShape, bool kSky>
+template <RcShape kShape, bool kSky, bool kElectric>
 void RowTangent(const SensRun& run, const RowTerms& r, const RowTermTangents& t,
                 const Linearised lins[], const RcStepResult results[], int passes,
-                const double start[2], double dt_s,
-                bool steady, const double* d_guess, const double* d_start0,
-                const double* d_start1, RcStepTangent* out) {
+                const double start[2], double dt_s, bool steady, const double* d_guess,
+                const double* d_start0, const double* d_start1, RcStepTangent* out) {
   RcNetworkTangent dn;
   Column d_lin;
   std::copy(d_guess, d_guess + run.cols, d_lin);
   for (int pass = 0; pass < passes; ++pass) {
     const Linearised& l = lins[pass];
-    NetworkTangent<kShape, kSky>(run, r, l, t, d_lin, d_start0, d_start1, &dn);
+    NetworkTangent<kShape, kSky, kElectric>(run, r, l, t, d_lin, d_start0, d_start1, &dn);
     if (steady) {
       SteadyRcTangent(l.net, results[pass], dn, out);
     } else {
@@ -258,7 +298,7 @@ void RowTangent(const SensRun& run, const RowTerms& r, const RowTermTangents& t,
 }
 
 // Row i's outputs and their derivatives from its step `res`, `dres`.
-template <RcShape kShape>
+template <RcShape kShape, bool kElectric>
 void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& t, std::size_t i,
                   const RcStepResult& res, const RcStepTangent& dres, SimSensitivities* out) {
   const RunConstants& k = run.k;
@@ -270,23 +310,51 @@ void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& 
   EfficiencyAt(k, r, t, t_pv, run.cols, &e);
   out->t_pv_c[i] = t_pv;
   out->q_th_w[i] = r.g_fluid_w_k * (t_fluid - r.t_in_c);
-  out->p_el_w[i] = e.eta * k.area_m2 * g_abs;
+  // The outlet as Simulate's WriteRow: without flow the fluid rests at the
+  // node temperature.
+  const bool flow = run.d.mdot_kg_s[i] > 0.0;
+  if (run.outlet) {
+    out->t_coll_c[i] = t_fluid;
+    out->t_out_c[i] = flow ? r.t_in_c + out->q_th_w[i] / run.d.capacity_flow_w_k[i] : t_fluid;
+  }
+  // P_el as Simulate's WriteRow: η·A·I_at, or RowTerms::PElW with electric
+  // effects (constant where clipped).
+  bool clipped = false;
+  if constexpr (kElectric) {
+    double unused_slope;
+    out->p_el_w[i] = r.PElW(t_pv, &unused_slope);
+    clipped = e.eta * r.p_per_eta_w >= r.p_limit_w;
+  } else {
+    out->p_el_w[i] = e.eta * k.area_m2 * g_abs;
+  }
   for (int j = 0; j < run.cols; ++j) {
     const auto col = static_cast<std::size_t>(j) * n;
     const double d_pv = dres.t_mean_c[0][j];
     const double d_fluid = dres.t_mean_c[FluidNode(kShape)][j];
     out->dt_pv_c[col + i] = d_pv;
     out->dq_th_w[col + i] = t.g_fluid_w_k[j] * (t_fluid - r.t_in_c) + r.g_fluid_w_k * d_fluid;
-    out->dp_el_w[col + i] = (e.d_eta[j] + e.slope_per_k * d_pv) * k.area_m2 * g_abs +
-                            e.eta * t.area_m2[j] * g_abs;
+    if (run.outlet) {
+      out->dt_coll_c[col + i] = d_fluid;
+      out->dt_out_c[col + i] = flow ? out->dq_th_w[col + i] / run.d.capacity_flow_w_k[i] : d_fluid;
+    }
+    if constexpr (kElectric) {
+      out->dp_el_w[col + i] =
+          clipped ? 0.0
+                  : (e.d_eta[j] + e.slope_per_k * d_pv) * r.p_per_eta_w + e.eta * t.p_per_eta_w[j];
+    } else {
+      out->dp_el_w[col + i] =
+          (e.d_eta[j] + e.slope_per_k * d_pv) * k.area_m2 * g_abs + e.eta * t.area_m2[j] * g_abs;
+    }
   }
 }
 
-void SetSensRowNaN(SimSensitivities* out, std::size_t i, int cols) {
+void SetSensRowNaN(SimSensitivities* out, std::size_t i, int cols, bool outlet) {
   out->p_el_w[i] = out->q_th_w[i] = out->t_pv_c[i] = kNaN;
+  if (outlet) out->t_coll_c[i] = out->t_out_c[i] = kNaN;
   for (int j = 0; j < cols; ++j) {
     const std::size_t at = static_cast<std::size_t>(j) * out->rows + i;
     out->dp_el_w[at] = out->dq_th_w[at] = out->dt_pv_c[at] = kNaN;
+    if (outlet) out->dt_coll_c[at] = out->dt_out_c[at] = kNaN;
   }
 }
 
@@ -307,7 +375,7 @@ struct SensState {
 };
 
 // The row loop of Simulate (IntegrateRows) with the derivatives.
-template <RcShape kShape, bool kSky>
+template <RcShape kShape, bool kSky, bool kElectric>
 void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
   const Drivers& d = run.d;
   const int cols = run.cols;
@@ -320,20 +388,20 @@ void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
   RcStepResult pass_results[kMaxNodeIterations];
   Column d_guess, zero{};
   for (std::size_t i = 0; i < d.size(); ++i) {
-    const RowTerms r = MakeRowTerms<false>(run.k, d, run.w, i);
+    const RowTerms r = MakeRowTerms<kElectric>(run.k, d, run.w, i);
     if (!d.usable[i] || !RowInputsFinite(r)) {
-      SetSensRowNaN(out, i, cols);
+      SetSensRowNaN(out, i, cols, run.outlet);
       need_restart = true;
       continue;
     }
     MakeRowTermTangents(run, r, i, &t);
     if (need_restart || d.restart[i]) {
       // Paper 2.2: the steady state of this row's inputs, from T_amb (data).
-      const int passes = SolveRowPasses<kShape, kSky>(run.k, r, s.t_c, 0.0, true, r.t_amb_c,
-                                                      lins, pass_results);
+      const int passes = SolveRowPasses<kShape, kSky, kElectric>(run.k, r, s.t_c, 0.0, true,
+                                                                 r.t_amb_c, lins, pass_results);
       res = pass_results[passes - 1];
-      RowTangent<kShape, kSky>(run, r, t, lins, pass_results, passes, s.t_c, 0.0, true, zero,
-                               zero, zero, &dres);
+      RowTangent<kShape, kSky, kElectric>(run, r, t, lins, pass_results, passes, s.t_c, 0.0, true,
+                                          zero, zero, zero, &dres);
       s.TakeEnd(res, dres, cols);
       s.t_pv_prev = s.t_pv_prev2 = res.t_mean_c[0];
       std::copy(dres.t_mean_c[0], dres.t_mean_c[0] + cols, s.d_prev);
@@ -343,25 +411,85 @@ void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
     const double start[2] = {s.t_c[0], s.t_c[1]};
     const double guess = 2.0 * s.t_pv_prev - s.t_pv_prev2;
     for (int j = 0; j < cols; ++j) d_guess[j] = 2.0 * s.d_prev[j] - s.d_prev2[j];
-    const int passes = SolveRowPasses<kShape, kSky>(run.k, r, start, d.dt_s[i], false, guess,
-                                                    lins, pass_results);
+    const int passes = SolveRowPasses<kShape, kSky, kElectric>(run.k, r, start, d.dt_s[i], false,
+                                                               guess, lins, pass_results);
     res = pass_results[passes - 1];
-    RowTangent<kShape, kSky>(run, r, t, lins, pass_results, passes, start, d.dt_s[i], false,
-                             d_guess, s.d_t0, s.d_t1, &dres);
+    RowTangent<kShape, kSky, kElectric>(run, r, t, lins, pass_results, passes, start, d.dt_s[i],
+                                        false, d_guess, s.d_t0, s.d_t1, &dres);
     s.TakeEnd(res, dres, cols);
     s.t_pv_prev2 = s.t_pv_prev;
     s.t_pv_prev = res.t_mean_c[0];
     std::copy(s.d_prev, s.d_prev + cols, s.d_prev2);
     std::copy(dres.t_mean_c[0], dres.t_mean_c[0] + cols, s.d_prev);
-    WriteSensRow<kShape>(run, r, t, i, res, dres, out);
+    WriteSensRow<kShape, kElectric>(run, r, t, i, res, dres, out);
   }
 }
 
 using SensLoop = void (*)(const SensRun& run, SimSensitivities* out);
 
+// The outputs and their derivatives through the spec's transform_outputs
+// hooks, each affine in the outputs (ModelExtension::outputs_affine): with
+// y the outputs before them and d a column, T(y + s·d) − T(y) = s·T'd. The
+// scale s makes the largest entry of s·d one unit (K or W), far above the
+// rounding of T(y) and, T being affine, without truncation error. Each
+// application starts from the hooks' work space as the run left it.
+void PushThroughOutputTransforms(const Drivers& d, const ParamVector& params, RunInputs* w,
+                                 SimSensitivities* out) {
+  const std::size_t n = out->rows, used = w->work_used;
+  auto apply = [&](SimOutputs* y) {
+    w->work_used = used;
+    for (const ModelExtension* e : d.spec.extensions) {
+      if (e->transform_outputs != nullptr) e->transform_outputs(d, params, w, y);
+    }
+  };
+  // (SimOutputs field, value before, derivatives before) of what a hook may read.
+  struct Field {
+    std::vector<double> SimOutputs::*y;
+    std::vector<double>* value;
+    std::vector<double>* d;
+  };
+  const Field fields[] = {{&SimOutputs::p_el_w, &out->p_el_w, &out->dp_el_w},
+                          {&SimOutputs::q_th_w, &out->q_th_w, &out->dq_th_w},
+                          {&SimOutputs::t_pv_c, &out->t_pv_c, &out->dt_pv_c},
+                          {&SimOutputs::t_coll_c, &out->t_coll_c, &out->dt_coll_c},
+                          {&SimOutputs::t_out_c, &out->t_out_c, &out->dt_out_c}};
+  SimOutputs& base = out->hook_work;
+  SimOutputs& pushed = out->pushed;
+  for (const Field& f : fields) base.*f.y = *f.value;
+  apply(&base);
+  for (std::size_t j = 0; j < out->wrt.size(); ++j) {
+    double largest = 0.0;
+    for (const Field& f : fields) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const double v = std::fabs((*f.d)[j * n + i]);
+        if (v > largest && std::isfinite(v)) largest = v;
+      }
+    }
+    if (!(largest > 0.0)) continue;  // a zero column stays zero
+    const double s = 1.0 / largest;
+    for (const Field& f : fields) {
+      std::vector<double>& y = pushed.*f.y;
+      y.resize(n);
+      for (std::size_t i = 0; i < n; ++i) y[i] = (*f.value)[i] + s * (*f.d)[j * n + i];
+    }
+    apply(&pushed);
+    for (const Field& f : fields) {
+      const std::vector<double>& y = pushed.*f.y;
+      const std::vector<double>& y0 = base.*f.y;
+      for (std::size_t i = 0; i < n; ++i) (*f.d)[j * n + i] = (y[i] - y0[i]) / s;
+    }
+  }
+  for (const Field& f : fields) *f.value = base.*f.y;
+}
+
 template <RcShape kShape>
-SensLoop PickSensLoop(bool sky) {
-  return sky ? &IntegrateRowsSens<kShape, true> : &IntegrateRowsSens<kShape, false>;
+SensLoop PickSensLoop(bool sky, bool electric) {
+  if (sky) {
+    return electric ? &IntegrateRowsSens<kShape, true, true>
+                    : &IntegrateRowsSens<kShape, true, false>;
+  }
+  return electric ? &IntegrateRowsSens<kShape, false, true>
+                  : &IntegrateRowsSens<kShape, false, false>;
 }
 
 // The network shape of a spec (every capacitance parameter is positive
@@ -374,35 +502,57 @@ RcShape SpecShape(const ModelSpec& spec) {
   return ShapeOf(net);
 }
 
-SensLoop PickSensLoop(const ModelSpec& spec) {
+SensLoop PickSensLoop(const ModelSpec& spec, bool electric) {
   switch (SpecShape(spec)) {
     case RcShape::kOneAlgebraic:
-      return PickSensLoop<RcShape::kOneAlgebraic>(spec.sky);
+      return PickSensLoop<RcShape::kOneAlgebraic>(spec.sky, electric);
     case RcShape::kOneCapacitive:
-      return PickSensLoop<RcShape::kOneCapacitive>(spec.sky);
+      return PickSensLoop<RcShape::kOneCapacitive>(spec.sky, electric);
     case RcShape::kTwoAlgebraic:
-      return PickSensLoop<RcShape::kTwoAlgebraic>(spec.sky);
+      return PickSensLoop<RcShape::kTwoAlgebraic>(spec.sky, electric);
     case RcShape::kTwoCapacitive0:
-      return PickSensLoop<RcShape::kTwoCapacitive0>(spec.sky);
+      return PickSensLoop<RcShape::kTwoCapacitive0>(spec.sky, electric);
     case RcShape::kTwoCapacitive1:
-      return PickSensLoop<RcShape::kTwoCapacitive1>(spec.sky);
+      return PickSensLoop<RcShape::kTwoCapacitive1>(spec.sky, electric);
     case RcShape::kTwoCapacitiveBoth:
       break;
   }
-  return PickSensLoop<RcShape::kTwoCapacitiveBoth>(spec.sky);
+  return PickSensLoop<RcShape::kTwoCapacitiveBoth>(spec.sky, electric);
 }
 
 }  // namespace
 
 std::size_t MaxSensitivityParams() { return kMaxCols; }
 
+std::vector<Param> HookParams(const ModelSpec& spec) {
+  std::vector<Param> out;
+  for (const ModelExtension* e : spec.extensions) {
+    for (const std::vector<Param>* list : {&e->params, &e->reads_base_params}) {
+      for (Param p : *list) {
+        if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
+      }
+    }
+  }
+  return out;
+}
+
 bool SensitivitiesSupported(const ModelSpec& spec, std::span<const Param> wrt, std::string* why) {
   auto fail = [why](const std::string& reason) {
     if (why != nullptr) *why = reason;
     return false;
   };
-  if (!spec.extensions.empty()) {
-    return fail(spec.Name() + ": effect extensions have no sensitivities (finite differences)");
+  for (const ModelExtension* e : spec.extensions) {
+    if (e->transform_outputs != nullptr && !e->outputs_affine) {
+      return fail(spec.Name() + ": +" + std::string(e->name) +
+                  " transforms the outputs, not affinely: no sensitivities (finite differences)");
+    }
+  }
+  const std::vector<Param> hook = HookParams(spec);
+  for (Param p : wrt) {
+    if (std::find(hook.begin(), hook.end(), p) != hook.end()) {
+      return fail(std::string(Info(p).name) + " is read by an effect's hook in " + spec.Name() +
+                  ": no sensitivity (finite differences)");
+    }
   }
   if (wrt.size() > MaxSensitivityParams()) {
     return fail(std::to_string(wrt.size()) + " parameters: at most " +
@@ -419,12 +569,18 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
   out->rows = n;
   for (auto* v : {&out->p_el_w, &out->q_th_w, &out->t_pv_c}) v->resize(n);
   for (auto* v : {&out->dp_el_w, &out->dq_th_w, &out->dt_pv_c}) v->resize(n * wrt.size());
+  const bool outlet = std::any_of(d.spec.extensions.begin(), d.spec.extensions.end(),
+                                  [](const ModelExtension* e) { return e->transform_outputs; });
+  if (outlet) {
+    for (auto* v : {&out->t_coll_c, &out->t_out_c}) v->resize(n);
+    for (auto* v : {&out->dt_coll_c, &out->dt_out_c}) v->resize(n * wrt.size());
+  }
   const RunConstants k = MakeConstants(d, params);
   RunInputs w;
-  SimOutputs unused_work;  // no extension: the hooks' work space stays empty
-  MakeRunInputs(d, params, &unused_work, &w);
-  const SensRun run{d, k, w, wrt, static_cast<int>(wrt.size())};
-  PickSensLoop(d.spec)(run, out);
+  MakeRunInputs(d, params, &out->hook_work, &w);
+  const SensRun run{d, k, w, wrt, static_cast<int>(wrt.size()), outlet};
+  PickSensLoop(d.spec, w.electric_effects)(run, out);
+  if (outlet) PushThroughOutputTransforms(d, params, &w, out);
   return true;
 }
 

@@ -24,8 +24,17 @@
 // order). The pass count changes with the parameters in steps; there
 // Simulate jumps (far below kNodeToleranceK) and has no derivative.
 //
-// Supported: the variants without extensions (so without electric effects),
-// every network shape. Parameters the variant does not use get zero columns.
+// Supported: every network shape, and effect extensions that change the
+// run's per-row inputs (ModelExtension::transform_drivers), electric effects
+// included: the run takes the inputs as the hooks leave them, so the
+// columns of the parameters no hook reads stay exact. The parameters a hook
+// reads (HookParams) have no column; the caller differences them (a mixed
+// Jacobian, core/fit/identification.cc). An extension that transforms the
+// outputs affinely (ModelExtension::outputs_affine: transport_delay's sensor
+// behind a pipe) gets the derivatives pushed through its hook: with y the
+// outputs and d a column, T(y + s·d) − T(y) = s·T'd exactly for an affine T,
+// one hook call per column. Parameters the variant does not use get zero
+// columns.
 #pragma once
 
 #include <cstddef>
@@ -50,10 +59,24 @@ struct SimSensitivities {
   const double* DPEl(std::size_t j) const { return dp_el_w.data() + j * rows; }
   const double* DQTh(std::size_t j) const { return dq_th_w.data() + j * rows; }
   const double* DTPv(std::size_t j) const { return dt_pv_c.data() + j * rows; }
+
+  // With an extension that transforms the outputs: the collector node's and
+  // the outlet's temperature before the transform, with their derivatives
+  // (same layout), which the transform reads.
+  std::vector<double> t_coll_c, t_out_c, dt_coll_c, dt_out_c;
+
+  // Work space of the extensions' hooks, and the outputs pushed through
+  // transform_outputs (kept between runs).
+  SimOutputs hook_work, pushed;
 };
 
 // Most parameters one sensitivity run differentiates for.
 std::size_t MaxSensitivityParams();
+
+// The parameters the spec's extension hooks read: each extension's own and
+// the base model's it declares (ModelExtension::reads_base_params). A run
+// with sensitivities has no column for them.
+std::vector<Param> HookParams(const ModelSpec& spec);
 
 // True when SimulateSensitivities handles `spec` with these parameters;
 // otherwise *why (may be null) says why (the caller then takes finite

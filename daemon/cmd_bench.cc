@@ -82,13 +82,12 @@ void BenchSimulation(const BenchArgs& a) {
                 median * 1e9 / static_cast<double>(series.size()));
     // The default free parameters that no effect hook reads: the columns
     // of the run with sensitivities (identification differences the rest).
-    std::vector<Param> wrt;
+    std::vector<Param> free_params;
     const auto free = DefaultFreeParams(spec);
-    const std::vector<Param> hook = HookParams(spec);
     for (std::size_t i = 0; i < kNumParams; ++i) {
-      const auto p = static_cast<Param>(i);
-      if (free.test(i) && std::find(hook.begin(), hook.end(), p) == hook.end()) wrt.push_back(p);
+      if (free.test(i)) free_params.push_back(static_cast<Param>(i));
     }
+    const std::vector<Param> wrt = WithoutHookParams(spec, free_params);
     if (SensitivitiesSupported(spec, wrt, nullptr)) {
       SimSensitivities sens;
       const double sens_s =

@@ -524,6 +524,15 @@ SensLoop PickSensLoop(const ModelSpec& spec, bool electric) {
 
 std::size_t MaxSensitivityParams() { return kMaxCols; }
 
+std::vector<Param> WithoutHookParams(const ModelSpec& spec, std::span<const Param> params) {
+  const std::vector<Param> hook = HookParams(spec);
+  std::vector<Param> out;
+  for (Param p : params) {
+    if (std::find(hook.begin(), hook.end(), p) == hook.end()) out.push_back(p);
+  }
+  return out;
+}
+
 std::vector<Param> HookParams(const ModelSpec& spec) {
   std::vector<Param> out;
   for (const ModelExtension* e : spec.extensions) {
@@ -569,8 +578,9 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
   out->rows = n;
   for (auto* v : {&out->p_el_w, &out->q_th_w, &out->t_pv_c}) v->resize(n);
   for (auto* v : {&out->dp_el_w, &out->dq_th_w, &out->dt_pv_c}) v->resize(n * wrt.size());
-  const bool outlet = std::any_of(d.spec.extensions.begin(), d.spec.extensions.end(),
-                                  [](const ModelExtension* e) { return e->transform_outputs; });
+  const bool outlet =
+      std::any_of(d.spec.extensions.begin(), d.spec.extensions.end(),
+                  [](const ModelExtension* e) { return e->transform_outputs != nullptr; });
   if (outlet) {
     for (auto* v : {&out->t_coll_c, &out->t_out_c}) v->resize(n);
     for (auto* v : {&out->dt_coll_c, &out->dt_out_c}) v->resize(n * wrt.size());

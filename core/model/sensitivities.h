@@ -78,6 +78,10 @@ std::size_t MaxSensitivityParams();
 // with sensitivities has no column for them.
 std::vector<Param> HookParams(const ModelSpec& spec);
 
+// `params` without the HookParams of `spec`: the ones a run with
+// sensitivities can differentiate for.
+std::vector<Param> WithoutHookParams(const ModelSpec& spec, std::span<const Param> params);
+
 // True when SimulateSensitivities handles `spec` with these parameters;
 // otherwise *why (may be null) says why (the caller then takes finite
 // differences of Simulate).

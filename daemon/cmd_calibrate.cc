@@ -352,8 +352,8 @@ void RegisterCalibrate(CLI::App& app) {
                   "mlsl_bobyqa");
   cmd->add_option("--jacobian", args->jacobian,
                   "how lad_lm (and the gradient methods lbfgs, mma) get their derivatives: "
-                  "sensitivities (default: the model run with exact derivatives, where the variant "
-                  "supports it; variants with effect extensions fall back to differences) or "
+                  "sensitivities (default: the model run with exact derivatives; the parameters an "
+                  "effect's hook reads take differences from it, one run each) or "
                   "differences (forward differences, one model run per free parameter)")
       ->check(CLI::IsMember({"sensitivities", "differences"}));
   cmd->add_option("--free", args->free,

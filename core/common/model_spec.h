@@ -20,7 +20,7 @@
 
 namespace pvtwin {
 
-class Series;
+struct Series;
 struct Drivers;
 struct RunInputs;
 struct SimOutputs;

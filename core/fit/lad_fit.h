@@ -51,6 +51,11 @@ struct LadFitOptions {
   // for the budget; ignored without one (forward differences: one per
   // parameter).
   int jacobian_cost = 1;
+  // An accepted step s is stretched to the minimiser of the objective along
+  // its line, z + α·s with 1 < α ≤ max_stretch, predicted from the
+  // residuals at both ends and checked with one more run (kept only if
+  // lower). ≤ 1: never stretched.
+  double max_stretch = 4.0;
 };
 
 struct LadFitResult {
@@ -59,6 +64,7 @@ struct LadFitResult {
   double final_cost = 0.0;
   int iterations = 0;
   int evaluations = 0;
+  int stretched = 0;  // accepted steps whose stretch (max_stretch) was kept
   bool converged = false;
   std::string message;
   // The last Jacobian computed (rows × free parameters), for the caller's

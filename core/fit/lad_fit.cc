@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -62,6 +63,19 @@ struct Majoriser {
   Eigen::MatrixXd h, h_movable;
   Eigen::VectorXd g, g_movable;
   std::vector<Eigen::Index> movable;
+
+  // H and g at z from the Jacobian, the IRLS weights and the residuals
+  // there (`block`: WeightedNormalEquations' buffer).
+  void Build(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w, const Eigen::VectorXd& r,
+             const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref, const LadFitOptions& o,
+             Eigen::MatrixXd* block) {
+    WeightedNormalEquations(jac, w, r, block, &h, &g);
+    h /= o.n_scale;
+    g /= o.n_scale;
+    h.diagonal().array() += 2.0 * o.prior_weight;
+    g += 2.0 * o.prior_weight * (z - z_ref);
+    SetMovable(z);
+  }
 
   void SetMovable(const Eigen::VectorXd& z) {
     movable.clear();
@@ -147,6 +161,21 @@ double LineMinimiser(const Eigen::VectorXd& r0, const Eigen::VectorXd& d, const 
   return 0.5 * (lo + hi);
 }
 
+// Forward-difference Jacobian at z (residuals r), stepping inwards at the
+// upper bound; a non-finite column gives no direction.
+void ForwardDifferences(const ResidualFunction& residuals, const Eigen::VectorXd& z,
+                        const Eigen::VectorXd& r, const LadFitOptions& o, Eigen::MatrixXd* jac,
+                        Eigen::VectorXd* r_step, LadFitResult* res) {
+  for (Eigen::Index j = 0; j < z.size(); ++j) {
+    Eigen::VectorXd zp = z;
+    const double h = z(j) + o.jacobian_step <= 1.0 ? o.jacobian_step : -o.jacobian_step;
+    zp(j) += h;
+    ++res->evaluations;
+    if (!residuals(zp, r_step)) *r_step = r;
+    jac->col(j) = (*r_step - r) / h;
+  }
+}
+
 // An accepted step from z (residuals r_z) to *z_to (residuals *r_to, cost
 // *cost_to): the IRLS majoriser overstates the curvature of the L1
 // objective (weights 1/|r| against a density of residuals near zero), so
@@ -205,6 +234,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   Eigen::VectorXd z_jac;
   double floor_rel = o.weight_floor_rel;
   int small_in_a_row = 0;  // accepted steps in a row that lowered O by less than ftol
+  double gain_per_promise = std::numeric_limits<double>::infinity();  // of the last accepted step
   const Eigen::Index jacobian_cost = jacobian ? o.jacobian_cost : n;
   for (int it = 0; it < o.max_iterations; ++it) {
     const bool jacobian_due = !(have_jac && z == z_jac);
@@ -222,24 +252,28 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     } else if (jacobian && jacobian(z, r, &jac)) {
       res.evaluations += static_cast<int>(jacobian_cost);
     } else {
-      // Forward-difference Jacobian, stepping inwards at the upper bound.
-      for (Eigen::Index j = 0; j < n; ++j) {
-        Eigen::VectorXd zp = z;
-        const double h = z(j) + o.jacobian_step <= 1.0 ? o.jacobian_step : -o.jacobian_step;
-        zp(j) += h;
-        if (!eval(zp, &r_step)) r_step = r;  // a non-finite column gives no direction
-        jac.col(j) = (r_step - r) / h;
-      }
+      ForwardDifferences(residuals, z, r, o, &jac, &r_step, &res);
     }
     have_jac = true;
     z_jac = z;
-    WeightedNormalEquations(jac, w, r, &weighted_block, &maj.h, &maj.g);
-    maj.h /= o.n_scale;
-    maj.g /= o.n_scale;
-    maj.h.diagonal().array() += 2.0 * o.prior_weight;
-    maj.g += 2.0 * o.prior_weight * (z - z_ref);
-    maj.SetMovable(z);
+    maj.Build(jac, w, r, z, z_ref, o, &weighted_block);
     const double promised = maj.Promised();
+    // A step predicted to gain less than the stop below asks of a decrease
+    // ends the fit before it is tried: the result then sits where its
+    // Jacobian was taken, which the caller's identifiability analysis
+    // reuses, instead of one short step away. The prediction is the
+    // undamped promise times what the last accepted step gained per unit
+    // of its promise (the majoriser understates the gain, about 2.5 times
+    // for noise-like residuals, far more while its weight floor smooths a
+    // kink away); no prediction before the first accepted step, nor once
+    // the weight floor has been sharpened (the fit is then after a kink the
+    // smoothing hid, which no promise foresees).
+    if (o.stop_promise_factor > 0.0 && floor_rel == o.weight_floor_rel &&
+        promised * gain_per_promise <= o.stop_promise_factor * o.ftol_rel * cost) {
+      res.converged = true;
+      res.message = "the next step is predicted to gain less than ftol";
+      break;
+    }
     bool accepted = false;
     double step_norm = 0.0;
     double new_cost = cost;
@@ -252,7 +286,13 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
       }
       new_cost = Objective(r_trial, z_new, z_ref, o);
       if (new_cost < cost) {
-        StretchStep(residuals, z, r, z_ref, o, &z_new, &r_trial, &new_cost, &r_step, &res);
+        // A step whose undamped promise is already below the stop's is a
+        // polish: stretching it gains less than ftol and moves the result
+        // away from the last Jacobian, which the caller's identifiability
+        // analysis reuses when the result is close to it.
+        if (!(promised <= o.stop_promise_factor * o.ftol_rel * cost)) {
+          StretchStep(residuals, z, r, z_ref, o, &z_new, &r_trial, &new_cost, &r_step, &res);
+        }
         step_norm = (z_new - z).cwiseAbs().maxCoeff();
         z = z_new;
         r.swap(r_trial);
@@ -277,6 +317,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
       break;
     }
     const double decrease = cost - new_cost;
+    gain_per_promise = promised > 0.0 ? std::max(decrease / promised, 1.0)
+                                      : std::numeric_limits<double>::infinity();
     cost = new_cost;
     if (step_norm <= o.xtol && floor_rel > 1e-6) {  // stalled on the smoothing
       floor_rel *= 0.1;

@@ -199,27 +199,34 @@ TEST(LadFit, TakesEachJacobianOnceAndReturnsTheLast) {
   EXPECT_DOUBLE_EQ(res.jacobian(0, 0), 1.0 + static_cast<double>(points.size()));
 }
 
-// Many rows with Gaussian noise, as the plant's residuals are: the IRLS
-// weights 1/max(|r|, δ) overstate the curvature of the L1 sum about 2.5
-// times, so each unstretched step covers about 0.4 of the way to the
-// optimum along its line. The stretch to the line's predicted minimiser
-// closes most of the rest with one more evaluation.
-TEST(LadFit, StretchedStepsCloseTheGapTheWeightsLeave) {
+// A line through 4000 rows with Gaussian noise (the plant's residuals near
+// the optimum are mostly noise); residuals of z = (intercept, slope).
+ResidualFunction NoisyLine(std::vector<double>* x, std::vector<double>* y) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> noise(0.0, 0.02);
-  std::vector<double> x(4000), y(4000);
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    x[i] = u(rng);
-    y[i] = 0.3 + 0.45 * x[i] + noise(rng);
+  x->resize(4000);
+  y->resize(4000);
+  for (std::size_t i = 0; i < x->size(); ++i) {
+    (*x)[i] = u(rng);
+    (*y)[i] = 0.3 + 0.45 * (*x)[i] + noise(rng);
   }
-  ResidualFunction f = [&](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
-    r->resize(static_cast<Eigen::Index>(x.size()));
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      (*r)(static_cast<Eigen::Index>(i)) = z(0) + z(1) * x[i] - y[i];
+  return [x, y](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
+    r->resize(static_cast<Eigen::Index>(x->size()));
+    for (std::size_t i = 0; i < x->size(); ++i) {
+      (*r)(static_cast<Eigen::Index>(i)) = z(0) + z(1) * (*x)[i] - (*y)[i];
     }
     return true;
   };
+}
+
+// On the noisy line the IRLS weights 1/max(|r|, δ) overstate the curvature
+// of the L1 sum about 2.5 times, so each unstretched step covers about 0.4
+// of the way to the optimum along its line. The stretch to the line's
+// predicted minimiser closes most of the rest with one more evaluation.
+TEST(LadFit, StretchedStepsCloseTheGapTheWeightsLeave) {
+  std::vector<double> x, y;
+  const ResidualFunction f = NoisyLine(&x, &y);
   LadFitOptions o;
   o.n_scale = static_cast<double>(x.size());
   o.ftol_rel = 1e-14;
@@ -238,6 +245,38 @@ TEST(LadFit, StretchedStepsCloseTheGapTheWeightsLeave) {
               gap_stretched, stretched.evaluations, gap_plain, plain.evaluations);
   EXPECT_GE(gap_stretched, -1e-12);
   EXPECT_LT(gap_stretched, 0.1 * gap_plain);
+}
+
+// A fit ends where its last Jacobian was taken when the next step is
+// predicted to gain less than ftol (its undamped promise times what the
+// last step gained per unit of promise), instead of taking that step and
+// leaving the caller's identifiability analysis a Jacobian one step back.
+// The end is still within ftol of the optimum.
+TEST(LadFit, EndsAtItsLastJacobianWhenTheNextStepCannotGainFtol) {
+  std::vector<double> x, y;
+  const ResidualFunction f = NoisyLine(&x, &y);
+  JacobianFunction jacobian = [&x](const Eigen::VectorXd&, const Eigen::VectorXd&,
+                                   Eigen::MatrixXd* jac) {
+    jac->resize(static_cast<Eigen::Index>(x.size()), 2);
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      (*jac)(static_cast<Eigen::Index>(i), 0) = 1.0;
+      (*jac)(static_cast<Eigen::Index>(i), 1) = x[i];
+    }
+    return true;
+  };
+  LadFitOptions o;
+  o.n_scale = static_cast<double>(x.size());
+  o.ftol_rel = 1e-14;
+  o.xtol = 1e-14;
+  const Eigen::Vector2d start(0.1, 0.9);
+  const double optimum = LadFit(f, start, Eigen::Vector2d::Zero(), o, jacobian).final_cost;
+  o.ftol_rel = 1e-3;
+  o.xtol = 1e-7;
+  const LadFitResult res = LadFit(f, start, Eigen::Vector2d::Zero(), o, jacobian);
+  EXPECT_TRUE(res.converged) << res.message;
+  EXPECT_NE(res.message.find("predicted"), std::string::npos) << res.message;
+  EXPECT_EQ(res.jacobian_distance, 0.0);
+  EXPECT_LE(res.final_cost - optimum, 1e-3 * optimum);
 }
 
 TEST(LadFit, NonFiniteStartIsReported) {

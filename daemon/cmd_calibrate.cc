@@ -364,8 +364,9 @@ void RegisterCalibrate(CLI::App& app) {
   cmd->add_option("--max-evaluations", args->max_evaluations, "simulation budget of the fit");
   cmd->add_option("--ftol", args->ftol_rel,
                   "stop when an iteration lowers the MAE by less than this fraction and, for "
-                  "lad_lm, its undamped step promised less than 0.3 times that (default 1e-3; "
-                  "1e-4 takes longer for a held-out MAE 0.1 % lower on synthetic data)")
+                  "lad_lm, its undamped step promised less than 0.3 times that, or before a "
+                  "step predicted to gain less (default 1e-3; on synthetic data 1e-4 takes "
+                  "longer for a held-out MAE within 0.05 % of the default's)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--parent-pid", args->parent_pid,
                   "exit when the process with this pid ends (used by pvtwin run for its "

@@ -258,6 +258,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     z_jac = z;
     maj.Build(jac, w, r, z, z_ref, o, &weighted_block);
     const double promised = maj.Promised();
+    // What the stop below asks of an undamped promise (of this cost).
+    const double small_promise = o.stop_promise_factor * o.ftol_rel * cost;
     // A step predicted to gain less than the stop below asks of a decrease
     // ends the fit before it is tried: the result then sits where its
     // Jacobian was taken, which the caller's identifiability analysis
@@ -269,7 +271,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     // the weight floor has been sharpened (the fit is then after a kink the
     // smoothing hid, which no promise foresees).
     if (o.stop_promise_factor > 0.0 && floor_rel == o.weight_floor_rel &&
-        promised * gain_per_promise <= o.stop_promise_factor * o.ftol_rel * cost) {
+        promised * gain_per_promise <= small_promise) {
       res.converged = true;
       res.message = "the next step is predicted to gain less than ftol";
       break;
@@ -290,7 +292,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
         // polish: stretching it gains less than ftol and moves the result
         // away from the last Jacobian, which the caller's identifiability
         // analysis reuses when the result is close to it.
-        if (!(promised <= o.stop_promise_factor * o.ftol_rel * cost)) {
+        if (!(promised <= small_promise)) {
           StretchStep(residuals, z, r, z_ref, o, &z_new, &r_trial, &new_cost, &r_step, &res);
         }
         step_norm = (z_new - z).cwiseAbs().maxCoeff();

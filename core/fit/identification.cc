@@ -469,6 +469,7 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
     lo.xtol = options.optimizer.xtol_rel;
     lo.prior_weight = options.prior_weight_w_m2;
     lo.n_scale = n_rows;
+    if (!options.correct_bends) lo.max_correction = 0.0;
     Eigen::VectorXd z0(static_cast<Eigen::Index>(n)), zr(static_cast<Eigen::Index>(n));
     for (std::size_t j = 0; j < n; ++j) {
       z0(static_cast<Eigen::Index>(j)) = ToUnit(infos[j], x0[j]);

@@ -105,6 +105,11 @@ struct IdentOptions {
   // given from that result; 0 or a step not at least twice the data step
   // disables the coarse stage.
   double coarse_step_s = 300.0;
+  // lad_lm corrects its trial steps for the bend of the residuals along
+  // them (LadFitOptions::max_correction, geodesic acceleration). The coarse
+  // stage sets it for its rungs: they walk the curved valley from the
+  // start; the fit on the data as given polishes without it (core/fit/README.md).
+  bool correct_bends = false;
   // Fewest objective rows accepted.
   int min_rows = 30;
   // Take lad_lm's Jacobian, the gradient of NLopt's gradient methods (kLbfgs,

@@ -176,6 +176,53 @@ void ForwardDifferences(const ResidualFunction& residuals, const Eigen::VectorXd
   }
 }
 
+// The trial z + v (residuals r_trial, cost *trial_cost) corrected for the
+// bend of the residuals along v (LadFitOptions::max_correction): the
+// majoriser's step for e = r_trial − r − J·v over the parameters v moves,
+// with the trial's damping. The corrected point replaces the trial if it
+// is lower (then returns true). `bend` is scratch of the rows' size.
+bool CorrectForBend(const ResidualFunction& residuals, const Eigen::VectorXd& z,
+                    const Eigen::VectorXd& r, const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
+                    const Eigen::MatrixXd& h, double lambda, const Eigen::VectorXd& z_ref,
+                    const LadFitOptions& o, Eigen::VectorXd* z_trial, Eigen::VectorXd* r_trial,
+                    double* trial_cost, Eigen::VectorXd* bend, Eigen::VectorXd* r_scratch,
+                    LadFitResult* res) {
+  if (!(o.max_correction > 0.0) || res->evaluations >= o.max_evaluations) return false;
+  const Eigen::VectorXd v = *z_trial - z;
+  std::vector<Eigen::Index> moved;
+  for (Eigen::Index j = 0; j < v.size(); ++j) {
+    if (v(j) != 0.0) moved.push_back(j);
+  }
+  if (moved.empty()) return false;
+  bend->noalias() = *r_trial - r;
+  bend->noalias() -= jac * v;
+  bend->array() *= w.array();
+  const Eigen::VectorXd jwe = jac.transpose() * *bend / o.n_scale;
+  const auto m = static_cast<Eigen::Index>(moved.size());
+  Eigen::MatrixXd h_moved(m, m);
+  Eigen::VectorXd jwe_moved(m);
+  for (Eigen::Index a = 0; a < m; ++a) {
+    jwe_moved(a) = jwe(moved[static_cast<std::size_t>(a)]);
+    for (Eigen::Index b = 0; b < m; ++b) {
+      h_moved(a, b) = h(moved[static_cast<std::size_t>(a)], moved[static_cast<std::size_t>(b)]);
+    }
+  }
+  const Eigen::VectorXd c_moved = DampedStep(h_moved, jwe_moved, lambda);
+  const double ratio = c_moved.cwiseAbs().maxCoeff() / v.cwiseAbs().maxCoeff();
+  if (!(ratio >= o.min_correction && ratio <= o.max_correction)) return false;
+  Eigen::VectorXd z_c = *z_trial;
+  for (Eigen::Index a = 0; a < m; ++a) z_c(moved[static_cast<std::size_t>(a)]) += c_moved(a);
+  z_c = z_c.cwiseMax(0.0).cwiseMin(1.0);
+  ++res->evaluations;
+  if (!residuals(z_c, r_scratch)) return false;
+  const double c_cost = Objective(*r_scratch, z_c, z_ref, o);
+  if (!(c_cost < *trial_cost)) return false;
+  *z_trial = z_c;
+  r_trial->swap(*r_scratch);
+  *trial_cost = c_cost;
+  return true;
+}
+
 // An accepted step from z (residuals r_z) to *z_to (residuals *r_to, cost
 // *cost_to): the IRLS majoriser overstates the curvature of the L1
 // objective (weights 1/|r| against a density of residuals near zero), so
@@ -212,7 +259,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   LadFitResult res;
   const Eigen::Index n = z0.size();
   Eigen::VectorXd z = z0.cwiseMax(0.0).cwiseMin(1.0);
-  Eigen::VectorXd r, r_trial, r_step;
+  Eigen::VectorXd r, r_trial, r_step, bend;
   auto eval = [&](const Eigen::VectorXd& at, Eigen::VectorXd* out) {
     ++res.evaluations;
     return residuals(at, out);
@@ -287,7 +334,10 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
         continue;
       }
       new_cost = Objective(r_trial, z_new, z_ref, o);
+      const bool corrected = CorrectForBend(residuals, z, r, jac, w, maj.h, lambda, z_ref, o,
+                                            &z_new, &r_trial, &new_cost, &bend, &r_step, &res);
       if (new_cost < cost) {
+        if (corrected) ++res.corrected;
         // A step whose undamped promise is already below the stop's is a
         // polish: stretching it gains less than ftol and moves the result
         // away from the last Jacobian, which the caller's identifiability

@@ -60,6 +60,19 @@ struct LadFitOptions {
   // residuals at both ends and checked with one more run (kept only if
   // lower). ≤ 1: never stretched.
   double max_stretch = 4.0;
+  // A trial step v from z also shows how the residuals bend away from
+  // their linearisation along it: e = r(z + v) − r(z) − J·v ≈ ½·vᵀ∇²r·v.
+  // The majoriser's step for that bend, c = −(H + λD)⁻¹·JᵀW·e / N_scale
+  // over the parameters v moves, is the second-order correction of
+  // geodesic acceleration (Transtrum & Sethna, arXiv:1201.5885) with its
+  // finite-difference step at 1, so that the trial's own run provides it.
+  // The corrected point z + v + c is tried with one more run when
+  // min_correction ≤ |c|/|v| ≤ max_correction (max norms) and kept if
+  // lower than the trial: in a curved valley (the r0_fluid/r1_fluid one)
+  // plain steps leave the valley floor and are cut short by the damping.
+  // max_correction ≤ 0: never corrected.
+  double max_correction = 3.0;
+  double min_correction = 0.1;  // a smaller correction is not worth its run
 };
 
 struct LadFitResult {
@@ -69,6 +82,7 @@ struct LadFitResult {
   int iterations = 0;
   int evaluations = 0;
   int stretched = 0;  // accepted steps whose stretch (max_stretch) was kept
+  int corrected = 0;  // trials whose correction for the bend (max_correction) was kept
   bool converged = false;
   std::string message;
   // The last Jacobian computed (rows × free parameters), for the caller's

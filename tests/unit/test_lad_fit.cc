@@ -107,6 +107,42 @@ TEST(LadFit, StopWaitsForTheUndampedPromiseInACurvedValley) {
   EXPECT_LT(guarded.final_cost, plain.final_cost);
 }
 
+// Residuals that bend along the step: r_i = u(z) + e_i with
+// u(z) = (z − 0.3) + 2·(z − 0.3)² and offsets e_i symmetric about zero, so
+// that the L1 optimum is u = 0, z = 0.3 (the other root lies outside the
+// box). From z = 0.9 the linearised step lands at z ≈ 0.51, where u has
+// kept 0.30 of its 1.32; the bend it saw there, e = 2·v², corrects the
+// step to z ≈ 0.42 (u ≈ 0.15), as geodesic acceleration's second-order
+// term does. One iteration, without the stretch so that only the
+// correction differs.
+TEST(LadFit, CorrectionForTheBendOfTheResidualsAlongTheStep) {
+  std::vector<double> offsets;
+  for (int k = -10; k <= 10; ++k) offsets.push_back(1e-3 * k);
+  ResidualFunction f = [&](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
+    const double d = z(0) - 0.3;
+    r->resize(static_cast<Eigen::Index>(offsets.size()));
+    for (std::size_t k = 0; k < offsets.size(); ++k) {
+      (*r)(static_cast<Eigen::Index>(k)) = d + 2.0 * d * d + offsets[k];
+    }
+    return true;
+  };
+  LadFitOptions o;
+  o.max_iterations = 1;
+  o.max_stretch = 1.0;
+  const Eigen::VectorXd start = Eigen::VectorXd::Constant(1, 0.9);
+  const LadFitResult corrected = LadFit(f, start, Eigen::VectorXd::Zero(1), o);
+  o.max_correction = 0.0;
+  const LadFitResult plain = LadFit(f, start, Eigen::VectorXd::Zero(1), o);
+  std::printf("one step from 0.9 towards 0.3: plain to %.4f, corrected to %.4f\n", plain.z(0),
+              corrected.z(0));
+  EXPECT_EQ(corrected.corrected, 1);
+  EXPECT_EQ(plain.corrected, 0);
+  EXPECT_NEAR(plain.z(0), 0.9 - 1.32 / 3.4, 0.01);  // the Gauss–Newton step
+  const double v = 1.32 / 3.4;
+  EXPECT_NEAR(corrected.z(0), 0.9 - v - 2.0 * v * v / 3.4, 0.01);  // … corrected for e = 2·v²
+  EXPECT_LT(corrected.final_cost, 0.6 * plain.final_cost);
+}
+
 // A line a + b·x through data whose unconstrained fit has a < 0, with x far
 // from zero so that a and b are strongly coupled: on the box a stays at 0
 // and b alone fits, its L1 optimum the weighted median of y_i/x_i (weights

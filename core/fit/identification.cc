@@ -708,6 +708,7 @@ int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOpt
   coarse.coarse_step_s =
       options.coarse_step_s > 60.0 && drivers.dt_s[0] < 30.0 ? options.coarse_step_s : 0.0;
   coarse.fix_unidentifiable = false;
+  coarse.correct_bends = true;
   coarse.optimizer.ftol_rel = std::max(options.optimizer.ftol_rel, 1e-3);
   coarse.optimizer.max_evaluations = options.optimizer.max_evaluations / 4;
   const IdentSummary cs = Identify(cd, cm, fs.base, coarse);

@@ -83,15 +83,8 @@ struct Majoriser {
       const bool pinned = (z(j) <= 0.0 && g(j) > 0.0) || (z(j) >= 1.0 && g(j) < 0.0);
       if (!pinned) movable.push_back(j);
     }
-    const auto m = static_cast<Eigen::Index>(movable.size());
-    h_movable.resize(m, m);
-    g_movable.resize(m);
-    for (Eigen::Index a = 0; a < m; ++a) {
-      const Eigen::Index ja = movable[static_cast<std::size_t>(a)];
-      g_movable(a) = g(ja);
-      for (Eigen::Index b = 0; b < m; ++b)
-        h_movable(a, b) = h(ja, movable[static_cast<std::size_t>(b)]);
-    }
+    h_movable = h(movable, movable);
+    g_movable = g(movable);
   }
 
   // What the undamped step promises over the movable parameters, ½·gᵀH⁻¹g.
@@ -113,8 +106,7 @@ struct Majoriser {
     if (movable.empty() || movable.size() == static_cast<std::size_t>(z.size())) return z_all;
     const Eigen::VectorXd step_movable = DampedStep(h_movable, g_movable, lambda);
     Eigen::VectorXd z_movable = z;
-    for (std::size_t a = 0; a < movable.size(); ++a)
-      z_movable(movable[a]) += step_movable(static_cast<Eigen::Index>(a));
+    z_movable(movable) += step_movable;
     z_movable = z_movable.cwiseMax(0.0).cwiseMin(1.0);
     return ModelChange(h, g, z_movable - z) < ModelChange(h, g, z_all - z) ? z_movable : z_all;
   }
@@ -198,20 +190,11 @@ bool CorrectForBend(const ResidualFunction& residuals, const Eigen::VectorXd& z,
   bend->noalias() -= jac * v;
   bend->array() *= w.array();
   const Eigen::VectorXd jwe = jac.transpose() * *bend / o.n_scale;
-  const auto m = static_cast<Eigen::Index>(moved.size());
-  Eigen::MatrixXd h_moved(m, m);
-  Eigen::VectorXd jwe_moved(m);
-  for (Eigen::Index a = 0; a < m; ++a) {
-    jwe_moved(a) = jwe(moved[static_cast<std::size_t>(a)]);
-    for (Eigen::Index b = 0; b < m; ++b) {
-      h_moved(a, b) = h(moved[static_cast<std::size_t>(a)], moved[static_cast<std::size_t>(b)]);
-    }
-  }
-  const Eigen::VectorXd c_moved = DampedStep(h_moved, jwe_moved, lambda);
+  const Eigen::VectorXd c_moved = DampedStep(h(moved, moved), jwe(moved), lambda);
   const double ratio = c_moved.cwiseAbs().maxCoeff() / v.cwiseAbs().maxCoeff();
   if (!(ratio >= o.min_correction && ratio <= o.max_correction)) return false;
   Eigen::VectorXd z_c = *z_trial;
-  for (Eigen::Index a = 0; a < m; ++a) z_c(moved[static_cast<std::size_t>(a)]) += c_moved(a);
+  z_c(moved) += c_moved;
   z_c = z_c.cwiseMax(0.0).cwiseMin(1.0);
   ++res->evaluations;
   if (!residuals(z_c, r_scratch)) return false;

@@ -31,12 +31,12 @@ std::string ChannelList(const std::vector<Channel>& channels) {
 // geometry at the row middles, measured wind and sky temperature, the beam
 // part of the absorbed irradiance, the transposed GHI/DHI and the soiling
 // clock.
-void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d) {
+void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
+                       std::span<const SolarPosition> sun, Drivers* d) {
   const std::size_t n = s.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   d->wind_m_s = s.Has(Channel::kWindMS) ? s[Channel::kWindMS] : std::vector<double>(n, nan);
   d->t_sky_c = SkyTemperaturesC(s, plant, &d->sky_note);
-  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   d->sun_azimuth_rad.resize(n);
   d->sun_elevation_rad.resize(n);
   d->aoi_rad.resize(n);
@@ -254,8 +254,9 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
     out.capacity_flow_w_k[i] = out.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
   }
 
-  ComputeIrradianceDrivers(s, plant, spec, &out.g_poa_w_m2, &out.g_abs_w_m2, &out.iam_parts);
-  FillEffectDrivers(s, plant, spec, &out);
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
+  ComputeIrradianceDrivers(s, plant, spec, sun, &out.g_poa_w_m2, &out.g_abs_w_m2, &out.iam_parts);
+  FillEffectDrivers(s, plant, spec, sun, &out);
   SetCleanings(DetectCleanings(s, plant), &out);
   for (const ModelExtension* e : spec.extensions) {
     if (e->prepare_drivers != nullptr && !e->prepare_drivers(s, &out, error)) return false;

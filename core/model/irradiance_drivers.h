@@ -3,6 +3,7 @@
 // absorbed irradiance I_at (paper 2.5; equal to I_gt without the 'I' option).
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "core/common/model_data.h"
@@ -25,9 +26,10 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant);
 //    Souka & Safwat IAM at its angle (aoi_deg when measured, else computed;
 //    Brandemuehl & Beckman angles for sky and ground diffuse).
 // Rows whose inputs are missing get NaN. With 'I' and parts non-null, also
-// the parts before the IAM (Drivers::IamParts).
+// the parts before the IAM (Drivers::IamParts). `sun` is SunAtRowMiddles(s,
+// plant), computed once by the caller, who needs it too.
 void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
-                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2,
-                              Drivers::IamParts* parts = nullptr);
+                              std::span<const SolarPosition> sun, std::vector<double>* g_poa_w_m2,
+                              std::vector<double>* g_abs_w_m2, Drivers::IamParts* parts = nullptr);
 
 }  // namespace pvtwin

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 
@@ -403,13 +404,36 @@ void ComputeGeocentric(double time_s, double delta_t_s, SolarPositionTrace* t) {
                                             std::cos(geo_latitude_rad) * sin_eps * sin_lambda);
 }
 
+// The observer's terms of steps 3.11 and 3.14 that depend on the site alone
+// (eqs. 34–37 and sin φ, cos φ): computed once for a run of positions.
+struct SiteTerms {
+  double x = 0.0, y = 0.0;  // observer's geocentric position terms (eqs. 36, 37)
+  double sin_lat = 0.0, cos_lat = 0.0;
+};
+
+SiteTerms ComputeSiteTerms(const SolarPositionInput& site) {
+  // Ellipsoid with flattening ratio 0.99664719 and equatorial radius 6378140 m.
+  constexpr double kPolarToEquatorialRatio = 0.99664719;
+  constexpr double kEquatorialRadiusM = 6378140.0;
+  const double lat_rad = site.latitude_rad;
+  const double u_rad = std::atan(kPolarToEquatorialRatio * std::tan(lat_rad));  // eq. 35
+  const double height_ratio = site.elevation_m / kEquatorialRadiusM;
+  SiteTerms s;
+  s.sin_lat = std::sin(lat_rad);
+  s.cos_lat = std::cos(lat_rad);
+  s.x = std::cos(u_rad) + height_ratio * s.cos_lat;
+  s.y = kPolarToEquatorialRatio * std::sin(u_rad) + height_ratio * s.sin_lat;
+  return s;
+}
+
 // Steps 3.10 … 3.15 of the report, the observer-dependent part: local hour
 // angle, parallax, topocentric coordinates, refraction, zenith and azimuth.
-// Reads α, δ, ν and R from *t and fills the rest.
-void ComputeTopocentric(const SolarPositionInput& site, SolarPositionTrace* t) {
+// Reads α, δ, ν and R from *t and fills the rest; `terms` are the site's
+// (ComputeSiteTerms(site)).
+void ComputeTopocentric(const SolarPositionInput& site, const SiteTerms& terms,
+                        SolarPositionTrace* t) {
   const double alpha_rad = t->geocentric_right_ascension_rad;
   const double delta_rad = t->geocentric_declination_rad;
-  const double lat_rad = site.latitude_rad;
 
   // 3.10 Observer local hour angle H (eq. 32).
   const double hour_angle_rad =
@@ -417,16 +441,11 @@ void ComputeTopocentric(const SolarPositionInput& site, SolarPositionTrace* t) {
   t->geocentric_hour_angle_rad = hour_angle_rad;
 
   // 3.11 Topocentric right ascension α' (eqs. 33–38): equatorial horizontal
-  // parallax ξ, observer's geocentric position terms x, y on an ellipsoid
-  // with flattening ratio 0.99664719 and equatorial radius 6378140 m.
+  // parallax ξ and the site's x, y.
   const double parallax_rad = DegToRad(8.794 / (kArcsecPerDeg * t->earth_sun_distance_au));
   t->equatorial_parallax_rad = parallax_rad;
-  constexpr double kPolarToEquatorialRatio = 0.99664719;
-  constexpr double kEquatorialRadiusM = 6378140.0;
-  const double u_rad = std::atan(kPolarToEquatorialRatio * std::tan(lat_rad));
-  const double height_ratio = site.elevation_m / kEquatorialRadiusM;
-  const double x = std::cos(u_rad) + height_ratio * std::cos(lat_rad);
-  const double y = kPolarToEquatorialRatio * std::sin(u_rad) + height_ratio * std::sin(lat_rad);
+  const double x = terms.x;
+  const double y = terms.y;
   const double sin_xi = std::sin(parallax_rad);
   const double cos_delta = std::cos(delta_rad);
   const double denom = cos_delta - x * sin_xi * std::cos(hour_angle_rad);
@@ -444,8 +463,8 @@ void ComputeTopocentric(const SolarPositionInput& site, SolarPositionTrace* t) {
   // 3.14 Topocentric elevation e0 without refraction (eq. 41), refraction
   // correction Δe (eq. 42, P in hPa = mbar, T in °C, e0 in degrees inside the
   // tangent), refracted elevation e (eq. 43) and zenith θ (eq. 44).
-  const double sin_lat = std::sin(lat_rad);
-  const double cos_lat = std::cos(lat_rad);
+  const double sin_lat = terms.sin_lat;
+  const double cos_lat = terms.cos_lat;
   const double cos_topo_ha = std::cos(topo_hour_angle_rad);
   const double elevation0_rad = std::asin(sin_lat * std::sin(topo_decl_rad) +
                                           cos_lat * std::cos(topo_decl_rad) * cos_topo_ha);
@@ -500,7 +519,7 @@ double Quadratic(double f_m, double f_0, double f_p, double n) {
 SolarPositionTrace ComputeSolarPositionTrace(const SolarPositionInput& in) {
   SolarPositionTrace t;
   ComputeGeocentric(in.time_s, in.delta_t_s, &t);
-  ComputeTopocentric(in, &t);
+  ComputeTopocentric(in, ComputeSiteTerms(in), &t);
   return t;
 }
 
@@ -511,13 +530,21 @@ SolarPosition ComputeSolarPosition(const SolarPositionInput& in) {
 void ComputeSolarPositions(std::span<const double> times_s, const SolarPositionInput& site,
                            std::vector<SolarPosition>* out) {
   out->resize(times_s.size());
+  ComputeSolarPositions(times_s, site, std::span<SolarPosition>(*out));
+}
+
+void ComputeSolarPositions(std::span<const double> times_s, const SolarPositionInput& site,
+                           std::span<SolarPosition> out) {
+  assert(out.size() == times_s.size());
+  const SiteTerms terms = ComputeSiteTerms(site);
+  SolarPositionInput at = site;
   double cached_day = std::nan("");
   DailyKnot knots[3] = {};  // 0 h UT of the day before, the day, the day after
   for (std::size_t i = 0; i < times_s.size(); ++i) {
     const double time_s = times_s[i];
     if (!std::isfinite(time_s)) {
       const double nan = std::nan("");
-      (*out)[i] = {nan, nan, nan, nan, nan, nan, nan};
+      out[i] = {nan, nan, nan, nan, nan, nan, nan};
       continue;
     }
     const double day = std::floor(time_s / kSecondsPerDay);
@@ -547,10 +574,9 @@ void ComputeSolarPositions(std::span<const double> times_s, const SolarPositionI
         Quadratic(knots[0].sidereal_nutation_rad, knots[1].sidereal_nutation_rad,
                   knots[2].sidereal_nutation_rad, n);
     t.apparent_sidereal_time_rad = WrapRad2Pi(DegToRad(MeanSiderealTimeDeg(time_s)) + nutation_rad);
-    SolarPositionInput at = site;
     at.time_s = time_s;
-    ComputeTopocentric(at, &t);
-    (*out)[i] = t.position;
+    ComputeTopocentric(at, terms, &t);
+    out[i] = t.position;
   }
 }
 

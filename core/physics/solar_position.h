@@ -101,6 +101,9 @@ SolarPosition ComputeSolarPosition(const SolarPositionInput& in);
 // rows cost about as much as 3 full SPA evaluations plus 1440 cheap ones.
 void ComputeSolarPositions(std::span<const double> times_s, const SolarPositionInput& site,
                            std::vector<SolarPosition>* out);
+// The same into out[i] for times_s[i] (out.size() == times_s.size()).
+void ComputeSolarPositions(std::span<const double> times_s, const SolarPositionInput& site,
+                           std::span<SolarPosition> out);
 
 // The plant's site with the standard-atmosphere pressure of its elevation,
 // P = 1013.25 hPa · exp(−h / 8434.5 m) (scale height 8.4 km), for the

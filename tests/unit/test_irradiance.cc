@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "core/common/units.h"
+#include "core/model/irradiance_drivers.h"
 #include "core/model/thermal_model.h"
 #include "core/physics/irradiance.h"
 #include "core/physics/solar_position.h"
@@ -260,6 +263,39 @@ TEST(Irradiance, AnIVariantWithoutInPlaneDiffuseReproducesItsTruthFromGhiAndDhi)
   EXPECT_GT(max_q, 100.0) << "no heat to compare";
   EXPECT_LT(worst_q, 1e-6 * max_q + 1e-6);
   EXPECT_LT(worst_p, 1e-6);
+}
+
+// SunAtRowMiddles splits a long series between two threads; every row must
+// still get the position the one-thread batch gives it, to the bit (14 days
+// at 1 min starting mid-day, so that the split falls inside a UT day).
+TEST(Irradiance, SunAtRowMiddlesOfALongSeriesEqualsTheOneThreadBatch) {
+  Plant plant;
+  plant.latitude_rad = DegToRad(49.23);
+  plant.longitude_rad = DegToRad(6.99);
+  plant.elevation_m = 230.0;
+  Series s;
+  s.step_s = 60.0;
+  for (std::int64_t t = 1718884800; s.size() < 20160; t += 60) s.time_s.push_back(t);
+  const std::vector<SolarPosition> split = SunAtRowMiddles(s, plant);
+
+  std::vector<double> mid_s;
+  for (std::int64_t t : s.time_s) mid_s.push_back(static_cast<double>(t) + 30.0);
+  SolarPositionInput site;
+  site.latitude_rad = plant.latitude_rad;
+  site.longitude_rad = plant.longitude_rad;
+  site.elevation_m = plant.elevation_m;
+  std::vector<SolarPosition> batch;
+  ComputeSolarPositions(mid_s, site, &batch);
+
+  ASSERT_EQ(split.size(), batch.size());
+  auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    ASSERT_EQ(bits(split[i].zenith_rad), bits(batch[i].zenith_rad)) << "row " << i;
+    ASSERT_EQ(bits(split[i].azimuth_rad), bits(batch[i].azimuth_rad)) << "row " << i;
+    ASSERT_EQ(bits(split[i].elevation_rad), bits(batch[i].elevation_rad)) << "row " << i;
+    ASSERT_EQ(bits(split[i].declination_rad), bits(batch[i].declination_rad)) << "row " << i;
+    ASSERT_EQ(bits(split[i].hour_angle_rad), bits(batch[i].hour_angle_rad)) << "row " << i;
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <deque>
@@ -106,6 +107,40 @@ std::string SeparatorHint(std::string_view header) {
     return "; the header looks separated by tabs: pvtwin reads comma-separated files";
   }
   return "";
+}
+
+// Clinger's fast path for a plain decimal, -?digits[.digits] with at most 15
+// digits in all: it is m / 10^k with m < 2^53 and 10^k (k ≤ 15) both exact
+// doubles, so one IEEE division gives the correctly rounded value, the one
+// from_chars gives. False for anything else (exponents, "nan", a leading
+// '+', more digits), which the caller reads with from_chars.
+bool ParsePlainDecimal(std::string_view text, double* value) {
+  static constexpr double kPow10[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                      1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
+  constexpr int kMaxDigits = 15;
+  if (text.size() > kMaxDigits + 2) return false;  // more digits than a sign and a point allow
+  std::size_t i = 0;
+  const bool negative = !text.empty() && text[0] == '-';
+  if (negative) ++i;
+  std::uint64_t mantissa = 0;
+  int digits = 0;
+  int decimals = -1;  // digits after the point; -1: no point yet
+  for (; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c >= '0' && c <= '9') {
+      if (++digits > kMaxDigits) return false;
+      mantissa = 10 * mantissa + static_cast<std::uint64_t>(c - '0');
+      if (decimals >= 0) ++decimals;
+    } else if (c == '.' && decimals < 0) {
+      decimals = 0;
+    } else {
+      return false;
+    }
+  }
+  if (digits == 0) return false;
+  const double magnitude = static_cast<double>(mantissa) / kPow10[decimals > 0 ? decimals : 0];
+  *value = negative ? -magnitude : magnitude;
+  return true;
 }
 
 // How a column's cells become a channel's values.
@@ -310,11 +345,13 @@ class CsvParser {
     std::string_view number = cell;
     if (number.starts_with('+') && !number.starts_with("+-")) number.remove_prefix(1);
     double value = 0.0;
-    const char* const number_end = number.data() + number.size();
-    const auto [end, ec] = std::from_chars(number.data(), number_end, value);
-    if (ec != std::errc() || end != number_end) {
-      Error(line_no, column.name, cell, "expected a number");
-      return kMissing;
+    if (!ParsePlainDecimal(number, &value)) {
+      const char* const number_end = number.data() + number.size();
+      const auto [end, ec] = std::from_chars(number.data(), number_end, value);
+      if (ec != std::errc() || end != number_end) {
+        Error(line_no, column.name, cell, "expected a number");
+        return kMissing;
+      }
     }
     if (std::isnan(value)) return kMissing;
     if (std::isinf(value)) {

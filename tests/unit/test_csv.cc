@@ -4,9 +4,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -266,6 +269,87 @@ TEST(CsvRead, StopsAfterTooManyErrors) {
   EXPECT_FALSE(ParseText(text, &s, &errors));
   ASSERT_EQ(errors.size(), kMaxCsvErrors + 1);
   EXPECT_EQ(errors.back().ToString(), "in.csv:101: too many errors; reading stopped here");
+}
+
+// The reader takes plain decimals of up to 15 digits by a fast path of its
+// own (one exact division) and everything else by std::from_chars: both
+// must give every cell the same double, and reject the same cells. Random
+// cells of every shape around the fast path's edges (15 and 16 digits, a
+// point first or last, a sign, exponents, long full-precision numbers),
+// all within t_amb_c's physical limits.
+TEST(CsvRead, NumbersReadAsStdFromCharsReadsThem) {
+  std::mt19937_64 rng(20261125);
+  auto digits = [&rng](int n) {
+    std::string out;
+    for (int i = 0; i < n; ++i) out += static_cast<char>('0' + rng() % 10);
+    return out;
+  };
+  // Signs and points at either end, leading zeros, 15, 16 and 18 digits,
+  // an exponent, and cells from_chars rejects.
+  std::vector<std::string> cells = {"0",
+                                    "-0",
+                                    "5.",
+                                    ".5",
+                                    "-.5",
+                                    "-5.",
+                                    "007.250",
+                                    "1e1",
+                                    "12.0000000000000",
+                                    "12.00000000000000",
+                                    "-59.9999999999999",
+                                    "9.99999999999999999",
+                                    "-",
+                                    ".",
+                                    "1.2.3",
+                                    "--1",
+                                    "0x10",
+                                    "1_0"};
+  for (int k = 0; k < 4000; ++k) {
+    const int int_digits = static_cast<int>(rng() % 3);
+    int frac_digits = static_cast<int>(rng() % 18);
+    if (int_digits == 0 && frac_digits == 0) frac_digits = 1;
+    std::string cell = rng() % 2 ? "-" : "";
+    if (int_digits == 2) cell += static_cast<char>('1' + rng() % 5);  // |value| < 60
+    if (int_digits >= 1) cell += digits(1);
+    if (frac_digits > 0) cell += "." + digits(frac_digits);
+    if (rng() % 50 == 0) cell += "e-1";
+    cells.push_back(cell);
+  }
+  const std::string header = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
+  std::string accepted_text = header, rejected_text = header;
+  std::vector<double> expected;
+  std::vector<std::string> accepted, rejected;
+  for (const std::string& cell : cells) {
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+    const bool ok = ec == std::errc() && end == cell.data() + cell.size();
+    std::vector<std::string>& list = ok ? accepted : rejected;
+    (ok ? accepted_text : rejected_text) +=
+        std::to_string(60 * list.size()) + ",1,2,0.03,500," + cell + ",100\n";
+    list.push_back(cell);
+    if (ok) expected.push_back(v);
+  }
+  ASSERT_GE(rejected.size(), 6u);
+  ASSERT_LT(rejected.size(), kMaxCsvErrors);
+
+  Series s;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseText(accepted_text, &s, &errors)) << errors.front().ToString();
+  ASSERT_EQ(s.size(), accepted.size());
+  for (std::size_t i = 0; i < accepted.size(); ++i) {
+    const double got = s[Channel::kTAmbC][i];
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(got), std::bit_cast<std::uint64_t>(expected[i]))
+        << "cell " << accepted[i] << ": read " << got << ", from_chars " << expected[i];
+  }
+
+  Series r;
+  errors.clear();
+  EXPECT_FALSE(ParseText(rejected_text, &r, &errors));
+  ASSERT_EQ(errors.size(), rejected.size());
+  for (std::size_t i = 0; i < rejected.size(); ++i) {
+    EXPECT_EQ(errors[i].ToString(), "in.csv:" + std::to_string(i + 2) +
+                                        ": t_amb_c = " + rejected[i] + ": expected a number");
+  }
 }
 
 TEST(CsvRead, MissingFileIsAnError) {

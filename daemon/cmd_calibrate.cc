@@ -241,7 +241,10 @@ int RunCalibrate(const CalibrateArgs& a) {
   if (!a.train_end.empty() && !ParseTimeOrReport("--train-end", a.train_end, &t_end)) {
     return kExitBadInput;
   }
-  Series train = series.Between(t_begin, t_end);
+  // The whole file is the usual window: moved, not copied.
+  const bool whole =
+      series.size() == 0 || (t_begin <= series.time_s.front() && t_end > series.time_s.back());
+  Series train = whole ? std::move(series) : series.Between(t_begin, t_end);
   if (!ResampleOrReport(a.csv, a.step_s, &train)) return kExitBadInput;
   Drivers drivers;
   if (!PrepareDriversOrReport(train, a.csv, config, spec, &drivers)) return kExitBadInput;

@@ -118,10 +118,11 @@ bool ParsePlainDecimal(std::string_view text, double* value) {
   static constexpr double kPow10[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                       1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
   constexpr int kMaxDigits = 15;
-  if (text.size() > kMaxDigits + 2) return false;  // more digits than a sign and a point allow
-  std::size_t i = 0;
   const bool negative = !text.empty() && text[0] == '-';
-  if (negative) ++i;
+  // Longer than the digits, the point and the sign allow: not for this path
+  // (full-precision numbers, 17 significant digits, stop here).
+  if (text.size() > kMaxDigits + 1 + (negative ? 1 : 0)) return false;
+  std::size_t i = negative ? 1 : 0;
   std::uint64_t mantissa = 0;
   int digits = 0;
   int decimals = -1;  // digits after the point; -1: no point yet

@@ -26,8 +26,9 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) 
   std::vector<SolarPosition> sun(n);
   // Each row's position depends on its time alone (ComputeSolarPositions),
   // so a long series is split between two threads with the same result: at
-  // about 0.3 µs a row, 14 days at 1 min take 6 ms on one core here, most
-  // of `pvtwin calibrate`'s preparation (README, bench ident).
+  // about 0.2 µs a row, 14 days at 1 min took 4-5 ms on one core of the AMD
+  // EPYC machine, half of `pvtwin calibrate`'s preparation (README,
+  // "Identification").
   constexpr std::size_t kRowsToSplit = 8192;
   const std::span<const double> times(mid_s);
   const std::span<SolarPosition> out(sun);

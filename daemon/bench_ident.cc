@@ -15,24 +15,38 @@
 //      the 5-s fit's split into its coarse stages and the fine stage at 5 s;
 //   5. the paper's MATLAB figures;
 //   6. the time split of the default at 1 min: parse (the training CSV from
-//      text), fit coarse / fine with their model runs, write (params.json).
-// With a data directory, the 1-min training and held-out days are written
-// there as train.csv and held_out.csv (config/examples/plant.toml is their
-// plant), so that `pvtwin calibrate` can be timed on them as a process.
+//      text), fit coarse / fine with their model runs, write (params.json);
+//   7. the whole `pvtwin calibrate` process on the 1-min training days (what
+//      issue 16's 50 ms is for): this executable run as a child, and its
+//      start and exit alone (`--version`).
+// The 1-min training and held-out days are written to the data directory
+// (a temporary one without --data-dir, removed afterwards) as train.csv and
+// held_out.csv, with plant.toml, the example plant's [plant] section
+// (config/examples/plant.toml), so that `pvtwin calibrate` runs on them.
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "config/plant_config.h"
 #include "core/fit/identification.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
+#include "io/child_process.h"
 #include "io/csv.h"
 #include "io/params_json.h"
 
@@ -43,6 +57,8 @@ namespace {
 constexpr int kTrainDays = 14;
 constexpr int kHeldOutDays = 3;
 constexpr const char* kVariant = "2N1Ccolwr";
+// Issue 16's target for the whole `pvtwin calibrate` process at 1 min.
+constexpr double kTargetProcessS = 0.05;
 
 // A data set split into the training window and the held-out days.
 struct SplitData {
@@ -141,6 +157,81 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, int runs) {
       fit.coarse_evaluations, 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
       fit.evaluations - fit.coarse_evaluations, fit.sensitivity_runs, kSensitivityRunCost,
       1e3 * Median(write));
+}
+
+// Wall time of this executable run with `args` (stdin, stdout and stderr on
+// /dev/null) until it ends; NaN when it cannot be started or does not exit
+// with 0.
+double ProcessSeconds(const std::vector<std::string>& args) {
+  const std::string self = SelfExecutable();
+  std::vector<char*> argv{const_cast<char*>(self.c_str())};
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  for (int fd : {0, 1, 2}) {
+    posix_spawn_file_actions_addopen(&files, fd, "/dev/null", fd == 0 ? O_RDONLY : O_WRONLY, 0);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  pid_t pid = -1;
+  const int spawned = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  if (spawned != 0) return std::nan("");
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  const double seconds = SecondsSince(start);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? seconds : std::nan("");
+}
+
+// The example plant of the synthetic data (DesignExamplePlant) as a config
+// file, checked against it: false (and a printed reason) if the two differ.
+bool WriteExamplePlantConfig(const std::string& path) {
+  const std::string text =
+      "# DesignExamplePlant (core/synth/synthetic_plant.h), written by pvtwin bench ident\n"
+      "[plant]\nlatitude_deg = 47.358\nlongitude_deg = 16.128\ntilt_deg = 20\n"
+      "azimuth_deg = 180\narea_m2 = 1.8\n";
+  std::string error;
+  Config config;
+  Diagnostics errors;
+  if (!WriteTextFileAtomically(path, text, &error) || !LoadConfig(path, &config, &errors)) {
+    std::printf("ident: %s: %s\n", path.c_str(),
+                error.empty() ? errors.front().ToString().c_str() : error.c_str());
+    return false;
+  }
+  if (!(config.plant == DesignExamplePlant())) {
+    std::printf("ident: %s does not give DesignExamplePlant(); no process figures\n", path.c_str());
+    return false;
+  }
+  return true;
+}
+
+// 7. The whole calibrate process on dir/train.csv (median of `runs`), and
+// the executable's start and exit alone.
+void PrintProcessTimes(const std::string& dir, int runs) {
+  const std::string config = dir + "/plant.toml";
+  if (!WriteExamplePlantConfig(config)) return;
+  const std::string out = dir + "/params.json";
+  const std::vector<std::string> calibrate = {
+      "calibrate", "--config", config,  "--csv", dir + "/train.csv",
+      "--variant", kVariant,   "--out", out};
+  std::vector<double> whole, start;
+  for (int r = 0; r < runs; ++r) {
+    whole.push_back(ProcessSeconds(calibrate));
+    start.push_back(ProcessSeconds({"--version"}));
+  }
+  std::remove(out.c_str());
+  if (std::any_of(whole.begin(), whole.end(), [](double t) { return std::isnan(t); })) {
+    std::printf("\nwhole process: `pvtwin calibrate` on %s/train.csv FAILED\n", dir.c_str());
+    return;
+  }
+  std::printf(
+      "\nwhole process at 1 min (`pvtwin calibrate --variant %s` on train.csv, wall time, "
+      "median of %d runs): %.1f ms (min %.1f, max %.1f; target %.0f ms); the executable's start "
+      "and exit alone (`pvtwin --version`, median of %d): %.1f ms\n",
+      kVariant, runs, 1e3 * Median(whole), 1e3 * *std::min_element(whole.begin(), whole.end()),
+      1e3 * *std::max_element(whole.begin(), whole.end()), 1e3 * kTargetProcessS, runs,
+      1e3 * Median(start));
 }
 
 // The paper's objective (MAE of P_el + MAE of Q_u, W/m²) of `params` on
@@ -268,7 +359,13 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
       kTrainDays + kHeldOutDays, d1.rows, kTrainDays, d1.train_meas.size(),
       d1.train_meas.rows.size(), kHeldOutDays, d1.held_out_meas.size(),
       d1.held_out_meas.rows.size());
-  if (!data_dir.empty()) WriteSplitData(d1, data_dir);
+  // Where train.csv and held_out.csv go (7. runs `pvtwin calibrate` on them).
+  std::string dir = data_dir;
+  if (dir.empty()) {
+    char scratch[] = "/tmp/pvtwin-bench-ident-XXXXXX";
+    if (mkdtemp(scratch) != nullptr) dir = scratch;
+  }
+  if (!dir.empty()) WriteSplitData(d1, dir);
   std::printf("objective (MAE P_el + MAE Q_u, W/m2)   %10s %10s\n", "train", "held-out");
   std::printf("  true parameters (noise floor)        %10.4f %10.4f\n",
               ObjectiveWM2(d1.train_drivers, d1.train_meas, truth),
@@ -375,8 +472,9 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
   char label[64];
   std::snprintf(label, sizeof(label), "(a) 14 d at 1 min, %zu rows", d1.train_meas.size());
   // Issue 16's targets: the whole `calibrate` process at 1 min within 50 ms
-  // (timed outside, README), so the fit alone must be below; 5 s within 0.3 s.
-  target_row(label, fit_1min, 0.05, ref_held_out);
+  // (timed as a process under 7.), so the fit alone must be below; 5 s
+  // within 0.3 s.
+  target_row(label, fit_1min, kTargetProcessS, ref_held_out);
   if (have_5s) {
     std::snprintf(label, sizeof(label), "(b) 14 d at 5 s, %zu rows", d5.train_meas.size());
     target_row(label, fit_5s, 0.3, ref_held_out_5s);
@@ -407,6 +505,8 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
     std::printf(" faster (different machines)");
   }
   if (fit_1min.summary.ok) PrintTimeSplit(d1, fit_1min.summary, repeats);
+  if (!dir.empty()) PrintProcessTimes(dir, std::max(repeats, 11));
+  if (data_dir.empty() && !dir.empty()) std::filesystem::remove_all(dir);
   std::printf("\nident: done in %.1f s\n", SecondsSince(bench_start));
 }
 

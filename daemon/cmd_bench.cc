@@ -106,8 +106,9 @@ void RegisterBench(CLI::App& app) {
       "bench",
       "Print speed figures (medians over repeated runs, one core) on synthetic data:\n"
       "  sim    one 14-day 1-min simulation of each variant\n"
-      "  ident  identification of 2N1Ccolwr: 14 days at 1 min and at 5 s, and the\n"
-      "         algorithm comparison behind the default\n"
+      "  ident  identification of 2N1Ccolwr: 14 days at 1 min and at 5 s, the\n"
+      "         algorithm comparison behind the default, and the whole `pvtwin\n"
+      "         calibrate` process on the 1-min days\n"
       "  table6 the paper's Table 6 protocol (9 variants x 29 test days) on both cores\n"
       "  store  the SQLite store: 14 days of 5 s samples ingested, aggregated, read back\n"
       "  daemon CPU and memory of `pvtwin run` polling `pvtwin sim` at 5 s (real time)\n"
@@ -128,7 +129,8 @@ void RegisterBench(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
   cmd->add_option("--data-dir", args->data_dir,
                   "ident: write its 1-min training and held-out days there (train.csv, "
-                  "held_out.csv; plant: config/examples/plant.toml)");
+                  "held_out.csv, and plant.toml: config/examples/plant.toml's plant) and time "
+                  "`pvtwin calibrate` on them (default: a temporary directory, removed after)");
   cmd->add_option("--daemon-seconds", args->daemon_seconds, "measuring time of `bench daemon`")
       ->check(CLI::PositiveNumber);
   cmd->callback([args] {

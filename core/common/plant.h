@@ -32,6 +32,8 @@ struct Plant {
   // (core/forecast/weather_resample.h). 10 = the forecast's wind as it is.
   double collector_height_m = 10.0;
   SkySource sky = SkySource::kAuto;
+
+  bool operator==(const Plant&) const = default;
 };
 
 }  // namespace pvtwin

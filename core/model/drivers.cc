@@ -30,7 +30,7 @@ std::string ChannelList(const std::vector<Channel>& channels) {
 // The raw drivers of the effect modules (core/common/model_data.h, Drivers): sun
 // geometry at the row middles, measured wind and sky temperature, the beam
 // part of the absorbed irradiance, the transposed GHI/DHI and the soiling
-// clock.
+// clock. Reads d->aoi_rad (AoiAtRows), set before.
 void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
                        std::span<const SolarPosition> sun, Drivers* d) {
   const std::size_t n = s.size();
@@ -39,19 +39,13 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
   d->t_sky_c = SkyTemperaturesC(s, plant, &d->sky_note);
   d->sun_azimuth_rad.resize(n);
   d->sun_elevation_rad.resize(n);
-  d->aoi_rad.resize(n);
   d->g_beam_w_m2.assign(n, nan);
   d->g_ref_w_m2.assign(n, nan);
   const bool have_horizontal = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
   for (std::size_t i = 0; i < n; ++i) {
     d->sun_azimuth_rad[i] = sun[i].azimuth_rad;
     d->sun_elevation_rad[i] = sun[i].elevation_rad;
-    double aoi_rad = s.At(Channel::kAoiRad, i);
-    if (std::isnan(aoi_rad)) {
-      aoi_rad = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
-                                    plant.azimuth_rad);
-    }
-    d->aoi_rad[i] = aoi_rad;
+    const double aoi_rad = d->aoi_rad[i];
     double beam_w_m2 = nan;
     if (have_horizontal) {
       IsotropicSkyInput h;
@@ -255,7 +249,9 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
   }
 
   const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
-  ComputeIrradianceDrivers(s, plant, spec, sun, &out.g_poa_w_m2, &out.g_abs_w_m2, &out.iam_parts);
+  out.aoi_rad = AoiAtRows(s, plant, sun);
+  ComputeIrradianceDrivers(s, plant, spec, sun, out.aoi_rad, &out.g_poa_w_m2, &out.g_abs_w_m2,
+                           &out.iam_parts);
   FillEffectDrivers(s, plant, spec, sun, &out);
   SetCleanings(DetectCleanings(s, plant), &out);
   for (const ModelExtension* e : spec.extensions) {

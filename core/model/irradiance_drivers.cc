@@ -25,10 +25,8 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) 
   site.elevation_m = plant.elevation_m;
   std::vector<SolarPosition> sun(n);
   // Each row's position depends on its time alone (ComputeSolarPositions),
-  // so a long series is split between two threads with the same result: at
-  // about 0.2 µs a row, 14 days at 1 min took 4-5 ms on one core of the AMD
-  // EPYC machine, half of `pvtwin calibrate`'s preparation (README,
-  // "Identification").
+  // so a long series is split between two threads with the same result: the
+  // positions are the largest part of `pvtwin calibrate --timing`'s prepare.
   constexpr std::size_t kRowsToSplit = 8192;
   const std::span<const double> times(mid_s);
   const std::span<SolarPosition> out(sun);
@@ -43,14 +41,28 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) 
   return sun;
 }
 
+std::vector<double> AoiAtRows(const Series& s, const Plant& plant,
+                              std::span<const SolarPosition> sun) {
+  assert(sun.size() == s.size());
+  std::vector<double> aoi_rad(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    aoi_rad[i] = s.At(Channel::kAoiRad, i);
+    if (std::isnan(aoi_rad[i])) {
+      aoi_rad[i] = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
+                                       plant.azimuth_rad);
+    }
+  }
+  return aoi_rad;
+}
+
 void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
-                              std::span<const SolarPosition> sun, std::vector<double>* g_poa_w_m2,
-                              std::vector<double>* g_abs_w_m2, Drivers::IamParts* parts) {
+                              std::span<const SolarPosition> sun, std::span<const double> aoi,
+                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2,
+                              Drivers::IamParts* parts) {
   const std::size_t n = s.size();
   const bool measured_poa = s.Has(Channel::kGPoaWM2);
-  const bool measured_aoi = s.Has(Channel::kAoiRad);
   const bool have_horizontal = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
-  assert(sun.size() == n);
+  assert(sun.size() == n && aoi.size() == n);
   const EffectiveDiffuseAngles diffuse_angles = BrandemuehlBeckmanAngles(plant.tilt_rad);
   g_poa_w_m2->assign(n, std::nan(""));
   g_abs_w_m2->assign(n, std::nan(""));
@@ -62,11 +74,7 @@ void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSp
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
-    double aoi_rad = measured_aoi ? s[Channel::kAoiRad][i] : std::nan("");
-    if (std::isnan(aoi_rad)) {
-      aoi_rad = AngleOfIncidenceRad(sun[i].zenith_rad, sun[i].azimuth_rad, plant.tilt_rad,
-                                    plant.azimuth_rad);
-    }
+    const double aoi_rad = aoi[i];
     PoaComponents poa;
     const double measured = measured_poa ? s[Channel::kGPoaWM2][i] : std::nan("");
     if (!std::isnan(measured)) {

@@ -18,6 +18,11 @@ namespace pvtwin {
 // [t_k, t_k + step)), at the plant's site.
 std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant);
 
+// Angle of incidence on the collector per row: the measured aoi where the
+// series has one, else from `sun` (SunAtRowMiddles).
+std::vector<double> AoiAtRows(const Series& s, const Plant& plant,
+                              std::span<const SolarPosition> sun);
+
 // Sources, in order of preference:
 //  * I_gt: measured g_poa_w_m2; else transposed from ghi_w_m2 + dhi_w_m2
 //    (isotropic sky, paper 2.5) with the sun at the middle of the row.
@@ -26,10 +31,12 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant);
 //    Souka & Safwat IAM at its angle (aoi_deg when measured, else computed;
 //    Brandemuehl & Beckman angles for sky and ground diffuse).
 // Rows whose inputs are missing get NaN. With 'I' and parts non-null, also
-// the parts before the IAM (Drivers::IamParts). `sun` is SunAtRowMiddles(s,
-// plant), computed once by the caller, who needs it too.
+// the parts before the IAM (Drivers::IamParts). `sun` and `aoi_rad` are
+// SunAtRowMiddles and AoiAtRows, computed once by the caller, who needs them
+// too.
 void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
-                              std::span<const SolarPosition> sun, std::vector<double>* g_poa_w_m2,
-                              std::vector<double>* g_abs_w_m2, Drivers::IamParts* parts = nullptr);
+                              std::span<const SolarPosition> sun, std::span<const double> aoi_rad,
+                              std::vector<double>* g_poa_w_m2, std::vector<double>* g_abs_w_m2,
+                              Drivers::IamParts* parts = nullptr);
 
 }  // namespace pvtwin

@@ -23,13 +23,7 @@
 // (a temporary one without --data-dir, removed afterwards) as train.csv and
 // held_out.csv, with plant.toml, the example plant's [plant] section
 // (config/examples/plant.toml), so that `pvtwin calibrate` runs on them.
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -159,29 +153,18 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, int runs) {
       1e3 * Median(write));
 }
 
-// Wall time of this executable run with `args` (stdin, stdout and stderr on
-// /dev/null) until it ends; NaN when it cannot be started or does not exit
-// with 0.
+// Wall time of this executable run with `args` (output to /dev/null) until
+// it ends; NaN when it cannot be started or does not exit with 0.
 double ProcessSeconds(const std::vector<std::string>& args) {
-  const std::string self = SelfExecutable();
-  std::vector<char*> argv{const_cast<char*>(self.c_str())};
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t files;
-  posix_spawn_file_actions_init(&files);
-  for (int fd : {0, 1, 2}) {
-    posix_spawn_file_actions_addopen(&files, fd, "/dev/null", fd == 0 ? O_RDONLY : O_WRONLY, 0);
-  }
+  std::vector<std::string> argv{SelfExecutable()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  ChildProcess child;
+  std::string error;
   const auto start = std::chrono::steady_clock::now();
-  pid_t pid = -1;
-  const int spawned = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&files);
-  if (spawned != 0) return std::nan("");
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
+  if (!child.Start(argv, "/dev/null", &error)) return std::nan("");
+  const int exit_code = child.Wait();
   const double seconds = SecondsSince(start);
-  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? seconds : std::nan("");
+  return exit_code == 0 ? seconds : std::nan("");
 }
 
 // The example plant of the synthetic data (DesignExamplePlant) as a config

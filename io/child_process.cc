@@ -139,6 +139,18 @@ bool ChildProcess::Finished(int* exit_code) {
   return true;
 }
 
+int ChildProcess::Wait() {
+  if (!running()) return -1;
+  int status = 0;
+  pid_t r = -1;
+  while ((r = ::waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {
+  }
+  pid_ = -1;
+  if (r < 0) return -SIGCHLD;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return WIFSIGNALED(status) ? -WTERMSIG(status) : -1;
+}
+
 int ChildProcess::Stop(int signal, double grace_s) {
   int code = -SIGKILL;
   if (to_child_ >= 0) {

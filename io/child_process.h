@@ -39,6 +39,9 @@ class ChildProcess {
   // Non-blocking. True once the child has ended; then *exit_code is its exit
   // status, or −N when signal N ended it.
   bool Finished(int* exit_code);
+  // Blocks until the child ends; returns the exit code as Finished does
+  // (-1 when no child is running).
+  int Wait();
   // Sends `signal` (0: only closes stdin), waits up to grace_s for the end,
   // then SIGKILL. Returns the exit code as Finished does.
   int Stop(int signal, double grace_s);

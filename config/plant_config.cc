@@ -1,6 +1,5 @@
 #include "config/plant_config.h"
 
-#include <libpq-fe.h>
 #include <sys/stat.h>
 #include <toml++/toml.h>
 
@@ -17,6 +16,7 @@
 #include <sstream>
 #include <vector>
 
+#include "config/libpq_api.h"
 #include "config/toml_reader.h"
 #include "core/common/units.h"
 #include "core/model/variant.h"
@@ -318,15 +318,21 @@ bool IsPlantId(std::string_view id) {
 // url: parsed by libpq itself (URI or key=value), so the check sees what the
 // connection will see; a password in it is refused without echoing it.
 void CheckUploadUrl(SectionReader& r, const std::string& url) {
+  try {
+    Libpq();
+  } catch (const std::runtime_error& e) {
+    r.RejectHidden("url", std::string("cannot be checked, and the upload cannot run: ") + e.what());
+    return;
+  }
   char* why = nullptr;
-  PQconninfoOption* options = PQconninfoParse(url.c_str(), &why);
+  PQconninfoOption* options = Libpq().PQconninfoParse(url.c_str(), &why);
   if (options == nullptr) {
     std::string rule = "not a libpq connection string (postgresql://... or key=value)";
     if (why != nullptr) {
       std::string detail = why;
       while (!detail.empty() && detail.back() == '\n') detail.pop_back();
       rule += ": " + detail;
-      PQfreemem(why);
+      Libpq().PQfreemem(why);
     }
     r.RejectHidden("url", rule);
     return;
@@ -338,7 +344,7 @@ void CheckUploadUrl(SectionReader& r, const std::string& url) {
                      "password in password_file, the systemd credential pgpassword, or ~/.pgpass");
     }
   }
-  PQconninfoFree(options);
+  Libpq().PQconninfoFree(options);
 }
 
 void ReadUpload(SectionReader& r, UploadConfig* upload) {

@@ -4,11 +4,48 @@
 
 #include <algorithm>
 #include <cctype>
-#include <mutex>
+#include <stdexcept>
+
+#include "config/shared_library.h"
 
 namespace pvtwin {
 
 namespace {
+
+// libcurl's functions, from libcurl.so.4 loaded by the first fetch
+// (config/shared_library.h); members drop the curl_ prefix, so that calls
+// do not meet curl.h's type-checking macros of the same names.
+// clang-format off
+#define PVTWIN_LIBCURL_FUNCTIONS(X) \
+  X(global_init) \
+  X(easy_init) \
+  X(easy_setopt) \
+  X(easy_perform) \
+  X(easy_getinfo) \
+  X(easy_cleanup) \
+  X(easy_strerror)
+// clang-format on
+
+struct LibcurlApi {
+#define PVTWIN_LIBCURL_MEMBER(name) decltype(&::curl_##name) name = nullptr;
+  PVTWIN_LIBCURL_FUNCTIONS(PVTWIN_LIBCURL_MEMBER)
+#undef PVTWIN_LIBCURL_MEMBER
+};
+
+// Loaded, bound and curl_global_init'ed once; throws std::runtime_error
+// when libcurl.so.4 is missing.
+const LibcurlApi& Libcurl() {
+  static const LibcurlApi api = [] {
+    static const SharedLibrary library("libcurl.so.4", "libcurl4");
+    LibcurlApi bound;
+#define PVTWIN_LIBCURL_BIND(name) library.Bind(&bound.name, "curl_" #name);
+    PVTWIN_LIBCURL_FUNCTIONS(PVTWIN_LIBCURL_BIND)
+#undef PVTWIN_LIBCURL_BIND
+    bound.global_init(CURL_GLOBAL_DEFAULT);
+    return bound;
+  }();
+  return api;
+}
 
 struct Transfer {
   std::string* body;
@@ -97,10 +134,16 @@ const char* OutcomeName(HttpResponse::Outcome outcome) {
 
 HttpResponse HttpGet(const std::string& url, const HttpOptions& options,
                      const std::atomic<bool>* abort) {
-  static std::once_flag init;
-  std::call_once(init, [] { curl_global_init(CURL_GLOBAL_DEFAULT); });
   HttpResponse response;
-  CURL* curl = curl_easy_init();
+  const LibcurlApi* api = nullptr;
+  try {
+    api = &Libcurl();
+  } catch (const std::runtime_error& e) {
+    response.outcome = HttpResponse::Outcome::kBroken;
+    response.error = e.what();
+    return response;
+  }
+  CURL* curl = api->easy_init();
   if (curl == nullptr) {
     response.outcome = HttpResponse::Outcome::kBroken;
     response.error = "curl_easy_init failed";
@@ -108,33 +151,33 @@ HttpResponse HttpGet(const std::string& url, const HttpOptions& options,
   }
   Transfer transfer{&response.body, options.max_body_bytes, false, abort};
   char error_buffer[CURL_ERROR_SIZE] = {};
-  curl_easy_setopt(curl, CURLOPT_URL, url.c_str());
-  curl_easy_setopt(curl, CURLOPT_NOSIGNAL, 1L);
-  curl_easy_setopt(curl, CURLOPT_FOLLOWLOCATION, 1L);
-  curl_easy_setopt(curl, CURLOPT_MAXREDIRS, 5L);
-  curl_easy_setopt(curl, CURLOPT_PROTOCOLS_STR, "http,https");
-  curl_easy_setopt(curl, CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
-  curl_easy_setopt(
+  api->easy_setopt(curl, CURLOPT_URL, url.c_str());
+  api->easy_setopt(curl, CURLOPT_NOSIGNAL, 1L);
+  api->easy_setopt(curl, CURLOPT_FOLLOWLOCATION, 1L);
+  api->easy_setopt(curl, CURLOPT_MAXREDIRS, 5L);
+  api->easy_setopt(curl, CURLOPT_PROTOCOLS_STR, "http,https");
+  api->easy_setopt(curl, CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
+  api->easy_setopt(
       curl, CURLOPT_CONNECTTIMEOUT_MS,
       static_cast<long>(std::min(options.connect_timeout_s, options.total_timeout_s) * 1000.0));
-  curl_easy_setopt(curl, CURLOPT_TIMEOUT_MS, static_cast<long>(options.total_timeout_s * 1000.0));
-  curl_easy_setopt(curl, CURLOPT_USERAGENT, "pvtwin");
-  curl_easy_setopt(curl, CURLOPT_ACCEPT_ENCODING, "");  // whatever curl can decode
-  curl_easy_setopt(curl, CURLOPT_WRITEFUNCTION, &OnData);
-  curl_easy_setopt(curl, CURLOPT_WRITEDATA, &transfer);
-  curl_easy_setopt(curl, CURLOPT_XFERINFOFUNCTION, &OnProgress);
-  curl_easy_setopt(curl, CURLOPT_XFERINFODATA, &transfer);
-  curl_easy_setopt(curl, CURLOPT_NOPROGRESS, 0L);
-  curl_easy_setopt(curl, CURLOPT_ERRORBUFFER, error_buffer);
-  const CURLcode rc = curl_easy_perform(curl);
-  curl_easy_getinfo(curl, CURLINFO_RESPONSE_CODE, &response.status);
-  curl_easy_cleanup(curl);
+  api->easy_setopt(curl, CURLOPT_TIMEOUT_MS, static_cast<long>(options.total_timeout_s * 1000.0));
+  api->easy_setopt(curl, CURLOPT_USERAGENT, "pvtwin");
+  api->easy_setopt(curl, CURLOPT_ACCEPT_ENCODING, "");  // whatever curl can decode
+  api->easy_setopt(curl, CURLOPT_WRITEFUNCTION, &OnData);
+  api->easy_setopt(curl, CURLOPT_WRITEDATA, &transfer);
+  api->easy_setopt(curl, CURLOPT_XFERINFOFUNCTION, &OnProgress);
+  api->easy_setopt(curl, CURLOPT_XFERINFODATA, &transfer);
+  api->easy_setopt(curl, CURLOPT_NOPROGRESS, 0L);
+  api->easy_setopt(curl, CURLOPT_ERRORBUFFER, error_buffer);
+  const CURLcode rc = api->easy_perform(curl);
+  api->easy_getinfo(curl, CURLINFO_RESPONSE_CODE, &response.status);
+  api->easy_cleanup(curl);
   if (rc != CURLE_OK) {
     response.outcome = transfer.too_large ? HttpResponse::Outcome::kBroken : OutcomeOf(rc);
     response.error = transfer.too_large
                          ? "response body over " + std::to_string(options.max_body_bytes) + " bytes"
                          : (error_buffer[0] != '\0' ? std::string(error_buffer)
-                                                    : std::string(curl_easy_strerror(rc)));
+                                                    : std::string(api->easy_strerror(rc)));
     return response;
   }
   if (response.status < 200 || response.status >= 300) {

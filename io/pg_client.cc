@@ -1,10 +1,11 @@
 // The PostgreSQL connection of the upload; see io/pg_client.h.
 #include "io/pg_client.h"
 
-#include <libpq-fe.h>
-
 #include <cassert>
 #include <cstring>
+#include <stdexcept>
+
+#include "config/libpq_api.h"
 
 namespace pvtwin {
 
@@ -41,20 +42,22 @@ PgFault ConnectFault(const std::string& message) {
 struct PgConnection::Impl {
   PGconn* conn = nullptr;
   ~Impl() {
-    if (conn != nullptr) PQfinish(conn);
+    if (conn != nullptr) Libpq().PQfinish(conn);
   }
 
   // The error of a finished command; false unless it succeeded.
   bool Check(PGresult* result, const std::string& what, PgError* error) {
-    const ExecStatusType status = result ? PQresultStatus(result) : PGRES_FATAL_ERROR;
+    const ExecStatusType status = result ? Libpq().PQresultStatus(result) : PGRES_FATAL_ERROR;
     const bool ok = status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK ||
                     status == PGRES_COPY_IN || status == PGRES_EMPTY_QUERY;
     if (!ok) {
-      const char* state = result ? PQresultErrorField(result, PG_DIAG_SQLSTATE) : nullptr;
+      const char* state = result ? Libpq().PQresultErrorField(result, PG_DIAG_SQLSTATE) : nullptr;
       error->sqlstate = state != nullptr ? state : "";
       error->message =
-          what + ": " + Trimmed(result ? PQresultErrorMessage(result) : PQerrorMessage(conn));
-      error->fault = PQstatus(conn) == CONNECTION_OK ? PgFault::kRefused : PgFault::kUnreachable;
+          what + ": " +
+          Trimmed(result ? Libpq().PQresultErrorMessage(result) : Libpq().PQerrorMessage(conn));
+      error->fault =
+          Libpq().PQstatus(conn) == CONNECTION_OK ? PgFault::kRefused : PgFault::kUnreachable;
       if (error->sqlstate.starts_with("08")) error->fault = PgFault::kUnreachable;
       if (error->sqlstate.starts_with("28")) error->fault = PgFault::kAuth;
     }
@@ -84,24 +87,30 @@ std::unique_ptr<PgConnection> PgConnection::Connect(const std::string& conninfo,
   }
   keys.push_back(nullptr);
   values.push_back(nullptr);
+  try {
+    Libpq();
+  } catch (const std::runtime_error& e) {
+    *error = {PgFault::kLocal, std::string("connect: ") + e.what(), ""};
+    return nullptr;
+  }
   auto impl = std::make_unique<Impl>();
-  impl->conn = PQconnectdbParams(keys.data(), values.data(), 1);
-  if (impl->conn == nullptr || PQstatus(impl->conn) != CONNECTION_OK) {
+  impl->conn = Libpq().PQconnectdbParams(keys.data(), values.data(), 1);
+  if (impl->conn == nullptr || Libpq().PQstatus(impl->conn) != CONNECTION_OK) {
     const std::string message =
-        impl->conn ? Trimmed(PQerrorMessage(impl->conn)) : "libpq out of memory";
+        impl->conn ? Trimmed(Libpq().PQerrorMessage(impl->conn)) : "libpq out of memory";
     *error = {ConnectFault(message), "connect: " + message, ""};
     return nullptr;
   }
   // The server's notices ("already exists, skipping") are no news here.
-  PQsetNoticeProcessor(
+  Libpq().PQsetNoticeProcessor(
       impl->conn, [](void*, const char*) {}, nullptr);
   return std::unique_ptr<PgConnection>(new PgConnection(std::move(impl)));
 }
 
 bool PgConnection::Exec(const std::string& sql, PgError* error) {
-  PGresult* result = PQexec(impl_->conn, sql.c_str());
+  PGresult* result = Libpq().PQexec(impl_->conn, sql.c_str());
   const bool ok = impl_->Check(result, sql.substr(0, 60), error);
-  PQclear(result);
+  Libpq().PQclear(result);
   return ok;
 }
 
@@ -109,46 +118,47 @@ bool PgConnection::Query(const std::string& sql, const std::vector<std::string>&
                          std::vector<std::vector<std::string>>* rows, PgError* error) {
   std::vector<const char*> values;
   for (const std::string& p : params) values.push_back(p.c_str());
-  PGresult* result = PQexecParams(impl_->conn, sql.c_str(), static_cast<int>(values.size()),
-                                  nullptr, values.data(), nullptr, nullptr, 0);
+  PGresult* result = Libpq().PQexecParams(impl_->conn, sql.c_str(), static_cast<int>(values.size()),
+                                          nullptr, values.data(), nullptr, nullptr, 0);
   const bool ok = impl_->Check(result, sql.substr(0, 60), error);
   if (ok && rows != nullptr) {
     rows->clear();
-    for (int r = 0; r < PQntuples(result); ++r) {
+    for (int r = 0; r < Libpq().PQntuples(result); ++r) {
       std::vector<std::string>& row = rows->emplace_back();
-      for (int c = 0; c < PQnfields(result); ++c) row.emplace_back(PQgetvalue(result, r, c));
+      for (int c = 0; c < Libpq().PQnfields(result); ++c)
+        row.emplace_back(Libpq().PQgetvalue(result, r, c));
     }
   }
-  PQclear(result);
+  Libpq().PQclear(result);
   return ok;
 }
 
 bool PgConnection::CopyIn(const std::string& copy_sql, const std::string& data, PgError* error) {
-  PGresult* start = PQexec(impl_->conn, copy_sql.c_str());
+  PGresult* start = Libpq().PQexec(impl_->conn, copy_sql.c_str());
   const bool started = impl_->Check(start, "COPY", error);
-  PQclear(start);
+  Libpq().PQclear(start);
   if (!started) return false;
-  if (PQputCopyData(impl_->conn, data.data(), static_cast<int>(data.size())) != 1 ||
-      PQputCopyEnd(impl_->conn, nullptr) != 1) {
-    *error = {PgFault::kUnreachable, "COPY: " + Trimmed(PQerrorMessage(impl_->conn)), ""};
+  if (Libpq().PQputCopyData(impl_->conn, data.data(), static_cast<int>(data.size())) != 1 ||
+      Libpq().PQputCopyEnd(impl_->conn, nullptr) != 1) {
+    *error = {PgFault::kUnreachable, "COPY: " + Trimmed(Libpq().PQerrorMessage(impl_->conn)), ""};
     return false;
   }
   bool ok = true;
-  while (PGresult* result = PQgetResult(impl_->conn)) {
+  while (PGresult* result = Libpq().PQgetResult(impl_->conn)) {
     if (ok) ok = impl_->Check(result, "COPY", error);
-    PQclear(result);
+    Libpq().PQclear(result);
   }
   return ok;
 }
 
 std::string PgConnection::Describe() const {
-  const char* host = PQhost(impl_->conn);
-  const char* port = PQport(impl_->conn);
-  const char* db = PQdb(impl_->conn);
+  const char* host = Libpq().PQhost(impl_->conn);
+  const char* port = Libpq().PQport(impl_->conn);
+  const char* db = Libpq().PQdb(impl_->conn);
   return std::string(host ? host : "") + ":" + (port ? port : "") + "/" + (db ? db : "");
 }
 
-bool PgConnection::Ok() const { return PQstatus(impl_->conn) == CONNECTION_OK; }
+bool PgConnection::Ok() const { return Libpq().PQstatus(impl_->conn) == CONNECTION_OK; }
 
 void AppendCopyText(const std::string& s, std::string* out) {
   const std::size_t n = s.size();

@@ -1,6 +1,5 @@
 #include "io/pg_scratch_server.h"
 
-#include <libpq-fe.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -9,6 +8,8 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+
+#include "config/libpq_api.h"
 
 namespace pvtwin {
 
@@ -130,27 +131,28 @@ std::string PgScratchServer::Conninfo(const std::string& dbname, const std::stri
 std::vector<std::vector<std::string>> PgScratchServer::Query(const std::string& sql,
                                                              const std::string& dbname) const {
   const std::string conninfo = Conninfo(dbname) + " password=" + password_;
-  PGconn* conn = PQconnectdb(conninfo.c_str());
+  PGconn* conn = Libpq().PQconnectdb(conninfo.c_str());
   std::vector<std::vector<std::string>> rows;
-  if (PQstatus(conn) != CONNECTION_OK) {
-    rows.push_back({"ERROR " + std::string(PQerrorMessage(conn))});
-    PQfinish(conn);
+  if (Libpq().PQstatus(conn) != CONNECTION_OK) {
+    rows.push_back({"ERROR " + std::string(Libpq().PQerrorMessage(conn))});
+    Libpq().PQfinish(conn);
     return rows;
   }
-  PGresult* result = PQexec(conn, sql.c_str());
-  const ExecStatusType status = PQresultStatus(result);
+  PGresult* result = Libpq().PQexec(conn, sql.c_str());
+  const ExecStatusType status = Libpq().PQresultStatus(result);
   if (status != PGRES_TUPLES_OK && status != PGRES_COMMAND_OK) {
-    rows.push_back({"ERROR " + std::string(PQresultErrorMessage(result))});
+    rows.push_back({"ERROR " + std::string(Libpq().PQresultErrorMessage(result))});
   } else {
-    for (int r = 0; r < PQntuples(result); ++r) {
+    for (int r = 0; r < Libpq().PQntuples(result); ++r) {
       std::vector<std::string>& row = rows.emplace_back();
-      for (int c = 0; c < PQnfields(result); ++c) {
-        row.push_back(PQgetisnull(result, r, c) ? "NULL" : PQgetvalue(result, r, c));
+      for (int c = 0; c < Libpq().PQnfields(result); ++c) {
+        row.push_back(Libpq().PQgetisnull(result, r, c) ? "NULL"
+                                                        : Libpq().PQgetvalue(result, r, c));
       }
     }
   }
-  PQclear(result);
-  PQfinish(conn);
+  Libpq().PQclear(result);
+  Libpq().PQfinish(conn);
   return rows;
 }
 

@@ -171,12 +171,14 @@ class CsvParser {
       if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // UTF-8 BOM
       if (header.ends_with('\r')) header.remove_suffix(1);
       const bool rows_readable = ReadHeader(header);
+      const std::size_t bytes_left = BytesLeft(in);
       int line_no = 1;
       while (rows_readable && errors_.size() < kMaxCsvErrors && std::getline(in, line)) {
         ++line_no;
         std::string_view row = line;
         if (row.ends_with('\r')) row.remove_suffix(1);
         if (Trim(row).empty()) continue;
+        if (series_.time_s.empty()) ReserveRows(bytes_left / (line.size() + 1), bytes_left);
         ReadRow(line_no, row);
       }
       if (errors_.size() >= kMaxCsvErrors) {
@@ -209,6 +211,31 @@ class CsvParser {
   }
 
  private:
+  // The bytes from the read position to the end, 0 when the stream cannot
+  // tell (a pipe).
+  static std::size_t BytesLeft(std::istream& in) {
+    const std::istream::pos_type here = in.tellg();
+    if (here == std::istream::pos_type(-1) || !in.seekg(0, std::ios::end)) {
+      in.clear();
+      return 0;
+    }
+    const std::istream::pos_type end = in.tellg();
+    in.seekg(here);
+    return end > here ? static_cast<std::size_t>(end - here) : 0;
+  }
+
+  // Room for about `rows` rows (from the first row's length) and a quarter
+  // more, so that the columns of a large file are not copied as they grow.
+  // Room only reserved, never written, costs no memory; and no more rows
+  // than `bytes_left` can hold (a comma or a newline per cell).
+  void ReserveRows(std::size_t rows, std::size_t bytes_left) {
+    rows = std::min(rows + rows / 4 + 16, bytes_left / std::max<std::size_t>(columns_.size(), 1));
+    series_.time_s.reserve(rows);
+    for (const Column& column : columns_) {
+      if (column.channel) series_[*column.channel].reserve(rows);
+    }
+  }
+
   void Error(int line, std::string_view field, std::string_view value, std::string rule) {
     errors_.push_back({path_, line, std::string(field), std::string(value), std::move(rule)});
   }

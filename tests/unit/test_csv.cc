@@ -252,6 +252,44 @@ TEST(CsvRead, AcceptsCrlfByteOrderMarkSpacesAndEmptyLines) {
   EXPECT_FALSE(s.Has(Channel::kWindMS));
 }
 
+// A stream buffer over a string that cannot seek, as a pipe's.
+class UnseekableBuf : public std::streambuf {
+ public:
+  explicit UnseekableBuf(std::string text) : text_(std::move(text)) {
+    setg(text_.data(), text_.data(), text_.data() + text_.size());
+  }
+
+ private:
+  std::string text_;
+};
+
+TEST(CsvRead, AStreamThatCannotSeekReadsAsAFileDoes) {
+  // The reader reserves room for the rows from the bytes left after the
+  // first row; a pipe tells no size, and rows longer than the first would
+  // outgrow the estimate.
+  std::string text = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n0,1,2,0,0,9,0\n";
+  for (int i = 1; i < 3000; ++i) {
+    text += std::to_string(60 * i) + ",21.125,22.5,0.0316,812.75,19.0625," +
+            std::to_string(100 + i % 7) + ".5\n";
+  }
+  Series from_string;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseText(text, &from_string, &errors)) << errors.front().ToString();
+  UnseekableBuf buf(text);
+  std::istream pipe(&buf);
+  ASSERT_EQ(pipe.tellg(), std::istream::pos_type(-1));
+  Series from_pipe;
+  Diagnostics warnings;
+  ASSERT_TRUE(ParseCanonicalCsv(pipe, "pipe.csv", {}, &from_pipe, &errors, &warnings))
+      << errors.front().ToString();
+  ASSERT_EQ(from_string.size(), 3000u);
+  EXPECT_EQ(from_pipe.time_s, from_string.time_s);
+  for (Channel c : {Channel::kTInC, Channel::kGPoaWM2, Channel::kPElW}) {
+    EXPECT_EQ(from_pipe[c], from_string[c]);
+  }
+  EXPECT_EQ(from_string[Channel::kPElW][2999], 100 + 2999 % 7 + 0.5);
+}
+
 TEST(CsvRead, FlowInLitresPerHourUsesTheConfiguredDensity) {
   const std::string text =
       "time,t_in_c,t_out_c,flow_l_h,g_poa_w_m2,t_amb_c,p_el_w\n0,1,2,360,500,20,100\n";

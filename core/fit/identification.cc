@@ -1123,10 +1123,21 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   }
   if (!std::isfinite(final_cost)) return finish(false, "the fitted model gives non-finite outputs");
   if (final_cost > initial_cost) {
+    // The start fits better than the result. The fit only ever lowers the
+    // cost, but fixing an undetermined parameter may raise it by up to
+    // fix_cost_tolerance: from a start at an optimum already (a warm start
+    // from the last calibration) the result can end a little above it. The
+    // start keeps every fixed parameter at its start value too, so it is
+    // the result.
     char buf[160];
-    std::snprintf(buf, sizeof(buf), "the fit is worse than the start values (%.4g > %.4g W/m2)",
-                  final_cost, initial_cost);
-    return finish(false, buf);
+    std::snprintf(buf, sizeof(buf),
+                  "the start values fit better than the fit's result (%.4g < %.4g W/m2): kept",
+                  initial_cost, final_cost);
+    summary.notes.emplace_back(buf);
+    summary.params = fs.base;
+    summary.final_cost_w_m2 = obj.DataCost(fs.base);
+    summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
+    summary.evaluations = obj.simulations() + coarse_simulations;
   }
   return finish(true, "");
 }

@@ -36,6 +36,7 @@ struct BacktestArgs {
   int test_days = 29;
   std::string json;
   int threads = 0;
+  bool warm_start = false;
   // --forecast: the daily forecast's backtest instead of the fit's.
   bool forecast = false;
   std::string issue_at = "00:00";
@@ -211,6 +212,7 @@ int RunBacktestCommand(const BacktestArgs& a) {
       a.train_days.empty() ? std::vector<int>{config.calibration.window_days} : a.train_days;
   options.test_days = a.test_days;
   options.threads = a.threads;
+  options.warm_start = a.warm_start;
   if (!a.first_test_day.empty()) {
     options.first_test_day_s =
         SolarDayStartOfDateS(year, month, day, SolarDayOffsetS(config.plant));
@@ -324,6 +326,10 @@ void RegisterBacktest(CLI::App& app) {
   cmd->add_option("--json", args->json, "write the report (every job and the means) as JSON");
   cmd->add_option("--threads", args->threads, "worker threads, 0 = all cores (default 0)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--warm-start", args->warm_start,
+                "start each day's identification from the parameters the same variant "
+                "identified the day before, as the daemon re-identifies nightly (the first day, "
+                "and a day after a failed one, from Table 3); default: every day from Table 3");
   cmd->add_flag("--forecast", args->forecast,
                 "backtest the daily 24 h forecast instead of the fit: for each test day, "
                 "identify on the window before the issue (the first --train-days, default "

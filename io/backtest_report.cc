@@ -20,6 +20,7 @@ nlohmann::ordered_json RunObject(const BacktestResult& r) {
   run["wall_time_s"] = Number(r.wall_time_s);
   run["test_days"] = r.test_days;
   run["solar_offset_s"] = r.solar_offset_s;
+  run["warm_start"] = r.warm_start;
   nlohmann::ordered_json averages = nlohmann::ordered_json::array();
   for (const BacktestAverage& a : r.averages) {
     averages.push_back({{"variant", a.variant},

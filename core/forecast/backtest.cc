@@ -57,6 +57,41 @@ struct Job {
   std::size_t train = 0;
 };
 
+// Each job its own work item.
+std::vector<std::vector<std::size_t>> SingleJobs(std::size_t n) {
+  std::vector<std::vector<std::size_t>> items(n);
+  for (std::size_t j = 0; j < n; ++j) items[j] = {j};
+  return items;
+}
+
+// One chain per variant and training length, its jobs in day order (the
+// jobs are ordered by day). The variants with more free parameters, the
+// longer fits, come first, so that the last chain to start is a short one.
+std::vector<std::vector<std::size_t>> WarmStartChains(const std::vector<Job>& jobs,
+                                                      const std::vector<ModelSpec>& specs) {
+  std::vector<std::vector<std::size_t>> chains;
+  std::vector<std::pair<std::size_t, std::size_t>> keys;  // (variant, train) of each chain
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    const std::pair<std::size_t, std::size_t> key{jobs[j].variant, jobs[j].train};
+    const auto at = std::find(keys.begin(), keys.end(), key);
+    if (at == keys.end()) {
+      keys.push_back(key);
+      chains.push_back({j});
+    } else {
+      chains[static_cast<std::size_t>(at - keys.begin())].push_back(j);
+    }
+  }
+  std::vector<std::size_t> order(chains.size());
+  for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return DefaultFreeParams(specs[keys[a].first]).count() >
+           DefaultFreeParams(specs[keys[b].first]).count();
+  });
+  std::vector<std::vector<std::size_t>> sorted;
+  for (const std::size_t c : order) sorted.push_back(std::move(chains[c]));
+  return sorted;
+}
+
 // Start of the n-th solar day with data before day_start_s (data_days:
 // sorted starts of the days that hold rows); n calendar days before it when
 // fewer days with data precede it.
@@ -92,8 +127,9 @@ std::vector<std::int64_t> DaysWithData(const Series& s, std::int64_t offset_s) {
 }
 
 void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
-            const ModelSpec& spec, std::int64_t day_start_s, std::int64_t solar_offset_s,
-            const std::vector<std::int64_t>& data_days, BacktestDay* out) {
+            const ModelSpec& spec, const ParamVector& start, std::int64_t day_start_s,
+            std::int64_t solar_offset_s, const std::vector<std::int64_t>& data_days,
+            BacktestDay* out) {
   const std::int64_t day_end_s = day_start_s + kSecondsPerDay;
   const std::int64_t train_start_s = TrainingStartS(data_days, day_start_s, out->train_days);
   const std::size_t min_rows = static_cast<std::size_t>(std::max(options.ident.min_rows, 0));
@@ -133,7 +169,7 @@ void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
   }
 
   const IdentSummary summary =
-      Identify(train.drivers, train.meas, StartParams(plant), options.ident);
+      Identify(train.drivers, train.meas, start, options.ident);
   out->runtime_s = summary.runtime_s;
   out->evaluations = summary.evaluations;
   out->params = summary.params;
@@ -403,22 +439,32 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
     days[j].train_days = options.train_days[jobs[j].train];
   }
 
+  // The work items: each job alone, or with warm starts one chain per
+  // variant and training length, its days in order.
+  const std::vector<std::vector<std::size_t>> chains =
+      options.warm_start ? WarmStartChains(jobs, specs) : SingleJobs(jobs.size());
+  const ParamVector table3 = StartParams(plant);
   std::atomic<std::size_t> next{0};
   std::mutex progress_mutex;
   int done = 0;
   const int total = static_cast<int>(jobs.size());
   auto worker = [&]() {
-    for (std::size_t j = next.fetch_add(1); j < jobs.size(); j = next.fetch_add(1)) {
-      RunJob(s, plant, options, specs[jobs[j].variant], days[j].day_start_s, offset_s, data_days,
-             &days[j]);
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      ++done;
-      if (progress) progress(done, total, days[j]);
+    for (std::size_t c = next.fetch_add(1); c < chains.size(); c = next.fetch_add(1)) {
+      const BacktestDay* before = nullptr;
+      for (const std::size_t j : chains[c]) {
+        const ParamVector& start = before != nullptr && before->ok ? before->params : table3;
+        RunJob(s, plant, options, specs[jobs[j].variant], start, days[j].day_start_s, offset_s,
+               data_days, &days[j]);
+        before = &days[j];
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        ++done;
+        if (progress) progress(done, total, days[j]);
+      }
     }
   };
   unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
                                          : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min<unsigned>(threads, static_cast<unsigned>(jobs.size()));
+  threads = std::min<unsigned>(threads, static_cast<unsigned>(chains.size()));
   std::vector<std::thread> pool;
   for (unsigned t = 1; t < threads; ++t) {
     try {
@@ -439,6 +485,7 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
   out.solar_offset_s = offset_s;
   out.test_days = static_cast<int>(day_starts.size());
   out.skipped_days = skipped_days;
+  out.warm_start = options.warm_start;
   out.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   *result = std::move(out);
@@ -472,7 +519,13 @@ std::string FormatBacktestTables(const BacktestResult& result) {
   out +=
       "Each test day is predicted by a model identified on the n days with data before it; means "
       "over "
-      "the days identified.\n\n";
+      "the days identified.\n";
+  if (result.warm_start) {
+    out +=
+        "Warm starts: each variant's identification starts from its parameters of the day "
+        "before (the first day, and a day after a failed one, from Table 3).\n";
+  }
+  out += "\n";
 
   // Table 6 shape.
   std::vector<std::vector<std::string>> rows;

@@ -88,6 +88,13 @@ struct BacktestOptions {
   IdentOptions ident;
   // Worker threads, ≥ 0; 0 = std::thread::hardware_concurrency().
   int threads = 0;
+  // False: every identification starts from Table 3 (StartParams), each job
+  // on its own. True: as the daemon re-identifies nightly (paper 3.3), each
+  // variant and training length starts its first test day from Table 3 and
+  // every next day from the parameters identified the day before (Table 3
+  // again after a failed day). The days of one variant then run in order,
+  // variants in parallel; the results do not depend on the thread count.
+  bool warm_start = false;
 
   // False if a field is out of range; *why (if not null) then lists every
   // problem as "field = value: rule", separated by "; ".
@@ -142,6 +149,7 @@ struct BacktestResult {
   std::int64_t solar_offset_s = 0;  // SolarDayOffsetS of the plant (labels the days)
   int test_days = 0;                // number of test days evaluated
   int skipped_days = 0;             // days of the range without data across solar noon
+  bool warm_start = false;          // BacktestOptions::warm_start of the run
 };
 
 // Runs the backtest. Returns false with *error (nothing in *result) when the

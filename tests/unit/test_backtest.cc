@@ -173,6 +173,42 @@ TEST_F(Backtest, FourJobsInDayVariantOrderAndSameNumbersOnTwoThreads) {
   EXPECT_EQ(r2.averages[0].mae_q_th_w_m2, r1.averages[0].mae_q_th_w_m2);
 }
 
+// --warm-start: each variant's first test day as without it (from Table
+// 3), the next day from the day before's parameters: the truth variant, at
+// its optimum already on noise-free data, then needs far fewer simulations.
+// The chains run variants in parallel and give the same numbers on any
+// number of threads.
+TEST_F(Backtest, WarmStartsTakeTheDayBeforesParametersOnAnyNumberOfThreads) {
+  BacktestOptions options = TwoDaysTwoVariants();
+  options.warm_start = true;
+  options.threads = 1;
+  BacktestResult warm1, warm2;
+  std::string error;
+  ASSERT_TRUE(RunBacktest(*data_, *plant_, options, &warm1, &error)) << error;
+  options.threads = 2;
+  ASSERT_TRUE(RunBacktest(*data_, *plant_, options, &warm2, &error)) << error;
+  const BacktestResult& cold = *one_thread_;
+  ASSERT_EQ(warm1.days.size(), 4u);
+  ASSERT_EQ(warm2.days.size(), 4u);
+  EXPECT_TRUE(warm1.warm_start);
+  EXPECT_FALSE(cold.warm_start);
+  for (std::size_t j = 0; j < 4; ++j) {
+    ASSERT_TRUE(warm1.days[j].ok) << warm1.days[j].failure_reason;
+    EXPECT_EQ(warm2.days[j].params, warm1.days[j].params) << j;
+    EXPECT_EQ(warm2.days[j].evaluations, warm1.days[j].evaluations) << j;
+  }
+  for (std::size_t j : {0u, 1u}) {  // the first test day: from Table 3
+    EXPECT_EQ(warm1.days[j].params, cold.days[j].params) << j;
+    EXPECT_EQ(warm1.days[j].evaluations, cold.days[j].evaluations) << j;
+  }
+  // The second day of 2N1Ccolwr, the truth: from the first day's optimum.
+  EXPECT_LT(2 * warm1.days[3].evaluations, cold.days[3].evaluations)
+      << warm1.days[3].evaluations << " against " << cold.days[3].evaluations;
+  EXPECT_LT(warm1.days[3].test.mae_q_th_w_m2, 0.05);
+  EXPECT_NE(FormatBacktestTables(warm1).find("Warm starts:"), std::string::npos);
+  EXPECT_EQ(FormatBacktestTables(cold).find("Warm starts:"), std::string::npos);
+}
+
 // The truth variant fitted on noise-free data from itself predicts the test
 // days almost exactly. Measured (seed kSeed): MAE P_el 0.000015 and 0.0059,
 // MAE Q_u 0.0007 and 0.0067 W/m² on the two test days, what the fit's

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <mutex>
 #include <set>
 #include <system_error>
@@ -56,6 +57,21 @@ struct Job {
   std::size_t variant = 0;
   std::size_t train = 0;
 };
+
+// worker() on `threads` threads, this one among them; fewer when the system
+// refuses a thread (the worker still takes every item).
+void RunOnThreads(unsigned threads, const std::function<void()>& worker) {
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) {
+    try {
+      pool.emplace_back(worker);
+    } catch (const std::system_error&) {
+      break;
+    }
+  }
+  worker();
+  for (std::thread& t : pool) t.join();
+}
 
 // Each job its own work item.
 std::vector<std::vector<std::size_t>> SingleJobs(std::size_t n) {
@@ -462,19 +478,9 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
       }
     }
   };
-  unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
-                                         : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min<unsigned>(threads, static_cast<unsigned>(chains.size()));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) {
-    try {
-      pool.emplace_back(worker);
-    } catch (const std::system_error&) {
-      break;  // fewer threads: the jobs still all run
-    }
-  }
-  worker();
-  for (std::thread& t : pool) t.join();
+  const unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
+                                               : std::max(1u, std::thread::hardware_concurrency());
+  RunOnThreads(std::min<unsigned>(threads, static_cast<unsigned>(chains.size())), worker);
 
   BacktestResult out;
   out.days = std::move(days);

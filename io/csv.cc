@@ -10,12 +10,15 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
+#include <exception>
 #include <fstream>
 #include <istream>
 #include <limits>
 #include <optional>
 #include <ostream>
 #include <string_view>
+#include <system_error>
+#include <thread>
 #include <vector>
 
 #include "core/common/units.h"
@@ -29,6 +32,9 @@ namespace {
 constexpr std::string_view kTimeColumn = "time";
 constexpr std::string_view kFlowLitrePerHourColumn = "flow_l_h";
 constexpr double kLitrePerHourTimesDensityToKgS = 1.0 / 3.6e6;  // (L/h)·(kg/m³) → kg/s
+// Values outside the physical limits named one by one per column; the rest
+// are counted.
+constexpr std::size_t kNamedOutOfLimits = 3;
 
 std::string FormatNumber(double x) {
   char buf[32];
@@ -162,30 +168,95 @@ class CsvParser {
   CsvParser(const std::string& path, const CsvReadOptions& options)
       : path_(path), options_(options) {}
 
-  bool Parse(std::istream& in, Series* out, Diagnostics* errors, Diagnostics* warnings) {
+  // Reads the header row. False when the rows cannot be read (no header, or
+  // no canonical CSV header); *header_bytes: the bytes it took, its newline
+  // included.
+  bool ReadHeaderRow(std::istream& in, std::size_t* header_bytes) {
     std::string line;
     if (!std::getline(in, line)) {
       Error(0, "", "", "empty file: a header row is expected");
-    } else {
-      std::string_view header = line;
-      if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // UTF-8 BOM
-      if (header.ends_with('\r')) header.remove_suffix(1);
-      const bool rows_readable = ReadHeader(header);
-      const std::size_t bytes_left = BytesLeft(in);
-      int line_no = 1;
-      while (rows_readable && errors_.size() < kMaxCsvErrors && std::getline(in, line)) {
-        ++line_no;
-        std::string_view row = line;
-        if (row.ends_with('\r')) row.remove_suffix(1);
-        if (Trim(row).empty()) continue;
-        if (series_.time_s.empty()) ReserveRows(bytes_left / (line.size() + 1), bytes_left);
-        ReadRow(line_no, row);
-      }
-      if (errors_.size() >= kMaxCsvErrors) {
-        Error(line_no, "", "", "too many errors; reading stopped here");
-      }
+      return false;
+    }
+    *header_bytes = line.size() + 1;
+    header_ = line;
+    std::string_view header = header_;
+    if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // UTF-8 BOM
+    if (header.ends_with('\r')) header.remove_suffix(1);
+    return ReadHeader(header);
+  }
+
+  // Takes the columns of `other`'s header (read by ReadHeaderRow), without
+  // its diagnostics: for a parser of the same file's later rows.
+  void TakeHeaderOf(const CsvParser& other) {
+    std::string_view header = other.header_;
+    if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);
+    if (header.ends_with('\r')) header.remove_suffix(1);
+    ReadHeader(header);
+    errors_.clear();
+    warnings_.clear();
+  }
+
+  // Reads the rows after line `line_no` until the end of `in`, or, with a
+  // byte limit, the rows that start within the next `limit` bytes. Room for
+  // the columns is reserved from `reserve_bytes` (the bytes to read, or
+  // more when later rows will be appended; 0: none).
+  void ReadRows(std::istream& in, int line_no, std::size_t limit, std::size_t reserve_bytes) {
+    std::string line;
+    std::size_t consumed = 0;
+    while (consumed < limit && errors_.size() < kMaxCsvErrors && std::getline(in, line)) {
+      ++line_no;
+      consumed += line.size() + 1;
+      std::string_view row = line;
+      if (row.ends_with('\r')) row.remove_suffix(1);
+      if (Trim(row).empty()) continue;
+      if (series_.time_s.empty()) ReserveRows(reserve_bytes / (line.size() + 1), reserve_bytes);
+      ReadRow(line_no, row);
+    }
+    if (errors_.size() >= kMaxCsvErrors) {
+      Error(line_no, "", "", "too many errors; reading stopped here");
     }
     if (in.bad()) Error(0, "", "", "read error");
+    last_line_ = line_no;
+  }
+
+  bool HasErrors() const { return !errors_.empty(); }
+
+  // Appends the rows `later` read from the lines after this parser's last,
+  // with its diagnostics, as one parser reading all of them would have
+  // found them. False (nothing appended) when either found an error or the
+  // times do not increase across the seam: a parser reading the whole file
+  // then reports what it finds.
+  bool Append(CsvParser&& later) {
+    if (HasErrors() || later.HasErrors()) return false;
+    if (!series_.time_s.empty() && !later.series_.time_s.empty() &&
+        later.series_.time_s.front() <= series_.time_s.back()) {
+      return false;
+    }
+    // Values outside the limits: the first few of each column named, in
+    // line order, as NoteOutOfLimits names them.
+    std::array<std::size_t, kNumChannels> named = out_of_limits_;
+    for (Diagnostic& w : later.warnings_) {
+      const auto column = std::find_if(columns_.begin(), columns_.end(),
+                                       [&](const Column& c) { return c.name == w.field; });
+      if (column == columns_.end() || !column->channel) continue;
+      if (named[static_cast<std::size_t>(*column->channel)]++ >= kNamedOutOfLimits) continue;
+      if (w.line > 0) w.line += last_line_;
+      warnings_.push_back(std::move(w));
+    }
+    for (std::size_t c = 0; c < kNumChannels; ++c) out_of_limits_[c] += later.out_of_limits_[c];
+    const auto append = [](auto* to, const auto& from) {
+      to->insert(to->end(), from.begin(), from.end());
+    };
+    append(&series_.time_s, later.series_.time_s);
+    for (const Column& column : columns_) {
+      if (column.channel) append(&series_[*column.channel], later.series_[*column.channel]);
+    }
+    last_line_ += later.last_line_;
+    return true;
+  }
+
+  // The series and the diagnostics: true (and *out written) without errors.
+  bool Finish(Series* out, Diagnostics* errors, Diagnostics* warnings) {
     SummariseOutOfLimits();
     if (warnings != nullptr) warnings->insert(warnings->end(), warnings_.begin(), warnings_.end());
     if (!errors_.empty()) {
@@ -210,7 +281,6 @@ class CsvParser {
     return true;
   }
 
- private:
   // The bytes from the read position to the end, 0 when the stream cannot
   // tell (a pipe).
   static std::size_t BytesLeft(std::istream& in) {
@@ -224,6 +294,7 @@ class CsvParser {
     return end > here ? static_cast<std::size_t>(end - here) : 0;
   }
 
+ private:
   // Room for about `rows` rows (from the first row's length) and a quarter
   // more, so that the columns of a large file are not copied as they grow.
   // Room only reserved, never written, costs no memory; and no more rows
@@ -428,9 +499,8 @@ class CsvParser {
   // Values outside the physical limits become missing: the first few are
   // named one by one, the rest of the column is counted.
   void NoteOutOfLimits(int line_no, const Column& column, std::string_view cell) {
-    constexpr int kNamed = 3;
     const auto c = static_cast<std::size_t>(*column.channel);
-    if (out_of_limits_[c]++ < kNamed) {
+    if (out_of_limits_[c]++ < kNamedOutOfLimits) {
       warnings_.push_back({path_, line_no, column.name, std::string(cell),
                            "outside the physical limits " +
                                DescribeLimit(*column.channel, options_.area_m2) +
@@ -439,13 +509,12 @@ class CsvParser {
   }
 
   void SummariseOutOfLimits() {
-    constexpr std::size_t kNamed = 3;
     for (const Column& column : columns_) {
       if (!column.channel) continue;
       const std::size_t n = out_of_limits_[static_cast<std::size_t>(*column.channel)];
-      if (n <= kNamed) continue;
+      if (n <= kNamedOutOfLimits) continue;
       warnings_.push_back({path_, 0, column.name, "",
-                           std::to_string(n - kNamed) + " more values outside " +
+                           std::to_string(n - kNamedOutOfLimits) + " more values outside " +
                                DescribeLimit(*column.channel, options_.area_m2) +
                                " read as missing (" + std::to_string(n) + " in all)"});
     }
@@ -468,6 +537,8 @@ class CsvParser {
   std::deque<std::string> unescaped_;     // its quoted fields that held ""
   std::array<std::size_t, kNumChannels> out_of_limits_{};
   int previous_line_ = 0;  // line of the last row read
+  int last_line_ = 0;      // line of the last line read, blank or not
+  std::string header_;     // the header row as read
   Series series_;
   Diagnostics errors_;
   Diagnostics warnings_;
@@ -480,8 +551,69 @@ bool ParseCanonicalCsv(std::istream& in, const std::string& path_for_messages,
                        Diagnostics* warnings) {
   assert(out != nullptr && errors != nullptr);
   CsvParser parser(path_for_messages, options);
-  return parser.Parse(in, out, errors, warnings);
+  std::size_t header_bytes = 0;
+  if (parser.ReadHeaderRow(in, &header_bytes)) {
+    parser.ReadRows(in, 1, std::numeric_limits<std::size_t>::max(), CsvParser::BytesLeft(in));
+  } else if (in.bad()) {
+    parser.ReadRows(in, 0, 0, 0);  // reports the read error
+  }
+  return parser.Finish(out, errors, warnings);
 }
+
+namespace {
+
+// Reads a large file on two threads: the caller the rows that start in the
+// first half of the bytes after the header, a helper the rest from a second
+// stream. False, with nothing written, when the file is too small to split,
+// the helper cannot start, or a half found an error or the seam's times do
+// not increase: the caller then reads the file again in one piece, which
+// reports every error in line order as always. Local times (a naive time
+// zone) read in one piece: a cell in the hour the clocks repeat depends on
+// the row before.
+bool ReadInTwoHalves(const std::string& path, std::ifstream& in, const CsvReadOptions& options,
+                     Series* out, Diagnostics* errors, Diagnostics* warnings) {
+  if (options.naive_time_zone != nullptr) return false;
+  CsvParser first(path, options);
+  std::size_t header_bytes = 0;
+  if (!first.ReadHeaderRow(in, &header_bytes) || first.HasErrors()) return false;
+  const std::size_t left = CsvParser::BytesLeft(in);
+  if (left < kCsvTwoThreadBytes) return false;
+  std::ifstream later_in(path, std::ios::binary);
+  std::string skipped;  // the end of the line in which the middle falls
+  if (!later_in.seekg(static_cast<std::streamoff>(header_bytes + left / 2)) ||
+      !std::getline(later_in, skipped)) {
+    return false;
+  }
+  const std::size_t split = left / 2 + skipped.size() + 1;  // bytes after the header
+  if (split >= left) return false;
+  CsvParser later(path, options);
+  later.TakeHeaderOf(first);
+  std::exception_ptr failure;  // of the helper (out of memory), raised here
+  std::thread helper;
+  try {
+    helper = std::thread([&] {
+      try {
+        later.ReadRows(later_in, 0, left, left - split);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+    });
+  } catch (const std::system_error&) {
+    return false;  // no thread to be had: one piece
+  }
+  try {
+    first.ReadRows(in, 1, split, left);
+  } catch (...) {
+    helper.join();
+    throw;
+  }
+  helper.join();
+  if (failure) std::rethrow_exception(failure);
+  if (!first.Append(std::move(later))) return false;
+  return first.Finish(out, errors, warnings);
+}
+
+}  // namespace
 
 bool ReadCanonicalCsv(const std::string& path, const CsvReadOptions& options, Series* out,
                       Diagnostics* errors, Diagnostics* warnings) {
@@ -491,6 +623,9 @@ bool ReadCanonicalCsv(const std::string& path, const CsvReadOptions& options, Se
     errors->push_back({path, 0, "", "", std::string("cannot open: ") + std::strerror(errno)});
     return false;
   }
+  if (ReadInTwoHalves(path, in, options, out, errors, warnings)) return true;
+  in.clear();
+  in.seekg(0);
   return ParseCanonicalCsv(in, path, options, out, errors, warnings);
 }
 

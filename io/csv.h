@@ -40,6 +40,11 @@ class NaiveTimeZone;
 
 inline constexpr std::size_t kMaxCsvErrors = 100;
 
+// ReadCanonicalCsv reads a file with this many bytes of rows or more on two
+// threads, each half of the rows; the result and the diagnostics are those
+// of a reading in one piece.
+inline constexpr std::size_t kCsvTwoThreadBytes = std::size_t{1} << 20;
+
 struct CsvReadOptions {
   double fluid_density_kg_m3 = 1040;  // converts flow_l_h to kg/s (plant config)
   // Collector area for the area-scaled physical limits (flow, P_el, Q_u);

@@ -290,6 +290,128 @@ TEST(CsvRead, AStreamThatCannotSeekReadsAsAFileDoes) {
   EXPECT_EQ(from_string[Channel::kPElW][2999], 100 + 2999 % 7 + 0.5);
 }
 
+// A file of `rows` rows of 1-min data, written to `path`, with the text's
+// awkward parts spread through it: CRLF on every third line, a blank line
+// every 997 rows, and the cells of `bad` (row, column, text) put in.
+struct BadCell {
+  int row;
+  int column;  // of time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w
+  std::string text;
+};
+std::string LargeCsvText(int rows, const std::vector<BadCell>& bad) {
+  std::string text = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
+  for (int i = 0; i < rows; ++i) {
+    std::vector<std::string> cells = {std::to_string(1700000000 + 60 * i),
+                                      "21.125",
+                                      "22.5",
+                                      "0.0316",
+                                      "812.75",
+                                      std::to_string(10 + i % 13) + ".0625",
+                                      std::to_string(100 + i % 7) + ".5"};
+    for (const BadCell& b : bad) {
+      if (b.row == i) cells[static_cast<std::size_t>(b.column)] = b.text;
+    }
+    for (std::size_t c = 0; c < cells.size(); ++c) text += (c > 0 ? "," : "") + cells[c];
+    text += i % 3 == 0 ? "\r\n" : "\n";
+    if (i % 997 == 0) text += "\n";
+  }
+  return text;
+}
+
+// What a read gave: the series and the diagnostics as text.
+struct ReadOutcome {
+  bool ok = false;
+  Series series;
+  std::vector<std::string> errors, warnings;
+};
+ReadOutcome ReadFileAndStrings(const std::string& text, bool from_file) {
+  ReadOutcome r;
+  Diagnostics errors, warnings;
+  const std::string path = TempPath("large.csv");
+  if (from_file) {
+    std::ofstream(path, std::ios::binary) << text;
+    r.ok = ReadCanonicalCsv(path, {}, &r.series, &errors, &warnings);
+    std::filesystem::remove(path);
+  } else {
+    std::istringstream in(text);
+    r.ok = ParseCanonicalCsv(in, path, {}, &r.series, &errors, &warnings);
+  }
+  for (const Diagnostic& d : errors) r.errors.push_back(d.ToString());
+  for (const Diagnostic& d : warnings) r.warnings.push_back(d.ToString());
+  return r;
+}
+
+// Equal values, NaN equal to NaN.
+void ExpectSameColumn(const std::vector<double>& a, const std::vector<double>& b,
+                      const char* name) {
+  ASSERT_EQ(a.size(), b.size()) << name;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::isnan(a[i]) && std::isnan(b[i])) continue;
+    ASSERT_EQ(a[i], b[i]) << name << " row " << i;
+  }
+}
+
+TEST(CsvRead, ALargeFileReadOnTwoThreadsGivesWhatOnePieceGives) {
+  // ReadCanonicalCsv reads a file of kCsvTwoThreadBytes or more in two
+  // halves (a helper thread the later one); a stream is read in one piece.
+  // Values outside the physical limits in both halves: the first three of a
+  // column named with their lines (the blank lines counted), the rest
+  // counted, as one reader finds them.
+  constexpr int kRows = 60000;
+  const std::vector<BadCell> bad = {{5, 5, "999"},      {40000, 5, "999"}, {40001, 5, "998"},
+                                    {50000, 5, "997"},  {20, 6, "1e9"},    {59999, 6, "2e9"},
+                                    {29999, 4, "9999"}, {30000, 4, "9999"}};
+  const std::string text = LargeCsvText(kRows, bad);
+  ASSERT_GE(text.size(), 2 * kCsvTwoThreadBytes);
+  const ReadOutcome file = ReadFileAndStrings(text, true);
+  const ReadOutcome stream = ReadFileAndStrings(text, false);
+  ASSERT_TRUE(file.ok) << file.errors.front();
+  ASSERT_TRUE(stream.ok);
+  EXPECT_EQ(file.series.time_s, stream.series.time_s);
+  ASSERT_EQ(file.series.size(), static_cast<std::size_t>(kRows));
+  for (const ChannelInfo& info : kChannels) {
+    ExpectSameColumn(file.series[info.channel], stream.series[info.channel], info.name.data());
+  }
+  EXPECT_EQ(file.series.step_s, 60);
+  EXPECT_EQ(file.warnings, stream.warnings);
+  // t_amb_c 999 at row 40000: line 40000 + 2 (header, 1-based) + 41 blank
+  // lines (after rows 0, 997, ..., 39880).
+  const std::string named = "large.csv:40043: t_amb_c = 999";
+  EXPECT_TRUE(std::any_of(file.warnings.begin(), file.warnings.end(), [&](const std::string& w) {
+    return w.find(named) != std::string::npos;
+  })) << named;
+  EXPECT_TRUE(std::isnan(file.series[Channel::kTAmbC][40000]));
+  EXPECT_EQ(file.series[Channel::kPElW][59998], 100 + 59998 % 7 + 0.5);
+}
+
+TEST(CsvRead, ALargeFileWithErrorsReportsThemInLineOrderAsOnePieceDoes) {
+  constexpr int kRows = 60000;
+  // A malformed number in either half, and times that repeat around the
+  // middle of the file, where a reader in two halves would put its seam.
+  std::vector<BadCell> bad = {{7, 1, "x"}, {45000, 2, "2,5"}};
+  for (int i = 29000; i < 31000; ++i) bad.push_back({i, 0, "1700000000"});
+  const std::string text = LargeCsvText(kRows, bad);
+  ASSERT_GE(text.size(), 2 * kCsvTwoThreadBytes);
+  const ReadOutcome file = ReadFileAndStrings(text, true);
+  const ReadOutcome stream = ReadFileAndStrings(text, false);
+  EXPECT_FALSE(file.ok);
+  EXPECT_EQ(file.errors, stream.errors);
+  EXPECT_EQ(file.warnings, stream.warnings);
+  ASSERT_FALSE(file.errors.empty());
+  EXPECT_NE(file.errors.front().find("large.csv:10: t_in_c = x"), std::string::npos)
+      << file.errors.front();
+  EXPECT_NE(file.errors.back().find("too many errors"), std::string::npos) << file.errors.back();
+
+  // Only the late malformed number: named at its line, from the later half.
+  const ReadOutcome late = ReadFileAndStrings(LargeCsvText(kRows, {{45000, 2, "2,5"}}), true);
+  EXPECT_FALSE(late.ok);
+  ASSERT_EQ(late.errors.size(), 1u);
+  // Line 45000 + 2 + 46 blank lines (after rows 0, 997, ..., 44865).
+  EXPECT_NE(late.errors.front().find("large.csv:45048: expected 7 fields, found 8"),
+            std::string::npos)
+      << late.errors.front();
+}
+
 TEST(CsvRead, FlowInLitresPerHourUsesTheConfiguredDensity) {
   const std::string text =
       "time,t_in_c,t_out_c,flow_l_h,g_poa_w_m2,t_amb_c,p_el_w\n0,1,2,360,500,20,100\n";

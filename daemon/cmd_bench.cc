@@ -130,8 +130,9 @@ void RegisterBench(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "seed of the synthetic weather");
   cmd->add_option("--data-dir", args->data_dir,
                   "ident: write its 1-min training and held-out days there (train.csv, "
-                  "held_out.csv, and plant.toml: config/examples/plant.toml's plant) and time "
-                  "`pvtwin calibrate` on them (default: a temporary directory, removed after)");
+                  "held_out.csv), its 5-s training days (train_5s.csv) and plant.toml "
+                  "(config/examples/plant.toml's plant), and time `pvtwin calibrate` on them "
+                  "(default: a temporary directory, removed after)");
   cmd->add_option("--daemon-seconds", args->daemon_seconds, "measuring time of `bench daemon`")
       ->check(CLI::PositiveNumber);
   cmd->callback([args] {

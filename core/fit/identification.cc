@@ -147,6 +147,7 @@ class Objective {
   // outputs (DifferenceColumns). A column with a non-finite entry is left
   // zero. False when not supported.
   bool Jacobian(const ParamVector& p, const std::vector<ParamInfo>& infos, Eigen::MatrixXd* jac) {
+    sens_.t_pv_derivatives = use_t_pv_;
     if (!HasSensitivities() || !SimulateSensitivities(drivers_, p, sens_free_, &sens_)) {
       return false;
     }
@@ -163,7 +164,7 @@ class Objective {
       const double dx_dz = DxDz(info, x);
       const double* dp = sens_.DPEl(a);
       const double* dq = sens_.DQTh(a);
-      const double* dt = sens_.DTPv(a);
+      const double* dt = use_t_pv_ ? sens_.DTPv(a) : nullptr;
       for (Eigen::Index k = 0; k < m; ++k) {
         const std::uint32_t i = meas_.rows[static_cast<std::size_t>(k)];
         (*jac)(k, j) = dp[i] * inv_area * dx_dz;

@@ -26,6 +26,7 @@ struct SensRun {
   std::span<const Param> wrt;
   int cols;
   bool outlet;  // also the collector node's and the outlet's temperature (SimSensitivities)
+  bool t_pv;    // the derivatives of T_PV (SimSensitivities::t_pv_derivatives)
 };
 
 // Derivatives of one row's terms (RowTerms, the parameters' products)
@@ -331,7 +332,7 @@ void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& 
     const auto col = static_cast<std::size_t>(j) * n;
     const double d_pv = dres.t_mean_c[0][j];
     const double d_fluid = dres.t_mean_c[FluidNode(kShape)][j];
-    out->dt_pv_c[col + i] = d_pv;
+    if (run.t_pv) out->dt_pv_c[col + i] = d_pv;
     out->dq_th_w[col + i] = t.g_fluid_w_k[j] * (t_fluid - r.t_in_c) + r.g_fluid_w_k * d_fluid;
     if (run.outlet) {
       out->dt_coll_c[col + i] = d_fluid;
@@ -348,13 +349,14 @@ void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& 
   }
 }
 
-void SetSensRowNaN(SimSensitivities* out, std::size_t i, int cols, bool outlet) {
+void SetSensRowNaN(const SensRun& run, SimSensitivities* out, std::size_t i) {
   out->p_el_w[i] = out->q_th_w[i] = out->t_pv_c[i] = kNaN;
-  if (outlet) out->t_coll_c[i] = out->t_out_c[i] = kNaN;
-  for (int j = 0; j < cols; ++j) {
+  if (run.outlet) out->t_coll_c[i] = out->t_out_c[i] = kNaN;
+  for (int j = 0; j < run.cols; ++j) {
     const std::size_t at = static_cast<std::size_t>(j) * out->rows + i;
-    out->dp_el_w[at] = out->dq_th_w[at] = out->dt_pv_c[at] = kNaN;
-    if (outlet) out->dt_coll_c[at] = out->dt_out_c[at] = kNaN;
+    out->dp_el_w[at] = out->dq_th_w[at] = kNaN;
+    if (run.t_pv) out->dt_pv_c[at] = kNaN;
+    if (run.outlet) out->dt_coll_c[at] = out->dt_out_c[at] = kNaN;
   }
 }
 
@@ -390,7 +392,7 @@ void IntegrateRowsSens(const SensRun& run, SimSensitivities* out) {
   for (std::size_t i = 0; i < d.size(); ++i) {
     const RowTerms r = MakeRowTerms<kElectric>(run.k, d, run.w, i);
     if (!d.usable[i] || !RowInputsFinite(r)) {
-      SetSensRowNaN(out, i, cols, run.outlet);
+      SetSensRowNaN(run, out, i);
       need_restart = true;
       continue;
     }
@@ -576,11 +578,18 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
   const std::size_t n = d.size();
   out->wrt.assign(wrt.begin(), wrt.end());
   out->rows = n;
-  for (auto* v : {&out->p_el_w, &out->q_th_w, &out->t_pv_c}) v->resize(n);
-  for (auto* v : {&out->dp_el_w, &out->dq_th_w, &out->dt_pv_c}) v->resize(n * wrt.size());
   const bool outlet =
       std::any_of(d.spec.extensions.begin(), d.spec.extensions.end(),
                   [](const ModelExtension* e) { return e->transform_outputs != nullptr; });
+  // The output transforms take every output's derivatives.
+  const bool t_pv = out->t_pv_derivatives || outlet;
+  for (auto* v : {&out->p_el_w, &out->q_th_w, &out->t_pv_c}) v->resize(n);
+  for (auto* v : {&out->dp_el_w, &out->dq_th_w}) v->resize(n * wrt.size());
+  if (t_pv) {
+    out->dt_pv_c.resize(n * wrt.size());
+  } else {
+    out->dt_pv_c.clear();
+  }
   if (outlet) {
     for (auto* v : {&out->t_coll_c, &out->t_out_c}) v->resize(n);
     for (auto* v : {&out->dt_coll_c, &out->dt_out_c}) v->resize(n * wrt.size());
@@ -588,7 +597,7 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
   const RunConstants k = MakeConstants(d, params);
   RunInputs w;
   MakeRunInputs(d, params, &out->hook_work, &w);
-  const SensRun run{d, k, w, wrt, static_cast<int>(wrt.size()), outlet};
+  const SensRun run{d, k, w, wrt, static_cast<int>(wrt.size()), outlet, t_pv};
   PickSensLoop(d.spec, w.electric_effects)(run, out);
   if (outlet) PushThroughOutputTransforms(d, params, &w, out);
   return true;

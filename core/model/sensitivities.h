@@ -48,12 +48,19 @@
 namespace pvtwin {
 
 struct SimSensitivities {
+  // Set by the caller: false leaves dt_pv_c empty when no extension
+  // transforms the outputs (an objective without T_PV: a third fewer
+  // derivatives written).
+  bool t_pv_derivatives = true;
+
   std::vector<Param> wrt;
   std::size_t rows = 0;
   // Simulate's outputs (NaN where Simulate's are).
   std::vector<double> p_el_w, q_th_w, t_pv_c;
   // d output[i] / d wrt[j] at index j·rows + i (one column per parameter,
-  // column-major): W (or K) per unit of the parameter (params.h).
+  // column-major): W (or K) per unit of the parameter (params.h). dt_pv_c
+  // is empty when t_pv_derivatives is false and no extension transforms the
+  // outputs.
   std::vector<double> dp_el_w, dq_th_w, dt_pv_c;
 
   const double* DPEl(std::size_t j) const { return dp_el_w.data() + j * rows; }

@@ -316,6 +316,38 @@ TEST(ModelSensitivities, EffectVariantsMatchCentralDifferences) {
   EXPECT_GT(clipped_rows, 20);  // the clipped rows' derivatives were compared
 }
 
+// Without the T_PV derivatives (an objective without T_PV) the run writes
+// the same P_el and Q_u derivatives to the bit and leaves dt_pv_c empty;
+// with an extension that transforms the outputs, the transform takes every
+// output's derivatives, and the run keeps T_PV's.
+TEST(ModelSensitivities, TheTPvDerivativesAreLeftOutOnlyWhenNoTransformReadsThem) {
+  const Plant plant = DesignExamplePlant();
+  const Series s = TestWeather(plant);
+  for (const std::string variant : {"2N1Ccolwr", "1N1Cwr+transport_delay"}) {
+    const Drivers d = TestDrivers(variant, s, plant);
+    const std::vector<Param> wrt = SensitivityColumns(plant, d.spec);
+    std::mt19937_64 rng(11);
+    const ParamVector p = PointNearTruth(plant, d.spec, &rng);
+    SimSensitivities all, without;
+    without.t_pv_derivatives = false;
+    ASSERT_TRUE(SimulateSensitivities(d, p, wrt, &all)) << variant;
+    ASSERT_TRUE(SimulateSensitivities(d, p, wrt, &without)) << variant;
+    ASSERT_EQ(all.dt_pv_c.size(), d.size() * wrt.size()) << variant;
+    const bool transforms = variant.find("transport_delay") != std::string::npos;
+    EXPECT_EQ(without.dt_pv_c.size(), transforms ? all.dt_pv_c.size() : 0u) << variant;
+    for (auto field : {&SimSensitivities::dp_el_w, &SimSensitivities::dq_th_w,
+                       &SimSensitivities::p_el_w, &SimSensitivities::t_pv_c}) {
+      const std::vector<double>& a = all.*field;
+      const std::vector<double>& b = without.*field;
+      ASSERT_EQ(a.size(), b.size()) << variant;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        if (std::isnan(a[i]) && std::isnan(b[i])) continue;
+        ASSERT_EQ(a[i], b[i]) << variant << " at " << i;
+      }
+    }
+  }
+}
+
 TEST(ModelSensitivities, UnsupportedSpecsSayWhy) {
   const Plant plant = DesignExamplePlant();
   for (const std::string variant : {"1N1Cr+wind", "2N2Cwr+transport_delay"}) {

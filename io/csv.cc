@@ -10,17 +10,15 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
-#include <exception>
 #include <fstream>
 #include <istream>
 #include <limits>
 #include <optional>
 #include <ostream>
 #include <string_view>
-#include <system_error>
-#include <thread>
 #include <vector>
 
+#include "core/common/threads.h"
 #include "core/common/units.h"
 #include "core/data/physical_limits.h"
 #include "core/data/qc.h"
@@ -564,8 +562,9 @@ namespace {
 
 // Reads a large file on two threads: the caller the rows that start in the
 // first half of the bytes after the header, a helper the rest from a second
-// stream. False, with nothing written, when the file is too small to split,
-// the helper cannot start, or a half found an error or the seam's times do
+// stream (both here, one after the other, when the system refuses the
+// thread). False, with nothing written, when the file is too small to split,
+// or a half found an error or the seam's times do
 // not increase: the caller then reads the file again in one piece, which
 // reports every error in line order as always. Local times (a naive time
 // zone) read in one piece: a cell in the hour the clocks repeat depends on
@@ -588,27 +587,8 @@ bool ReadInTwoHalves(const std::string& path, std::ifstream& in, const CsvReadOp
   if (split >= left) return false;
   CsvParser later(path, options);
   later.TakeHeaderOf(first);
-  std::exception_ptr failure;  // of the helper (out of memory), raised here
-  std::thread helper;
-  try {
-    helper = std::thread([&] {
-      try {
-        later.ReadRows(later_in, 0, left, left - split);
-      } catch (...) {
-        failure = std::current_exception();
-      }
-    });
-  } catch (const std::system_error&) {
-    return false;  // no thread to be had: one piece
-  }
-  try {
-    first.ReadRows(in, 1, split, left);
-  } catch (...) {
-    helper.join();
-    throw;
-  }
-  helper.join();
-  if (failure) std::rethrow_exception(failure);
+  RunBoth([&] { later.ReadRows(later_in, 0, left, left - split); },
+          [&] { first.ReadRows(in, 1, split, left); });
   if (!first.Append(std::move(later))) return false;
   return first.Finish(out, errors, warnings);
 }

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <map>
 #include <sstream>
-#include <thread>
 
 #include "core/common/calendar.h"
+#include "core/common/threads.h"
 #include "core/diagnosis/stages.h"
 
 namespace pvtwin::diagnosis_stages {
@@ -421,11 +421,9 @@ StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& cur
       in.progress(ProgressLine(step, finished, candidates.size(), out.trials[k], in.test_unit));
     }
   };
-  std::vector<std::thread> pool;
-  const int n_threads = std::min<int>(in.threads, static_cast<int>(candidates.size()));
-  for (int w = 1; w < n_threads; ++w) pool.emplace_back(worker);
-  worker();
-  for (std::thread& th : pool) th.join();
+  RunOnThreads(
+      static_cast<unsigned>(std::clamp<int>(in.threads, 1, static_cast<int>(candidates.size()))),
+      worker);
   for (std::size_t k = 0; k < out.trials.size(); ++k) {
     out.trials[k].evidence =
         EvidenceSentence(out.trials[k], *candidates[k].module, step, in.test_unit);

@@ -8,10 +8,10 @@
 #include <functional>
 #include <mutex>
 #include <set>
-#include <system_error>
 #include <thread>
 #include <utility>
 
+#include "core/common/threads.h"
 #include "core/common/units.h"
 #include "core/data/resample.h"
 #include "core/model/thermal_model.h"
@@ -57,21 +57,6 @@ struct Job {
   std::size_t variant = 0;
   std::size_t train = 0;
 };
-
-// worker() on `threads` threads, this one among them; fewer when the system
-// refuses a thread (the worker still takes every item).
-void RunOnThreads(unsigned threads, const std::function<void()>& worker) {
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) {
-    try {
-      pool.emplace_back(worker);
-    } catch (const std::system_error&) {
-      break;
-    }
-  }
-  worker();
-  for (std::thread& t : pool) t.join();
-}
 
 // Each job its own work item.
 std::vector<std::vector<std::size_t>> SingleJobs(std::size_t n) {

@@ -6,6 +6,7 @@
 #include <span>
 #include <thread>
 
+#include "core/common/threads.h"
 #include "core/common/units.h"
 #include "core/physics/iam.h"
 #include "core/physics/irradiance.h"
@@ -32,9 +33,8 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) 
   const std::span<SolarPosition> out(sun);
   if (n >= kRowsToSplit && std::thread::hardware_concurrency() >= 2) {
     const std::size_t half = n / 2;
-    std::thread helper([&] { ComputeSolarPositions(times.first(half), site, out.first(half)); });
-    ComputeSolarPositions(times.subspan(half), site, out.subspan(half));
-    helper.join();
+    RunBoth([&] { ComputeSolarPositions(times.first(half), site, out.first(half)); },
+            [&] { ComputeSolarPositions(times.subspan(half), site, out.subspan(half)); });
   } else {
     ComputeSolarPositions(times, site, out);
   }

@@ -1,0 +1,20 @@
+// Work on more than one thread, for the callers that split their work:
+// each keeps working when the system refuses a thread (std::system_error
+// on a plant controller at its thread limit), on fewer threads.
+#pragma once
+
+#include <functional>
+
+namespace pvtwin {
+
+// worker() on `threads` threads, the calling one among them; on fewer when
+// the system refuses a thread. Each worker takes its items from a counter
+// shared by all, so every item is done on however many run.
+void RunOnThreads(unsigned threads, const std::function<void()>& worker);
+
+// first() on a helper thread while second() runs on this one; both on this
+// one, first() first, when the system refuses the thread. An exception of
+// either is thrown here once both have ended (first()'s when both throw).
+void RunBoth(const std::function<void()>& first, const std::function<void()>& second);
+
+}  // namespace pvtwin

@@ -165,13 +165,22 @@ class Objective {
       const double* dp = sens_.DPEl(a);
       const double* dq = sens_.DQTh(a);
       const double* dt = use_t_pv_ ? sens_.DTPv(a) : nullptr;
+      double* col = jac->col(j).data();
+      bool finite = true;  // checked in the pass that fills the column
       for (Eigen::Index k = 0; k < m; ++k) {
         const std::uint32_t i = meas_.rows[static_cast<std::size_t>(k)];
-        (*jac)(k, j) = dp[i] * inv_area * dx_dz;
-        (*jac)(m + k, j) = dq[i] * inv_area * dx_dz;
-        if (use_t_pv_) (*jac)(2 * m + k, j) = options_.t_pv_weight_w_m2k * dt[i] * dx_dz;
+        const double vp = dp[i] * inv_area * dx_dz;
+        const double vq = dq[i] * inv_area * dx_dz;
+        col[k] = vp;
+        col[m + k] = vq;
+        finite &= std::isfinite(vp) & std::isfinite(vq);
+        if (use_t_pv_) {
+          const double vt = options_.t_pv_weight_w_m2k * dt[i] * dx_dz;
+          col[2 * m + k] = vt;
+          finite &= std::isfinite(vt);
+        }
       }
-      if (!jac->col(j).allFinite()) jac->col(j).setZero();
+      if (!finite) jac->col(j).setZero();
     }
     if (!diff_cols_.empty()) {
       Eigen::VectorXd r0;

@@ -1,7 +1,8 @@
 // systemd service notifications (sd_notify(3)): READY=1 once the daemon
 // serves, WATCHDOG=1 while its loop runs, STOPPING=1 on the way out, and a
 // STATUS= line. Without $NOTIFY_SOCKET (not run by systemd) every call is a
-// no-op.
+// no-op. libsystemd is loaded by the first call that notifies (dlopen), so
+// the other commands do not map it.
 #pragma once
 
 #include <string>

@@ -53,13 +53,16 @@ bool Maps(const testing::ProcessResult& run, const std::string& soname) {
   return run.err.find("file=" + soname + " [0];") != std::string::npos;
 }
 
-TEST(SharedLibrary, PvtwinMapsLibpqAndLibcurlOnlyWhenACommandNeedsThem) {
+TEST(SharedLibrary, PvtwinMapsItsOptionalLibrariesOnlyWhenACommandNeedsThem) {
   const testing::ProcessResult traced =
       testing::RunCommand(".", "LD_DEBUG=files '" + std::string(PVTWIN_BINARY) + "' --version");
   ASSERT_EQ(traced.exit_code, 0);
   ASSERT_TRUE(Maps(traced, "libc.so.6")) << "LD_DEBUG gave no list of mapped files";
   EXPECT_FALSE(Maps(traced, "libpq.so.5"));
   EXPECT_FALSE(Maps(traced, "libcurl.so.4"));
+  // libsystemd: loaded by `pvtwin run` under systemd only
+  // (DaemonPaths.TellsSystemdReadyWatchdogReloadingAndStopping).
+  EXPECT_FALSE(Maps(traced, "libsystemd.so.0"));
 
   // A config with an [upload] section is checked by libpq itself, which is
   // then loaded: the lazy path is the one the upload takes.

@@ -177,19 +177,13 @@ class CsvParser {
     }
     *header_bytes = line.size() + 1;
     header_ = line;
-    std::string_view header = header_;
-    if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // UTF-8 BOM
-    if (header.ends_with('\r')) header.remove_suffix(1);
-    return ReadHeader(header);
+    return ReadHeader(HeaderNames(header_));
   }
 
   // Takes the columns of `other`'s header (read by ReadHeaderRow), without
   // its diagnostics: for a parser of the same file's later rows.
   void TakeHeaderOf(const CsvParser& other) {
-    std::string_view header = other.header_;
-    if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);
-    if (header.ends_with('\r')) header.remove_suffix(1);
-    ReadHeader(header);
+    ReadHeader(HeaderNames(other.header_));
     errors_.clear();
     warnings_.clear();
   }
@@ -213,8 +207,12 @@ class CsvParser {
     if (errors_.size() >= kMaxCsvErrors) {
       Error(line_no, "", "", "too many errors; reading stopped here");
     }
-    if (in.bad()) Error(0, "", "", "read error");
+    NoteReadError(in);
     last_line_ = line_no;
+  }
+
+  void NoteReadError(const std::istream& in) {
+    if (in.bad()) Error(0, "", "", "read error");
   }
 
   bool HasErrors() const { return !errors_.empty(); }
@@ -293,6 +291,13 @@ class CsvParser {
   }
 
  private:
+  // The header row without a UTF-8 byte order mark and a CR at its end.
+  static std::string_view HeaderNames(std::string_view header) {
+    if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);
+    if (header.ends_with('\r')) header.remove_suffix(1);
+    return header;
+  }
+
   // Room for about `rows` rows (from the first row's length) and a quarter
   // more, so that the columns of a large file are not copied as they grow.
   // Room only reserved, never written, costs no memory; and no more rows
@@ -552,8 +557,8 @@ bool ParseCanonicalCsv(std::istream& in, const std::string& path_for_messages,
   std::size_t header_bytes = 0;
   if (parser.ReadHeaderRow(in, &header_bytes)) {
     parser.ReadRows(in, 1, std::numeric_limits<std::size_t>::max(), CsvParser::BytesLeft(in));
-  } else if (in.bad()) {
-    parser.ReadRows(in, 0, 0, 0);  // reports the read error
+  } else {
+    parser.NoteReadError(in);
   }
   return parser.Finish(out, errors, warnings);
 }
@@ -563,12 +568,12 @@ namespace {
 // Reads a large file on two threads: the caller the rows that start in the
 // first half of the bytes after the header, a helper the rest from a second
 // stream (both here, one after the other, when the system refuses the
-// thread). False, with nothing written, when the file is too small to split,
-// or a half found an error or the seam's times do
-// not increase: the caller then reads the file again in one piece, which
-// reports every error in line order as always. Local times (a naive time
-// zone) read in one piece: a cell in the hour the clocks repeat depends on
-// the row before.
+// thread). False, with nothing written, when the file is too small to
+// split, a half found an error, or the times do not increase across the
+// seam: the caller then reads the file again in one piece, which reports
+// every error in line order as always. Local times (a naive time zone) are
+// read in one piece: a cell in the hour the clocks repeat depends on the
+// row before.
 bool ReadInTwoHalves(const std::string& path, std::ifstream& in, const CsvReadOptions& options,
                      Series* out, Diagnostics* errors, Diagnostics* warnings) {
   if (options.naive_time_zone != nullptr) return false;

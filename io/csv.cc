@@ -581,7 +581,7 @@ bool ReadInTwoHalves(const std::string& path, std::ifstream& in, const CsvReadOp
   std::size_t header_bytes = 0;
   if (!first.ReadHeaderRow(in, &header_bytes) || first.HasErrors()) return false;
   const std::size_t left = CsvParser::BytesLeft(in);
-  if (left < kCsvTwoThreadBytes) return false;
+  if (left < options.two_thread_bytes) return false;
   std::ifstream later_in(path, std::ios::binary);
   std::string skipped;  // the end of the line in which the middle falls
   if (!later_in.seekg(static_cast<std::streamoff>(header_bytes + left / 2)) ||

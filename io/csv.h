@@ -42,7 +42,7 @@ inline constexpr std::size_t kMaxCsvErrors = 100;
 
 // ReadCanonicalCsv reads a file with this many bytes of rows or more on two
 // threads, each half of the rows; the result and the diagnostics are those
-// of a reading in one piece.
+// of a reading in one piece (CsvReadOptions::two_thread_bytes).
 inline constexpr std::size_t kCsvTwoThreadBytes = std::size_t{1} << 20;
 
 struct CsvReadOptions {
@@ -56,6 +56,10 @@ struct CsvReadOptions {
   // A weather file (pvtwin import-weather): required are only `time`,
   // g_poa_w_m2 or ghi_w_m2 + dhi_w_m2, and t_amb_c.
   bool weather_only = false;
+  // ReadCanonicalCsv reads a file with at least this many bytes after the
+  // header on two threads (the tests and the fuzzer set it low, so that
+  // small files take that path too).
+  std::size_t two_thread_bytes = kCsvTwoThreadBytes;
 };
 
 // Reads the file at path. Returns true if it was read without errors; then

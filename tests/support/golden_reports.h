@@ -31,20 +31,35 @@ inline std::string ConfigCaseReport(const std::filesystem::path& case_dir, bool*
   return report;
 }
 
+// How CsvCaseReport reads the case: as a stream (ParseCanonicalCsv), or as
+// a file by ReadCanonicalCsv with every file large enough for its reading on
+// two threads.
+enum class CsvRead { kStream, kFileOnTwoThreads };
+
 // <case>/input.csv read with fluid density 1040 kg/m³ and the example
 // plant's area of 1.8 m² (for the area-scaled physical limits):
 //   error: <diagnostic>      every error, in order
 //   warning: <diagnostic>    every warning, in order
 // and, if the file was read, "step_s = <median step>" followed by the series
 // as WriteCsv writes it (time and every channel present, in channel order).
-inline std::string CsvCaseReport(const std::filesystem::path& case_dir, bool* ok) {
-  std::ifstream in(case_dir / "input.csv", std::ios::binary);
+// Diagnostics name the file input.csv either way.
+inline std::string CsvCaseReport(const std::filesystem::path& case_dir, bool* ok,
+                                 CsvRead how = CsvRead::kStream) {
   Series series;
   Diagnostics errors;
   Diagnostics warnings;
   CsvReadOptions options;
   options.area_m2 = 1.8;
-  *ok = ParseCanonicalCsv(in, "input.csv", options, &series, &errors, &warnings);
+  if (how == CsvRead::kStream) {
+    std::ifstream in(case_dir / "input.csv", std::ios::binary);
+    *ok = ParseCanonicalCsv(in, "input.csv", options, &series, &errors, &warnings);
+  } else {
+    options.two_thread_bytes = 1;
+    *ok = ReadCanonicalCsv((case_dir / "input.csv").string(), options, &series, &errors, &warnings);
+    for (Diagnostics* list : {&errors, &warnings}) {
+      for (Diagnostic& d : *list) d.file = "input.csv";
+    }
+  }
   std::ostringstream out;
   for (const Diagnostic& d : errors) out << "error: " << d.ToString() << "\n";
   for (const Diagnostic& d : warnings) out << "warning: " << d.ToString() << "\n";

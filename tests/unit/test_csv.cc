@@ -324,13 +324,16 @@ struct ReadOutcome {
   Series series;
   std::vector<std::string> errors, warnings;
 };
-ReadOutcome ReadFileAndStrings(const std::string& text, bool from_file) {
+ReadOutcome ReadFileAndStrings(const std::string& text, bool from_file,
+                               std::size_t two_thread_bytes = kCsvTwoThreadBytes) {
   ReadOutcome r;
   Diagnostics errors, warnings;
   const std::string path = TempPath("large.csv");
   if (from_file) {
     std::ofstream(path, std::ios::binary) << text;
-    r.ok = ReadCanonicalCsv(path, {}, &r.series, &errors, &warnings);
+    CsvReadOptions options;
+    options.two_thread_bytes = two_thread_bytes;
+    r.ok = ReadCanonicalCsv(path, options, &r.series, &errors, &warnings);
     std::filesystem::remove(path);
   } else {
     std::istringstream in(text);
@@ -382,6 +385,25 @@ TEST(CsvRead, ALargeFileReadOnTwoThreadsGivesWhatOnePieceGives) {
   })) << named;
   EXPECT_TRUE(std::isnan(file.series[Channel::kTAmbC][40000]));
   EXPECT_EQ(file.series[Channel::kPElW][59998], 100 + 59998 % 7 + 0.5);
+}
+
+// One time that does not increase, at each row in turn of a small file read
+// on two threads: wherever it falls, in a half or at the seam between them,
+// the error is the one a reading in one piece gives.
+TEST(CsvRead, ATimeThatDoesNotIncreaseIsFoundAtTheSeamToo) {
+  constexpr int kRows = 24;
+  for (int at = 1; at < kRows; ++at) {
+    const std::string text =
+        LargeCsvText(kRows, {{at, 0, std::to_string(1700000000 + 60 * (at - 1))}});
+    const ReadOutcome file = ReadFileAndStrings(text, true, 1);
+    const ReadOutcome stream = ReadFileAndStrings(text, false);
+    EXPECT_FALSE(file.ok) << "row " << at;
+    EXPECT_EQ(file.errors, stream.errors) << "row " << at;
+    ASSERT_EQ(file.errors.size(), 1u) << "row " << at;
+    EXPECT_NE(file.errors.front().find("must be later than the time of the row before"),
+              std::string::npos)
+        << file.errors.front();
+  }
 }
 
 TEST(CsvRead, ALargeFileWithErrorsReportsThemInLineOrderAsOnePieceDoes) {

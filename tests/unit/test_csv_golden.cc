@@ -29,6 +29,17 @@ TEST_P(CsvGoldenTest, ReportMatchesExpected) {
   EXPECT_EQ(actual, ReadFile(dir / "expected.txt"));
 }
 
+// The reading of a large file on two threads (io/csv.h), here made to take
+// every case: the same series and the same diagnostics, errors included.
+TEST_P(CsvGoldenTest, ReadOnTwoThreadsAsInOnePiece) {
+  const fs::path dir = kGoldenCsvDir / GetParam();
+  bool ok = false;
+  const std::string split =
+      pvtwin::testing::CsvCaseReport(dir, &ok, pvtwin::testing::CsvRead::kFileOnTwoThreads);
+  EXPECT_EQ(ok, GetParam().starts_with("ok_")) << split;
+  EXPECT_EQ(split, ReadFile(dir / "expected.txt"));
+}
+
 INSTANTIATE_TEST_SUITE_P(Csv, CsvGoldenTest, ::testing::ValuesIn(CaseNames()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param;

@@ -103,29 +103,15 @@ std::vector<Channel> ChannelsOf(const Series& s) {
   return channels;
 }
 
-// Writes train.csv and held_out.csv of `data` into dir.
-void WriteSplitData(const SplitData& data, const std::string& dir) {
+// Writes `series` into dir as `name`, saying so.
+void WriteDataFile(const std::string& dir, const char* name, const Series& series) {
   std::string error;
-  for (const auto& [name, series] :
-       {std::pair{"train.csv", &data.train}, std::pair{"held_out.csv", &data.held_out}}) {
-    const std::string path = dir + "/" + name;
-    if (!WriteCsv(path, *series, ChannelsOf(*series), &error)) {
-      std::printf("ident: %s\n", error.c_str());
-      return;
-    }
-    std::printf("ident: wrote %s (%zu rows)\n", path.c_str(), series->size());
-  }
-}
-
-// Writes the 5-s training days of `data` into dir as train_5s.csv.
-void WriteCsv5s(const SplitData& data, const std::string& dir) {
-  std::string error;
-  const std::string path = dir + "/train_5s.csv";
-  if (!WriteCsv(path, data.train, ChannelsOf(data.train), &error)) {
+  const std::string path = dir + "/" + name;
+  if (!WriteCsv(path, series, ChannelsOf(series), &error)) {
     std::printf("ident: %s\n", error.c_str());
     return;
   }
-  std::printf("ident: wrote %s (%zu rows)\n", path.c_str(), data.train.size());
+  std::printf("ident: wrote %s (%zu rows)\n", path.c_str(), series.size());
 }
 
 // The time split of the default at 1 min: median parse time of the training
@@ -396,7 +382,10 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
     char scratch[] = "/tmp/pvtwin-bench-ident-XXXXXX";
     if (mkdtemp(scratch) != nullptr) dir = scratch;
   }
-  if (!dir.empty()) WriteSplitData(d1, dir);
+  if (!dir.empty()) {
+    WriteDataFile(dir, "train.csv", d1.train);
+    WriteDataFile(dir, "held_out.csv", d1.held_out);
+  }
   std::printf("objective (MAE P_el + MAE Q_u, W/m2)   %10s %10s\n", "train", "held-out");
   std::printf("  true parameters (noise floor)        %10.4f %10.4f\n",
               ObjectiveWM2(d1.train_drivers, d1.train_meas, truth),
@@ -479,7 +468,7 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
   double ref_held_out_5s = std::nan("");
   double floor_held_out_5s = std::nan("");
   if (have_5s) {
-    if (!dir.empty()) WriteCsv5s(d5, dir);
+    if (!dir.empty()) WriteDataFile(dir, "train_5s.csv", d5.train);
     fit_5s = RunFits(d5, start, IdentOptions{}, slow_runs);
     if (ref.summary.ok) {
       ref_held_out_5s = ObjectiveWM2(d5.held_out_drivers, d5.held_out_meas, ref.summary.params);

@@ -395,4 +395,3 @@ TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
 
 }  // namespace
 }  // namespace pvtwin
-

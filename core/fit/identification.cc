@@ -148,6 +148,7 @@ class Objective {
   // zero. False when not supported.
   bool Jacobian(const ParamVector& p, const std::vector<ParamInfo>& infos, Eigen::MatrixXd* jac) {
     sens_.t_pv_derivatives = use_t_pv_;
+    sens_.threads = options_.threads;
     if (!HasSensitivities() || !SimulateSensitivities(drivers_, p, sens_free_, &sens_)) {
       return false;
     }
@@ -406,6 +407,7 @@ bool IdentOptions::IsValid(std::string* why) const {
     return fail("prior_weight_w_m2", prior_weight_w_m2, "must be >= 0");
   if (!(undetermined_se > 0.0)) return fail("undetermined_se", undetermined_se, "must be > 0");
   if (min_rows < 1) return fail("min_rows", min_rows, "must be >= 1");
+  if (threads < 1 || threads > 2) return fail("threads", threads, "must be 1 or 2");
   return true;
 }
 

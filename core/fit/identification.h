@@ -118,6 +118,10 @@ struct IdentOptions {
   // supports the variant, instead of forward differences of one simulation
   // per free parameter.
   bool analytic_jacobian = true;
+  // Threads one run with sensitivities splits its columns over
+  // (SimSensitivities::threads; 1 or 2). The fit is the same to the bit on
+  // either; callers that run identifications side by side keep 1.
+  int threads = 1;
 
   static OptimizerOptions DefaultOptimizerOptions();
   // False if a field is out of range; *why names field, value and rule.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/common/threads.h"
 #include "core/model/model_row.h"
 #include "core/model/thermal_model.h"
 #include "core/physics/rc_network_tangent.h"
@@ -18,13 +19,17 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kMaxCols = kMaxRcTangents;
 using Column = double[kMaxCols];
 
-// What one sensitivity run reads besides the row.
+// What one sensitivity run reads besides the row. A run may do a share of
+// the columns (SimSensitivities::threads): wrt are then its parameters,
+// written to the output's columns from col0 on.
 struct SensRun {
   const Drivers& d;
   const RunConstants& k;
   const RunInputs& w;
   std::span<const Param> wrt;
   int cols;
+  std::size_t col0;
+  bool values;  // writes the outputs' values too (one share does)
   bool outlet;  // also the collector node's and the outlet's temperature (SimSensitivities)
   bool t_pv;    // the derivatives of T_PV (SimSensitivities::t_pv_derivatives)
 };
@@ -309,27 +314,30 @@ void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& 
   const double g_abs = run.w.g_abs_w_m2[i];
   EfficiencyTangent e;
   EfficiencyAt(k, r, t, t_pv, run.cols, &e);
-  out->t_pv_c[i] = t_pv;
-  out->q_th_w[i] = r.g_fluid_w_k * (t_fluid - r.t_in_c);
-  // The outlet as Simulate's WriteRow: without flow the fluid rests at the
-  // node temperature.
   const bool flow = run.d.mdot_kg_s[i] > 0.0;
-  if (run.outlet) {
-    out->t_coll_c[i] = t_fluid;
-    out->t_out_c[i] = flow ? r.t_in_c + out->q_th_w[i] / run.d.capacity_flow_w_k[i] : t_fluid;
+  if (run.values) {
+    out->t_pv_c[i] = t_pv;
+    const double q_th_w = r.g_fluid_w_k * (t_fluid - r.t_in_c);
+    out->q_th_w[i] = q_th_w;
+    // The outlet as Simulate's WriteRow: without flow the fluid rests at
+    // the node temperature.
+    if (run.outlet) {
+      out->t_coll_c[i] = t_fluid;
+      out->t_out_c[i] = flow ? r.t_in_c + q_th_w / run.d.capacity_flow_w_k[i] : t_fluid;
+    }
+    // P_el as Simulate's WriteRow: η·A·I_at, or RowTerms::PElW with
+    // electric effects (constant where clipped).
+    if constexpr (kElectric) {
+      double unused_slope;
+      out->p_el_w[i] = r.PElW(t_pv, &unused_slope);
+    } else {
+      out->p_el_w[i] = e.eta * k.area_m2 * g_abs;
+    }
   }
-  // P_el as Simulate's WriteRow: η·A·I_at, or RowTerms::PElW with electric
-  // effects (constant where clipped).
   bool clipped = false;
-  if constexpr (kElectric) {
-    double unused_slope;
-    out->p_el_w[i] = r.PElW(t_pv, &unused_slope);
-    clipped = e.eta * r.p_per_eta_w >= r.p_limit_w;
-  } else {
-    out->p_el_w[i] = e.eta * k.area_m2 * g_abs;
-  }
+  if constexpr (kElectric) clipped = e.eta * r.p_per_eta_w >= r.p_limit_w;
   for (int j = 0; j < run.cols; ++j) {
-    const auto col = static_cast<std::size_t>(j) * n;
+    const auto col = (run.col0 + static_cast<std::size_t>(j)) * n;
     const double d_pv = dres.t_mean_c[0][j];
     const double d_fluid = dres.t_mean_c[FluidNode(kShape)][j];
     if (run.t_pv) out->dt_pv_c[col + i] = d_pv;
@@ -350,10 +358,12 @@ void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& 
 }
 
 void SetSensRowNaN(const SensRun& run, SimSensitivities* out, std::size_t i) {
-  out->p_el_w[i] = out->q_th_w[i] = out->t_pv_c[i] = kNaN;
-  if (run.outlet) out->t_coll_c[i] = out->t_out_c[i] = kNaN;
+  if (run.values) {
+    out->p_el_w[i] = out->q_th_w[i] = out->t_pv_c[i] = kNaN;
+    if (run.outlet) out->t_coll_c[i] = out->t_out_c[i] = kNaN;
+  }
   for (int j = 0; j < run.cols; ++j) {
-    const std::size_t at = static_cast<std::size_t>(j) * out->rows + i;
+    const std::size_t at = (run.col0 + static_cast<std::size_t>(j)) * out->rows + i;
     out->dp_el_w[at] = out->dq_th_w[at] = kNaN;
     if (run.t_pv) out->dt_pv_c[at] = kNaN;
     if (run.outlet) out->dt_coll_c[at] = out->dt_out_c[at] = kNaN;
@@ -597,8 +607,23 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
   const RunConstants k = MakeConstants(d, params);
   RunInputs w;
   MakeRunInputs(d, params, &out->hook_work, &w);
-  const SensRun run{d, k, w, wrt, static_cast<int>(wrt.size()), outlet, t_pv};
-  PickSensLoop(d.spec, w.electric_effects)(run, out);
+  const SensLoop loop = PickSensLoop(d.spec, w.electric_effects);
+  // Two shares of the columns, each with its own pass through the rows
+  // (the values computed twice, written once): each column's derivatives
+  // are the same arithmetic on either thread. For 14 days at 1 min and 11
+  // columns 5.3 -> 4.0 ms (`bench sim`); at 5 min (4 032 rows) nothing
+  // measurable in `calibrate --timing`, hence kSensitivitySplitWork.
+  const std::size_t cols = wrt.size();
+  const std::size_t first =
+      out->threads > 1 && cols >= 2 && n * cols >= kSensitivitySplitWork ? (cols + 1) / 2 : cols;
+  const SensRun run{d, k, w, wrt.first(first), static_cast<int>(first), 0, true, outlet, t_pv};
+  if (first == cols) {
+    loop(run, out);
+  } else {
+    const SensRun rest{
+        d, k, w, wrt.subspan(first), static_cast<int>(cols - first), first, false, outlet, t_pv};
+    RunBoth([&] { loop(rest, out); }, [&] { loop(run, out); });
+  }
   if (outlet) PushThroughOutputTransforms(d, params, &w, out);
   return true;
 }

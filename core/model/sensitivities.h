@@ -52,6 +52,10 @@ struct SimSensitivities {
   // transforms the outputs (an objective without T_PV: a third fewer
   // derivatives written).
   bool t_pv_derivatives = true;
+  // Set by the caller: threads the columns are split over (at most two; a
+  // run too small to gain stays on one). The results are the same to the
+  // bit on any number.
+  int threads = 1;
 
   std::vector<Param> wrt;
   std::size_t rows = 0;
@@ -76,6 +80,11 @@ struct SimSensitivities {
   // transform_outputs (kept between runs).
   SimOutputs hook_work, pushed;
 };
+
+// Rows × columns from which a run with SimSensitivities::threads = 2 splits
+// its columns over two threads (below, the helper's start and the values
+// computed twice outweigh the gain).
+inline constexpr std::size_t kSensitivitySplitWork = 100000;
 
 // Most parameters one sensitivity run differentiates for.
 std::size_t MaxSensitivityParams();

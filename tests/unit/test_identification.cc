@@ -10,6 +10,7 @@
 #include "core/common/units.h"
 #include "core/fit/identification.h"
 #include "core/fit/iso9806.h"
+#include "core/model/sensitivities.h"
 #include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
 #include "tests/support/synthetic_series.h"
@@ -137,6 +138,29 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   const IdentSummary f = Identify(both.drivers, both.meas, StartParams(plant), sensitivities);
   EXPECT_TRUE(f.ok) << f.BriefReport();
   EXPECT_GT(f.sensitivity_runs, 0);
+}
+
+// The runs with sensitivities split over two threads (IdentOptions::threads)
+// give the same fit to the bit, on data long enough for the split (7 days
+// at 1 min, 11 columns: SimulateSensitivities splits from
+// kSensitivitySplitWork rows × columns).
+TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
+  ASSERT_GE(c.drivers.size() * 11, kSensitivitySplitWork);
+  IdentOptions options;
+  const IdentSummary one = Identify(c.drivers, c.meas, StartParams(plant), options);
+  options.threads = 2;
+  const IdentSummary two = Identify(c.drivers, c.meas, StartParams(plant), options);
+  ASSERT_TRUE(one.ok && two.ok) << one.BriefReport() << "\n" << two.BriefReport();
+  EXPECT_GT(two.sensitivity_runs, 0);
+  EXPECT_EQ(two.params, one.params);
+  EXPECT_EQ(two.final_cost_w_m2, one.final_cost_w_m2);
+  EXPECT_EQ(two.evaluations, one.evaluations);
+  ASSERT_EQ(two.estimates.size(), one.estimates.size());
+  for (std::size_t i = 0; i < one.estimates.size(); ++i) {
+    EXPECT_EQ(two.estimates[i].se_unit, one.estimates[i].se_unit) << i;
+  }
 }
 
 // Issue 16: an effect that changes the run's inputs keeps the exact
@@ -276,6 +300,10 @@ TEST(IdentOptions, IsValidNamesFieldValueAndRule) {
   o.optimizer.max_evaluations = 0;
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_NE(why.find("max_evaluations = 0"), std::string::npos) << why;
+  o = IdentOptions{};
+  o.threads = 3;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why, "threads = 3: must be 1 or 2");
   EXPECT_TRUE(SetIdentAlgorithm("sbplx", &o));
   EXPECT_EQ(IdentAlgorithmName(o), "sbplx");
   EXPECT_TRUE(SetIdentAlgorithm("lad_lm", &o));

@@ -348,6 +348,56 @@ TEST(ModelSensitivities, TheTPvDerivativesAreLeftOutOnlyWhenNoTransformReadsThem
   }
 }
 
+// With the columns split over two threads the run writes every value and
+// every derivative as on one, to the bit and NaN for NaN: variants of each
+// network shape, an odd number of columns, an electric effect and an
+// output transform (which then reads all the derivatives).
+TEST(ModelSensitivities, TwoThreadsGiveTheSameRunToTheBit) {
+  const Plant plant = DesignExamplePlant();
+  WeatherOptions w;
+  w.num_days = 10;
+  w.step_s = 60.0;
+  w.seed = 5;
+  w.flow_mode = FlowMode::kVariable;
+  const Series s = GenerateWeather(plant, w);
+  for (const std::string variant :
+       {"1N", "1N1Cwr", "2Nwr", "2N1Cpvwr", "2N1Ccolwr", "2N2Cwr", "1N1Cwr+transport_delay",
+        "2N1Ccolwr+pv_clipping+shading+soiling"}) {
+    const Drivers d = TestDrivers(variant, s, plant);
+    const std::vector<Param> wrt = SensitivityColumns(plant, d.spec);
+    ASSERT_GE(d.size() * wrt.size(), kSensitivitySplitWork) << variant << ": not split";
+    std::mt19937_64 rng(3);
+    const ParamVector p = PointNearTruth(plant, d.spec, &rng);
+    SimSensitivities one, two;
+    two.threads = 2;
+    ASSERT_TRUE(SimulateSensitivities(d, p, wrt, &one)) << variant;
+    ASSERT_TRUE(SimulateSensitivities(d, p, wrt, &two)) << variant;
+    for (auto field :
+         {&SimSensitivities::p_el_w, &SimSensitivities::q_th_w, &SimSensitivities::t_pv_c,
+          &SimSensitivities::dp_el_w, &SimSensitivities::dq_th_w, &SimSensitivities::dt_pv_c,
+          &SimSensitivities::t_coll_c, &SimSensitivities::t_out_c, &SimSensitivities::dt_coll_c,
+          &SimSensitivities::dt_out_c}) {
+      const std::vector<double>& a = one.*field;
+      const std::vector<double>& b = two.*field;
+      ASSERT_EQ(a.size(), b.size()) << variant;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        if (std::isnan(a[i]) && std::isnan(b[i])) continue;
+        ASSERT_EQ(a[i], b[i]) << variant << " at " << i << " of " << a.size();
+      }
+    }
+    EXPECT_EQ(one.dt_pv_c.size(), d.size() * wrt.size()) << variant;
+    // Every column has derivatives: the second share's are not left at zero.
+    for (std::size_t j = 0; j < wrt.size(); ++j) {
+      double largest = 0.0;
+      for (std::size_t i = 0; i < d.size(); ++i) {
+        const double v = std::fabs(two.DQTh(j)[i]) + std::fabs(two.DTPv(j)[i]);
+        if (std::isfinite(v)) largest = std::max(largest, v);
+      }
+      EXPECT_GT(largest, 0.0) << variant << ", column " << Info(wrt[j]).name;
+    }
+  }
+}
+
 TEST(ModelSensitivities, UnsupportedSpecsSayWhy) {
   const Plant plant = DesignExamplePlant();
   for (const std::string variant : {"1N1Cr+wind", "2N2Cwr+transport_delay"}) {

@@ -51,6 +51,10 @@ class Objective {
     const double area = d.plant.area_m2;
     inv_rows_area_ = 1.0 / (static_cast<double>(m.rows.size()) * area);
     use_t_pv_ = o.use_t_pv && !m.t_pv_c.empty();
+    position_.assign(d.size(), -1);
+    for (std::size_t k = 0; k < m.rows.size(); ++k) {
+      position_[m.rows[k]] = static_cast<std::int32_t>(k);
+    }
   }
 
   void SetFree(const std::vector<Param>& free, const std::vector<ParamInfo>& infos,
@@ -147,17 +151,36 @@ class Objective {
   // outputs (DifferenceColumns). A column with a non-finite entry is left
   // zero. False when not supported.
   bool Jacobian(const ParamVector& p, const std::vector<ParamInfo>& infos, Eigen::MatrixXd* jac) {
-    sens_.t_pv_derivatives = use_t_pv_;
-    sens_.threads = options_.threads;
-    if (!HasSensitivities() || !SimulateSensitivities(drivers_, p, sens_free_, &sens_)) {
-      return false;
-    }
-    simulations_ += kSensitivityRunCost;
-    ++sensitivity_runs_;
+    if (!HasSensitivities()) return false;
     const auto m = static_cast<Eigen::Index>(meas_.rows.size());
     jac->resize((use_t_pv_ ? 3 : 2) * m, static_cast<Eigen::Index>(free_.size()));
     const double inv_area = 1.0 / drivers_.plant.area_m2;
+    // The run writes the sensitivities' columns straight into *jac, scaled
+    // to unit coordinates (dx/dz) per W/m² (or weighted K) at the objective
+    // rows, as the copy below does when it cannot (an output transform).
+    sink_factors_.resize(sens_cols_.size());
     for (std::size_t a = 0; a < sens_cols_.size(); ++a) {
+      const std::size_t uj = sens_cols_[a];
+      sink_factors_[a] = DxDz(infos[uj], p[static_cast<std::size_t>(free_[uj])]);
+    }
+    sink_.base = jac->data();
+    sink_.stride = static_cast<std::size_t>(jac->rows());
+    sink_.rows = static_cast<std::size_t>(m);
+    sink_.position = position_;
+    sink_.column = sens_cols_;
+    sink_.column_factor = sink_factors_;
+    sink_.value_factor = inv_area;
+    sink_.t_pv_factor = options_.t_pv_weight_w_m2k;
+    sens_.sink = &sink_;
+    sens_.t_pv_derivatives = use_t_pv_;
+    sens_.threads = options_.threads;
+    if (!SimulateSensitivities(drivers_, p, sens_free_, &sens_)) return false;
+    simulations_ += kSensitivityRunCost;
+    ++sensitivity_runs_;
+    for (std::size_t a = 0; a < sens_cols_.size() && sens_.in_sink; ++a) {
+      if (!sink_.finite[a]) jac->col(static_cast<Eigen::Index>(sens_cols_[a])).setZero();
+    }
+    for (std::size_t a = 0; a < sens_cols_.size() && !sens_.in_sink; ++a) {
       const std::size_t uj = sens_cols_[a];
       const auto j = static_cast<Eigen::Index>(uj);
       const ParamInfo& info = infos[uj];
@@ -277,6 +300,9 @@ class Objective {
   std::vector<double> z_ref_;
   SimOutputs sim_;
   SimSensitivities sens_;
+  SensitivitySink sink_;
+  std::vector<double> sink_factors_;    // per column of sens_free_: dx/dz
+  std::vector<std::int32_t> position_;  // per simulated row: its objective row, or −1
   double inv_rows_area_ = 0.0;
   bool use_t_pv_ = false;
   int simulations_ = 0;

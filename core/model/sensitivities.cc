@@ -30,6 +30,7 @@ struct SensRun {
   int cols;
   std::size_t col0;
   bool values;  // writes the outputs' values too (one share does)
+  SensitivitySink* sink;  // the derivatives go there when set
   bool outlet;  // also the collector node's and the outlet's temperature (SimSensitivities)
   bool t_pv;    // the derivatives of T_PV (SimSensitivities::t_pv_derivatives)
 };
@@ -336,24 +337,45 @@ void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& 
   }
   bool clipped = false;
   if constexpr (kElectric) clipped = e.eta * r.p_per_eta_w >= r.p_limit_w;
+  SensitivitySink* sink = run.sink;
+  if (sink != nullptr && sink->position[i] < 0) return;
   for (int j = 0; j < run.cols; ++j) {
-    const auto col = (run.col0 + static_cast<std::size_t>(j)) * n;
+    const std::size_t c = run.col0 + static_cast<std::size_t>(j);
     const double d_pv = dres.t_mean_c[0][j];
     const double d_fluid = dres.t_mean_c[FluidNode(kShape)][j];
+    const double dq = t.g_fluid_w_k[j] * (t_fluid - r.t_in_c) + r.g_fluid_w_k * d_fluid;
+    double dp;
+    if constexpr (kElectric) {
+      dp = clipped ? 0.0
+                   : (e.d_eta[j] + e.slope_per_k * d_pv) * r.p_per_eta_w + e.eta * t.p_per_eta_w[j];
+    } else {
+      dp = (e.d_eta[j] + e.slope_per_k * d_pv) * k.area_m2 * g_abs + e.eta * t.area_m2[j] * g_abs;
+    }
+    if (sink != nullptr) {
+      double* at =
+          sink->base + sink->column[c] * sink->stride + static_cast<std::size_t>(sink->position[i]);
+      const double f = sink->column_factor[c];
+      const double vp = dp * sink->value_factor * f;
+      const double vq = dq * sink->value_factor * f;
+      at[0] = vp;
+      at[sink->rows] = vq;
+      bool finite = std::isfinite(vp) & std::isfinite(vq);
+      if (run.t_pv) {
+        const double vt = sink->t_pv_factor * d_pv * f;
+        at[2 * sink->rows] = vt;
+        finite &= std::isfinite(vt);
+      }
+      if (!finite) sink->finite[c] = 0;
+      continue;
+    }
+    const std::size_t col = c * n;
     if (run.t_pv) out->dt_pv_c[col + i] = d_pv;
-    out->dq_th_w[col + i] = t.g_fluid_w_k[j] * (t_fluid - r.t_in_c) + r.g_fluid_w_k * d_fluid;
+    out->dq_th_w[col + i] = dq;
     if (run.outlet) {
       out->dt_coll_c[col + i] = d_fluid;
-      out->dt_out_c[col + i] = flow ? out->dq_th_w[col + i] / run.d.capacity_flow_w_k[i] : d_fluid;
+      out->dt_out_c[col + i] = flow ? dq / run.d.capacity_flow_w_k[i] : d_fluid;
     }
-    if constexpr (kElectric) {
-      out->dp_el_w[col + i] =
-          clipped ? 0.0
-                  : (e.d_eta[j] + e.slope_per_k * d_pv) * r.p_per_eta_w + e.eta * t.p_per_eta_w[j];
-    } else {
-      out->dp_el_w[col + i] =
-          (e.d_eta[j] + e.slope_per_k * d_pv) * k.area_m2 * g_abs + e.eta * t.area_m2[j] * g_abs;
-    }
+    out->dp_el_w[col + i] = dp;
   }
 }
 
@@ -361,6 +383,13 @@ void SetSensRowNaN(const SensRun& run, SimSensitivities* out, std::size_t i) {
   if (run.values) {
     out->p_el_w[i] = out->q_th_w[i] = out->t_pv_c[i] = kNaN;
     if (run.outlet) out->t_coll_c[i] = out->t_out_c[i] = kNaN;
+  }
+  if (SensitivitySink* sink = run.sink; sink != nullptr) {
+    // A row in the sink without a result: its columns are not finite.
+    if (sink->position[i] >= 0) {
+      for (int j = 0; j < run.cols; ++j) sink->finite[run.col0 + static_cast<std::size_t>(j)] = 0;
+    }
+    return;
   }
   for (int j = 0; j < run.cols; ++j) {
     const std::size_t at = (run.col0 + static_cast<std::size_t>(j)) * out->rows + i;
@@ -593,13 +622,14 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
                   [](const ModelExtension* e) { return e->transform_outputs != nullptr; });
   // The output transforms take every output's derivatives.
   const bool t_pv = out->t_pv_derivatives || outlet;
+  // The output transforms read the stored derivatives.
+  SensitivitySink* sink = outlet ? nullptr : out->sink;
+  out->in_sink = sink != nullptr;
+  const std::size_t stored = sink != nullptr ? 0 : n * wrt.size();
   for (auto* v : {&out->p_el_w, &out->q_th_w, &out->t_pv_c}) v->resize(n);
-  for (auto* v : {&out->dp_el_w, &out->dq_th_w}) v->resize(n * wrt.size());
-  if (t_pv) {
-    out->dt_pv_c.resize(n * wrt.size());
-  } else {
-    out->dt_pv_c.clear();
-  }
+  for (auto* v : {&out->dp_el_w, &out->dq_th_w}) v->resize(stored);
+  out->dt_pv_c.resize(t_pv ? stored : 0);
+  if (sink != nullptr) sink->finite.assign(wrt.size(), 1);
   if (outlet) {
     for (auto* v : {&out->t_coll_c, &out->t_out_c}) v->resize(n);
     for (auto* v : {&out->dt_coll_c, &out->dt_out_c}) v->resize(n * wrt.size());
@@ -616,12 +646,14 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
   const std::size_t cols = wrt.size();
   const std::size_t first =
       out->threads > 1 && cols >= 2 && n * cols >= kSensitivitySplitWork ? (cols + 1) / 2 : cols;
-  const SensRun run{d, k, w, wrt.first(first), static_cast<int>(first), 0, true, outlet, t_pv};
+  const SensRun run{d, k,    w,    wrt.first(first), static_cast<int>(first),
+                    0, true, sink, outlet,           t_pv};
   if (first == cols) {
     loop(run, out);
   } else {
     const SensRun rest{
-        d, k, w, wrt.subspan(first), static_cast<int>(cols - first), first, false, outlet, t_pv};
+        d,    k,      w,   wrt.subspan(first), static_cast<int>(cols - first), first, false,
+        sink, outlet, t_pv};
     RunBoth([&] { loop(rest, out); }, [&] { loop(run, out); });
   }
   if (outlet) PushThroughOutputTransforms(d, params, &w, out);

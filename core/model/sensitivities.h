@@ -38,6 +38,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -46,6 +47,29 @@
 #include "core/common/params.h"
 
 namespace pvtwin {
+
+// Where a caller takes the derivatives straight into a matrix of its own
+// (identification's Jacobian) instead of SimSensitivities' dp_el_w,
+// dq_th_w and dt_pv_c: scaled and at its own rows, which saves their
+// storage and a copy. Column-major, `stride` doubles per column.
+struct SensitivitySink {
+  double* base = nullptr;
+  std::size_t stride = 0;
+  // Rows per output: P_el's derivatives at rows 0.., Q_u's at `rows`..,
+  // T_PV's at 2·rows.. (when SimSensitivities::t_pv_derivatives).
+  std::size_t rows = 0;
+  // Per simulated row: its row in the sink, or −1 (not written).
+  std::span<const std::int32_t> position;
+  // Per parameter of wrt: the sink's column, and the column's factor.
+  std::span<const std::size_t> column;
+  std::span<const double> column_factor;
+  // P_el and Q_u: (d·value_factor)·column_factor; T_PV:
+  // (t_pv_factor·d)·column_factor.
+  double value_factor = 1.0;
+  double t_pv_factor = 1.0;
+  // Out, per parameter of wrt: 0 once a value written is not finite.
+  std::vector<std::uint8_t> finite;
+};
 
 struct SimSensitivities {
   // Set by the caller: false leaves dt_pv_c empty when no extension
@@ -56,6 +80,11 @@ struct SimSensitivities {
   // run too small to gain stays on one). The results are the same to the
   // bit on any number.
   int threads = 1;
+  // Set by the caller: the derivatives go to this sink (the values stay
+  // here), unless an extension transforms the outputs, which reads them
+  // here. in_sink says which.
+  SensitivitySink* sink = nullptr;
+  bool in_sink = false;
 
   std::vector<Param> wrt;
   std::size_t rows = 0;
@@ -64,7 +93,7 @@ struct SimSensitivities {
   // d output[i] / d wrt[j] at index j·rows + i (one column per parameter,
   // column-major): W (or K) per unit of the parameter (params.h). dt_pv_c
   // is empty when t_pv_derivatives is false and no extension transforms the
-  // outputs.
+  // outputs; all three are empty when in_sink.
   std::vector<double> dp_el_w, dq_th_w, dt_pv_c;
 
   const double* DPEl(std::size_t j) const { return dp_el_w.data() + j * rows; }

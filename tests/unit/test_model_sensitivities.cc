@@ -398,6 +398,114 @@ TEST(ModelSensitivities, TwoThreadsGiveTheSameRunToTheBit) {
   }
 }
 
+// With a sink the run writes each derivative scaled into the caller's
+// matrix at the caller's rows, to the bit what the stored derivatives give
+// (the sink's arithmetic order), on one thread and on two, and flags a
+// column with a non-finite entry; rows the sink has no place for and the
+// matrix's other columns stay untouched. An output transform reads the
+// stored derivatives: the run then keeps them and leaves the sink alone.
+TEST(ModelSensitivities, ASinkTakesTheScaledDerivativesAtItsRows) {
+  const Plant plant = DesignExamplePlant();
+  WeatherOptions w;
+  w.num_days = 10;
+  w.step_s = 60.0;
+  w.seed = 5;
+  w.flow_mode = FlowMode::kVariable;
+  const Series s = GenerateWeather(plant, w);
+  for (const std::string variant : {"2N1Ccolwr", "1N1Cwr", "1N1Cwr+transport_delay"}) {
+    Drivers d = TestDrivers(variant, s, plant);
+    d.usable[700] = 0;  // a row without a result (a gap in the data)
+    const std::vector<Param> wrt = SensitivityColumns(plant, d.spec);
+    std::mt19937_64 rng(7);
+    const ParamVector p = PointNearTruth(plant, d.spec, &rng);
+    SimSensitivities stored;
+    ASSERT_TRUE(SimulateSensitivities(d, p, wrt, &stored)) << variant;
+    ASSERT_FALSE(stored.in_sink);
+    // The sink's columns are wrt's reversed, one to the right (column 0 is
+    // the caller's own).
+    const std::size_t cols = wrt.size() + 1;
+    std::vector<std::size_t> column(wrt.size());
+    std::vector<double> factor(wrt.size());
+    for (std::size_t j = 0; j < wrt.size(); ++j) {
+      column[j] = wrt.size() - j;
+      factor[j] = 0.5 + 0.25 * static_cast<double>(j);
+    }
+    // The sink's rows: every third row with a result, in order; then also
+    // the first row without one (every column non-finite).
+    std::size_t no_result = d.size();
+    for (std::size_t i = 0; i < d.size() && no_result == d.size(); ++i) {
+      if (std::isnan(stored.q_th_w[i])) no_result = i;
+    }
+    ASSERT_LT(no_result, d.size()) << variant << ": the data have no row without a result";
+    for (int threads : {1, 2, -1}) {
+      std::vector<std::int32_t> position(d.size(), -1);
+      std::size_t rows = 0;
+      for (std::size_t i = 0; i < d.size(); ++i) {
+        if ((i % 3 == 0 && !std::isnan(stored.q_th_w[i])) || (threads < 0 && i == no_result)) {
+          position[i] = static_cast<std::int32_t>(rows++);
+        }
+      }
+      const double kUntouched = -12345.0;
+      std::vector<double> matrix(3 * rows * cols, kUntouched);
+      SensitivitySink sink;
+      sink.base = matrix.data();
+      sink.stride = 3 * rows;
+      sink.rows = rows;
+      sink.position = position;
+      sink.column = column;
+      sink.column_factor = factor;
+      sink.value_factor = 1.0 / 1.8;
+      sink.t_pv_factor = 5.0;
+      SimSensitivities run;
+      run.sink = &sink;
+      run.threads = std::abs(threads);
+      ASSERT_TRUE(SimulateSensitivities(d, p, wrt, &run)) << variant;
+      const bool transforms = variant.find("transport_delay") != std::string::npos;
+      EXPECT_EQ(run.in_sink, !transforms) << variant;
+      for (std::size_t i = 0; i < d.size(); ++i) {
+        if (std::isnan(stored.q_th_w[i])) continue;
+        ASSERT_EQ(run.q_th_w[i], stored.q_th_w[i]) << variant << " row " << i;
+        ASSERT_EQ(run.p_el_w[i], stored.p_el_w[i]) << variant << " row " << i;
+      }
+      if (transforms) {
+        ASSERT_EQ(run.dq_th_w.size(), stored.dq_th_w.size()) << variant;
+        for (std::size_t i = 0; i < stored.dq_th_w.size(); ++i) {
+          if (std::isnan(stored.dq_th_w[i]) && std::isnan(run.dq_th_w[i])) continue;
+          ASSERT_EQ(run.dq_th_w[i], stored.dq_th_w[i]) << variant << " at " << i;
+        }
+        EXPECT_TRUE(std::all_of(matrix.begin(), matrix.end(), [&](double v) {
+          return v == kUntouched;
+        })) << variant;
+        continue;
+      }
+      EXPECT_TRUE(run.dp_el_w.empty() && run.dq_th_w.empty() && run.dt_pv_c.empty()) << variant;
+      ASSERT_EQ(sink.finite.size(), wrt.size());
+      for (std::size_t j = 0; j < wrt.size(); ++j) {
+        const double* col = matrix.data() + column[j] * sink.stride;
+        bool finite = true;
+        for (std::size_t i = 0; i < d.size(); ++i) {
+          if (position[i] < 0) continue;
+          const auto k = static_cast<std::size_t>(position[i]);
+          const double vp = stored.DPEl(j)[i] * sink.value_factor * factor[j];
+          const double vq = stored.DQTh(j)[i] * sink.value_factor * factor[j];
+          const double vt = sink.t_pv_factor * stored.DTPv(j)[i] * factor[j];
+          finite = finite && std::isfinite(vp) && std::isfinite(vq) && std::isfinite(vt);
+          if (!std::isfinite(vp)) continue;  // a row without a result
+          ASSERT_EQ(col[k], vp) << variant << " column " << j << " row " << i;
+          ASSERT_EQ(col[rows + k], vq) << variant << " column " << j << " row " << i;
+          ASSERT_EQ(col[2 * rows + k], vt) << variant << " column " << j << " row " << i;
+        }
+        EXPECT_EQ(sink.finite[j] != 0, finite) << variant << " column " << j;
+        EXPECT_EQ(finite, threads > 0) << variant << " column " << j;
+      }
+      // The caller's own column.
+      EXPECT_TRUE(std::all_of(matrix.begin(), matrix.begin() + static_cast<long>(sink.stride),
+                              [&](double v) { return v == kUntouched; }))
+          << variant;
+    }
+  }
+}
+
 TEST(ModelSensitivities, UnsupportedSpecsSayWhy) {
   const Plant plant = DesignExamplePlant();
   for (const std::string variant : {"1N1Cr+wind", "2N2Cwr+transport_delay"}) {

@@ -160,7 +160,9 @@ struct IdentSummary {
   Termination termination = Termination::kFailure;
   double initial_cost_w_m2 = 0.0;  // objective at the start values
   double final_cost_w_m2 = 0.0;    // objective at the result (without the prior)
-  int evaluations = 0;             // model simulations, all stages
+  // Model simulations charged, all stages (an evaluation at the parameters
+  // of the run before it reuses that run's outputs, and is charged too).
+  int evaluations = 0;
   // Runs with sensitivities among them (analytic_jacobian), each counted in
   // `evaluations` as kSensitivityRunCost simulations.
   int sensitivity_runs = 0;

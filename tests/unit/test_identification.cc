@@ -163,6 +163,30 @@ TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
   }
 }
 
+// The summary's cost and training errors are those of a fresh run at the
+// result, to the bit, whether the fit's own last run served them (a repeat
+// of the last run's parameters reuses its outputs) or a new run, with a
+// fixed parameter (2Nwr) and without; a reuse that served another run's
+// outputs fails here.
+TEST(IdentifySynthetic, TheSummaryDescribesTheResult) {
+  const Plant plant = DesignExamplePlant();
+  for (const std::string variant : {"2N1Ccolwr", "2Nwr", "1N1Cwr"}) {
+    const Case c = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
+    Drivers d;
+    std::string error;
+    ASSERT_TRUE(PrepareDrivers(c.series, plant, testing::SpecOf(variant), &d, &error)) << error;
+    const Measurements meas = MakeMeasurements(c.series, d);
+    const IdentSummary s = Identify(d, meas, StartParams(plant), IdentOptions{});
+    ASSERT_TRUE(s.ok) << s.BriefReport();
+    SimOutputs fresh;
+    Simulate(d, s.params, &fresh);
+    const ErrorMetrics e = ComputeErrors(meas, fresh, plant.area_m2);
+    EXPECT_EQ(s.train.mae_p_el_w, e.mae_p_el_w) << variant;
+    EXPECT_EQ(s.train.mae_q_th_w, e.mae_q_th_w) << variant;
+    EXPECT_NEAR(s.final_cost_w_m2, e.objective_w_m2(), 1e-12 * e.objective_w_m2()) << variant;
+  }
+}
+
 // Issue 16: an effect that changes the run's inputs keeps the exact
 // columns of the parameters its hook does not read (the inverter limit with
 // its electric effects here: the clipped power stays in the laminate as

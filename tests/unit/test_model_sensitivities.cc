@@ -164,6 +164,16 @@ Series TestWeather(const Plant& plant) {
   return GenerateWeather(plant, w);
 }
 
+// `days` days at 1 min, the pump on and off.
+Series MinuteWeather(const Plant& plant, int days) {
+  WeatherOptions w;
+  w.num_days = days;
+  w.step_s = 60.0;
+  w.seed = 5;
+  w.flow_mode = FlowMode::kVariable;
+  return GenerateWeather(plant, w);
+}
+
 Drivers TestDrivers(const std::string& variant, const Series& s, const Plant& plant) {
   ModelSpec spec;
   std::string error;
@@ -199,12 +209,7 @@ TEST(ModelSensitivities, Table6VariantsMatchCentralDifferences) {
 // At 1 min, the step of the identification's fine stage.
 TEST(ModelSensitivities, OneMinuteStepMatchesCentralDifferences) {
   const Plant plant = DesignExamplePlant();
-  WeatherOptions w;
-  w.num_days = 2;
-  w.step_s = 60.0;
-  w.seed = 5;
-  w.flow_mode = FlowMode::kVariable;
-  const Series s = GenerateWeather(plant, w);
+  const Series s = MinuteWeather(plant, 2);
   for (const std::string variant : {"1N1Cwr", "2N1Ccolwr", "2N1Cpvwr", "2N2Cwr"}) {
     const Drivers d = TestDrivers(variant, s, plant);
     const std::vector<Param> wrt = UsedWithRange(plant, d.spec);
@@ -354,12 +359,7 @@ TEST(ModelSensitivities, TheTPvDerivativesAreLeftOutOnlyWhenNoTransformReadsThem
 // output transform (which then reads all the derivatives).
 TEST(ModelSensitivities, TwoThreadsGiveTheSameRunToTheBit) {
   const Plant plant = DesignExamplePlant();
-  WeatherOptions w;
-  w.num_days = 10;
-  w.step_s = 60.0;
-  w.seed = 5;
-  w.flow_mode = FlowMode::kVariable;
-  const Series s = GenerateWeather(plant, w);
+  const Series s = MinuteWeather(plant, 10);
   for (const std::string variant :
        {"1N", "1N1Cwr", "2Nwr", "2N1Cpvwr", "2N1Ccolwr", "2N2Cwr", "1N1Cwr+transport_delay",
         "2N1Ccolwr+pv_clipping+shading+soiling"}) {
@@ -406,12 +406,7 @@ TEST(ModelSensitivities, TwoThreadsGiveTheSameRunToTheBit) {
 // stored derivatives: the run then keeps them and leaves the sink alone.
 TEST(ModelSensitivities, ASinkTakesTheScaledDerivativesAtItsRows) {
   const Plant plant = DesignExamplePlant();
-  WeatherOptions w;
-  w.num_days = 10;
-  w.step_s = 60.0;
-  w.seed = 5;
-  w.flow_mode = FlowMode::kVariable;
-  const Series s = GenerateWeather(plant, w);
+  const Series s = MinuteWeather(plant, 10);
   for (const std::string variant : {"2N1Ccolwr", "1N1Cwr", "1N1Cwr+transport_delay"}) {
     Drivers d = TestDrivers(variant, s, plant);
     d.usable[700] = 0;  // a row without a result (a gap in the data)

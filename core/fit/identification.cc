@@ -196,11 +196,11 @@ class Objective {
         const double vq = dq[i] * inv_area * dx_dz;
         col[k] = vp;
         col[m + k] = vq;
-        finite &= std::isfinite(vp) & std::isfinite(vq);
+        if (!std::isfinite(vp) || !std::isfinite(vq)) finite = false;
         if (use_t_pv_) {
           const double vt = options_.t_pv_weight_w_m2k * dt[i] * dx_dz;
           col[2 * m + k] = vt;
-          finite &= std::isfinite(vt);
+          if (!std::isfinite(vt)) finite = false;
         }
       }
       if (!finite) jac->col(j).setZero();

@@ -359,13 +359,12 @@ void WriteSensRow(const SensRun& run, const RowTerms& r, const RowTermTangents& 
       const double vq = dq * sink->value_factor * f;
       at[0] = vp;
       at[sink->rows] = vq;
-      bool finite = std::isfinite(vp) & std::isfinite(vq);
+      if (!std::isfinite(vp) || !std::isfinite(vq)) sink->finite[c] = 0;
       if (run.t_pv) {
         const double vt = sink->t_pv_factor * d_pv * f;
         at[2 * sink->rows] = vt;
-        finite &= std::isfinite(vt);
+        if (!std::isfinite(vt)) sink->finite[c] = 0;
       }
-      if (!finite) sink->finite[c] = 0;
       continue;
     }
     const std::size_t col = c * n;

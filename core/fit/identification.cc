@@ -180,11 +180,8 @@ class Objective {
       if (!sink_.finite[a]) jac->col(static_cast<Eigen::Index>(sens_cols_[a])).setZero();
     }
     for (std::size_t a = 0; a < sens_cols_.size() && !sens_.in_sink; ++a) {
-      const std::size_t uj = sens_cols_[a];
-      const auto j = static_cast<Eigen::Index>(uj);
-      const ParamInfo& info = infos[uj];
-      const double x = p[static_cast<std::size_t>(free_[uj])];
-      const double dx_dz = DxDz(info, x);
+      const auto j = static_cast<Eigen::Index>(sens_cols_[a]);
+      const double dx_dz = sink_factors_[a];
       const double* dp = sens_.DPEl(a);
       const double* dq = sens_.DQTh(a);
       const double* dt = use_t_pv_ ? sens_.DTPv(a) : nullptr;

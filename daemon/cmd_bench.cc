@@ -110,7 +110,7 @@ void RegisterBench(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand(
       "bench",
-      "Print speed figures (medians over repeated runs, one core) on synthetic data:\n"
+      "Print speed figures (medians over repeated runs, one core unless noted) on synthetic data:\n"
       "  sim    one 14-day 1-min simulation of each variant\n"
       "  ident  identification of 2N1Ccolwr: 14 days at 1 min and at 5 s, the\n"
       "         algorithm comparison behind the default, and the whole `pvtwin\n"

@@ -187,6 +187,28 @@ TEST(IdentifySynthetic, TheSummaryDescribesTheResult) {
   }
 }
 
+// A fit whose budget ends before its first step returns its start to the
+// bit: the fit evaluates the start itself, not the start's round trip
+// through the unit coordinates (which is the start only within rounding on
+// a log scale), so that its first run is the one the caller's cost check
+// has just made. A fit that took the round trip fails here.
+TEST(IdentifySynthetic, AFitWithoutAStepReturnsItsStartToTheBit) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 3, 60.0, /*seed=*/12, RealisticSensorNoise(13));
+  Drivers d;
+  std::string error;
+  ASSERT_TRUE(PrepareDrivers(c.series, plant, testing::SpecOf("2N1Ccolwr"), &d, &error)) << error;
+  const Measurements meas = MakeMeasurements(c.series, d);
+  IdentOptions options;
+  options.optimizer.max_evaluations = 4;  // the start's cost and the first residuals: no step
+  const ParamVector start = StartParams(plant);
+  const IdentSummary s = Identify(d, meas, start, options);
+  ASSERT_TRUE(s.ok) << s.BriefReport();
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    EXPECT_EQ(s.params[i], start[i]) << kParamTable[i].name;
+  }
+}
+
 // Issue 16: an effect that changes the run's inputs keeps the exact
 // columns of the parameters its hook does not read (the inverter limit with
 // its electric effects here: the clipped power stays in the laminate as

@@ -627,13 +627,10 @@ std::string Name(Param p) { return std::string(kParamTable[static_cast<std::size
 // thirds of its runs walking back.
 void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, Measurements* cm) {
   const std::size_t n = d.size();
-  std::vector<std::uint8_t> in_obj(n, 0);
-  for (std::uint32_t i : m.rows) in_obj[i] = 1;
-  cd->spec = d.spec;
-  cd->plant = d.plant;
-  const bool t_pv = !m.t_pv_c.empty();
-  std::size_t i = 0;
-  while (i < n) {
+  RowGroups groups;
+  groups.begin.reserve(n / static_cast<std::size_t>(factor) * 5 / 4 + 16);
+  groups.dt_s.reserve(groups.begin.capacity());
+  for (std::size_t i = 0; i < n;) {
     std::size_t end = i + 1;
     if (d.usable[i]) {
       const bool flow = d.capacity_flow_w_k[i] > 0.0;
@@ -642,38 +639,60 @@ void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, M
         ++end;
       }
     }
-    double dt = 0.0;
-    for (std::size_t k = i; k < end; ++k) dt += d.dt_s[k];
-    auto mean = [&](const std::vector<double>& v) {
-      double acc = 0.0;
-      for (std::size_t k = i; k < end; ++k) acc += v[k] * d.dt_s[k];
-      return acc / dt;
-    };
+    groups.Add(end, d.dt_s);
+    i = end;
+  }
+  const std::size_t coarse_rows = groups.size();
+  cd->spec = d.spec;
+  cd->plant = d.plant;
+  cd->dt_s = groups.dt_s;
+  cd->time_s.resize(coarse_rows);
+  cd->restart.resize(coarse_rows);
+  cd->usable.resize(coarse_rows);
+  cd->ln_wind.resize(coarse_rows);
+  for (std::size_t g = 0; g < coarse_rows; ++g) {
+    const std::size_t first = groups.begin[g];
+    cd->time_s[g] = d.time_s[first];
+    cd->restart[g] = d.restart[first];
+    cd->usable[g] = d.usable[first];
     double wind = 0.0;
-    bool all_obj = true;
-    for (std::size_t k = i; k < end; ++k) {
+    for (std::size_t k = first; k < groups.begin[g + 1]; ++k) {
       wind += std::exp(d.ln_wind[k]) * d.dt_s[k];
+    }
+    cd->ln_wind[g] = std::log(wind / groups.dt_s[g]);
+  }
+  auto mean = [&](const std::vector<double>& v, std::vector<double>* out) {
+    groups.Means(v, d.dt_s, out);
+  };
+  mean(d.t_in_c, &cd->t_in_c);
+  mean(d.mdot_kg_s, &cd->mdot_kg_s);
+  mean(d.capacity_flow_w_k, &cd->capacity_flow_w_k);
+  mean(d.g_poa_w_m2, &cd->g_poa_w_m2);
+  mean(d.g_abs_w_m2, &cd->g_abs_w_m2);
+  mean(d.t_amb_c, &cd->t_amb_c);
+  mean(d.t_back_c, &cd->t_back_c);
+  mean(d.t_sky_k4, &cd->t_sky_k4);
+  CoarsenEffectDrivers(d, groups, cd);
+  // The measurements of a group whose rows are all in the objective; NaN
+  // (and not in the objective) for the others.
+  std::vector<std::uint8_t> in_obj(n, 0);
+  for (std::uint32_t i : m.rows) in_obj[i] = 1;
+  const bool t_pv = !m.t_pv_c.empty();
+  mean(m.p_el_w, &cm->p_el_w);
+  mean(m.q_th_w, &cm->q_th_w);
+  if (t_pv) mean(m.t_pv_c, &cm->t_pv_c);
+  cm->rows.clear();
+  for (std::size_t g = 0; g < coarse_rows; ++g) {
+    bool all_obj = true;
+    for (std::size_t k = groups.begin[g]; k < groups.begin[g + 1]; ++k) {
       all_obj = all_obj && in_obj[k];
     }
-    cd->time_s.push_back(d.time_s[i]);
-    cd->dt_s.push_back(dt);
-    cd->restart.push_back(d.restart[i]);
-    cd->usable.push_back(d.usable[i]);
-    cd->t_in_c.push_back(mean(d.t_in_c));
-    cd->mdot_kg_s.push_back(mean(d.mdot_kg_s));
-    cd->capacity_flow_w_k.push_back(mean(d.capacity_flow_w_k));
-    cd->g_poa_w_m2.push_back(mean(d.g_poa_w_m2));
-    cd->g_abs_w_m2.push_back(mean(d.g_abs_w_m2));
-    cd->t_amb_c.push_back(mean(d.t_amb_c));
-    cd->t_back_c.push_back(mean(d.t_back_c));
-    cd->ln_wind.push_back(std::log(wind / dt));
-    cd->t_sky_k4.push_back(mean(d.t_sky_k4));
-    AppendCoarseEffectDrivers(d, i, end, cd);
-    if (all_obj) cm->rows.push_back(static_cast<std::uint32_t>(cm->p_el_w.size()));
-    cm->p_el_w.push_back(all_obj ? mean(m.p_el_w) : kNaN);
-    cm->q_th_w.push_back(all_obj ? mean(m.q_th_w) : kNaN);
-    if (t_pv) cm->t_pv_c.push_back(all_obj ? mean(m.t_pv_c) : kNaN);
-    i = end;
+    if (all_obj) {
+      cm->rows.push_back(static_cast<std::uint32_t>(g));
+    } else {
+      cm->p_el_w[g] = cm->q_th_w[g] = kNaN;
+      if (t_pv) cm->t_pv_c[g] = kNaN;
+    }
   }
 }
 

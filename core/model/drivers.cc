@@ -70,35 +70,52 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
 
 }  // namespace
 
-void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t end,
-                               Drivers* coarse) {
-  double dt_s = 0.0;
-  for (std::size_t k = begin; k < end; ++k) dt_s += d.dt_s[k];
-  auto mean = [&](const std::vector<double>& v) {
+void RowGroups::Add(std::size_t end, const std::vector<double>& row_dt_s) {
+  if (begin.empty()) begin.push_back(0);
+  double dt = 0.0;
+  for (std::size_t k = begin.back(); k < end; ++k) dt += row_dt_s[k];
+  begin.push_back(end);
+  dt_s.push_back(dt);
+}
+
+void RowGroups::Means(const std::vector<double>& v, const std::vector<double>& row_dt_s,
+                      std::vector<double>* out) const {
+  out->resize(size());
+  for (std::size_t g = 0; g < size(); ++g) {
     double acc = 0.0;
-    for (std::size_t k = begin; k < end; ++k) acc += v[k] * d.dt_s[k];
-    return acc / dt_s;
+    for (std::size_t k = begin[g]; k < begin[g + 1]; ++k) acc += v[k] * row_dt_s[k];
+    (*out)[g] = acc / dt_s[g];
+  }
+}
+
+void RowGroups::Middles(const std::vector<double>& v, std::vector<double>* out) const {
+  out->resize(size());
+  for (std::size_t g = 0; g < size(); ++g) (*out)[g] = v[begin[g] + (begin[g + 1] - begin[g]) / 2];
+}
+
+void CoarsenEffectDrivers(const Drivers& d, const RowGroups& groups, Drivers* coarse) {
+  auto mean = [&](const std::vector<double>& v, std::vector<double>* out) {
+    groups.Means(v, d.dt_s, out);
   };
-  const std::size_t mid = begin + (end - begin) / 2;
-  coarse->wind_m_s.push_back(mean(d.wind_m_s));
-  coarse->t_sky_c.push_back(mean(d.t_sky_c));
-  coarse->sun_azimuth_rad.push_back(d.sun_azimuth_rad[mid]);
-  coarse->sun_elevation_rad.push_back(d.sun_elevation_rad[mid]);
-  coarse->aoi_rad.push_back(d.aoi_rad[mid]);
-  coarse->g_beam_w_m2.push_back(mean(d.g_beam_w_m2));
-  coarse->g_ref_w_m2.push_back(mean(d.g_ref_w_m2));
-  coarse->days_since_clean.push_back(mean(d.days_since_clean));
+  mean(d.wind_m_s, &coarse->wind_m_s);
+  mean(d.t_sky_c, &coarse->t_sky_c);
+  groups.Middles(d.sun_azimuth_rad, &coarse->sun_azimuth_rad);
+  groups.Middles(d.sun_elevation_rad, &coarse->sun_elevation_rad);
+  groups.Middles(d.aoi_rad, &coarse->aoi_rad);
+  mean(d.g_beam_w_m2, &coarse->g_beam_w_m2);
+  mean(d.g_ref_w_m2, &coarse->g_ref_w_m2);
+  mean(d.days_since_clean, &coarse->days_since_clean);
   if (d.soiling_recovered.size() == d.size()) {
-    coarse->soiling_recovered.push_back(mean(d.soiling_recovered));
+    mean(d.soiling_recovered, &coarse->soiling_recovered);
   }
   coarse->irradiance_bias = d.irradiance_bias;
   Drivers::IamParts& parts = coarse->iam_parts;
   if (d.iam_parts.beam_w_m2.size() == d.size()) {
-    parts.beam_w_m2.push_back(mean(d.iam_parts.beam_w_m2));
-    parts.sky_w_m2.push_back(mean(d.iam_parts.sky_w_m2));
-    parts.ground_w_m2.push_back(mean(d.iam_parts.ground_w_m2));
-    parts.beam_excess.push_back(d.iam_parts.beam_excess[mid]);
-    parts.paper_k_beam.push_back(d.iam_parts.paper_k_beam[mid]);
+    mean(d.iam_parts.beam_w_m2, &parts.beam_w_m2);
+    mean(d.iam_parts.sky_w_m2, &parts.sky_w_m2);
+    mean(d.iam_parts.ground_w_m2, &parts.ground_w_m2);
+    groups.Middles(d.iam_parts.beam_excess, &parts.beam_excess);
+    groups.Middles(d.iam_parts.paper_k_beam, &parts.paper_k_beam);
   }
 }
 

@@ -93,11 +93,28 @@ std::vector<Cleaning> DetectCleanings(const Series& series, const Plant& plant);
 // to each row.
 void SetCleanings(const std::vector<Cleaning>& cleanings, Drivers* drivers);
 
-// Appends to *coarse the effect modules' raw drivers of rows [begin, end) of d
-// averaged to one row (time-weighted means; sun angles of the middle row),
-// for a coarsened copy of d such as identification's coarse stage builds.
-void AppendCoarseEffectDrivers(const Drivers& d, std::size_t begin, std::size_t end,
-                               Drivers* coarse);
+// Consecutive groups of rows, group g being rows [begin[g], begin[g + 1]),
+// each averaged to one row of a coarsened copy of the data (identification's
+// coarse stage). The averages go channel by channel over all groups: one
+// input stream at a time, each output written once.
+struct RowGroups {
+  std::vector<std::size_t> begin;  // one more than the groups: the last is the end
+  std::vector<double> dt_s;        // each group's length, its rows' dt_s summed in order
+
+  std::size_t size() const { return dt_s.size(); }
+  // Adds the group of rows [begin.back(), end); row_dt_s: the rows' dt_s.
+  void Add(std::size_t end, const std::vector<double>& row_dt_s);
+  // *out[g]: the mean of v over group g weighted by row_dt_s (Σ v·dt / Σ dt).
+  void Means(const std::vector<double>& v, const std::vector<double>& row_dt_s,
+             std::vector<double>* out) const;
+  // *out[g]: v at group g's middle row.
+  void Middles(const std::vector<double>& v, std::vector<double>* out) const;
+};
+
+// The effect modules' raw drivers of d averaged over `groups` into *coarse
+// (time-weighted means; sun angles of the middle row), for a coarsened copy
+// of d such as identification's coarse stage builds.
+void CoarsenEffectDrivers(const Drivers& d, const RowGroups& groups, Drivers* coarse);
 
 // Runs the model. `out` is resized to the drivers' length; reusing it between
 // calls avoids any allocation.

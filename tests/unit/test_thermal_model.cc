@@ -169,6 +169,27 @@ TEST(RcNetwork, ExpPhisMatchALongDoubleReference) {
 
 // No sun, no flow: a one-node model with capacitance relaxes to the
 // conductance-weighted mix of ambient and back temperature with τ = C/ΣU.
+// The coarse stage's averaging: time-weighted means over groups of rows of
+// unequal length, and the middle row's value (sun angles). Worked by hand:
+// (1·60 + 2·60)/120, (3·30 + 4·90)/120, 5·60/60.
+TEST(RowGroups, TimeWeightedMeansAndMiddleRows) {
+  const std::vector<double> dt = {60.0, 60.0, 30.0, 90.0, 60.0};
+  const std::vector<double> v = {1.0, 2.0, 3.0, 4.0, 5.0};
+  RowGroups groups;
+  groups.Add(2, dt);
+  groups.Add(4, dt);
+  groups.Add(5, dt);
+  ASSERT_EQ(groups.size(), 3u);
+  EXPECT_EQ(groups.begin, (std::vector<std::size_t>{0, 2, 4, 5}));
+  EXPECT_EQ(groups.dt_s, (std::vector<double>{120.0, 120.0, 60.0}));
+  std::vector<double> means = {9.0};  // overwritten, resized
+  groups.Means(v, dt, &means);
+  EXPECT_EQ(means, (std::vector<double>{1.5, 3.75, 5.0}));
+  std::vector<double> middles;
+  groups.Middles(v, &middles);
+  EXPECT_EQ(middles, (std::vector<double>{2.0, 4.0, 5.0}));
+}
+
 TEST(ThermalModel, NoSunNoFlowRelaxesToAmbientBackMix) {
   ConstantInputs in;
   in.mdot_kg_s = 0.0;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 
+#include "core/common/threads.h"
 #include "core/effects/registry.h"
 #include "core/fit/lad_fit.h"
 #include "core/model/sensitivities.h"
@@ -758,22 +759,35 @@ std::vector<ParamVector> RestartsFromResiduals(const Drivers& drivers, const Mea
 // Coarse stage: the same fit on the data averaged to about 5 min gets close
 // to the optimum at a fraction of the cost; the fine stage starts from there.
 // (The model at 5 min is the same model: its exact step makes the coarse
-// optimum close to the fine one.) Replaces *best when the coarse optimum
-// also beats the start on the data as given; returns its simulations.
-int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOptions& options,
-                const FreeSet& fs, Objective& obj, double initial_cost, ParamVector* best,
-                int* sensitivity_runs) {
+// optimum close to the fine one.) CoarseFits fits on the coarsened data
+// only, without the fine objective, so that it can run beside the start's
+// cost on the data as given; PickCoarse then compares on those data.
+struct CoarseFits {
+  std::vector<IdentSummary> fits;  // the first from the start, then the restarts
+  int simulations = 0;
+  int sensitivity_runs = 0;
+};
+
+// The factor of the coarse stage's averaging, below 2 when there is none.
+int CoarseFactor(const Drivers& drivers, const IdentOptions& options, const FreeSet& fs) {
   const double data_step_s = drivers.dt_s.empty() ? 0.0 : drivers.dt_s[0];
   const double coarse_step_s =
       data_step_s < 30.0 && options.coarse_step_s > 60.0 ? 60.0 : options.coarse_step_s;
-  const int coarse_factor = coarse_step_s > 0.0 && data_step_s > 0.0
-                                ? static_cast<int>(coarse_step_s / data_step_s + 0.5)
-                                : 1;
-  if (coarse_factor < 2 || fs.free.empty() || options.optimizer.max_evaluations < 200) return 0;
+  if (fs.free.empty() || options.optimizer.max_evaluations < 200) return 1;
+  return coarse_step_s > 0.0 && data_step_s > 0.0
+             ? static_cast<int>(coarse_step_s / data_step_s + 0.5)
+             : 1;
+}
+
+CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const IdentOptions& options,
+                     const FreeSet& fs) {
+  CoarseFits out;
+  const int coarse_factor = CoarseFactor(drivers, options, fs);
+  if (coarse_factor < 2) return out;
   Drivers cd;
   Measurements cm;
   Coarsen(drivers, meas, coarse_factor, &cd, &cm);
-  if (static_cast<int>(cm.rows.size()) < options.min_rows) return 0;
+  if (static_cast<int>(cm.rows.size()) < options.min_rows) return out;
   IdentOptions coarse = options;
   // From data finer than 30 s the ladder has two rungs: 1 min, then the
   // configured coarse step.
@@ -783,36 +797,36 @@ int CoarseStart(const Drivers& drivers, const Measurements& meas, const IdentOpt
   coarse.correct_bends = true;
   coarse.optimizer.ftol_rel = std::max(options.optimizer.ftol_rel, 1e-3);
   coarse.optimizer.max_evaluations = options.optimizer.max_evaluations / 4;
-  const IdentSummary cs = Identify(cd, cm, fs.base, coarse);
-  // A misspecified model can have its coarse optimum far from the fine one:
-  // keep it only if it also beats the start on the data as given.
-  double best_cost = initial_cost;
-  if (cs.ok) {
-    const double cost = obj.DataCost(cs.params);
-    if (cost < best_cost) {
-      *best = cs.params;
-      best_cost = cost;
-    }
-  }
-  *sensitivity_runs = cs.sensitivity_runs;
-  int simulations = cs.evaluations;
+  out.fits.push_back(Identify(cd, cm, fs.base, coarse));
+  out.simulations = out.fits.back().evaluations;
+  out.sensitivity_runs = out.fits.back().sensitivity_runs;
   // Restarts from the residuals of that optimum (RestartsFromResiduals), on
   // the coarsest rung only (a coarse fit with a coarse stage of its own
   // restarts there).
   const std::vector<ParamVector> restarts =
       coarse.coarse_step_s > 0.0 ? std::vector<ParamVector>{}
-                                 : RestartsFromResiduals(drivers, meas, fs, cs.params);
+                                 : RestartsFromResiduals(drivers, meas, fs, out.fits[0].params);
   for (const ParamVector& restart : restarts) {
-    const IdentSummary rs = Identify(cd, cm, restart, coarse);
-    simulations += rs.evaluations + 1;  // + the run without the effect
-    *sensitivity_runs += rs.sensitivity_runs;
-    const double cost = rs.ok ? obj.DataCost(rs.params) : kNaN;
+    out.fits.push_back(Identify(cd, cm, restart, coarse));
+    out.simulations += out.fits.back().evaluations + 1;  // + the run without the effect
+    out.sensitivity_runs += out.fits.back().sensitivity_runs;
+  }
+  return out;
+}
+
+// The best of the coarse fits on the data as given, in their order: a
+// misspecified model can have its coarse optimum far from the fine one, so
+// one replaces *best only if it also beats the start (`initial_cost`).
+void PickCoarse(const CoarseFits& coarse, Objective& obj, double initial_cost, ParamVector* best) {
+  double best_cost = initial_cost;
+  for (const IdentSummary& fit : coarse.fits) {
+    if (!fit.ok) continue;
+    const double cost = obj.DataCost(fit.params);
     if (cost < best_cost) {
-      *best = rs.params;
+      *best = fit.params;
       best_cost = cost;
     }
   }
-  return simulations;
 }
 
 // The fine stage: the fit of the active parameters, then identifiability
@@ -1163,18 +1177,36 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
 
   const FreeSet fs = SelectFree(drivers, start, options);
   Objective obj(drivers, meas, options, fs.base);
-  const double initial_cost = obj.DataCost(fs.base);
+  // The start's cost on the data as given and the coarse stage's fits do
+  // not depend on each other: with a second thread the first runs beside
+  // the second (one run of the data as given, 12 ms at 5 s, and the
+  // averaging of the coarse stage's data). The fit is the same either way.
+  double initial_cost = kNaN;
+  CoarseFits coarse;
+  auto t_coarse = std::chrono::steady_clock::now();
+  auto start_cost = [&] { initial_cost = obj.DataCost(fs.base); };
+  auto coarse_fits = [&] {
+    t_coarse = std::chrono::steady_clock::now();
+    coarse = FitCoarse(drivers, meas, options, fs);
+  };
+  if (options.threads > 1 && CoarseFactor(drivers, options, fs) >= 2) {
+    RunBoth(start_cost, coarse_fits);
+  } else {
+    start_cost();
+    if (std::isfinite(initial_cost)) coarse_fits();
+  }
   summary.initial_cost_w_m2 = initial_cost;
   if (!std::isfinite(initial_cost)) {
     return finish(false, "the model gives non-finite outputs at the start values");
   }
   ParamVector best = fs.base;
-  const auto t_coarse = std::chrono::steady_clock::now();
-  int coarse_sensitivity_runs = 0;
-  const int coarse_simulations =
-      CoarseStart(drivers, meas, options, fs, obj, initial_cost, &best, &coarse_sensitivity_runs);
-  summary.coarse_runtime_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_coarse).count();
+  PickCoarse(coarse, obj, initial_cost, &best);
+  if (!coarse.fits.empty()) {
+    summary.coarse_runtime_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_coarse).count();
+  }
+  const int coarse_simulations = coarse.simulations;
+  const int coarse_sensitivity_runs = coarse.sensitivity_runs;
   summary.coarse_evaluations = coarse_simulations;
   FineFit fine(obj, fs, meas, options, drivers.plant, coarse_simulations, best);
   fine.FitAll();

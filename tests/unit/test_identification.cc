@@ -140,10 +140,11 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
   EXPECT_GT(f.sensitivity_runs, 0);
 }
 
-// The runs with sensitivities split over two threads (IdentOptions::threads)
-// give the same fit to the bit, on data long enough for the split (7 days
-// at 1 min, 11 columns: SimulateSensitivities splits from
-// kSensitivitySplitWork rows × columns).
+// Two threads (IdentOptions::threads) give the same fit to the bit: the runs
+// with sensitivities split their columns, on data long enough for the split
+// (7 days at 1 min, 11 columns: SimulateSensitivities splits from
+// kSensitivitySplitWork rows × columns), and the start's cost runs beside
+// the coarse stage.
 TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
   const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
@@ -281,6 +282,24 @@ TEST(IdentifyFailures, TooLittleDataIsAFailureWithReason) {
   const IdentSummary s = Identify(c.drivers, c.meas, StartParams(plant), IdentOptions{});
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.failure_reason.find("too little data"), std::string::npos) << s.failure_reason;
+}
+
+// A start at which the model gives no finite output fails with that reason,
+// on one thread and on two, where the start's cost runs beside the coarse
+// stage instead of before it.
+TEST(IdentifyFailures, ANonFiniteStartIsAFailureOnEitherThreadCount) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 2, 60.0, 15, SensorNoise{});
+  ParamVector start = StartParams(plant);
+  start[static_cast<std::size_t>(Param::kUBackWM2K)] = std::nan("");
+  for (int threads : {1, 2}) {
+    IdentOptions options;
+    options.threads = threads;
+    const IdentSummary s = Identify(c.drivers, c.meas, start, options);
+    EXPECT_FALSE(s.ok) << threads;
+    EXPECT_NE(s.failure_reason.find("non-finite outputs at the start values"), std::string::npos)
+        << threads << ": " << s.failure_reason;
+  }
 }
 
 TEST(IdentifyFailures, EvaluationCapNeverReturnsAWorseFit) {

@@ -119,8 +119,9 @@ struct IdentOptions {
   // per free parameter.
   bool analytic_jacobian = true;
   // Threads one run with sensitivities splits its columns over
-  // (SimSensitivities::threads; 1 or 2). The fit is the same to the bit on
-  // either; callers that run identifications side by side keep 1.
+  // (SimSensitivities::threads; 1 or 2); with 2 the start's cost on the data
+  // as given also runs beside the coarse stage. The fit is the same to the
+  // bit on either; callers that run identifications side by side keep 1.
   int threads = 1;
 
   static OptimizerOptions DefaultOptimizerOptions();

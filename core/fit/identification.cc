@@ -779,11 +779,11 @@ int CoarseFactor(const Drivers& drivers, const IdentOptions& options, const Free
              : 1;
 }
 
+// The coarse fits on the data averaged by `coarse_factor` (CoarseFactor, at
+// least 2).
 CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const IdentOptions& options,
-                     const FreeSet& fs) {
+                     const FreeSet& fs, int coarse_factor) {
   CoarseFits out;
-  const int coarse_factor = CoarseFactor(drivers, options, fs);
-  if (coarse_factor < 2) return out;
   Drivers cd;
   Measurements cm;
   Coarsen(drivers, meas, coarse_factor, &cd, &cm);
@@ -1181,15 +1181,18 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   // not depend on each other: with a second thread the first runs beside
   // the second (one run of the data as given, 12 ms at 5 s, and the
   // averaging of the coarse stage's data). The fit is the same either way.
+  const int coarse_factor = CoarseFactor(drivers, options, fs);
   double initial_cost = kNaN;
   CoarseFits coarse;
   auto t_coarse = std::chrono::steady_clock::now();
   auto start_cost = [&] { initial_cost = obj.DataCost(fs.base); };
   auto coarse_fits = [&] {
     t_coarse = std::chrono::steady_clock::now();
-    coarse = FitCoarse(drivers, meas, options, fs);
+    coarse = FitCoarse(drivers, meas, options, fs, coarse_factor);
   };
-  if (options.threads > 1 && CoarseFactor(drivers, options, fs) >= 2) {
+  if (coarse_factor < 2) {
+    start_cost();
+  } else if (options.threads > 1) {
     RunBoth(start_cost, coarse_fits);
   } else {
     start_cost();

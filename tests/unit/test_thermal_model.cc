@@ -167,8 +167,6 @@ TEST(RcNetwork, ExpPhisMatchALongDoubleReference) {
   }
 }
 
-// No sun, no flow: a one-node model with capacitance relaxes to the
-// conductance-weighted mix of ambient and back temperature with τ = C/ΣU.
 // The coarse stage's averaging: time-weighted means over groups of rows of
 // unequal length, and the middle row's value (sun angles). Worked by hand:
 // (1·60 + 2·60)/120, (3·30 + 4·90)/120, 5·60/60.
@@ -190,6 +188,8 @@ TEST(RowGroups, TimeWeightedMeansAndMiddleRows) {
   EXPECT_EQ(middles, (std::vector<double>{2.0, 4.0, 5.0}));
 }
 
+// No sun, no flow: a one-node model with capacitance relaxes to the
+// conductance-weighted mix of ambient and back temperature with τ = C/ΣU.
 TEST(ThermalModel, NoSunNoFlowRelaxesToAmbientBackMix) {
   ConstantInputs in;
   in.mdot_kg_s = 0.0;

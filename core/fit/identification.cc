@@ -320,28 +320,17 @@ class Objective {
   int sensitivity_runs_ = 0;
 };
 
-// Standard errors of the free parameters (unit coordinates) from the
-// sensitivity matrix J (residuals × parameters) and the residuals r at the
-// fit: se_j = σ·√[(JᵀJ)⁻¹]_jj with σ the residual RMS (floored at
-// sigma_floor) inflated by √((1+ρ)/(1−ρ)) for the lag-1 autocorrelation ρ
-// of the residuals, which are far from independent at a 1-min step.
-// `active` marks the parameters still free; the covariance is taken over
-// those only.
+// Standard errors of the parameters of J's columns (unit coordinates) from
+// J (residuals × parameters) and the residuals r at the fit: se_j =
+// σ·√[(JᵀJ)⁻¹]_jj with σ the residual RMS (floored at sigma_floor)
+// inflated by √((1+ρ)/(1−ρ)) for the lag-1 autocorrelation ρ of the
+// residuals, which are far from independent at a 1-min step. JᵀJ is summed
+// on `threads` (WeightedNormalEquations).
 Eigen::VectorXd StandardErrors(const Eigen::MatrixXd& jac, const Eigen::VectorXd& r,
-                               const std::vector<bool>& active, double sigma_floor) {
-  const Eigen::Index n = jac.cols();
-  std::vector<Eigen::Index> idx;
-  for (Eigen::Index j = 0; j < n; ++j) {
-    if (active[static_cast<std::size_t>(j)]) idx.push_back(j);
-  }
-  const auto m = static_cast<Eigen::Index>(idx.size());
-  Eigen::MatrixXd jtj(m, m);
-  for (Eigen::Index a = 0; a < m; ++a) {
-    for (Eigen::Index b = a; b < m; ++b) {
-      jtj(a, b) = jtj(b, a) =
-          jac.col(idx[static_cast<std::size_t>(a)]).dot(jac.col(idx[static_cast<std::size_t>(b)]));
-    }
-  }
+                               double sigma_floor, int threads) {
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd no_g;
+  WeightedNormalEquations(jac, Eigen::VectorXd(), Eigen::VectorXd(), threads, &jtj, &no_g);
   const double rms =
       std::sqrt(r.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(r.size(), 1)));
   // Lag-1 autocorrelation of the residual sequences (blocks per output).
@@ -357,10 +346,7 @@ Eigen::VectorXd StandardErrors(const Eigen::MatrixXd& jac, const Eigen::VectorXd
       eig.eigenvalues().cwiseMax(1e-14 * std::max(eig.eigenvalues().maxCoeff(), 1e-300));
   const Eigen::MatrixXd cov =
       eig.eigenvectors() * lam.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
-  Eigen::VectorXd se = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index a = 0; a < m; ++a)
-    se(idx[static_cast<std::size_t>(a)]) = sigma * std::sqrt(cov(a, a));
-  return se;
+  return sigma * cov.diagonal().cwiseSqrt();
 }
 
 }  // namespace
@@ -518,6 +504,7 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
     lo.xtol = options.optimizer.xtol_rel;
     lo.prior_weight = options.prior_weight_w_m2;
     lo.n_scale = n_rows;
+    lo.threads = options.threads;
     if (!options.correct_bends) lo.max_correction = 0.0;
     Eigen::VectorXd z0(static_cast<Eigen::Index>(n)), zr(static_cast<Eigen::Index>(n));
     for (std::size_t j = 0; j < n; ++j) {
@@ -964,8 +951,7 @@ class FineFit {
         jac_ = SensitivityMatrix(obj_, ActiveInfos(), best_, &r_);
       }
     }
-    const Eigen::VectorXd act_se =
-        StandardErrors(jac_, r_, std::vector<bool>(act_index.size(), true), sigma_floor_);
+    const Eigen::VectorXd act_se = StandardErrors(jac_, r_, sigma_floor_, options_.threads);
     Eigen::Index worst = -1;
     for (Eigen::Index a = 0; a < m; ++a) {
       const std::size_t j = act_index[static_cast<std::size_t>(a)];
@@ -1028,9 +1014,9 @@ class FineFit {
     const double delta = std::max(0.3 * r_.cwiseAbs().mean(), sigma_floor_);
     const Eigen::VectorXd w = r_.cwiseAbs().cwiseMax(delta).cwiseInverse();
     const Eigen::VectorXd b = r_ + jac_.col(worst) * dz_j;
-    const Eigen::MatrixXd wj = j_others.array().colwise() * w.array();
-    const Eigen::MatrixXd h = j_others.transpose() * wj;
-    const Eigen::VectorXd g = wj.transpose() * b;
+    Eigen::MatrixXd h;
+    Eigen::VectorXd g;
+    WeightedNormalEquations(j_others, w, b, options_.threads, &h, &g);
     const double mean_diag = std::max(h.diagonal().mean(), 1e-300);
     const double limit_dz = std::max(std::fabs(dz_j), 0.02);
     double cost = kNaN;

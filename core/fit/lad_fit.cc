@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/common/threads.h"
+
 namespace pvtwin {
 
 namespace {
@@ -18,26 +20,61 @@ double Objective(const Eigen::VectorXd& r, const Eigen::VectorXd& z, const Eigen
   return r.cwiseAbs().sum() / o.n_scale + o.prior_weight * (z - z_ref).squaredNorm();
 }
 
-// JᵀWJ and JᵀW·r (W = diag(w)) by blocks of rows through `buffer`, without
-// a weighted copy of the whole Jacobian: at 5-s data that copy was 42 MB,
-// fresh pages from the kernel on every iteration.
-void WeightedNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
-                             const Eigen::VectorXd& r, Eigen::MatrixXd* buffer, Eigen::MatrixXd* h,
-                             Eigen::VectorXd* g) {
-  constexpr Eigen::Index kBlockRows = 2048;
-  const Eigen::Index rows = jac.rows();
+constexpr Eigen::Index kBlockRows = 2048;
+
+// The sums of WeightedNormalEquations over the rows [begin, end) by blocks
+// of kBlockRows rows (begin a multiple of it) through one block's buffer,
+// without a weighted copy of the whole Jacobian: at 5-s data that copy was
+// 42 MB, fresh pages from the kernel on every iteration.
+void SumNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
+                        const Eigen::VectorXd& r, Eigen::Index begin, Eigen::Index end,
+                        Eigen::MatrixXd* h, Eigen::VectorXd* g) {
   const Eigen::Index n = jac.cols();
   h->setZero(n, n);
-  g->setZero(n);
-  for (Eigen::Index start = 0; start < rows; start += kBlockRows) {
-    const Eigen::Index b = std::min(kBlockRows, rows - start);
-    buffer->resize(b, n);
-    buffer->noalias() =
-        (jac.middleRows(start, b).array().colwise() * w.segment(start, b).array()).matrix();
-    h->noalias() += jac.middleRows(start, b).transpose() * *buffer;
-    g->noalias() += buffer->transpose() * r.segment(start, b);
+  if (r.size() > 0) g->setZero(n);
+  Eigen::MatrixXd buffer;
+  for (Eigen::Index start = begin; start < end; start += kBlockRows) {
+    const Eigen::Index b = std::min(kBlockRows, end - start);
+    const auto block = jac.middleRows(start, b);
+    if (w.size() == 0) {
+      h->noalias() += block.transpose() * block;
+      if (r.size() > 0) g->noalias() += block.transpose() * r.segment(start, b);
+      continue;
+    }
+    buffer.resize(b, n);
+    buffer.noalias() = (block.array().colwise() * w.segment(start, b).array()).matrix();
+    h->noalias() += block.transpose() * buffer;
+    if (r.size() > 0) g->noalias() += buffer.transpose() * r.segment(start, b);
   }
 }
+
+}  // namespace
+
+void WeightedNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
+                             const Eigen::VectorXd& r, int threads, Eigen::MatrixXd* h,
+                             Eigen::VectorXd* g) {
+  const Eigen::Index rows = jac.rows();
+  if (rows < kSplitNormalEquationsRows) {
+    SumNormalEquations(jac, w, r, 0, rows, h, g);
+    return;
+  }
+  // The halves meet at a block boundary: the blocks are those of one sum.
+  const Eigen::Index half = (rows / 2 + kBlockRows - 1) / kBlockRows * kBlockRows;
+  Eigen::MatrixXd h_second;
+  Eigen::VectorXd g_second;
+  auto first = [&] { SumNormalEquations(jac, w, r, 0, half, h, g); };
+  auto second = [&] { SumNormalEquations(jac, w, r, half, rows, &h_second, &g_second); };
+  if (threads > 1) {
+    RunBoth(second, first);
+  } else {
+    first();
+    second();
+  }
+  *h += h_second;
+  if (r.size() > 0) *g += g_second;
+}
+
+namespace {
 
 // s solving (H + λ·D) s = −g, D the diagonal of H floored so that a
 // direction without curvature is damped too (λ = 0: the undamped step).
@@ -65,11 +102,10 @@ struct Majoriser {
   std::vector<Eigen::Index> movable;
 
   // H and g at z from the Jacobian, the IRLS weights and the residuals
-  // there (`block`: WeightedNormalEquations' buffer).
+  // there.
   void Build(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w, const Eigen::VectorXd& r,
-             const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref, const LadFitOptions& o,
-             Eigen::MatrixXd* block) {
-    WeightedNormalEquations(jac, w, r, block, &h, &g);
+             const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref, const LadFitOptions& o) {
+    WeightedNormalEquations(jac, w, r, o.threads, &h, &g);
     h /= o.n_scale;
     g /= o.n_scale;
     h.diagonal().array() += 2.0 * o.prior_weight;
@@ -257,7 +293,6 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   res.initial_cost = cost;
   double lambda = 1e-3;
   Eigen::MatrixXd jac(r.size(), n);
-  Eigen::MatrixXd weighted_block;
   Eigen::VectorXd w;
   Majoriser maj;
   bool have_jac = false;  // jac was computed, at z_jac
@@ -286,7 +321,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     }
     have_jac = true;
     z_jac = z;
-    maj.Build(jac, w, r, z, z_ref, o, &weighted_block);
+    maj.Build(jac, w, r, z, z_ref, o);
     const double promised = maj.Promised();
     // What the stop below asks of an undamped promise (of this cost).
     const double small_promise = o.stop_promise_factor * o.ftol_rel * cost;

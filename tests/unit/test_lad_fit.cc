@@ -2,8 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -325,6 +328,82 @@ TEST(LadFit, NonFiniteStartIsReported) {
   EXPECT_FALSE(res.converged);
   EXPECT_NE(res.message.find("non-finite"), std::string::npos);
   EXPECT_EQ(res.evaluations, 1);
+}
+
+// JᵀW·J and JᵀW·r on both sides of the split into halves, with the rows
+// not a multiple of the summing blocks. Entries, weights and residuals are
+// small integers, so that every partial sum is exact in any order: the
+// sums must equal the integer sums to the bit, on one thread and on two.
+TEST(WeightedNormalEquations, ExactSumsOnBothSidesOfTheSplitOnOneThreadAndTwo) {
+  for (const Eigen::Index rows : {Eigen::Index{5001}, kSplitNormalEquationsRows + 3001}) {
+    constexpr Eigen::Index n = 3;
+    Eigen::MatrixXd jac(rows, n);
+    Eigen::VectorXd w(rows), r(rows);
+    std::int64_t h_exact[n][n] = {}, g_exact[n] = {}, gram_exact[n][n] = {};
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      const std::int64_t col[n] = {1, i % 7 - 3, (i * 13) % 11 - 5};
+      const std::int64_t wi = i % 3 == 0 ? 2 : 1;
+      const std::int64_t ri = (i * 7) % 9 - 4;
+      for (Eigen::Index a = 0; a < n; ++a) {
+        jac(i, a) = static_cast<double>(col[a]);
+        g_exact[a] += col[a] * wi * ri;
+        for (Eigen::Index b = 0; b < n; ++b) {
+          h_exact[a][b] += col[a] * wi * col[b];
+          gram_exact[a][b] += col[a] * col[b];
+        }
+      }
+      w(i) = static_cast<double>(wi);
+      r(i) = static_cast<double>(ri);
+    }
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE("rows " + std::to_string(rows) + ", threads " + std::to_string(threads));
+      Eigen::MatrixXd h, gram;
+      Eigen::VectorXd g, untouched = Eigen::VectorXd::Constant(2, 7.0);
+      WeightedNormalEquations(jac, w, r, threads, &h, &g);
+      WeightedNormalEquations(jac, Eigen::VectorXd(), Eigen::VectorXd(), threads, &gram,
+                              &untouched);
+      ASSERT_EQ(h.rows(), n);
+      ASSERT_EQ(h.cols(), n);
+      ASSERT_EQ(g.size(), n);
+      for (Eigen::Index a = 0; a < n; ++a) {
+        EXPECT_EQ(g(a), static_cast<double>(g_exact[a]));
+        for (Eigen::Index b = 0; b < n; ++b) {
+          EXPECT_EQ(h(a, b), static_cast<double>(h_exact[a][b]));
+          EXPECT_EQ(gram(a, b), static_cast<double>(gram_exact[a][b]));
+        }
+      }
+      EXPECT_EQ(untouched, Eigen::VectorXd::Constant(2, 7.0));  // no r: g left alone
+    }
+  }
+}
+
+// With real entries the order of the sums shows in the last bits: above the
+// split the halves are summed apart on one thread as on two, so the results
+// are the same to the bit; both stay within rounding of one plain product.
+TEST(WeightedNormalEquations, TheSameToTheBitOnOneThreadAndTwo) {
+  const Eigen::Index rows = kSplitNormalEquationsRows + 777;
+  constexpr Eigen::Index n = 4;
+  std::mt19937 rng(16);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::MatrixXd jac(rows, n);
+  Eigen::VectorXd w(rows), r(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    for (Eigen::Index a = 0; a < n; ++a) jac(i, a) = normal(rng);
+    w(i) = 1.0 / (0.1 + std::fabs(normal(rng)));
+    r(i) = normal(rng);
+  }
+  Eigen::MatrixXd h1, h2;
+  Eigen::VectorXd g1, g2;
+  WeightedNormalEquations(jac, w, r, 1, &h1, &g1);
+  WeightedNormalEquations(jac, w, r, 2, &h2, &g2);
+  EXPECT_EQ(h1, h2);
+  EXPECT_EQ(g1, g2);
+  const Eigen::MatrixXd wj = jac.array().colwise() * w.array();
+  const Eigen::MatrixXd h_plain = jac.transpose() * wj;
+  const Eigen::VectorXd g_plain = wj.transpose() * r;
+  EXPECT_LE((h1 - h_plain).cwiseAbs().maxCoeff(), 1e-12 * h_plain.cwiseAbs().maxCoeff());
+  const Eigen::VectorXd g_size = wj.cwiseAbs().transpose() * r.cwiseAbs();
+  EXPECT_LE((g1 - g_plain).cwiseAbs().maxCoeff(), 1e-12 * g_size.maxCoeff());
 }
 
 }  // namespace

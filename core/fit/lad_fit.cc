@@ -37,7 +37,11 @@ void SumNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
     const Eigen::Index b = std::min(kBlockRows, end - start);
     const auto block = jac.middleRows(start, b);
     if (w.size() == 0) {
-      h->noalias() += block.transpose() * block;
+      // The upper triangle by column products of the block, which stays in
+      // the cache: half the product's multiplications.
+      for (Eigen::Index a = 0; a < n; ++a) {
+        for (Eigen::Index c = a; c < n; ++c) (*h)(a, c) += block.col(a).dot(block.col(c));
+      }
       if (r.size() > 0) g->noalias() += block.transpose() * r.segment(start, b);
       continue;
     }
@@ -45,6 +49,10 @@ void SumNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
     buffer.noalias() = (block.array().colwise() * w.segment(start, b).array()).matrix();
     h->noalias() += block.transpose() * buffer;
     if (r.size() > 0) g->noalias() += buffer.transpose() * r.segment(start, b);
+  }
+  if (w.size() > 0) return;
+  for (Eigen::Index a = 1; a < n; ++a) {
+    for (Eigen::Index c = 0; c < a; ++c) (*h)(a, c) = (*h)(c, a);
   }
 }
 

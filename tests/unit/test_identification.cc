@@ -5,11 +5,14 @@
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <string>
+#include <utility>
 
 #include "config/plant_config.h"
 #include "core/common/units.h"
 #include "core/fit/identification.h"
 #include "core/fit/iso9806.h"
+#include "core/fit/lad_fit.h"
 #include "core/model/sensitivities.h"
 #include "core/synth/synthetic_plant.h"
 #include "io/csv.h"
@@ -144,23 +147,32 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
 // with sensitivities split their columns, on data long enough for the split
 // (7 days at 1 min, 11 columns: SimulateSensitivities splits from
 // kSensitivitySplitWork rows × columns), and the start's cost runs beside
-// the coarse stage.
+// the coarse stage; at 5 s (5 days, two residual rows per row) the normal
+// equations and the standard errors' JᵀJ are summed as two halves too
+// (from kSplitNormalEquationsRows rows).
 TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
   const Plant plant = DesignExamplePlant();
-  const Case c = MakeCase(plant, "2N1Ccolwr", 7, 60.0, /*seed=*/12, RealisticSensorNoise(13));
-  ASSERT_GE(c.drivers.size() * 11, kSensitivitySplitWork);
-  IdentOptions options;
-  const IdentSummary one = Identify(c.drivers, c.meas, StartParams(plant), options);
-  options.threads = 2;
-  const IdentSummary two = Identify(c.drivers, c.meas, StartParams(plant), options);
-  ASSERT_TRUE(one.ok && two.ok) << one.BriefReport() << "\n" << two.BriefReport();
-  EXPECT_GT(two.sensitivity_runs, 0);
-  EXPECT_EQ(two.params, one.params);
-  EXPECT_EQ(two.final_cost_w_m2, one.final_cost_w_m2);
-  EXPECT_EQ(two.evaluations, one.evaluations);
-  ASSERT_EQ(two.estimates.size(), one.estimates.size());
-  for (std::size_t i = 0; i < one.estimates.size(); ++i) {
-    EXPECT_EQ(two.estimates[i].se_unit, one.estimates[i].se_unit) << i;
+  for (const auto& [days, step_s] : {std::pair{7, 60.0}, std::pair{5, 5.0}}) {
+    SCOPED_TRACE(std::to_string(days) + " days at " + std::to_string(static_cast<int>(step_s)) + " s");
+    const Case c =
+        MakeCase(plant, "2N1Ccolwr", days, step_s, /*seed=*/12, RealisticSensorNoise(13));
+    ASSERT_GE(c.drivers.size() * 11, kSensitivitySplitWork);
+    if (step_s < 60.0) {
+      ASSERT_GE(static_cast<Eigen::Index>(2 * c.meas.rows.size()), kSplitNormalEquationsRows);
+    }
+    IdentOptions options;
+    const IdentSummary one = Identify(c.drivers, c.meas, StartParams(plant), options);
+    options.threads = 2;
+    const IdentSummary two = Identify(c.drivers, c.meas, StartParams(plant), options);
+    ASSERT_TRUE(one.ok && two.ok) << one.BriefReport() << "\n" << two.BriefReport();
+    EXPECT_GT(two.sensitivity_runs, 0);
+    EXPECT_EQ(two.params, one.params);
+    EXPECT_EQ(two.final_cost_w_m2, one.final_cost_w_m2);
+    EXPECT_EQ(two.evaluations, one.evaluations);
+    ASSERT_EQ(two.estimates.size(), one.estimates.size());
+    for (std::size_t i = 0; i < one.estimates.size(); ++i) {
+      EXPECT_EQ(two.estimates[i].se_unit, one.estimates[i].se_unit) << i;
+    }
   }
 }
 

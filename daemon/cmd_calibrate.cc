@@ -398,9 +398,10 @@ void RegisterCalibrate(CLI::App& app) {
                   "longer for a held-out MAE within 0.05 % of the default's)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->threads,
-                  "threads for the runs with exact derivatives, their columns split, and for "
-                  "the start's cost beside the coarse stage (1 or 2; default 2 on a machine "
-                  "with two cores or more); the result is the same on either")
+                  "threads for the runs with exact derivatives, their columns split, for "
+                  "the start's cost beside the coarse stage and for the normal equations of "
+                  "fits on 65536 rows or more, e.g. 14 days at 15 s (1 or 2; default 2 on a "
+                  "machine with two cores or more); the result is the same on either")
       ->check(CLI::Range(1, 2));
   cmd->add_option("--parent-pid", args->parent_pid,
                   "exit when the process with this pid ends (used by pvtwin run for its "

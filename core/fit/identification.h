@@ -120,8 +120,10 @@ struct IdentOptions {
   bool analytic_jacobian = true;
   // Threads one run with sensitivities splits its columns over
   // (SimSensitivities::threads; 1 or 2); with 2 the start's cost on the data
-  // as given also runs beside the coarse stage. The fit is the same to the
-  // bit on either; callers that run identifications side by side keep 1.
+  // as given also runs beside the coarse stage, and the normal equations of
+  // large fits are summed as two halves side by side (LadFitOptions::threads,
+  // WeightedNormalEquations). The fit is the same to the bit on either;
+  // callers that run identifications side by side keep 1.
   int threads = 1;
 
   static OptimizerOptions DefaultOptimizerOptions();

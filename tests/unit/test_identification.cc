@@ -153,7 +153,8 @@ TEST(IdentifySynthetic, SensitivityJacobianReachesTheSameFit) {
 TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
   const Plant plant = DesignExamplePlant();
   for (const auto& [days, step_s] : {std::pair{7, 60.0}, std::pair{5, 5.0}}) {
-    SCOPED_TRACE(std::to_string(days) + " days at " + std::to_string(static_cast<int>(step_s)) + " s");
+    SCOPED_TRACE(std::to_string(days) + " days at " + std::to_string(static_cast<int>(step_s)) +
+                 " s");
     const Case c =
         MakeCase(plant, "2N1Ccolwr", days, step_s, /*seed=*/12, RealisticSensorNoise(13));
     ASSERT_GE(c.drivers.size() * 11, kSensitivitySplitWork);

@@ -31,7 +31,7 @@ void SumNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
                         Eigen::MatrixXd* h, Eigen::VectorXd* g) {
   const Eigen::Index n = jac.cols();
   h->setZero(n, n);
-  if (r.size() > 0) g->setZero(n);
+  if (w.size() > 0) g->setZero(n);
   Eigen::MatrixXd buffer;
   for (Eigen::Index start = begin; start < end; start += kBlockRows) {
     const Eigen::Index b = std::min(kBlockRows, end - start);
@@ -42,13 +42,12 @@ void SumNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
       for (Eigen::Index a = 0; a < n; ++a) {
         for (Eigen::Index c = a; c < n; ++c) (*h)(a, c) += block.col(a).dot(block.col(c));
       }
-      if (r.size() > 0) g->noalias() += block.transpose() * r.segment(start, b);
       continue;
     }
     buffer.resize(b, n);
     buffer.noalias() = (block.array().colwise() * w.segment(start, b).array()).matrix();
     h->noalias() += block.transpose() * buffer;
-    if (r.size() > 0) g->noalias() += buffer.transpose() * r.segment(start, b);
+    g->noalias() += buffer.transpose() * r.segment(start, b);
   }
   if (w.size() > 0) return;
   for (Eigen::Index a = 1; a < n; ++a) {
@@ -79,7 +78,7 @@ void WeightedNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& 
     second();
   }
   *h += h_second;
-  if (r.size() > 0) *g += g_second;
+  if (w.size() > 0) *g += g_second;
 }
 
 namespace {

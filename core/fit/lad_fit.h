@@ -114,8 +114,8 @@ using JacobianFunction =
 // halves of the rows apart.
 inline constexpr Eigen::Index kSplitNormalEquationsRows = Eigen::Index{1} << 17;
 
-// H = JᵀW·J and g = JᵀW·r, W = diag(w) (unit weights when w is empty; g is left
-// alone when r is empty), summed over blocks of rows. From
+// H = JᵀW·J and g = JᵀW·r, W = diag(w), summed over blocks of rows; with w
+// empty, H = JᵀJ alone (r unread, g left alone). From
 // kSplitNormalEquationsRows rows on (65 536 rows in the objective, two
 // residuals each: 14 days at 15 s, 46 days at 1 min), the first and the second
 // half of the rows are summed apart and then added, the second half on a helper

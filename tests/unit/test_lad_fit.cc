@@ -372,7 +372,7 @@ TEST(WeightedNormalEquations, ExactSumsOnBothSidesOfTheSplitOnOneThreadAndTwo) {
           EXPECT_EQ(gram(a, b), static_cast<double>(gram_exact[a][b]));
         }
       }
-      EXPECT_EQ(untouched, Eigen::VectorXd::Constant(2, 7.0));  // no r: g left alone
+      EXPECT_EQ(untouched, Eigen::VectorXd::Constant(2, 7.0));  // JᵀJ alone: g left alone
     }
   }
 }

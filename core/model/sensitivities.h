@@ -17,7 +17,11 @@
 // explicit, see Linearise). These are the derivatives of Simulate's own
 // arithmetic for its number of passes, which central differences of
 // Simulate confirm to about 1e-9 of a column's scale
-// (tests/unit/test_model_sensitivities.cc). The linearisation point's own
+// (tests/unit/test_model_sensitivities.cc). The values P_el, Q_u and T_PV
+// are Simulate's to the bit, on every variant and effect the tests run: the
+// same arithmetic in the same order (no -ffast-math, no FMA contraction at
+// the build's baseline ISA), so that a caller may take a run with
+// sensitivities for a plain run of the same parameters. The linearisation point's own
 // dependence is not negligible: left out, the same tests find errors of
 // 1e-4 to 5e-2 of a column's scale (the step-mean of a capacitive node
 // depends on the point, and an explicit Q_abs slope depends on it to first

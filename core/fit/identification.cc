@@ -152,17 +152,15 @@ class Objective {
   // zero. False when not supported.
   bool Jacobian(const ParamVector& p, const std::vector<ParamInfo>& infos, Eigen::MatrixXd* jac) {
     if (!HasSensitivities()) return false;
+    ColumnFactors(p, infos, &sink_factors_);
+    if (TakeAhead(p, jac)) return true;
     const auto m = static_cast<Eigen::Index>(meas_.rows.size());
     jac->resize((use_t_pv_ ? 3 : 2) * m, static_cast<Eigen::Index>(free_.size()));
     const double inv_area = 1.0 / drivers_.plant.area_m2;
     // The run writes the sensitivities' columns straight into *jac, scaled
-    // to unit coordinates (dx/dz) per W/m² (or weighted K) at the objective
-    // rows, as the copy below does when it cannot (an output transform).
-    sink_factors_.resize(sens_cols_.size());
-    for (std::size_t a = 0; a < sens_cols_.size(); ++a) {
-      const std::size_t uj = sens_cols_[a];
-      sink_factors_[a] = DxDz(infos[uj], p[static_cast<std::size_t>(free_[uj])]);
-    }
+    // to unit coordinates (dx/dz, sink_factors_) per W/m² (or weighted K) at
+    // the objective rows, as the copy below does when it cannot (an output
+    // transform).
     sink_.base = jac->data();
     sink_.stride = static_cast<std::size_t>(jac->rows());
     sink_.rows = static_cast<std::size_t>(m);
@@ -208,7 +206,34 @@ class Objective {
       FillResiduals(sens_.p_el_w, sens_.q_th_w, sens_.t_pv_c, &r0);
       DifferenceColumns(p, infos, r0, diff_cols_, jac);
     }
+    // The run's P_el, Q_u and T_PV are Simulate's to the bit
+    // (sensitivities.h): they serve the next run at p, as a plain run's
+    // would.
+    sim_.p_el_w.swap(sens_.p_el_w);
+    sim_.q_th_w.swap(sens_.q_th_w);
+    sim_.t_pv_c.swap(sens_.t_pv_c);
+    sim_at_ = p;
     return true;
+  }
+
+  // DataCost(p), with the Jacobian at p (Jacobian(p, infos)) computed by
+  // the same run when the active parameters have sensitivities: the fit
+  // that starts at p asks for that Jacobian first, and gets it without
+  // another run (TakeAhead); the plain run the cost would have taken is
+  // saved. The Jacobian is charged when it is taken, as if computed then,
+  // so that the counts and the budget's course do not depend on it; one
+  // that is not taken (the fit starts elsewhere) was a run with
+  // sensitivities in vain, uncharged.
+  double DataCostWithJacobianAhead(const ParamVector& p, const std::vector<ParamInfo>& infos) {
+    const int simulations = simulations_;
+    const int runs = sensitivity_runs_;
+    ahead_.reset();
+    if (Jacobian(p, infos, &ahead_jac_)) {
+      ahead_ = Ahead{p, free_, sink_factors_, simulations_ - simulations, sensitivity_runs_ - runs};
+      simulations_ = simulations;
+      sensitivity_runs_ = runs;
+    }
+    return DataCost(p);
   }
 
   // Columns `cols` of the Jacobian at p (residuals r0) by forward
@@ -242,7 +267,7 @@ class Objective {
     Eigen::MatrixXd jac;
     if (!Jacobian(p, infos_, &jac)) return false;
     Eigen::VectorXd r;
-    FillResiduals(sens_.p_el_w, sens_.q_th_w, sens_.t_pv_c, &r);
+    FillResiduals(sim_.p_el_w, sim_.q_th_w, sim_.t_pv_c, &r);  // Jacobian() left p's there
     const auto m = static_cast<Eigen::Index>(meas_.rows.size());
     const double rows = static_cast<double>(m);
     const double area = drivers_.plant.area_m2;
@@ -267,22 +292,57 @@ class Objective {
     return true;
   }
 
+  // The last run's P_el, Q_u and T_PV (sim_).
   const SimOutputs& last() const { return sim_; }
   int simulations() const { return simulations_; }
   int sensitivity_runs() const { return sensitivity_runs_; }
+  int served() const { return served_; }
 
  private:
   // Simulate's outputs at p in sim_, charged as one simulation. The stages
   // after a fit ask again for its result (its cost, its residuals for the
   // identifiability analysis), which the fit's last run often computed:
-  // a repeat of the last run's parameters is served from sim_, the same
-  // outputs to the bit, and still charged, so that the budget's course and
-  // the counts do not depend on it.
+  // a repeat of the last run's parameters (a plain run's, or a run with
+  // sensitivities', Jacobian) is served from sim_, the same outputs to the
+  // bit, and still charged, so that the budget's course and the counts do
+  // not depend on it.
   void Run(const ParamVector& p) {
     ++simulations_;
-    if (sim_at_ && *sim_at_ == p) return;
+    if (sim_at_ && *sim_at_ == p) {
+      ++served_;
+      return;
+    }
     Simulate(drivers_, p, &sim_);
     sim_at_ = p;
+  }
+
+  // Per column of sens_free_: dx/dz at p.
+  void ColumnFactors(const ParamVector& p, const std::vector<ParamInfo>& infos,
+                     std::vector<double>* factors) const {
+    factors->resize(sens_cols_.size());
+    for (std::size_t a = 0; a < sens_cols_.size(); ++a) {
+      const std::size_t uj = sens_cols_[a];
+      (*factors)[a] = DxDz(infos[uj], p[static_cast<std::size_t>(free_[uj])]);
+    }
+  }
+
+  // The Jacobian computed ahead (DataCostWithJacobianAhead) into *jac, and
+  // charged now, when it is the one asked for: at p, for the same active
+  // parameters and scales (sink_factors_, just set), with p's values still
+  // in sim_. Any other request drops it.
+  bool TakeAhead(const ParamVector& p, Eigen::MatrixXd* jac) {
+    if (!ahead_) return false;
+    const bool same = ahead_->at == p && ahead_->free == free_ &&
+                      ahead_->factors == sink_factors_ && sim_at_ && *sim_at_ == p;
+    if (same) {
+      jac->swap(ahead_jac_);
+      simulations_ += ahead_->simulations;
+      sensitivity_runs_ += ahead_->sensitivity_runs;
+      served_ += ahead_->simulations;
+    }
+    ahead_.reset();
+    ahead_jac_.resize(0, 0);
+    return same;
   }
 
   void FillResiduals(const std::vector<double>& p_el_w, const std::vector<double>& q_th_w,
@@ -308,8 +368,21 @@ class Objective {
   Eigen::VectorXd diff_r_;
   std::vector<ParamInfo> infos_;
   std::vector<double> z_ref_;
+  // The last run's outputs: P_el, Q_u and T_PV at sim_at_, which a run with
+  // sensitivities leaves too (Jacobian); the others are the last plain
+  // run's.
   SimOutputs sim_;
-  std::optional<ParamVector> sim_at_;  // the parameters of sim_'s run
+  std::optional<ParamVector> sim_at_;  // the parameters of sim_'s P_el, Q_u, T_PV
+  // A Jacobian computed ahead (DataCostWithJacobianAhead), until TakeAhead.
+  struct Ahead {
+    ParamVector at;
+    std::vector<Param> free;
+    std::vector<double> factors;  // sink_factors_ of its run
+    int simulations = 0;          // what its computation was charged, and undone
+    int sensitivity_runs = 0;
+  };
+  std::optional<Ahead> ahead_;
+  Eigen::MatrixXd ahead_jac_;
   SimSensitivities sens_;
   SensitivitySink sink_;
   std::vector<double> sink_factors_;    // per column of sens_free_: dx/dz
@@ -318,6 +391,7 @@ class Objective {
   bool use_t_pv_ = false;
   int simulations_ = 0;
   int sensitivity_runs_ = 0;
+  int served_ = 0;  // of simulations_, served without a model run
 };
 
 // Standard errors of the parameters of J's columns (unit coordinates) from
@@ -560,8 +634,10 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
     log_scale[j] = infos[j].scale == ParamScale::kLog;
   }
   CostFunction cost = [&](std::span<const double> x, std::span<double> grad) -> double {
+    // The run with sensitivities first: its values serve the cost.
+    const bool exact = !grad.empty() && obj.CostGradient(x, smoothing_w, grad);
     const double c = obj.Cost(x, smoothing_w);
-    if (!grad.empty() && !obj.CostGradient(x, smoothing_w, grad)) {
+    if (!grad.empty() && !exact) {
       // Forward differences on the smoothed objective.
       std::copy(x.begin(), x.end(), xp.begin());
       for (std::size_t j = 0; j < n; ++j) {
@@ -594,9 +670,14 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
 Eigen::MatrixXd SensitivityMatrix(Objective& obj, const std::vector<ParamInfo>& infos,
                                   const ParamVector& p, Eigen::VectorXd* r0) {
   const std::vector<Param>& active = obj.free();
+  Eigen::MatrixXd jac;
+  // The run with sensitivities first: its values serve the residuals.
+  if (obj.Jacobian(p, infos, &jac)) {
+    obj.Residuals(p, r0);
+    return jac;
+  }
   obj.Residuals(p, r0);
-  Eigen::MatrixXd jac(r0->size(), static_cast<Eigen::Index>(active.size()));
-  if (obj.Jacobian(p, infos, &jac)) return jac;
+  jac.resize(r0->size(), static_cast<Eigen::Index>(active.size()));
   std::vector<std::size_t> all(active.size());
   for (std::size_t j = 0; j < all.size(); ++j) all[j] = j;
   obj.DifferenceColumns(p, infos, *r0, all, &jac);
@@ -753,6 +834,7 @@ struct CoarseFits {
   std::vector<IdentSummary> fits;  // the first from the start, then the restarts
   int simulations = 0;
   int sensitivity_runs = 0;
+  int served_runs = 0;
 };
 
 // The factor of the coarse stage's averaging, below 2 when there is none.
@@ -787,6 +869,7 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
   out.fits.push_back(Identify(cd, cm, fs.base, coarse));
   out.simulations = out.fits.back().evaluations;
   out.sensitivity_runs = out.fits.back().sensitivity_runs;
+  out.served_runs = out.fits.back().served_runs;
   // Restarts from the residuals of that optimum (RestartsFromResiduals), on
   // the coarsest rung only (a coarse fit with a coarse stage of its own
   // restarts there).
@@ -797,18 +880,36 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
     out.fits.push_back(Identify(cd, cm, restart, coarse));
     out.simulations += out.fits.back().evaluations + 1;  // + the run without the effect
     out.sensitivity_runs += out.fits.back().sensitivity_runs;
+    out.served_runs += out.fits.back().served_runs;
   }
   return out;
 }
 
+// The cost of p on the data as given where the fine stage will most likely
+// start from p: with the Jacobian of all free parameters at p computed by
+// the same run (Objective::DataCostWithJacobianAhead), when the fit asks
+// for it first, at p itself: lad_lm (RunFit takes the start, not its round
+// trip through the unit coordinates). NLopt's methods start at that round
+// trip, a few ulps away, where the Jacobian would be in vain.
+double CostOfTheFineStart(Objective& obj, const FreeSet& fs, const IdentOptions& options,
+                          const ParamVector& p) {
+  if (!options.jacobian_ahead || options.method != IdentMethod::kLadLm) return obj.DataCost(p);
+  obj.SetFree(fs.free, fs.infos, std::vector<double>(fs.free.size(), 0.0));
+  return obj.DataCostWithJacobianAhead(p, fs.infos);
+}
+
 // The best of the coarse fits on the data as given, in their order: a
 // misspecified model can have its coarse optimum far from the fine one, so
-// one replaces *best only if it also beats the start (`initial_cost`).
-void PickCoarse(const CoarseFits& coarse, Objective& obj, double initial_cost, ParamVector* best) {
+// one replaces *best only if it also beats the start (`initial_cost`). A
+// single coarse fit is almost always the fine stage's start
+// (CostOfTheFineStart).
+void PickCoarse(const CoarseFits& coarse, Objective& obj, const FreeSet& fs,
+                const IdentOptions& options, double initial_cost, ParamVector* best) {
   double best_cost = initial_cost;
   for (const IdentSummary& fit : coarse.fits) {
     if (!fit.ok) continue;
-    const double cost = obj.DataCost(fit.params);
+    const double cost = coarse.fits.size() == 1 ? CostOfTheFineStart(obj, fs, options, fit.params)
+                                                : obj.DataCost(fit.params);
     if (cost < best_cost) {
       *best = fit.params;
       best_cost = cost;
@@ -1171,7 +1272,11 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   double initial_cost = kNaN;
   CoarseFits coarse;
   auto t_coarse = std::chrono::steady_clock::now();
-  auto start_cost = [&] { initial_cost = obj.DataCost(fs.base); };
+  // Without a coarse stage the fine stage starts at the start.
+  auto start_cost = [&] {
+    initial_cost =
+        coarse_factor < 2 ? CostOfTheFineStart(obj, fs, options, fs.base) : obj.DataCost(fs.base);
+  };
   auto coarse_fits = [&] {
     t_coarse = std::chrono::steady_clock::now();
     coarse = FitCoarse(drivers, meas, options, fs, coarse_factor);
@@ -1189,7 +1294,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
     return finish(false, "the model gives non-finite outputs at the start values");
   }
   ParamVector best = fs.base;
-  PickCoarse(coarse, obj, initial_cost, &best);
+  PickCoarse(coarse, obj, fs, options, initial_cost, &best);
   if (!coarse.fits.empty()) {
     summary.coarse_runtime_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_coarse).count();
@@ -1209,6 +1314,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
   summary.evaluations = obj.simulations() + coarse_simulations;
   summary.sensitivity_runs = obj.sensitivity_runs() + coarse_sensitivity_runs;
+  summary.served_runs = obj.served() + coarse.served_runs;
   summary.estimates = Estimates(drivers, fs, fine, options);
   if (!fit.ok) {
     return finish(false, "optimiser stopped with " + std::string(ToString(fit.termination)) +
@@ -1231,6 +1337,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
     summary.final_cost_w_m2 = obj.DataCost(fs.base);
     summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
     summary.evaluations = obj.simulations() + coarse_simulations;
+    summary.served_runs = obj.served() + coarse.served_runs;
   }
   return finish(true, "");
 }

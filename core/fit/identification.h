@@ -118,6 +118,13 @@ struct IdentOptions {
   // supports the variant, instead of forward differences of one simulation
   // per free parameter.
   bool analytic_jacobian = true;
+  // lad_lm: price the fine stage's start (the coarse optimum, or the start
+  // without a coarse stage) with a run with sensitivities, whose Jacobian
+  // the fit then takes first, instead of a plain run before it: one plain
+  // run less per fit, and the same fit, counts and budget to the bit (its
+  // values are Simulate's, core/model/sensitivities.h). False prices it
+  // with the plain run, for the test that proves the sameness.
+  bool jacobian_ahead = true;
   // Threads one run with sensitivities splits its columns over
   // (SimSensitivities::threads; 1 or 2); with 2 the start's cost on the data
   // as given also runs beside the coarse stage, and the normal equations of
@@ -169,6 +176,10 @@ struct IdentSummary {
   // Runs with sensitivities among them (analytic_jacobian), each counted in
   // `evaluations` as kSensitivityRunCost simulations.
   int sensitivity_runs = 0;
+  // Charged simulations among `evaluations` that were served from an
+  // earlier run's outputs without a model run: repeats of the last run's
+  // parameters, and the Jacobian computed ahead (jacobian_ahead).
+  int served_runs = 0;
   double runtime_s = 0.0;
   // Time split: the coarse stage's share of runtime_s and of evaluations
   // (0 without a coarse stage); the fine stage (fit, identifiability,

@@ -177,6 +177,51 @@ TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
   }
 }
 
+// lad_lm's start is priced by a run with sensitivities whose Jacobian the
+// fit then takes first (IdentOptions::jacobian_ahead): the same fit to the
+// bit as with a plain run before it (parameters, cost, counts, standard
+// errors), from the coarse optimum and, without a coarse stage, from the
+// start. The runs served without a model run show that the Jacobian and the
+// start's cost were taken from that run: at the coarse rung's start and at
+// the coarse optimum, or at the start. L-BFGS, which starts a few ulps away
+// and so keeps the plain run, gives the same fit too, and each of its runs
+// with sensitivities serves the cost at its point (Objective::CostGradient
+// runs first). A Jacobian taken at another point or with other scales, or
+// values that are not Simulate's, would move the fit.
+TEST(IdentifySynthetic, TheJacobianComputedAheadGivesTheSameFit) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 7, 120.0, /*seed=*/12, RealisticSensorNoise(13));
+  IdentOptions no_coarse;
+  no_coarse.coarse_step_s = 0.0;
+  IdentOptions lbfgs;
+  ASSERT_TRUE(SetIdentAlgorithm("lbfgs", &lbfgs));
+  const std::pair<const char*, IdentOptions> cases[] = {
+      {"lad_lm", IdentOptions{}}, {"lad_lm without a coarse stage", no_coarse}, {"lbfgs", lbfgs}};
+  for (const auto& [name, options] : cases) {
+    SCOPED_TRACE(name);
+    IdentOptions plain = options;
+    plain.jacobian_ahead = false;
+    const IdentSummary ahead = Identify(c.drivers, c.meas, StartParams(plant), options);
+    const IdentSummary before = Identify(c.drivers, c.meas, StartParams(plant), plain);
+    ASSERT_TRUE(ahead.ok && before.ok) << ahead.BriefReport() << "\n" << before.BriefReport();
+    EXPECT_EQ(ahead.params, before.params);
+    EXPECT_EQ(ahead.final_cost_w_m2, before.final_cost_w_m2);
+    EXPECT_EQ(ahead.evaluations, before.evaluations);
+    EXPECT_EQ(ahead.sensitivity_runs, before.sensitivity_runs);
+    ASSERT_EQ(ahead.estimates.size(), before.estimates.size());
+    for (std::size_t i = 0; i < ahead.estimates.size(); ++i) {
+      EXPECT_EQ(ahead.estimates[i].se_unit, before.estimates[i].se_unit) << i;
+    }
+    if (options.method == IdentMethod::kNlopt) {
+      EXPECT_EQ(ahead.served_runs, before.served_runs);
+      EXPECT_GE(before.served_runs, before.sensitivity_runs);
+    } else {
+      const int starts = options.coarse_step_s > 0.0 ? 2 : 1;
+      EXPECT_EQ(ahead.served_runs - before.served_runs, starts * (kSensitivityRunCost + 1));
+    }
+  }
+}
+
 // The summary's cost and training errors are those of a fresh run at the
 // result, to the bit, whether the fit's own last run served them (a repeat
 // of the last run's parameters reuses its outputs) or a new run, with a

@@ -1293,12 +1293,15 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   if (!std::isfinite(initial_cost)) {
     return finish(false, "the model gives non-finite outputs at the start values");
   }
-  ParamVector best = fs.base;
-  PickCoarse(coarse, obj, fs, options, initial_cost, &best);
+  // The coarse stage's time ends with its fits: the check of their optima on
+  // the data as given is the fine stage's first run (with sensitivities
+  // for lad_lm, CostOfTheFineStart).
   if (!coarse.fits.empty()) {
     summary.coarse_runtime_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_coarse).count();
   }
+  ParamVector best = fs.base;
+  PickCoarse(coarse, obj, fs, options, initial_cost, &best);
   const int coarse_simulations = coarse.simulations;
   const int coarse_sensitivity_runs = coarse.sensitivity_runs;
   summary.coarse_evaluations = coarse_simulations;

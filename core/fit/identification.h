@@ -182,8 +182,9 @@ struct IdentSummary {
   int served_runs = 0;
   double runtime_s = 0.0;
   // Time split: the coarse stage's share of runtime_s and of evaluations
-  // (0 without a coarse stage); the fine stage (fit, identifiability,
-  // polish) is the rest.
+  // (its fits; 0 without a coarse stage); the fine stage (the check of the
+  // coarse optima on the data as given, fit, identifiability, polish) is
+  // the rest.
   double coarse_runtime_s = 0.0;
   int coarse_evaluations = 0;
   ParamVector params{};

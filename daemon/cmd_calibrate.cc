@@ -410,7 +410,8 @@ void RegisterCalibrate(CLI::App& app) {
                   "exit when the process with this pid ends (used by pvtwin run for its "
                   "calibration child)");
   cmd->add_flag("--timing", args->timing,
-                "print the time split (parse, prepare, fit coarse/fine with their model runs, "
+                "print the time split (parse, prepare, fit coarse/fine with their model runs as "
+                "counted against the budget and how many of them an earlier run served, "
                 "held-out, write) on standard error");
   cmd->add_flag("--use-t-pv", args->use_t_pv,
                 "add the measured PV temperature (t_pv_c) to the objective");

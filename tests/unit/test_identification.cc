@@ -44,6 +44,19 @@ Case MakeCase(const Plant& plant, const std::string& variant, int days, double s
   return c;
 }
 
+// The same fit to the bit: parameters, cost, simulations charged (runs
+// with sensitivities among them) and standard errors.
+void ExpectTheSameFit(const IdentSummary& a, const IdentSummary& b) {
+  EXPECT_EQ(a.params, b.params);
+  EXPECT_EQ(a.final_cost_w_m2, b.final_cost_w_m2);
+  EXPECT_EQ(a.evaluations, b.evaluations);
+  EXPECT_EQ(a.sensitivity_runs, b.sensitivity_runs);
+  ASSERT_EQ(a.estimates.size(), b.estimates.size());
+  for (std::size_t i = 0; i < a.estimates.size(); ++i) {
+    EXPECT_EQ(a.estimates[i].se_unit, b.estimates[i].se_unit) << i;
+  }
+}
+
 // Noise-free data from the model itself: the identifiable parameters come
 // back within 1 % and the MAE falls below 0.5 W/m².
 TEST(IdentifySynthetic, NoiseFreeRecoversIdentifiableParameters) {
@@ -167,13 +180,7 @@ TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
     const IdentSummary two = Identify(c.drivers, c.meas, StartParams(plant), options);
     ASSERT_TRUE(one.ok && two.ok) << one.BriefReport() << "\n" << two.BriefReport();
     EXPECT_GT(two.sensitivity_runs, 0);
-    EXPECT_EQ(two.params, one.params);
-    EXPECT_EQ(two.final_cost_w_m2, one.final_cost_w_m2);
-    EXPECT_EQ(two.evaluations, one.evaluations);
-    ASSERT_EQ(two.estimates.size(), one.estimates.size());
-    for (std::size_t i = 0; i < one.estimates.size(); ++i) {
-      EXPECT_EQ(two.estimates[i].se_unit, one.estimates[i].se_unit) << i;
-    }
+    ExpectTheSameFit(two, one);
   }
 }
 
@@ -204,14 +211,7 @@ TEST(IdentifySynthetic, TheJacobianComputedAheadGivesTheSameFit) {
     const IdentSummary ahead = Identify(c.drivers, c.meas, StartParams(plant), options);
     const IdentSummary before = Identify(c.drivers, c.meas, StartParams(plant), plain);
     ASSERT_TRUE(ahead.ok && before.ok) << ahead.BriefReport() << "\n" << before.BriefReport();
-    EXPECT_EQ(ahead.params, before.params);
-    EXPECT_EQ(ahead.final_cost_w_m2, before.final_cost_w_m2);
-    EXPECT_EQ(ahead.evaluations, before.evaluations);
-    EXPECT_EQ(ahead.sensitivity_runs, before.sensitivity_runs);
-    ASSERT_EQ(ahead.estimates.size(), before.estimates.size());
-    for (std::size_t i = 0; i < ahead.estimates.size(); ++i) {
-      EXPECT_EQ(ahead.estimates[i].se_unit, before.estimates[i].se_unit) << i;
-    }
+    ExpectTheSameFit(ahead, before);
     if (options.method == IdentMethod::kNlopt) {
       EXPECT_EQ(ahead.served_runs, before.served_runs);
       EXPECT_GE(before.served_runs, before.sensitivity_runs);

@@ -19,14 +19,15 @@
 // Simulate confirm to about 1e-9 of a column's scale
 // (tests/unit/test_model_sensitivities.cc). The values P_el, Q_u and T_PV
 // are Simulate's to the bit, on every variant and effect the tests run: the
-// same arithmetic in the same order (no -ffast-math, no FMA contraction at
-// the build's baseline ISA), so that a caller may take a run with
-// sensitivities for a plain run of the same parameters. The linearisation point's own
-// dependence is not negligible: left out, the same tests find errors of
-// 1e-4 to 5e-2 of a column's scale (the step-mean of a capacitive node
-// depends on the point, and an explicit Q_abs slope depends on it to first
-// order). The pass count changes with the parameters in steps; there
-// Simulate jumps (far below kNodeToleranceK) and has no derivative.
+// same arithmetic in the same order (no -ffast-math, and no FMA contraction
+// at x86-64's baseline ISA), so that a caller may take a run with
+// sensitivities for a plain run of the same parameters (identification's
+// objective does). The linearisation point's own dependence is not
+// negligible: left out, the same tests find errors of 1e-4 to 5e-2 of a
+// column's scale (the step-mean of a capacitive node depends on the point,
+// and an explicit Q_abs slope depends on it to first order). The pass count
+// changes with the parameters in steps; there Simulate jumps (far below
+// kNodeToleranceK) and has no derivative.
 //
 // Supported: every network shape, and effect extensions that change the
 // run's per-row inputs (ModelExtension::transform_drivers), electric effects

@@ -194,7 +194,8 @@ TEST(IdentifySynthetic, TwoThreadsGiveTheSameFit) {
 // and so keeps the plain run, gives the same fit too, and each of its runs
 // with sensitivities serves the cost at its point (Objective::CostGradient
 // runs first). A Jacobian taken at another point or with other scales, or
-// values that are not Simulate's, would move the fit.
+// values that are not Simulate's, would move the fit. From a warm start the
+// coarse optimum is priced by a plain run.
 TEST(IdentifySynthetic, TheJacobianComputedAheadGivesTheSameFit) {
   const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 7, 120.0, /*seed=*/12, RealisticSensorNoise(13));
@@ -220,6 +221,19 @@ TEST(IdentifySynthetic, TheJacobianComputedAheadGivesTheSameFit) {
       EXPECT_EQ(ahead.served_runs - before.served_runs, starts * (kSensitivityRunCost + 1));
     }
   }
+  // From a start that fits already (the fit's own result: a warm start) the
+  // coarse fit hardly lowers its cost, and its optimum is priced by a plain
+  // run, which it may lose to the start; only the coarse rung's start takes
+  // its Jacobian ahead.
+  const IdentSummary first = Identify(c.drivers, c.meas, StartParams(plant), IdentOptions{});
+  ASSERT_TRUE(first.ok) << first.BriefReport();
+  IdentOptions plain;
+  plain.jacobian_ahead = false;
+  const IdentSummary ahead = Identify(c.drivers, c.meas, first.params, IdentOptions{});
+  const IdentSummary before = Identify(c.drivers, c.meas, first.params, plain);
+  ASSERT_TRUE(ahead.ok && before.ok) << ahead.BriefReport() << "\n" << before.BriefReport();
+  ExpectTheSameFit(ahead, before);
+  EXPECT_EQ(ahead.served_runs - before.served_runs, kSensitivityRunCost + 1);
 }
 
 // The summary's cost and training errors are those of a fresh run at the

@@ -907,7 +907,8 @@ double CostOfTheFineStart(Objective& obj, const FreeSet& fs, const IdentOptions&
 // (a warm start, the daemon's nightly case) the coarse optimum often loses
 // to it on the data as given, and a Jacobian computed ahead there would be
 // a run with sensitivities in vain: 15 % more instructions on the bench's
-// warm starts at 1 min.
+// warm starts at 1 min when every coarse optimum was priced ahead (callgrind,
+// 18520fd against bf74886; core/fit/README.md).
 void PickCoarse(const CoarseFits& coarse, Objective& obj, const FreeSet& fs,
                 const IdentOptions& options, double initial_cost, ParamVector* best) {
   double best_cost = initial_cost;

@@ -118,12 +118,13 @@ struct IdentOptions {
   // supports the variant, instead of forward differences of one simulation
   // per free parameter.
   bool analytic_jacobian = true;
-  // lad_lm: price the fine stage's start (the coarse optimum, or the start
-  // without a coarse stage) with a run with sensitivities, whose Jacobian
-  // the fit then takes first, instead of a plain run before it: one plain
-  // run less per fit, and the same fit, counts and budget to the bit (its
-  // values are Simulate's, core/model/sensitivities.h). False prices it
-  // with the plain run, for the test that proves the sameness.
+  // lad_lm: price the fine stage's start (the coarse optimum after a coarse
+  // fit that at least halved its cost, or the start without a coarse stage)
+  // with a run with sensitivities, whose Jacobian the fit then takes first,
+  // instead of a plain run before it: one plain run less per such start,
+  // and the same fit, counts and budget to the bit (its values are
+  // Simulate's, core/model/sensitivities.h). False prices it with the plain
+  // run, for the test that proves the sameness.
   bool jacobian_ahead = true;
   // Threads one run with sensitivities splits its columns over
   // (SimSensitivities::threads; 1 or 2); with 2 the start's cost on the data

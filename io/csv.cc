@@ -565,6 +565,18 @@ bool ParseCanonicalCsv(std::istream& in, const std::string& path_for_messages,
 
 namespace {
 
+// The stream's buffer: 256 kB, where the default 8 kB made a 14-day 1-min
+// file (4.6 MB) about 600 reads.
+using StreamBuffer = std::vector<char>;
+
+// Opens `path` for binary reading through `buffer` (kept alive beside the
+// stream).
+void OpenBuffered(const std::string& path, StreamBuffer* buffer, std::ifstream* in) {
+  buffer->resize(std::size_t{1} << 18);
+  in->rdbuf()->pubsetbuf(buffer->data(), static_cast<std::streamsize>(buffer->size()));
+  in->open(path, std::ios::binary);
+}
+
 // Reads a large file on two threads: the caller the rows that start in the
 // first half of the bytes after the header, a helper the rest from a second
 // stream (both here, one after the other, when the system refuses the
@@ -582,7 +594,9 @@ bool ReadInTwoHalves(const std::string& path, std::ifstream& in, const CsvReadOp
   if (!first.ReadHeaderRow(in, &header_bytes) || first.HasErrors()) return false;
   const std::size_t left = CsvParser::BytesLeft(in);
   if (left < options.two_thread_bytes) return false;
-  std::ifstream later_in(path, std::ios::binary);
+  StreamBuffer later_buffer;
+  std::ifstream later_in;
+  OpenBuffered(path, &later_buffer, &later_in);
   std::string skipped;  // the end of the line in which the middle falls
   if (!later_in.seekg(static_cast<std::streamoff>(header_bytes + left / 2)) ||
       !std::getline(later_in, skipped)) {
@@ -603,7 +617,9 @@ bool ReadInTwoHalves(const std::string& path, std::ifstream& in, const CsvReadOp
 bool ReadCanonicalCsv(const std::string& path, const CsvReadOptions& options, Series* out,
                       Diagnostics* errors, Diagnostics* warnings) {
   assert(out != nullptr && errors != nullptr);
-  std::ifstream in(path, std::ios::binary);
+  StreamBuffer buffer;
+  std::ifstream in;
+  OpenBuffered(path, &buffer, &in);
   if (!in) {
     errors->push_back({path, 0, "", "", std::string("cannot open: ") + std::strerror(errno)});
     return false;

@@ -121,6 +121,7 @@ inline constexpr Eigen::Index kSplitNormalEquationsRows = Eigen::Index{1} << 17;
 // half of the rows are summed apart and then added, the second half on a helper
 // thread when threads > 1: at 5-s data one sum took 20 ms of each iteration on
 // one core. The sums, and so H and g, are the same on one thread and on two.
+// H is symmetric to the bit: one triangle is summed, the other mirrored.
 void WeightedNormalEquations(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
                              const Eigen::VectorXd& r, int threads, Eigen::MatrixXd* h,
                              Eigen::VectorXd* g);

@@ -37,7 +37,7 @@ struct SensRun {
   std::span<const Param> wrt;
   int cols;
   std::size_t col0;
-  bool values;  // writes the outputs' values too (one share does)
+  bool values;            // writes the outputs' values too (one share does)
   SensitivitySink* sink;  // the derivatives go there when set
   bool outlet;  // also the collector node's and the outlet's temperature (SimSensitivities)
   bool t_pv;    // the derivatives of T_PV (SimSensitivities::t_pv_derivatives)
@@ -47,7 +47,7 @@ struct SensRun {
 // with respect to each parameter of wrt: d(term)/d(wrt[j]) at [j].
 struct RowTermTangents {
   Column g_front_w_k, g_fluid_w_k, q_sun_w;
-  Column eta_at_ref_temp;  // η_PVref·(1 + f_corr_I·(I_gt − I_gtref))
+  Column eta_at_ref_temp;   // η_PVref·(1 + f_corr_I·(I_gt − I_gtref))
   Column temp_coeff_per_k;  // f_corr_T
   Column eps_pvt, area_m2;
   Column g_back_w_k, g_coll_w_k, c_pv_j_k, c_coll_j_k;
@@ -56,12 +56,11 @@ struct RowTermTangents {
 
 // The partial derivatives of row i's terms by parameter, scattered to the
 // columns. A column's parameter writes the same entries at every row (zero
-// where the row has none), so *t is zeroed once per run, not per row. Paper 2.8 ('w'): U = 1/(1/U_front + r_refwind·v^n), so
-// dU/dU_front = U²/U_front², dU/dr_refwind = −U²·v^n, dU/dn = −U²·r_refwind·
-// v^n·ln v. Eq. 2.7 per field: G_fluid = 2w/(r1 + 2w·r0/A), so dG/dr1 =
-// −G²/(2w), dG/dr0 = −G²/A, dG/dA = G²·r0/A².
-void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i,
-                         RowTermTangents* t) {
+// where the row has none), so *t is zeroed once per run, not per row. Paper 2.8 ('w'): U =
+// 1/(1/U_front + r_refwind·v^n), so dU/dU_front = U²/U_front², dU/dr_refwind = −U²·v^n, dU/dn =
+// −U²·r_refwind· v^n·ln v. Eq. 2.7 per field: G_fluid = 2w/(r1 + 2w·r0/A), so dG/dr1 = −G²/(2w),
+// dG/dr0 = −G²/A, dG/dA = G²·r0/A².
+void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i, RowTermTangents* t) {
   const RunConstants& k = run.k;
   const double area = k.area_m2;
   const double u_front = r.g_front_w_k / area;
@@ -220,8 +219,8 @@ void NetworkTangent(const SensRun& run, const RowTerms& r, const Linearised& l,
   double kappa_g = 0.0, kappa_s = 0.0, r1 = 0.0, r0 = 0.0;
   if constexpr (kSky) {
     const double xk = CToK(x);
-    r1 = 4.0 * kStefanBoltzmannW_m2k4 * xk * xk * xk;                  // q_rad'/(ε·A)
-    r0 = kStefanBoltzmannW_m2k4 * (xk * xk * xk * xk - r.t_sky_k4);   // q_rad/(ε·A)
+    r1 = 4.0 * kStefanBoltzmannW_m2k4 * xk * xk * xk;                // q_rad'/(ε·A)
+    r0 = kStefanBoltzmannW_m2k4 * (xk * xk * xk * xk - r.t_sky_k4);  // q_rad/(ε·A)
     kappa_g = 12.0 * k.eps_pvt * kStefanBoltzmannW_m2k4 * k.area_m2 * xk * xk;
     kappa_s = kappa_g * x;
   }

@@ -56,9 +56,10 @@ struct RowTermTangents {
 
 // The partial derivatives of row i's terms by parameter, scattered to the
 // columns. A column's parameter writes the same entries at every row (zero
-// where the row has none), so *t is zeroed once per run, not per row. Paper 2.8 ('w'): U =
-// 1/(1/U_front + r_refwind·v^n), so dU/dU_front = U²/U_front², dU/dr_refwind = −U²·v^n, dU/dn =
-// −U²·r_refwind· v^n·ln v. Eq. 2.7 per field: G_fluid = 2w/(r1 + 2w·r0/A), so dG/dr1 = −G²/(2w),
+// where the row has none), so *t is zeroed once per run, not per row.
+// Paper 2.8 ('w'): U = 1/(1/U_front + r_refwind·v^n), so dU/dU_front =
+// U²/U_front², dU/dr_refwind = −U²·v^n, dU/dn = −U²·r_refwind·v^n·ln v.
+// Eq. 2.7 per field: G_fluid = 2w/(r1 + 2w·r0/A), so dG/dr1 = −G²/(2w),
 // dG/dr0 = −G²/A, dG/dA = G²·r0/A².
 void MakeRowTermTangents(const SensRun& run, const RowTerms& r, std::size_t i, RowTermTangents* t) {
   const RunConstants& k = run.k;

@@ -152,10 +152,11 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, const std::s
       "fit: the last run)\n",
       runs);
   std::printf(
-      "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs) + fine %.1f "
-      "(%d model runs); %d of the runs with sensitivities, each counted as %d | write %.2f\n",
+      "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs, first on %d of "
+      "the days) + fine %.1f (%d model runs); %d of the runs with sensitivities, each counted "
+      "as %d | write %.2f\n",
       1e3 * Median(parse), csv.size() / 1024, 1e3 * fit.runtime_s, 1e3 * fit.coarse_runtime_s,
-      fit.coarse_evaluations, 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
+      fit.coarse_evaluations, fit.coarse_subset_days, 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
       fit.evaluations - fit.coarse_evaluations, fit.sensitivity_runs, kSensitivityRunCost,
       1e3 * Median(write));
 }

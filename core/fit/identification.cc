@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 
+#include "core/common/calendar.h"
 #include "core/common/threads.h"
 #include "core/effects/registry.h"
 #include "core/fit/lad_fit.h"
@@ -694,16 +695,23 @@ std::string Name(Param p) { return std::string(kParamTable[static_cast<std::size
 // 2w/(r1 + 2w·r0) is far from linear in w: that bias moved the coarse
 // optimum along the r0_fluid/r1_fluid valley, and the fine stage spent two
 // thirds of its runs walking back.
-void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, Measurements* cm) {
+// With `keep` (one flag per row of d), the rows not kept are left out: each
+// stretch of them becomes one group that is not usable and not in the
+// objective (the model restarts after it, as after a gap in the data).
+void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, Measurements* cm,
+             const std::vector<std::uint8_t>* keep = nullptr) {
   const std::size_t n = d.size();
+  auto kept = [&](std::size_t i) { return keep == nullptr || (*keep)[i] != 0; };
   RowGroups groups;
   groups.begin.reserve(n / static_cast<std::size_t>(factor) * 5 / 4 + 16);
   groups.dt_s.reserve(groups.begin.capacity());
   for (std::size_t i = 0; i < n;) {
     std::size_t end = i + 1;
-    if (d.usable[i]) {
+    if (!kept(i)) {
+      while (end < n && !kept(end)) ++end;
+    } else if (d.usable[i]) {
       const bool flow = d.capacity_flow_w_k[i] > 0.0;
-      while (end < n && end - i < static_cast<std::size_t>(factor) && d.usable[end] &&
+      while (end < n && end - i < static_cast<std::size_t>(factor) && d.usable[end] && kept(end) &&
              !d.restart[end] && (d.capacity_flow_w_k[end] > 0.0) == flow) {
         ++end;
       }
@@ -723,7 +731,7 @@ void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, M
     const std::size_t first = groups.begin[g];
     cd->time_s[g] = d.time_s[first];
     cd->restart[g] = d.restart[first];
-    cd->usable[g] = d.usable[first];
+    cd->usable[g] = d.usable[first] && kept(first);
     double wind = 0.0;
     for (std::size_t k = first; k < groups.begin[g + 1]; ++k) {
       wind += std::exp(d.ln_wind[k]) * d.dt_s[k];
@@ -745,7 +753,7 @@ void Coarsen(const Drivers& d, const Measurements& m, int factor, Drivers* cd, M
   // The measurements of a group whose rows are all in the objective; NaN
   // (and not in the objective) for the others.
   std::vector<std::uint8_t> in_obj(n, 0);
-  for (std::uint32_t i : m.rows) in_obj[i] = 1;
+  for (std::uint32_t i : m.rows) in_obj[i] = kept(i) ? 1 : 0;
   const bool t_pv = !m.t_pv_c.empty();
   mean(m.p_el_w, &cm->p_el_w);
   mean(m.q_th_w, &cm->q_th_w);
@@ -835,6 +843,12 @@ struct CoarseFits {
   int simulations = 0;
   int sensitivity_runs = 0;
   int served_runs = 0;
+  // The first fit, with the day subset's before it, at least halved the
+  // cost of its start.
+  bool far = false;
+  // The days of the subset whose optimum the first fit started from; 0
+  // when it started from the start (IdentSummary::coarse_subset_days).
+  int subset_days = 0;
 };
 
 // The factor of the coarse stage's averaging, below 2 when there is none.
@@ -846,6 +860,41 @@ int CoarseFactor(const Drivers& drivers, const IdentOptions& options, const Free
   return coarse_step_s > 0.0 && data_step_s > 0.0
              ? static_cast<int>(coarse_step_s / data_step_s + 0.5)
              : 1;
+}
+
+// IdentOptions::day_subset_stage: flags for the rows of every k-th solar
+// day of d (k = max(2, days / 3): four or five days of 8 to 14, five of 29),
+// and in *kept the number of days kept; empty for data covering fewer than
+// kSubsetMinDays days.
+constexpr double kSubsetMinDays = 8.0;
+// The day subset's fit stops at this relative decrease (IdentOptions::ftol_rel),
+// and the fit on all the days after it at this factor times the coarse one.
+constexpr double kSubsetFtol = 1e-2;
+constexpr double kAllDaysFtolFactor = 0.3;
+std::vector<std::uint8_t> DaySubset(const Drivers& d, int* kept) {
+  *kept = 0;
+  if (d.size() < 2) return {};
+  const double days =
+      static_cast<double>(d.time_s.back() - d.time_s.front() + d.dt_s.back()) / 86400.0;
+  if (days < kSubsetMinDays) return {};
+  const std::int64_t offset_s = SolarDayOffsetS(d.plant);
+  auto day = [&](std::size_t i) {
+    const std::int64_t t = d.time_s[i] + offset_s;
+    return t / 86400 - (t % 86400 < 0 ? 1 : 0);
+  };
+  const std::int64_t first = day(0);
+  const std::int64_t every = std::max<std::int64_t>(2, static_cast<std::int64_t>(days) / 3);
+  std::vector<std::uint8_t> keep(d.size());
+  std::int64_t last_kept = first - 1;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const std::int64_t k = day(i);
+    keep[i] = (k - first) % every == 0 ? 1 : 0;
+    if (keep[i] && k != last_kept) {
+      ++*kept;
+      last_kept = k;
+    }
+  }
+  return keep;
 }
 
 // The coarse fits on the data averaged by `coarse_factor` (CoarseFactor, at
@@ -866,10 +915,44 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
   coarse.correct_bends = true;
   coarse.optimizer.ftol_rel = std::max(options.optimizer.ftol_rel, 1e-3);
   coarse.optimizer.max_evaluations = options.optimizer.max_evaluations / 4;
-  out.fits.push_back(Identify(cd, cm, fs.base, coarse));
-  out.simulations = out.fits.back().evaluations;
-  out.sensitivity_runs = out.fits.back().sensitivity_runs;
-  out.served_runs = out.fits.back().served_runs;
+  // The coarsest rung's far descent on a subset of the days
+  // (IdentOptions::day_subset_stage): stopped at a looser tolerance, as it
+  // only has to bring the start near the optimum, whose polish on all the
+  // days (and then on the data as given) follows.
+  ParamVector start = fs.base;
+  if (options.day_subset_stage && coarse.coarse_step_s == 0.0) {
+    int days = 0;
+    const std::vector<std::uint8_t> keep = DaySubset(drivers, &days);
+    Drivers sd;
+    Measurements sm;
+    if (!keep.empty()) Coarsen(drivers, meas, coarse_factor, &sd, &sm, &keep);
+    if (static_cast<int>(sm.rows.size()) >= options.min_rows) {
+      IdentOptions subset = coarse;
+      subset.optimizer.ftol_rel = std::max(coarse.optimizer.ftol_rel, kSubsetFtol);
+      const IdentSummary sub = Identify(sd, sm, fs.base, subset);
+      out.simulations += sub.evaluations;
+      out.sensitivity_runs += sub.sensitivity_runs;
+      out.served_runs += sub.served_runs;
+      out.far = sub.ok && sub.final_cost_w_m2 <= 0.5 * sub.initial_cost_w_m2;
+      if (out.far) {
+        start = sub.params;
+        out.subset_days = days;
+      }
+    }
+  }
+  // From the subset's optimum the fit on all the days polishes: a tighter
+  // stop (kAllDaysFtolFactor) lets it move the directions the subset left
+  // flat, whose end the stop at the coarse tolerance left where the subset
+  // put them (one case of the other-form battery lost its verdict on P_el).
+  IdentOptions all_days = coarse;
+  if (out.subset_days > 0) all_days.optimizer.ftol_rel *= kAllDaysFtolFactor;
+  out.fits.push_back(Identify(cd, cm, start, all_days));
+  out.simulations += out.fits.back().evaluations;
+  out.sensitivity_runs += out.fits.back().sensitivity_runs;
+  out.served_runs += out.fits.back().served_runs;
+  const IdentSummary& first = out.fits.back();
+  out.far = out.far || (first.ok && first.final_cost_w_m2 <= 0.5 * first.initial_cost_w_m2);
+  if (out.subset_days == 0) out.subset_days = first.coarse_subset_days;  // a finer rung's
   // Restarts from the residuals of that optimum (RestartsFromResiduals), on
   // the coarsest rung only (a coarse fit with a coarse stage of its own
   // restarts there).
@@ -914,8 +997,7 @@ void PickCoarse(const CoarseFits& coarse, Objective& obj, const FreeSet& fs,
   double best_cost = initial_cost;
   for (const IdentSummary& fit : coarse.fits) {
     if (!fit.ok) continue;
-    const bool far = fit.final_cost_w_m2 <= 0.5 * fit.initial_cost_w_m2;
-    const double cost = coarse.fits.size() == 1 && far
+    const double cost = coarse.fits.size() == 1 && coarse.far
                             ? CostOfTheFineStart(obj, fs, options, fit.params)
                             : obj.DataCost(fit.params);
     if (cost < best_cost) {
@@ -1313,6 +1395,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   const int coarse_simulations = coarse.simulations;
   const int coarse_sensitivity_runs = coarse.sensitivity_runs;
   summary.coarse_evaluations = coarse_simulations;
+  summary.coarse_subset_days = coarse.subset_days;
   FineFit fine(obj, fs, meas, options, drivers.plant, coarse_simulations, best);
   fine.FitAll();
   fine.FixUnidentifiable(&summary.notes);

@@ -105,6 +105,13 @@ struct IdentOptions {
   // given from that result; 0 or a step not at least twice the data step
   // disables the coarse stage.
   double coarse_step_s = 300.0;
+  // The coarsest rung first fits on every k-th solar day of its data (four
+  // or five days; data covering at least 8 days only) to a loose tolerance,
+  // and the fit on all the days starts from that optimum when it at least
+  // halved its cost, then stops at 0.3 times the coarse tolerance: the far
+  // descent from a poor start runs on a third of the rows
+  // (core/fit/README.md). False: the fit on all the days from the start.
+  bool day_subset_stage = true;
   // lad_lm corrects its trial steps for the bend of the residuals along
   // them (LadFitOptions::max_correction, geodesic acceleration). The coarse
   // stage sets it for its rungs: they walk the curved valley from the
@@ -188,6 +195,9 @@ struct IdentSummary {
   // the rest.
   double coarse_runtime_s = 0.0;
   int coarse_evaluations = 0;
+  // The days of the coarsest rung's first fit when the fit on all the days
+  // started from its optimum (IdentOptions::day_subset_stage); 0 otherwise.
+  int coarse_subset_days = 0;
   ParamVector params{};
   std::vector<ParamEstimate> estimates;  // the parameters the variant uses
   std::vector<std::string> notes;        // identifiability findings, in words

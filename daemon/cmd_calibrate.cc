@@ -254,6 +254,9 @@ int RunCalibrate(const CalibrateArgs& a) {
       return kExitBadInput;
     }
     start = file.values;
+    // Most often the last calibration: the day subset stage's fit would
+    // only move away from it (IdentOptions::day_subset_stage).
+    options.day_subset_stage = false;
   }
 
   // The working set is written once (see heap.h): some 2.6 times the CSV's
@@ -381,7 +384,9 @@ void RegisterCalibrate(CLI::App& app) {
   cmd->add_option("--test-csv", args->test_csv,
                   "held-out data: print the errors of the identified model on it");
   cmd->add_option("--start", args->start_params,
-                  "params.json with start values (e.g. the last calibration); default Table 3");
+                  "params.json with start values (e.g. the last calibration: the coarse stage then "
+                  "fits all the days from it, without its first fit on every k-th day); "
+                  "default Table 3");
   cmd->add_option("--algorithm", args->algorithm,
                   "lad_lm (default: Levenberg-Marquardt on IRLS) or an NLopt method: bobyqa, "
                   "sbplx, nelder_mead, cobyla, lbfgs, mma, crs2_bobyqa, multistart_bobyqa, "

@@ -127,8 +127,11 @@ std::vector<std::int64_t> DaysWithData(const Series& s, std::int64_t offset_s) {
   return days;
 }
 
+// `warm`: the start is the day before's fit (BacktestOptions::warm_start),
+// which the identification's day subset stage would only move away from
+// (IdentOptions::day_subset_stage).
 void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
-            const ModelSpec& spec, const ParamVector& start, std::int64_t day_start_s,
+            const ModelSpec& spec, const ParamVector& start, bool warm, std::int64_t day_start_s,
             std::int64_t solar_offset_s, const std::vector<std::int64_t>& data_days,
             BacktestDay* out) {
   const std::int64_t day_end_s = day_start_s + kSecondsPerDay;
@@ -169,8 +172,9 @@ void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
     return;
   }
 
-  const IdentSummary summary =
-      Identify(train.drivers, train.meas, start, options.ident);
+  IdentOptions ident = options.ident;
+  if (warm) ident.day_subset_stage = false;
+  const IdentSummary summary = Identify(train.drivers, train.meas, start, ident);
   out->runtime_s = summary.runtime_s;
   out->evaluations = summary.evaluations;
   out->params = summary.params;
@@ -453,9 +457,10 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
     for (std::size_t c = next.fetch_add(1); c < chains.size(); c = next.fetch_add(1)) {
       const BacktestDay* before = nullptr;
       for (const std::size_t j : chains[c]) {
-        const ParamVector& start = before != nullptr && before->ok ? before->params : table3;
-        RunJob(s, plant, options, specs[jobs[j].variant], start, days[j].day_start_s, offset_s,
-               data_days, &days[j]);
+        const bool warm = before != nullptr && before->ok;
+        const ParamVector& start = warm ? before->params : table3;
+        RunJob(s, plant, options, specs[jobs[j].variant], start, warm, days[j].day_start_s,
+               offset_s, data_days, &days[j]);
         before = &days[j];
         std::lock_guard<std::mutex> lock(progress_mutex);
         ++done;

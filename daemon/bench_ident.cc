@@ -151,12 +151,16 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, const std::s
       "\ntime split of the default (lad_lm) at 1 min, ms (parse and write: median of %d runs; "
       "fit: the last run)\n",
       runs);
+  // As `calibrate --timing` says it: only when the day subset stage was used.
+  const std::string subset =
+      fit.coarse_subset_days > 0
+          ? ", first on " + std::to_string(fit.coarse_subset_days) + " of the days"
+          : std::string();
   std::printf(
-      "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs, first on %d of "
-      "the days) + fine %.1f (%d model runs); %d of the runs with sensitivities, each counted "
-      "as %d | write %.2f\n",
+      "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs%s) + fine %.1f "
+      "(%d model runs); %d of the runs with sensitivities, each counted as %d | write %.2f\n",
       1e3 * Median(parse), csv.size() / 1024, 1e3 * fit.runtime_s, 1e3 * fit.coarse_runtime_s,
-      fit.coarse_evaluations, fit.coarse_subset_days, 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
+      fit.coarse_evaluations, subset.c_str(), 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
       fit.evaluations - fit.coarse_evaluations, fit.sensitivity_runs, kSensitivityRunCost,
       1e3 * Median(write));
 }

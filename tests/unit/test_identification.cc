@@ -278,6 +278,28 @@ TEST(IdentifySynthetic, TheDaySubsetStageEndsWhereTheFitWithoutItEnds) {
   EXPECT_LE(warm.final_cost_w_m2, with.final_cost_w_m2 * (1.0 + 1e-3));
 }
 
+// With both capacitances free (2N2Cwr) the fit skips the day subset's
+// stage: a subset's far descent can land in the network's other basin
+// (C_PV large, C_coll small), core/fit/README.md. With C_coll fixed the
+// same variant has one capacitance free and uses the stage.
+TEST(IdentifySynthetic, TwoFreeCapacitancesSkipTheDaySubsetStage) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 10, 120.0, /*seed=*/21, RealisticSensorNoise(22));
+  Drivers d;
+  std::string error;
+  ASSERT_TRUE(PrepareDrivers(c.series, plant, testing::SpecOf("2N2Cwr"), &d, &error)) << error;
+  const Measurements meas = MakeMeasurements(c.series, d);
+  const IdentSummary both = Identify(d, meas, StartParams(plant), IdentOptions{});
+  ASSERT_TRUE(both.ok) << both.BriefReport();
+  EXPECT_EQ(both.coarse_subset_days, 0);
+  IdentOptions one;
+  one.free = DefaultFreeParams(d.spec);
+  one.free.reset(static_cast<std::size_t>(Param::kCCollJM2K));
+  const IdentSummary fixed = Identify(d, meas, StartParams(plant), one);
+  ASSERT_TRUE(fixed.ok) << fixed.BriefReport();
+  EXPECT_EQ(fixed.coarse_subset_days, 4);
+}
+
 // The summary's cost and training errors are those of a fresh run at the
 // result, to the bit, whether the fit's own last run served them (a repeat
 // of the last run's parameters reuses its outputs) or a new run, with a

@@ -43,11 +43,29 @@ std::string FormatNumber(double x) {
   return std::string(buf, result.ptr);
 }
 
-std::string_view Trim(std::string_view s) {
-  const auto is_space = [](char c) { return c == ' ' || c == '\t'; };
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+inline bool IsBlank(char c) { return c == ' ' || c == '\t'; }
+
+inline std::string_view Trim(std::string_view s) {
+  while (!s.empty() && IsBlank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && IsBlank(s.back())) s.remove_suffix(1);
   return s;
+}
+
+// SplitFields for a line without quotes, with one memchr per field and the
+// trim inline; false (*fields untouched) for a line with a quote, which the
+// general path reads. A row of the canonical CSV has no quotes: at 1 min,
+// 14 days (20 160 rows of 16 fields) took 32.1 M instructions in
+// SplitFields before this.
+bool SplitUnquotedFields(std::string_view line, std::vector<std::string_view>* fields) {
+  if (line.find('"') != std::string_view::npos) return false;
+  fields->clear();
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', begin);
+    fields->push_back(Trim(line.substr(begin, comma - begin)));  // npos: to the end
+    if (comma == std::string_view::npos) return true;
+    begin = comma + 1;
+  }
 }
 
 // Splits a line at its commas. A field may be quoted as RFC 4180 writes it
@@ -56,11 +74,12 @@ std::string_view Trim(std::string_view s) {
 // *why) for a quote that is not closed on the line.
 bool SplitFields(std::string_view line, std::vector<std::string_view>* fields,
                  std::deque<std::string>* storage, std::string* why) {
-  fields->clear();
   storage->clear();
+  if (SplitUnquotedFields(line, fields)) return true;
+  fields->clear();
   std::size_t pos = 0;
   while (true) {
-    while (pos < line.size() && (line[pos] == ' ' || line[pos] == '\t')) ++pos;
+    while (pos < line.size() && IsBlank(line[pos])) ++pos;
     if (pos < line.size() && line[pos] == '"') {
       std::string unescaped;
       std::size_t i = pos + 1;
@@ -162,6 +181,7 @@ struct Column {
   std::string name;                // as written in the header
   std::optional<Channel> channel;  // nullopt: the time column or an ignored one
   Conversion conversion = Conversion::kNone;
+  PhysicalLimit limit;  // PhysicalLimitOf(*channel, the options' area), when channel is set
 };
 
 class CsvParser {
@@ -360,6 +380,7 @@ class CsvParser {
         if (first.empty()) {
           first = name;
           column.channel = channel;
+          column.limit = PhysicalLimitOf(*channel, options_.area_m2);
         } else if (first == name) {
           Error(1, name, "", "duplicate column");
         } else {
@@ -494,7 +515,7 @@ class CsvParser {
     if (!(column.channel == Channel::kGPoaWM2 || column.channel == Channel::kGhiWM2 ||
           column.channel == Channel::kDhiWM2 || column.channel == Channel::kGPoaDiffuseWM2) ||
         !IsIrradianceGlitch(value)) {
-      if (!PhysicalLimitOf(*column.channel, options_.area_m2).Contains(value)) {
+      if (!column.limit.Contains(value)) {
         NoteOutOfLimits(line_no, column, cell);
         return kMissing;
       }

@@ -252,6 +252,43 @@ TEST(CsvRead, AcceptsCrlfByteOrderMarkSpacesAndEmptyLines) {
   EXPECT_FALSE(s.Has(Channel::kWindMS));
 }
 
+// A row without quotes is split by a fast path, one with a quote by the
+// general one: the same cells, blanks around them, an empty one and one at
+// the end read alike either way, and a quote inside a plain cell is that
+// cell's text (which then is no number).
+TEST(CsvRead, RowsWithAndWithoutQuotesReadAlike) {
+  const std::string header = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
+  const std::string plain = "0, 1.5 ,2,0.03,\t500\t,,100\n60,1,2,0.03,500,20,\n";
+  const std::string quoted =
+      "\"0\", \"1.5\" ,\"2\",\"0.03\",\t\"500\"\t,\"\",\"100\"\n"
+      "\"60\",\"1\",\"2\",\"0.03\",\"500\",\"20\",\"\"\n";
+  Series a, b;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseText(header + plain, &a, &errors)) << errors.front().ToString();
+  ASSERT_TRUE(ParseText(header + quoted, &b, &errors)) << errors.front().ToString();
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(a.time_s, b.time_s);
+  for (const Channel c : {Channel::kTInC, Channel::kTOutC, Channel::kMdotKgS, Channel::kGPoaWM2,
+                          Channel::kTAmbC, Channel::kPElW}) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      const double x = a[c][i];
+      const double y = b[c][i];
+      EXPECT_TRUE(x == y || (std::isnan(x) && std::isnan(y))) << i << ": " << x << " " << y;
+    }
+  }
+  EXPECT_EQ(a[Channel::kTInC][0], 1.5);
+  EXPECT_EQ(a[Channel::kGPoaWM2][0], 500.0);
+  EXPECT_TRUE(std::isnan(a[Channel::kTAmbC][0]));
+  EXPECT_TRUE(std::isnan(a[Channel::kPElW][1]));
+  Series c;
+  errors.clear();
+  EXPECT_FALSE(ParseText(header + "0,1,2,0.03,5\"00,20,100\n", &c, &errors));
+  ASSERT_FALSE(errors.empty());
+  EXPECT_EQ(errors.front().field, "g_poa_w_m2");
+  EXPECT_EQ(errors.front().value, "5\"00");
+}
+
 // A stream buffer over a string that cannot seek, as a pipe's.
 class UnseekableBuf : public std::streambuf {
  public:

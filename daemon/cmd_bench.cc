@@ -1,9 +1,14 @@
 // pvtwin bench: speed figures of the model and of identification, printed
 // as medians over repeated runs on synthetic data with a recorded seed.
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "core/common/units.h"
@@ -46,6 +51,74 @@ double MedianTime(int repeats, const Run& run) {
     times.push_back(SecondsSince(start));
   }
   return Median(times);
+}
+
+// Milliseconds of a fixed workload on the calling thread: a chain of 1e7
+// dependent multiply-adds, which neither memory nor the compiler can
+// shorten (about 20 ms on the AMD EPYC behind README.md's figures).
+double FixedWorkloadMs() {
+  volatile double seed = 1.0;
+  double x = seed;
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 10'000'000; ++i) x = x * 0.9999999 + 1e-7;
+  const double ms = 1e3 * SecondsSince(start);
+  seed = x;
+  return ms;
+}
+
+// Milliseconds of one pass over `memory` reading one double per 64-byte
+// line: bound by the memory's bandwidth, which a neighbour on a shared
+// machine takes share of without slowing the core's own arithmetic.
+double MemoryPassMs(const std::vector<double>& memory) {
+  const auto start = std::chrono::steady_clock::now();
+  double sum = 0.0;
+  for (std::size_t i = 0; i < memory.size(); i += 8) sum += memory[i];
+  const double ms = 1e3 * SecondsSince(start);
+  volatile double sink = sum;
+  (void)sink;
+  return ms;
+}
+
+// The fixed workloads' median times (of 5) on each core the process may run
+// on, one thread pinned to each in turn: on a shared virtual machine whose
+// cores are at times of unequal speed, or slower for minutes, the figures
+// that follow are read against these. Printed before and after the
+// benchmarks.
+void PrintCoreSpeeds(const char* when) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return;
+  const std::vector<double> memory(std::size_t{8} << 20, 1.0);  // 64 MB, written once
+  std::string line;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+    if (!CPU_ISSET(cpu, &allowed)) continue;
+    double chain_ms = 0.0;
+    double memory_ms = 0.0;
+    bool pinned = false;
+    std::thread worker([&] {
+      cpu_set_t one;
+      CPU_ZERO(&one);
+      CPU_SET(cpu, &one);
+      pinned = pthread_setaffinity_np(pthread_self(), sizeof one, &one) == 0;
+      std::vector<double> chain, pass;
+      for (int r = 0; r < 5; ++r) {
+        chain.push_back(FixedWorkloadMs());
+        pass.push_back(MemoryPassMs(memory));
+      }
+      chain_ms = Median(chain);
+      memory_ms = Median(pass);
+    });
+    worker.join();
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%scpu%d %.1f / %.1f ms%s", line.empty() ? "" : ", ", cpu,
+                  chain_ms, memory_ms, pinned ? "" : " (not pinned)");
+    line += buf;
+  }
+  std::printf(
+      "cores %s: fixed workloads (1e7 dependent multiply-adds / a pass over 64 MB, medians of 5) "
+      "took %s\n",
+      when, line.c_str());
+  std::fflush(stdout);
 }
 
 // One 14-day, 1-min simulation (20 160 rows) of each variant, and where the
@@ -110,7 +183,9 @@ void RegisterBench(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand(
       "bench",
-      "Print speed figures (medians over repeated runs, one core unless noted) on synthetic data:\n"
+      "Print speed figures (medians over repeated runs, one core unless noted) on synthetic data,\n"
+      "before and after each core's time for a fixed workload (cores of a shared machine may\n"
+      "differ in speed, and drift):\n"
       "  sim    one 14-day 1-min simulation of each variant\n"
       "  ident  identification of 2N1Ccolwr: 14 days at 1 min and at 5 s, the\n"
       "         algorithm comparison behind the default, and the whole `pvtwin\n"
@@ -142,6 +217,7 @@ void RegisterBench(CLI::App& app) {
   cmd->add_option("--daemon-seconds", args->daemon_seconds, "measuring time of `bench daemon`")
       ->check(CLI::PositiveNumber);
   cmd->callback([args] {
+    PrintCoreSpeeds("before");
     for (const std::string& w : args->what) {
       if (w == "sim") BenchSimulation(*args);
       if (w == "ident") BenchIdentification(args->repeats, args->seed, args->data_dir);
@@ -153,6 +229,7 @@ void RegisterBench(CLI::App& app) {
       if (w == "diagnose") BenchDiagnosis(args->seed);
       if (w == "upload") BenchUpload(args->seed);
     }
+    PrintCoreSpeeds("after");
     SetExitCode(kExitOk);
   });
 }

@@ -51,11 +51,13 @@ inline std::string_view Trim(std::string_view s) {
   return s;
 }
 
-// SplitFields for a line without quotes, with one memchr per field and the
-// trim inline; false (*fields untouched) for a line with a quote, which the
-// general path reads. A row of the canonical CSV has no quotes: at 1 min,
-// 14 days (20 160 rows of 16 fields) took 32.1 M instructions in
-// SplitFields before this.
+// SplitFields for a line without quotes, with one search (memchr) per field
+// and the trim inline; false (*fields untouched) for a line with a quote,
+// which the general path reads. A row of the canonical CSV has no quotes: at
+// 1 min, 14 days (20 160 rows of 16 fields) took 32.1 M instructions in
+// SplitFields before this and 26.3 M with it (callgrind). A loop over the
+// characters that stops at commas and quotes took 53.7 M: memchr steps
+// over a field's digits many bytes at a time.
 bool SplitUnquotedFields(std::string_view line, std::vector<std::string_view>* fields) {
   if (line.find('"') != std::string_view::npos) return false;
   fields->clear();

@@ -13,17 +13,22 @@
 namespace pvtwin {
 namespace {
 
+// The wall-time limit leaves room for the first calibration, its refit on
+// the whole window and the daily checks after them (asserted below): with
+// 15 s the ASan/UBSan suite, beside another test, once stopped the demo
+// during the refit, before any day was scored. 1100 live minutes at 600x
+// take 110 s, so 30 s still cuts the live part short.
 TEST(Demo, ALiveRunCutShortByItsTimeLimitStillSucceedsAndCountsItsForecasts) {
   testing::ScratchDir dir("demo");
   const testing::ProcessResult run =
-      testing::RunPvtwin(dir.path(), "demo --speed 600 --live-minutes 1100 --max-wall 15 --dir '" +
+      testing::RunPvtwin(dir.path(), "demo --speed 600 --live-minutes 1100 --max-wall 30 --dir '" +
                                          (dir / "d").string() + "'");
   EXPECT_EQ(run.exit_code, 0) << run.out << run.err;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(run.out, m, std::regex(R"(with (\d+) forecasts? written)")))
       << run.out;
-  EXPECT_GE(std::stoi(m[1]), 2) << "600x for 15 s spans more than one hourly refresh";
-  EXPECT_NE(run.out.find("Stopped at the wall-time limit (--max-wall 15 s)"), std::string::npos)
+  EXPECT_GE(std::stoi(m[1]), 2) << "600x for 30 s spans more than one hourly refresh";
+  EXPECT_NE(run.out.find("Stopped at the wall-time limit (--max-wall 30 s)"), std::string::npos)
       << run.out;
   EXPECT_EQ(run.err.find("without a forecast"), std::string::npos) << run.err;
   EXPECT_EQ(run.out.find("| forecast written"), std::string::npos)

@@ -20,6 +20,8 @@ namespace pvtwin {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// A parameter this close to a bound of its unit coordinate is at it.
+constexpr double kAtBoundZ = 1e-3;
 
 // Unit coordinate of value x in [lower, upper] (log where the range spans
 // decades), as the optimiser sees it.
@@ -902,14 +904,22 @@ std::vector<std::uint8_t> DaySubset(const Drivers& d, int* kept) {
 }
 
 // The network with two capacitances (2N2Cwr) has two basins whose costs
-// are close on a few days: C_PV at its lower bound, or C_PV large and C_coll
-// small with U_coll at its upper bound. A day subset's far descent lands in
-// the second on some windows of the Table 6 protocol where the fit on all
-// the days finds the first (mean P_el MAE 0.188 -> 0.201 W/m² over its 29
-// windows, core/fit/README.md), so such fits skip the stage.
-bool BothCapacitancesFree(const FreeSet& fs) {
-  auto is_free = [&](Param p) { return std::ranges::find(fs.free, p) != fs.free.end(); };
-  return is_free(Param::kCPvJM2K) && is_free(Param::kCCollJM2K);
+// are close on a few days: C_PV at its lower bound, or the two nodes merged
+// into one (U_coll at its upper bound) that holds the heat capacity in C_PV
+// (C_coll small). A day subset's far descent lands in the second on some
+// windows of the Table 6 protocol where the fit on all the days from the
+// start finds the first (mean P_el MAE 0.188 -> 0.201 W/m² over its 29
+// windows, core/fit/README.md). So when a fit with both capacitances free
+// ends its fit on all the days from the subset's optimum with the nodes
+// merged, a fit on all the days from the start follows, and the better of
+// the two on the data as given is the fine stage's start (PickCoarse).
+bool MergedNodesWithBothCapacitancesFree(const FreeSet& fs, const ParamVector& p) {
+  auto position = [&](Param q) { return std::ranges::find(fs.free, q) - fs.free.begin(); };
+  const auto n = static_cast<std::ptrdiff_t>(fs.free.size());
+  const std::ptrdiff_t u = position(Param::kUCollWM2K);
+  if (position(Param::kCPvJM2K) == n || position(Param::kCCollJM2K) == n || u == n) return false;
+  const ParamInfo& info = fs.infos[static_cast<std::size_t>(u)];
+  return ToUnit(info, p[static_cast<std::size_t>(info.param)]) > 1.0 - kAtBoundZ;
 }
 
 // The coarse fits on the data averaged by `coarse_factor` (CoarseFactor, at
@@ -917,6 +927,12 @@ bool BothCapacitancesFree(const FreeSet& fs) {
 CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const IdentOptions& options,
                      const FreeSet& fs, int coarse_factor) {
   CoarseFits out;
+  // Counts a fit's runs (and `extra_runs` more) in the stage's.
+  auto add = [&](const IdentSummary& fit, int extra_runs) {
+    out.simulations += fit.evaluations + extra_runs;
+    out.sensitivity_runs += fit.sensitivity_runs;
+    out.served_runs += fit.served_runs;
+  };
   Drivers& cd = out.drivers;
   Measurements& cm = out.meas;
   Coarsen(drivers, meas, coarse_factor, &cd, &cm);
@@ -935,7 +951,7 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
   // only has to bring the start near the optimum, whose polish on all the
   // days (and then on the data as given) follows.
   ParamVector start = fs.base;
-  if (options.day_subset_stage && coarse.coarse_step_s == 0.0 && !BothCapacitancesFree(fs)) {
+  if (options.day_subset_stage && coarse.coarse_step_s == 0.0) {
     int days = 0;
     const std::vector<std::uint8_t> keep = DaySubset(drivers, &days);
     Drivers sd;
@@ -945,9 +961,7 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
       IdentOptions subset = coarse;
       subset.optimizer.ftol_rel = std::max(coarse.optimizer.ftol_rel, kSubsetFtol);
       const IdentSummary sub = Identify(sd, sm, fs.base, subset);
-      out.simulations += sub.evaluations;
-      out.sensitivity_runs += sub.sensitivity_runs;
-      out.served_runs += sub.served_runs;
+      add(sub, 0);
       out.far = sub.ok && sub.final_cost_w_m2 <= 0.5 * sub.initial_cost_w_m2;
       if (out.far) {
         start = sub.params;
@@ -962,12 +976,17 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
   IdentOptions all_days = coarse;
   if (out.subset_days > 0) all_days.optimizer.ftol_rel *= kAllDaysFtolFactor;
   out.fits.push_back(Identify(cd, cm, start, all_days));
-  out.simulations += out.fits.back().evaluations;
-  out.sensitivity_runs += out.fits.back().sensitivity_runs;
-  out.served_runs += out.fits.back().served_runs;
+  add(out.fits.back(), 0);
   const IdentSummary& first = out.fits.back();
   out.far = out.far || (first.ok && first.final_cost_w_m2 <= 0.5 * first.initial_cost_w_m2);
-  if (out.subset_days == 0) out.subset_days = first.coarse_subset_days;  // a finer rung's
+  const bool from_subset = out.subset_days > 0;
+  if (!from_subset) out.subset_days = first.coarse_subset_days;  // a finer rung's
+  // The other basin of two capacitances: a fit on all the days from the
+  // start too (MergedNodesWithBothCapacitancesFree).
+  if (from_subset && MergedNodesWithBothCapacitancesFree(fs, out.fits[0].params)) {
+    out.fits.push_back(Identify(cd, cm, fs.base, coarse));
+    add(out.fits.back(), 0);
+  }
   // Restarts from the residuals of that optimum (RestartsFromResiduals), on
   // the coarsest rung only (a coarse fit with a coarse stage of its own
   // restarts there).
@@ -976,9 +995,7 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
                                  : RestartsFromResiduals(drivers, meas, fs, out.fits[0].params);
   for (const ParamVector& restart : restarts) {
     out.fits.push_back(Identify(cd, cm, restart, coarse));
-    out.simulations += out.fits.back().evaluations + 1;  // + the run without the effect
-    out.sensitivity_runs += out.fits.back().sensitivity_runs;
-    out.served_runs += out.fits.back().served_runs;
+    add(out.fits.back(), 1);  // + the run without the effect
   }
   return out;
 }
@@ -1359,7 +1376,7 @@ std::vector<ParamEstimate> Estimates(const Drivers& drivers, const FreeSet& fs, 
       e.se_unit = fine.se()[j];
       e.weak = fine.active()[j] && fine.se()[j] > options.undetermined_se;
       const double z = ToUnit(fs.infos[j], e.value);
-      e.at_bound = fine.active()[j] && (z < 1e-3 || z > 1.0 - 1e-3);
+      e.at_bound = fine.active()[j] && (z < kAtBoundZ || z > 1.0 - kAtBoundZ);
     }
     out.push_back(e);
   }

@@ -1209,9 +1209,10 @@ class FineFit {
     // by the data at all, se > 1) a short re-fit decides. It runs on the
     // coarse stage's data when there are (a fifth of the time per run at
     // 1 min), and its optimum is priced on the data as given. On the bench
-    // days that price was below the re-fit's on the data as given in five
-    // of the six trials (four variants), whose budget ended those re-fits
-    // short; the sixth rejected either way (core/fit/README.md).
+    // days that price was below the re-fit's on the data as given in four
+    // of the six trials, whose budget ended those re-fits short, and 2-7 %
+    // above it in the other two; all six rejected the fix either way
+    // (core/fit/README.md).
     if (std::isfinite(cost) && cost > limit &&
         (cost <= 10.0 * limit - 9.0 * best_cost_ || se_[j] > 1.0)) {
       std::vector<bool> trial_mask = active_;

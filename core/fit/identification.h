@@ -110,9 +110,11 @@ struct IdentOptions {
   // and the fit on all the days starts from that optimum when it at least
   // halved its cost, then stops at 0.3 times the coarse tolerance: the far
   // descent from a poor start runs on a third of the rows
-  // (core/fit/README.md). Not with both capacitances free (2N2Cwr), whose
-  // network has a second basin that a subset's descent can land in. False:
-  // the fit on all the days from the start.
+  // (core/fit/README.md). With both capacitances free (2N2Cwr), whose
+  // network has a second basin that a subset's descent can land in (the
+  // nodes merged, U_coll at its upper bound), a fit on all the days from the
+  // start follows when the subset's path ends there. False: the fit on all
+  // the days from the start.
   bool day_subset_stage = true;
   // lad_lm corrects its trial steps for the bend of the residuals along
   // them (LadFitOptions::max_correction, geodesic acceleration). The coarse

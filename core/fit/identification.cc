@@ -1208,11 +1208,8 @@ class FineFit {
     // is inconclusive (close to the limit, or the parameter is not bounded
     // by the data at all, se > 1) a short re-fit decides. It runs on the
     // coarse stage's data when there are (a fifth of the time per run at
-    // 1 min), and its optimum is priced on the data as given. On the bench
-    // days that price was below the re-fit's on the data as given in four
-    // of the six trials, whose budget ended those re-fits short, and 2-7 %
-    // above it in the other two; all six rejected the fix either way
-    // (core/fit/README.md).
+    // 1 min), and its optimum is priced on the data as given, which decides
+    // (core/fit/README.md compares it with the re-fit on the data as given).
     if (std::isfinite(cost) && cost > limit &&
         (cost <= 10.0 * limit - 9.0 * best_cost_ || se_[j] > 1.0)) {
       std::vector<bool> trial_mask = active_;
@@ -1462,10 +1459,14 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   const double final_cost = obj.DataCost(fine.best());
   summary.final_cost_w_m2 = final_cost;
   summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
-  summary.evaluations = obj.simulations() + coarse_simulations + fine.TrialSimulations();
-  summary.sensitivity_runs =
-      obj.sensitivity_runs() + coarse_sensitivity_runs + fine.TrialSensitivityRuns();
-  summary.served_runs = obj.served() + coarse.served_runs + fine.TrialServed();
+  // The runs of all the stages; again when the start is kept (its cost run).
+  auto count_runs = [&] {
+    summary.evaluations = obj.simulations() + coarse_simulations + fine.TrialSimulations();
+    summary.sensitivity_runs =
+        obj.sensitivity_runs() + coarse_sensitivity_runs + fine.TrialSensitivityRuns();
+    summary.served_runs = obj.served() + coarse.served_runs + fine.TrialServed();
+  };
+  count_runs();
   summary.estimates = Estimates(drivers, fs, fine, options);
   if (!fit.ok) {
     return finish(false, "optimiser stopped with " + std::string(ToString(fit.termination)) +
@@ -1487,8 +1488,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
     summary.params = fs.base;
     summary.final_cost_w_m2 = obj.DataCost(fs.base);
     summary.train = ComputeErrors(meas, obj.last(), drivers.plant.area_m2);
-    summary.evaluations = obj.simulations() + coarse_simulations + fine.TrialSimulations();
-    summary.served_runs = obj.served() + coarse.served_runs + fine.TrialServed();
+    count_runs();
   }
   return finish(true, "");
 }

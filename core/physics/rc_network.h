@@ -127,6 +127,37 @@ namespace rc_step {
   *t_mean = t0 + rate * phi.phi2;
 }
 
+// Eigen-decomposition of the symmetric M = [m00, m01; m01, m11]: the
+// rotation (c, s) = (cos θ, sin θ) with θ = ½·atan2(2·m01, m00 − m11), whose
+// first column (c, s) belongs to λa = mean + radius and second (−s, c) to
+// λb = mean − radius. The rotation comes from the half-angle formulas with
+// cos 2θ = (m00 − m11)/(2·radius) and sin 2θ = m01/radius instead of atan2,
+// cos and sin, which were a seventh of a two-capacitance fit's instructions:
+// the larger of |c|, |s| from √((1 ± cos 2θ)/2), which has no cancellation,
+// the other from sin 2θ = 2·s·c. θ lies in (−π/2, π/2], so c ≥ 0 and s has
+// the sign of m01 (as atan2 gives it, −0 included).
+struct SymmetricModes {
+  double c, s;
+  double lambda_a, lambda_b;
+};
+[[gnu::always_inline]] inline SymmetricModes DiagonaliseSymmetric(double m00, double m11,
+                                                                  double m01) {
+  const double half_sum = 0.5 * (m00 + m11);
+  const double half_diff = 0.5 * (m00 - m11);
+  const double radius = std::sqrt(half_diff * half_diff + m01 * m01);
+  SymmetricModes modes{1.0, 0.0, half_sum + radius, half_sum - radius};
+  if (radius == 0.0) return modes;  // M = λ·I: any rotation, θ = 0 as atan2(0, 0)
+  const double inv_2r = 0.5 / radius;
+  if (half_diff >= 0.0) {
+    modes.c = std::sqrt((radius + half_diff) * inv_2r);
+    modes.s = m01 * inv_2r / modes.c;
+  } else {
+    modes.s = std::copysign(std::sqrt((radius - half_diff) * inv_2r), m01);
+    modes.c = m01 * inv_2r / modes.s;
+  }
+  return modes;
+}
+
 // Two capacitive nodes. With y = C^(1/2)·T the system matrix becomes the
 // symmetric M = C^(-1/2)·K·C^(-1/2), diagonalised by a rotation R(θ); each
 // mode then evolves as in AdvanceOne.
@@ -136,17 +167,12 @@ inline void AdvanceTwo(const RcNetwork& net, const double t0[2], double dt_s, Rc
   const double k11 = net.node[1].conductance_w_k + g;
   const double sc0 = 1.0 / std::sqrt(net.node[0].capacitance_j_k);
   const double sc1 = 1.0 / std::sqrt(net.node[1].capacitance_j_k);
-  const double m00 = k00 * sc0 * sc0;
-  const double m11 = k11 * sc1 * sc1;
-  const double m01 = -g * sc0 * sc1;
-  const double half_sum = 0.5 * (m00 + m11);
-  const double half_diff = 0.5 * (m00 - m11);
-  const double radius = std::hypot(half_diff, m01);
-  const double theta = 0.5 * std::atan2(2.0 * m01, m00 - m11);
-  const double c = std::cos(theta);
-  const double s = std::sin(theta);
-  const double lambda_a = half_sum + radius;  // along (c, s)
-  const double lambda_b = half_sum - radius;  // along (−s, c)
+  const SymmetricModes modes =
+      DiagonaliseSymmetric(k00 * sc0 * sc0, k11 * sc1 * sc1, -g * sc0 * sc1);
+  const double c = modes.c;
+  const double s = modes.s;
+  const double lambda_a = modes.lambda_a;  // along (c, s)
+  const double lambda_b = modes.lambda_b;  // along (−s, c)
   // Initial rate dy/dt = C^(-1/2)·(S − K·T0), projected on the modes.
   const double f0 = (net.node[0].source_w - k00 * t0[0] + g * t0[1]) * sc0;
   const double f1 = (net.node[1].source_w - k11 * t0[1] + g * t0[0]) * sc1;

@@ -123,12 +123,11 @@ inline void AdvanceTwoTangent(const RcNetwork& net, const double t0[2], double d
   const double m00 = k00 * p0 * p0;
   const double m11 = k11 * p1 * p1;
   const double m01 = -g * p0 * p1;
-  const double radius = std::hypot(0.5 * (m00 - m11), m01);
-  const double theta = 0.5 * std::atan2(2.0 * m01, m00 - m11);
-  const double c = std::cos(theta);
-  const double s = std::sin(theta);
-  const double lambda_a = 0.5 * (m00 + m11) + radius;
-  const double lambda_b = 0.5 * (m00 + m11) - radius;
+  const rc_step::SymmetricModes modes = rc_step::DiagonaliseSymmetric(m00, m11, m01);
+  const double c = modes.c;
+  const double s = modes.s;
+  const double lambda_a = modes.lambda_a;
+  const double lambda_b = modes.lambda_b;
   const PhiSlopes pa = ExpPhisWithSlopes(lambda_a * dt_s);
   const PhiSlopes pb = ExpPhisWithSlopes(lambda_b * dt_s);
   const double dt2 = dt_s * dt_s;

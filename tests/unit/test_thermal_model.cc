@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include "core/common/units.h"
 #include "core/effects/effects.h"
@@ -164,6 +165,46 @@ TEST(RcNetwork, ExpPhisMatchALongDoubleReference) {
     EXPECT_NEAR(slopes.dphi2, static_cast<double>(dphi2),
                 tol * std::fabs(static_cast<double>(dphi2)))
         << x;
+  }
+}
+
+// The two-capacitance step's eigen-decomposition (half-angle formulas)
+// against the rotation angle θ = ½·atan2(2·m01, m00 − m11) in long double,
+// and against its definition M·v = λ·v, on both sides of m00 = m11, with a
+// zero coupling of either sign, equal modes, a stiffness ratio of 1e8 and
+// random matrices of the model's signs (m01 ≤ 0).
+TEST(RcNetwork, SymmetricModesMatchTheRotationAngleAndDiagonalise) {
+  struct Case {
+    double m00, m11, m01;
+  };
+  std::vector<Case> cases = {{3e-3, 1e-3, -1e-3}, {1e-3, 3e-3, -1e-3}, {2e-3, 2e-3, -5e-4},
+                             {1e-3, 3e-3, -0.0},  {1e-3, 3e-3, 0.0},   {3e-3, 1e-3, -0.0},
+                             {2e-3, 2e-3, 0.0},   {1e-9, 0.1, -1e-6},  {0.1, 1e-9, -1e-6}};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> log_u(-7.0, -1.0);
+  for (int k = 0; k < 200; ++k) {
+    cases.push_back(
+        {std::pow(10.0, log_u(rng)), std::pow(10.0, log_u(rng)), -std::pow(10.0, log_u(rng))});
+  }
+  for (const Case& m : cases) {
+    SCOPED_TRACE(::testing::Message() << m.m00 << " " << m.m11 << " " << m.m01);
+    const rc_step::SymmetricModes got = rc_step::DiagonaliseSymmetric(m.m00, m.m11, m.m01);
+    const long double theta =
+        0.5L * std::atan2(2.0L * m.m01, static_cast<long double>(m.m00) - m.m11);
+    EXPECT_NEAR(got.c, static_cast<double>(std::cos(theta)), 4e-16);
+    EXPECT_NEAR(got.s, static_cast<double>(std::sin(theta)), 4e-16);
+    EXPECT_GE(got.c, 0.0);
+    if (m.m01 != 0.0 || m.m00 < m.m11) {
+      EXPECT_EQ(std::signbit(got.s), std::signbit(m.m01));
+    }
+    const double scale = std::max({std::fabs(m.m00), std::fabs(m.m11), std::fabs(m.m01)});
+    const double tol = 4e-16 * scale;
+    // M·(c, s) = λa·(c, s) and M·(−s, c) = λb·(−s, c).
+    EXPECT_NEAR(m.m00 * got.c + m.m01 * got.s, got.lambda_a * got.c, tol);
+    EXPECT_NEAR(m.m01 * got.c + m.m11 * got.s, got.lambda_a * got.s, tol);
+    EXPECT_NEAR(-m.m00 * got.s + m.m01 * got.c, -got.lambda_b * got.s, tol);
+    EXPECT_NEAR(-m.m01 * got.s + m.m11 * got.c, got.lambda_b * got.c, tol);
+    EXPECT_GE(got.lambda_a, got.lambda_b);
   }
 }
 

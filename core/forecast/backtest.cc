@@ -8,12 +8,14 @@
 #include <functional>
 #include <mutex>
 #include <set>
+#include <span>
 #include <thread>
 #include <utility>
 
 #include "core/common/threads.h"
 #include "core/common/units.h"
 #include "core/data/resample.h"
+#include "core/model/irradiance_drivers.h"
 #include "core/model/thermal_model.h"
 #include "core/model/variant.h"
 
@@ -37,17 +39,21 @@ struct Slice {
   Measurements meas;
 };
 
-// Drivers and measurements of rows [begin, end). False with *error if the
-// drivers cannot be built (not expected: the columns were checked up front).
-bool PrepareSlice(const Series& s, std::size_t begin, std::size_t end, const Plant& plant,
-                  const ModelSpec& spec, Slice* out, std::string* error) {
+// Drivers and measurements of rows [begin, end); `sun` holds the positions of
+// every row of s. False with *error if the drivers cannot be built (not
+// expected: the columns were checked up front).
+bool PrepareSlice(const Series& s, std::span<const SolarPosition> sun, std::size_t begin,
+                  std::size_t end, const Plant& plant, const ModelSpec& spec, Slice* out,
+                  std::string* error) {
   if (begin >= end) {
     out->drivers = Drivers{};
     out->meas = Measurements{};
     return true;
   }
   const Series rows = s.Slice(begin, end);
-  if (!PrepareDrivers(rows, plant, spec, &out->drivers, error)) return false;
+  if (!PrepareDrivers(rows, plant, spec, sun.subspan(begin, end - begin), &out->drivers, error)) {
+    return false;
+  }
   out->meas = MakeMeasurements(rows, out->drivers);
   return true;
 }
@@ -130,18 +136,18 @@ std::vector<std::int64_t> DaysWithData(const Series& s, std::int64_t offset_s) {
 // `warm`: the start is the day before's fit (BacktestOptions::warm_start),
 // which the identification's day subset stage would only move away from
 // (IdentOptions::day_subset_stage).
-void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
-            const ModelSpec& spec, const ParamVector& start, bool warm, std::int64_t day_start_s,
-            std::int64_t solar_offset_s, const std::vector<std::int64_t>& data_days,
-            BacktestDay* out) {
+void RunJob(const Series& s, std::span<const SolarPosition> sun, const Plant& plant,
+            const BacktestOptions& options, const ModelSpec& spec, const ParamVector& start,
+            bool warm, std::int64_t day_start_s, std::int64_t solar_offset_s,
+            const std::vector<std::int64_t>& data_days, BacktestDay* out) {
   const std::int64_t day_end_s = day_start_s + kSecondsPerDay;
   const std::int64_t train_start_s = TrainingStartS(data_days, day_start_s, out->train_days);
   const std::size_t min_rows = static_cast<std::size_t>(std::max(options.ident.min_rows, 0));
   std::string error;
 
   Slice test;
-  if (!PrepareSlice(s, s.RowAtOrAfter(day_start_s), s.RowAtOrAfter(day_end_s), plant, spec, &test,
-                    &error)) {
+  if (!PrepareSlice(s, sun, s.RowAtOrAfter(day_start_s), s.RowAtOrAfter(day_end_s), plant, spec,
+                    &test, &error)) {
     out->failure = BacktestFailure::kTooLittleData;
     out->failure_reason = "test day " + SolarDate(day_start_s, solar_offset_s) + ": " + error;
     return;
@@ -158,7 +164,7 @@ void RunJob(const Series& s, const Plant& plant, const BacktestOptions& options,
   const std::string window = "training window " + SolarDate(train_start_s, solar_offset_s) + " … " +
                              SolarDate(day_start_s - 1, solar_offset_s) + " (" +
                              std::to_string(out->train_days) + " days with data)";
-  if (!PrepareSlice(s, s.RowAtOrAfter(train_start_s), s.RowAtOrAfter(day_start_s), plant, spec,
+  if (!PrepareSlice(s, sun, s.RowAtOrAfter(train_start_s), s.RowAtOrAfter(day_start_s), plant, spec,
                     &train, &error)) {
     out->failure = BacktestFailure::kTooLittleData;
     out->failure_reason = window + ": " + error;
@@ -449,6 +455,9 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
   const std::vector<std::vector<std::size_t>> chains =
       options.warm_start ? WarmStartChains(jobs, specs) : SingleJobs(jobs.size());
   const ParamVector table3 = StartParams(plant);
+  // The sun at every row once: each job's slices take their part of it
+  // instead of computing it again per variant and window.
+  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   std::atomic<std::size_t> next{0};
   std::mutex progress_mutex;
   int done = 0;
@@ -459,7 +468,7 @@ bool RunBacktest(const Series& data, const Plant& plant, const BacktestOptions& 
       for (const std::size_t j : chains[c]) {
         const bool warm = before != nullptr && before->ok;
         const ParamVector& start = warm ? before->params : table3;
-        RunJob(s, plant, options, specs[jobs[j].variant], start, warm, days[j].day_start_s,
+        RunJob(s, sun, plant, options, specs[jobs[j].variant], start, warm, days[j].day_start_s,
                offset_s, data_days, &days[j]);
         before = &days[j];
         std::lock_guard<std::mutex> lock(progress_mutex);

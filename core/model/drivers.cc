@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <span>
+#include <string>
 
 #include "core/common/calendar.h"
 #include "core/common/units.h"
@@ -208,6 +210,11 @@ void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers
 
 bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d,
                     std::string* error) {
+  return PrepareDrivers(s, plant, spec, SunAtRowMiddles(s, plant), d, error);
+}
+
+bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
+                    std::span<const SolarPosition> sun, Drivers* d, std::string* error) {
   std::string missing;
   for (const InputRequirement& req : RequiredInputs(spec)) {
     const bool ok = std::any_of(req.alternatives.begin(), req.alternatives.end(),
@@ -226,6 +233,10 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
   const std::size_t n = s.size();
   if (n == 0) {
     *error = "no data rows";
+    return false;
+  }
+  if (sun.size() != n) {
+    *error = std::to_string(sun.size()) + " sun positions for " + std::to_string(n) + " rows";
     return false;
   }
   Drivers out;
@@ -265,7 +276,6 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, 
     out.capacity_flow_w_k[i] = out.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
   }
 
-  const std::vector<SolarPosition> sun = SunAtRowMiddles(s, plant);
   out.aoi_rad = AoiAtRows(s, plant, sun);
   ComputeIrradianceDrivers(s, plant, spec, sun, out.aoi_rad, &out.g_poa_w_m2, &out.g_abs_w_m2,
                            &out.iam_parts);

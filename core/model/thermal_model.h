@@ -31,6 +31,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,7 @@
 #include "core/common/plant.h"
 #include "core/common/series.h"
 #include "core/model/variant.h"
+#include "core/physics/solar_position.h"
 
 namespace pvtwin {
 
@@ -50,6 +52,15 @@ inline constexpr int kMaxNodeIterations = 8;
 // Gaps longer than max_gap_s restart the states.
 bool PrepareDrivers(const Series& series, const Plant& plant, const ModelSpec& spec,
                     Drivers* drivers, std::string* error);
+
+// The same with the sun positions at the rows' middles given: SunAtRowMiddles
+// of `series` (core/model/irradiance_drivers.h), or the part of a longer
+// series' positions that `series` slices (a row's position depends on its
+// time and the step alone). A caller that prepares many slices of one series
+// for several variants (the backtest) computes them once. Fails when `sun`
+// does not have one position per row.
+bool PrepareDrivers(const Series& series, const Plant& plant, const ModelSpec& spec,
+                    std::span<const SolarPosition> sun, Drivers* drivers, std::string* error);
 
 // The measured sky temperature of row i, °C: t_sky_c, else the equivalent of
 // lw_down_w_m2 (paper 3.1); NaN without either.

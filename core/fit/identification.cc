@@ -851,6 +851,10 @@ struct CoarseFits {
   // The days of the subset whose optimum the first fit started from; 0
   // when it started from the start (IdentSummary::coarse_subset_days).
   int subset_days = 0;
+  // The position in `fits` of the fit on all the days from the start that
+  // followed a merge of the two nodes (MergedNodesWithBothCapacitancesFree);
+  // 0 when there was none.
+  std::size_t from_start_after_merge = 0;
   // The coarse stage's data (the first rung's averages), which the fine
   // stage's trial fits run on too.
   Drivers drivers;
@@ -984,6 +988,7 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
   // The other basin of two capacitances: a fit on all the days from the
   // start too (MergedNodesWithBothCapacitancesFree).
   if (from_subset && MergedNodesWithBothCapacitancesFree(fs, out.fits[0].params)) {
+    out.from_start_after_merge = out.fits.size();
     out.fits.push_back(Identify(cd, cm, fs.base, coarse));
     add(out.fits.back(), 0);
   }
@@ -1445,6 +1450,14 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   }
   ParamVector best = fs.base;
   PickCoarse(coarse, obj, fs, options, initial_cost, &best);
+  if (coarse.from_start_after_merge > 0) {
+    const bool from_start = best == coarse.fits[coarse.from_start_after_merge].params;
+    summary.notes.push_back(
+        "the coarse fit from the day subset's optimum merged the two nodes (u_coll_w_m2k at its "
+        "upper bound); a coarse fit from the start followed, and the fine stage starts from " +
+        std::string(from_start ? "that fit" : "the merged nodes") +
+        ", the lower cost on the data as given");
+  }
   const int coarse_simulations = coarse.simulations;
   const int coarse_sensitivity_runs = coarse.sensitivity_runs;
   summary.coarse_evaluations = coarse_simulations;

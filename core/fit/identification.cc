@@ -1451,12 +1451,13 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   ParamVector best = fs.base;
   PickCoarse(coarse, obj, fs, options, initial_cost, &best);
   if (coarse.from_start_after_merge > 0) {
-    const bool from_start = best == coarse.fits[coarse.from_start_after_merge].params;
+    const char* from = best == coarse.fits[coarse.from_start_after_merge].params ? "that fit"
+                       : best == coarse.fits[0].params ? "the merged nodes"
+                                                       : "neither (another point costs less)";
     summary.notes.push_back(
         "the coarse fit from the day subset's optimum merged the two nodes (u_coll_w_m2k at its "
         "upper bound); a coarse fit from the start followed, and the fine stage starts from " +
-        std::string(from_start ? "that fit" : "the merged nodes") +
-        ", the lower cost on the data as given");
+        std::string(from) + ", the lowest cost on the data as given");
   }
   const int coarse_simulations = coarse.simulations;
   const int coarse_sensitivity_runs = coarse.sensitivity_runs;

@@ -208,13 +208,11 @@ void SetCleaningTimes(const std::vector<std::int64_t>& cleaning_times_s, Drivers
   }
 }
 
-bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d,
-                    std::string* error) {
-  return PrepareDrivers(s, plant, spec, SunAtRowMiddles(s, plant), d, error);
-}
+namespace {
 
-bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
-                    std::span<const SolarPosition> sun, Drivers* d, std::string* error) {
+// False with *error naming each input `spec` needs that the series lacks,
+// or when it has no rows.
+bool HasInputsFor(const Series& s, const ModelSpec& spec, std::string* error) {
   std::string missing;
   for (const InputRequirement& req : RequiredInputs(spec)) {
     const bool ok = std::any_of(req.alternatives.begin(), req.alternatives.end(),
@@ -230,11 +228,27 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
     *error = "variant " + spec.Name() + " needs columns the data lacks: " + missing;
     return false;
   }
-  const std::size_t n = s.size();
-  if (n == 0) {
+  if (s.size() == 0) {
     *error = "no data rows";
     return false;
   }
+  return true;
+}
+
+}  // namespace
+
+// The inputs are checked before the sun is computed: a series that lacks a
+// column fails without the positions of all its rows.
+bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d,
+                    std::string* error) {
+  if (!HasInputsFor(s, spec, error)) return false;
+  return PrepareDrivers(s, plant, spec, SunAtRowMiddles(s, plant), d, error);
+}
+
+bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
+                    std::span<const SolarPosition> sun, Drivers* d, std::string* error) {
+  if (!HasInputsFor(s, spec, error)) return false;
+  const std::size_t n = s.size();
   if (sun.size() != n) {
     *error = std::to_string(sun.size()) + " sun positions for " + std::to_string(n) + " rows";
     return false;

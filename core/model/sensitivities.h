@@ -82,8 +82,8 @@ struct SimSensitivities {
   // derivatives written).
   bool t_pv_derivatives = true;
   // Set by the caller: threads the columns are split over (at most two; a
-  // run too small to gain stays on one). The results are the same to the
-  // bit on any number.
+  // run too small to gain, or of a one-node variant, stays on one). The
+  // results are the same to the bit on any number.
   int threads = 1;
   // Set by the caller: the derivatives go to this sink (the values stay
   // here), unless an extension transforms the outputs, which reads them
@@ -115,9 +115,10 @@ struct SimSensitivities {
   SimOutputs hook_work, pushed;
 };
 
-// Rows × columns from which a run with SimSensitivities::threads = 2 splits
-// its columns over two threads (below, the helper's start and the values
-// computed twice outweigh the gain).
+// Rows × columns from which a run of a two-node variant with
+// SimSensitivities::threads = 2 splits its columns over two threads
+// (below, the helper's start and the values computed twice outweigh the
+// gain; a one-node variant's columns are too cheap at any size).
 inline constexpr std::size_t kSensitivitySplitWork = 100000;
 
 // Most parameters one sensitivity run differentiates for.

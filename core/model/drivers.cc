@@ -235,19 +235,9 @@ bool HasInputsFor(const Series& s, const ModelSpec& spec, std::string* error) {
   return true;
 }
 
-}  // namespace
-
-// The inputs are checked before the sun is computed: a series that lacks a
-// column fails without the positions of all its rows.
-bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d,
-                    std::string* error) {
-  if (!HasInputsFor(s, spec, error)) return false;
-  return PrepareDrivers(s, plant, spec, SunAtRowMiddles(s, plant), d, error);
-}
-
-bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
-                    std::span<const SolarPosition> sun, Drivers* d, std::string* error) {
-  if (!HasInputsFor(s, spec, error)) return false;
+// PrepareDrivers of a series whose inputs HasInputsFor has checked.
+bool PrepareCheckedDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
+                           std::span<const SolarPosition> sun, Drivers* d, std::string* error) {
   const std::size_t n = s.size();
   if (sun.size() != n) {
     *error = std::to_string(sun.size()) + " sun positions for " + std::to_string(n) + " rows";
@@ -331,6 +321,22 @@ bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
   }
   *d = std::move(out);
   return true;
+}
+
+}  // namespace
+
+// The inputs are checked before the sun is computed: a series that lacks a
+// column fails without the positions of all its rows.
+bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec, Drivers* d,
+                    std::string* error) {
+  if (!HasInputsFor(s, spec, error)) return false;
+  return PrepareCheckedDrivers(s, plant, spec, SunAtRowMiddles(s, plant), d, error);
+}
+
+bool PrepareDrivers(const Series& s, const Plant& plant, const ModelSpec& spec,
+                    std::span<const SolarPosition> sun, Drivers* d, std::string* error) {
+  if (!HasInputsFor(s, spec, error)) return false;
+  return PrepareCheckedDrivers(s, plant, spec, sun, d, error);
 }
 
 double MeasuredSkyTemperatureC(const Series& s, std::size_t i) {

@@ -652,11 +652,11 @@ bool SimulateSensitivities(const Drivers& d, const ParamVector& params, std::spa
   // columns 5.3 -> 4.0 ms (`bench sim`); at 5 min (4 032 rows) nothing
   // measurable in `calibrate --timing`, hence kSensitivitySplitWork. One
   // node's columns are too cheap to pay for writing the output arrays from
-  // both cores (core/fit/README.md): `calibrate --timing` on the bench's
-  // 1-min days (medians of 9, alternated) had the fine
-  // stage of 1N at 29.7 ms on one thread and 34.1 ms on two (1Nwr 41.7
-  // and 48.3 ms, 1N1C 30.3 and 31.5 ms), where two nodes gained (2N1Ccolwr
-  // 18.8 -> 16.1 ms, 2N2Cwr 100.0 -> 85.0 ms, 2N1Cpvwr 92.6 -> 85.2 ms).
+  // both cores (core/fit/README.md): `calibrate --timing --threads 1` and
+  // `--threads 2` on the bench's 1-min days (medians of 9, alternated) had
+  // the fine stage of 1N at 29.7 and 34.1 ms (1Nwr 41.7 and 48.3 ms, 1N1C
+  // 30.3 and 31.5 ms), where two nodes gained (2N1Ccolwr 18.8 -> 16.1 ms,
+  // 2N2Cwr 100.0 -> 85.0 ms, 2N1Cpvwr 92.6 -> 85.2 ms).
   const std::size_t cols = wrt.size();
   const bool split = out->threads > 1 && cols >= 2 && n * cols >= kSensitivitySplitWork &&
                      TwoNodes(SpecShape(d.spec));

@@ -357,14 +357,14 @@ TEST(ModelSensitivities, TheTPvDerivativesAreLeftOutOnlyWhenNoTransformReadsThem
 
 // With the columns split over two threads the run writes every value and
 // every derivative as on one, to the bit and NaN for NaN: variants of each
-// two-node network shape (one node's runs are not split, and give the same
-// run trivially), an odd number of columns, an electric effect and an
-// output transform (which then reads all the derivatives).
+// two-node network shape (one node's runs are not split), an odd number of
+// columns, an electric effect and an output transform (which then reads
+// all the derivatives).
 TEST(ModelSensitivities, TwoThreadsGiveTheSameRunToTheBit) {
   const Plant plant = DesignExamplePlant();
   const Series s = MinuteWeather(plant, 10);
   for (const std::string variant :
-       {"1N", "1N1Cwr", "2Nwr", "2N1Cpvwr", "2N1Ccolwr", "2N2Cwr", "2N1Ccolwr+transport_delay",
+       {"2Nwr", "2N1Cpvwr", "2N1Ccolwr", "2N2Cwr", "2N1Ccolwr+transport_delay",
         "2N1Ccolwr+pv_clipping+shading+soiling"}) {
     const Drivers d = TestDrivers(variant, s, plant);
     const std::vector<Param> wrt = SensitivityColumns(plant, d.spec);

@@ -167,7 +167,10 @@ TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
             3);
   // The daily checks after the calibration scored the days of the imported
   // history with the accepted model (the simulator's own plant: near 1).
-  ASSERT_TRUE(WaitFor(10, [&] {
+  // They run after the refit and its forecast, which take 10 s and more
+  // under the sanitizers on two loaded cores: the wait is generous, and it
+  // ends as soon as the rows are there.
+  ASSERT_TRUE(WaitFor(90, [&] {
     return db.Count("SELECT count(*) FROM performance_daily WHERE pi_el IS NOT NULL") >= 7;
   })) << DaemonLog();
   EXPECT_EQ(db.Count("SELECT count(*) FROM performance_daily WHERE pi_el NOT BETWEEN 0.9 AND 1.1"),

@@ -266,8 +266,9 @@ TEST_F(DaemonPaths, AnAcceptedFitIsRefitOnTheWholeWindow) {
                       "'$.params.' || h.name)"),
             0);
   // The forecast is issued again after the refit (in the same minute here,
-  // so its rows replace the first issue's).
-  ASSERT_TRUE(WaitFor(10, [&] {
+  // so its rows replace the first issue's). A forecast takes seconds under
+  // the sanitizers: the waits on the daemon's work are generous.
+  ASSERT_TRUE(WaitFor(60, [&] {
     const std::string log = Log();
     const std::size_t refit = log.find("refit on the whole window");
     return refit != std::string::npos && log.find("forecast issued", refit) != std::string::npos;
@@ -287,7 +288,7 @@ TEST_F(DaemonPaths, TheRefitCanBeTurnedOff) {
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
   })) << Log();
-  ASSERT_TRUE(WaitFor(10, [&] { return Log().find("forecast issued") != std::string::npos; }))
+  ASSERT_TRUE(WaitFor(60, [&] { return Log().find("forecast issued") != std::string::npos; }))
       << Log();
   EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE reason LIKE '%refit%'"), 0);
   EXPECT_EQ(Log().find("refit"), std::string::npos) << Log();

@@ -106,6 +106,37 @@ double ModelChange(const Eigen::MatrixXd& h, const Eigen::VectorXd& g, const Eig
   return g.dot(s) + 0.5 * s.dot(h * s);
 }
 
+// Broyden's rank-one secant update of the last Jacobian J (taken at the
+// start of an accepted step s): J + u·vᵀ with v = s and
+// u = (r_new − r_old − J·s) / sᵀs, which maps s to the change of the
+// residuals the step's runs measured. It stands in for a new Jacobian for
+// one iteration (LadFitOptions::secant_max_step); J itself is kept as it
+// was taken.
+struct Secant {
+  bool active = false;
+  Eigen::VectorXd u, v;
+
+  // Sets u and v from the step s = z_new − z_old of J's iteration.
+  void Set(const Eigen::MatrixXd& jac, const Eigen::VectorXd& s, const Eigen::VectorXd& r_old,
+           const Eigen::VectorXd& r_new) {
+    u.noalias() = r_new - r_old;
+    u.noalias() -= jac * s;
+    u /= s.squaredNorm();
+    v = s;
+    active = true;
+  }
+
+  // y − (J + u·vᵀ)·x into *out, from y − J·x.
+  void SubtractTimes(const Eigen::VectorXd& x, Eigen::VectorXd* out) const {
+    if (active) out->noalias() -= u * v.dot(x);
+  }
+
+  // c·(J + u·vᵀ)ᵀ·y into *out, from c·Jᵀ·y.
+  void AddTransposeTimes(const Eigen::VectorXd& y, double c, Eigen::VectorXd* out) const {
+    if (active) *out += v * (c * u.dot(y));
+  }
+};
+
 // The quadratic majoriser of one iteration: H = JᵀWJ / N + 2p·I and
 // g = JᵀW r / N + 2p (z − z_ref), with both restricted to the parameters
 // free to move from z: all but those at a bound of the unit box whose
@@ -115,11 +146,23 @@ struct Majoriser {
   Eigen::VectorXd g, g_movable;
   std::vector<Eigen::Index> movable;
 
-  // H and g at z from the Jacobian, the IRLS weights and the residuals
-  // there.
-  void Build(const Eigen::MatrixXd& jac, const Eigen::VectorXd& w, const Eigen::VectorXd& r,
-             const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref, const LadFitOptions& o) {
+  // H and g at z from the Jacobian (with the secant update when active),
+  // the IRLS weights and the residuals there.
+  void Build(const Eigen::MatrixXd& jac, const Secant& secant, const Eigen::VectorXd& w,
+             const Eigen::VectorXd& r, const Eigen::VectorXd& z, const Eigen::VectorXd& z_ref,
+             const LadFitOptions& o) {
     WeightedNormalEquations(jac, w, r, o.threads, &h, &g);
+    if (secant.active) {
+      // (J + u·vᵀ)ᵀW(J + u·vᵀ) = JᵀWJ + a·vᵀ + v·aᵀ + (uᵀWu)·v·vᵀ with
+      // a = JᵀWu, and (J + u·vᵀ)ᵀW·r = JᵀW·r + (uᵀW·r)·v.
+      const Eigen::VectorXd wu = w.cwiseProduct(secant.u);
+      const Eigen::VectorXd a = jac.transpose() * wu;
+      const Eigen::VectorXd& v = secant.v;
+      h.noalias() += a * v.transpose();
+      h.noalias() += v * a.transpose();
+      h.noalias() += (wu.dot(secant.u) * v) * v.transpose();
+      g.noalias() += wu.dot(r) * v;
+    }
     h /= o.n_scale;
     g /= o.n_scale;
     h.diagonal().array() += 2.0 * o.prior_weight;
@@ -224,11 +267,11 @@ void ForwardDifferences(const ResidualFunction& residuals, const Eigen::VectorXd
 // with the trial's damping. The corrected point replaces the trial if it
 // is lower (then returns true). `bend` is scratch of the rows' size.
 bool CorrectForBend(const ResidualFunction& residuals, const Eigen::VectorXd& z,
-                    const Eigen::VectorXd& r, const Eigen::MatrixXd& jac, const Eigen::VectorXd& w,
-                    const Eigen::MatrixXd& h, double lambda, const Eigen::VectorXd& z_ref,
-                    const LadFitOptions& o, Eigen::VectorXd* z_trial, Eigen::VectorXd* r_trial,
-                    double* trial_cost, Eigen::VectorXd* bend, Eigen::VectorXd* r_scratch,
-                    LadFitResult* res) {
+                    const Eigen::VectorXd& r, const Eigen::MatrixXd& jac, const Secant& secant,
+                    const Eigen::VectorXd& w, const Eigen::MatrixXd& h, double lambda,
+                    const Eigen::VectorXd& z_ref, const LadFitOptions& o, Eigen::VectorXd* z_trial,
+                    Eigen::VectorXd* r_trial, double* trial_cost, Eigen::VectorXd* bend,
+                    Eigen::VectorXd* r_scratch, LadFitResult* res) {
   if (!(o.max_correction > 0.0) || res->evaluations >= o.max_evaluations) return false;
   const Eigen::VectorXd v = *z_trial - z;
   std::vector<Eigen::Index> moved;
@@ -238,8 +281,10 @@ bool CorrectForBend(const ResidualFunction& residuals, const Eigen::VectorXd& z,
   if (moved.empty()) return false;
   bend->noalias() = *r_trial - r;
   bend->noalias() -= jac * v;
+  secant.SubtractTimes(v, bend);
   bend->array() *= w.array();
-  const Eigen::VectorXd jwe = jac.transpose() * *bend / o.n_scale;
+  Eigen::VectorXd jwe = jac.transpose() * *bend / o.n_scale;
+  secant.AddTransposeTimes(*bend, 1.0 / o.n_scale, &jwe);
   const Eigen::VectorXd c_moved = DampedStep(h(moved, moved), jwe(moved), lambda);
   const double ratio = c_moved.cwiseAbs().maxCoeff() / v.cwiseAbs().maxCoeff();
   if (!(ratio >= o.min_correction && ratio <= o.max_correction)) return false;
@@ -311,12 +356,14 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
   Majoriser maj;
   bool have_jac = false;  // jac was computed, at z_jac
   Eigen::VectorXd z_jac;
+  Secant secant;  // active: the next iteration takes jac with this update
   double floor_rel = o.weight_floor_rel;
   int small_in_a_row = 0;  // accepted steps in a row that lowered O by less than ftol
   double gain_per_promise = std::numeric_limits<double>::infinity();  // of the last accepted step
   const Eigen::Index jacobian_cost = jacobian ? o.jacobian_cost : n;
   for (int it = 0; it < o.max_iterations; ++it) {
-    const bool jacobian_due = !(have_jac && z == z_jac);
+    const bool on_secant = secant.active;
+    const bool jacobian_due = !on_secant && !(have_jac && z == z_jac);
     if (res.evaluations + (jacobian_due ? jacobian_cost : 0) + 1 > o.max_evaluations) {
       res.message = "evaluation budget reached";
       break;
@@ -325,7 +372,9 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     // IRLS weights at the current residuals.
     const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
     w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
-    if (!jacobian_due) {
+    if (on_secant) {
+      // One step past the last Jacobian: its secant update stands in.
+    } else if (!jacobian_due) {
       // Still where the last Jacobian was taken (a sharper weight floor
       // after a rejected iteration): only the weights change.
     } else if (jacobian && jacobian(z, r, &jac)) {
@@ -333,9 +382,12 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     } else {
       ForwardDifferences(residuals, z, r, o, &jac, &r_step, &res);
     }
-    have_jac = true;
-    z_jac = z;
-    maj.Build(jac, w, r, z, z_ref, o);
+    if (!on_secant) {
+      have_jac = true;
+      z_jac = z;
+    }
+    const double lambda_at_start = lambda;
+    maj.Build(jac, secant, w, r, z, z_ref, o);
     const double promised = maj.Promised();
     // What the stop below asks of an undamped promise (of this cost).
     const double small_promise = o.stop_promise_factor * o.ftol_rel * cost;
@@ -366,8 +418,8 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
         continue;
       }
       new_cost = Objective(r_trial, z_new, z_ref, o);
-      const bool corrected = CorrectForBend(residuals, z, r, jac, w, maj.h, lambda, z_ref, o,
-                                            &z_new, &r_trial, &new_cost, &bend, &r_step, &res);
+      const bool corrected = CorrectForBend(residuals, z, r, jac, secant, w, maj.h, lambda, z_ref,
+                                            o, &z_new, &r_trial, &new_cost, &bend, &r_step, &res);
       if (new_cost < cost) {
         if (corrected) ++res.corrected;
         // A step whose undamped promise is already below the stop's is a
@@ -378,6 +430,10 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
           StretchStep(residuals, z, r, z_ref, o, &z_new, &r_trial, &new_cost, &r_step, &res);
         }
         step_norm = (z_new - z).cwiseAbs().maxCoeff();
+        if (!on_secant && jacobian_cost > 1 && step_norm > o.xtol &&
+            step_norm <= o.secant_max_step) {
+          secant.Set(jac, z_new - z, r, r_trial);
+        }
         z = z_new;
         r.swap(r_trial);
         accepted = true;
@@ -387,6 +443,12 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
         break;
       }
       lambda *= 4.0;
+    }
+    if (on_secant) secant.active = false;
+    if (!accepted && on_secant) {
+      // The secant update misled the steps: a Jacobian here decides.
+      lambda = lambda_at_start;
+      continue;
     }
     if (!accepted) {
       // The smoothed model found no descent of the true objective: sharpen

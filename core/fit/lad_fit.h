@@ -73,6 +73,19 @@ struct LadFitOptions {
   // max_correction ≤ 0: never corrected.
   double max_correction = 3.0;
   double min_correction = 0.1;  // a smaller correction is not worth its run
+  // After an iteration that took a Jacobian (costing more than one
+  // residual evaluation) and accepted a step s no longer than this (max
+  // norm in z), the next iteration takes that Jacobian with Broyden's
+  // rank-one secant update along s instead of a new one:
+  // J + u·sᵀ, u = (r(z + s) − r(z) − J·s) / sᵀs, which the step's own runs
+  // give. The iteration after takes a Jacobian again, and so does a secant
+  // iteration that finds no step. Near the optimum a fit walks its valley
+  // in many short steps, along which J barely changes, and a run with
+  // sensitivities costs five plain ones or more; after a long step the
+  // update misleads more than it saves (from Table 3's start the fits took
+  // more runs). The returned Jacobian (LadFitResult::jacobian) is always
+  // one that was taken, never an update. 0: never.
+  double secant_max_step = 0.05;
   // Threads for the normal equations of an iteration (1 or 2; see
   // WeightedNormalEquations). The fit is the same on either.
   int threads = 1;

@@ -1226,6 +1226,18 @@ class FineFit {
               : FitActive(obj_, n_rows_, trial_mask, predicted, nullptr, trial_budget);
       point = trial.params;
       cost = trial.ok ? obj_.DataCost(point) : kNaN;
+      // A coarse-data trial priced just above the limit: a short fit on the
+      // data as given from its point decides.
+      if (trial_obj_ && trial.ok && std::isfinite(cost) && cost > limit &&
+          cost <= limit + options_.fix_cost_tolerance * best_cost_) {
+        double fine_cost = kNaN;
+        const FitOutcome fine_trial =
+            FitActive(obj_, n_rows_, trial_mask, point, &fine_cost, 4 * (static_cast<int>(m) + 2));
+        if (fine_trial.ok && fine_cost < cost) {
+          point = fine_trial.params;
+          cost = fine_cost;
+        }
+      }
     }
     if (std::isfinite(cost) && cost <= limit) {
       Fix(worst, j, point, cost, point == predicted ? &r_pred : nullptr);

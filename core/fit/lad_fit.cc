@@ -329,6 +329,40 @@ void StretchStep(const ResidualFunction& residuals, const Eigen::VectorXd& z,
   ++res->stretched;
 }
 
+// The IRLS weights at the residuals r: 1/|r|, with |r| floored at floor_rel
+// times its mean.
+Eigen::VectorXd IrlsWeights(const Eigen::VectorXd& r, double floor_rel) {
+  const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
+  return r.cwiseAbs().cwiseMax(delta).cwiseInverse();
+}
+
+// The Jacobian at z: a run with sensitivities when `jacobian` gives one
+// (counted as jacobian_cost evaluations), forward differences otherwise.
+void TakeJacobian(const ResidualFunction& residuals, const JacobianFunction& jacobian,
+                  Eigen::Index jacobian_cost, const Eigen::VectorXd& z, const Eigen::VectorXd& r,
+                  const LadFitOptions& o, Eigen::MatrixXd* jac, Eigen::VectorXd* r_step,
+                  LadFitResult* res) {
+  if (jacobian && jacobian(z, r, jac)) {
+    res->evaluations += static_cast<int>(jacobian_cost);
+  } else {
+    ForwardDifferences(residuals, z, r, o, jac, r_step, res);
+  }
+}
+
+// A small decrease (below ftol_rel of the new cost) ends the fit if the
+// undamped step of the iteration's majoriser promised little too, or if it
+// is the third small one in a row: one short, damped step of a fit still
+// making its way along a valley does not stop it, and a promise the steps
+// do not keep (a flat direction) does not hold it for long. Counts the
+// small decreases in a row in *small_in_a_row.
+bool SmallDecreaseStops(double decrease, double cost, double promised, const LadFitOptions& o,
+                        int* small_in_a_row) {
+  const bool small = decrease <= o.ftol_rel * cost;
+  *small_in_a_row = small ? *small_in_a_row + 1 : 0;
+  return small && (o.stop_promise_factor <= 0.0 || *small_in_a_row >= 3 ||
+                   promised <= o.stop_promise_factor * o.ftol_rel * cost);
+}
+
 }  // namespace
 
 LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0,
@@ -369,20 +403,12 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
       break;
     }
     ++res.iterations;
-    // IRLS weights at the current residuals.
-    const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
-    w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
-    if (on_secant) {
-      // One step past the last Jacobian: its secant update stands in.
-    } else if (!jacobian_due) {
-      // Still where the last Jacobian was taken (a sharper weight floor
-      // after a rejected iteration): only the weights change.
-    } else if (jacobian && jacobian(z, r, &jac)) {
-      res.evaluations += static_cast<int>(jacobian_cost);
-    } else {
-      ForwardDifferences(residuals, z, r, o, &jac, &r_step, &res);
-    }
-    if (!on_secant) {
+    w = IrlsWeights(r, floor_rel);
+    // One step past the last Jacobian its secant update stands in; still
+    // where it was taken (a sharper weight floor after a rejected
+    // iteration) only the weights change.
+    if (jacobian_due) {
+      TakeJacobian(residuals, jacobian, jacobian_cost, z, r, o, &jac, &r_step, &res);
       have_jac = true;
       z_jac = z;
     }
@@ -471,15 +497,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
       lambda = 1e-3;
       continue;
     }
-    // A small decrease ends the fit if the undamped step of this iteration's
-    // majoriser promised little too, or if it is the third small one in a
-    // row: one short, damped step of a fit still making its way along a
-    // valley does not stop it, and a promise the steps do not keep (a flat
-    // direction) does not hold it for long.
-    const bool small = decrease <= o.ftol_rel * cost;
-    small_in_a_row = small ? small_in_a_row + 1 : 0;
-    const bool small_decrease = small && (o.stop_promise_factor <= 0.0 || small_in_a_row >= 3 ||
-                                          promised <= o.stop_promise_factor * o.ftol_rel * cost);
+    const bool small_decrease = SmallDecreaseStops(decrease, cost, promised, o, &small_in_a_row);
     if (small_decrease || step_norm <= o.xtol) {
       res.converged = true;
       res.message = small_decrease ? "relative decrease below ftol" : "step below xtol";

@@ -329,11 +329,11 @@ void StretchStep(const ResidualFunction& residuals, const Eigen::VectorXd& z,
   ++res->stretched;
 }
 
-// The IRLS weights at the residuals r: 1/|r|, with |r| floored at floor_rel
-// times its mean.
-Eigen::VectorXd IrlsWeights(const Eigen::VectorXd& r, double floor_rel) {
+// The IRLS weights at the residuals r into *w (its storage reused): 1/|r|,
+// with |r| floored at floor_rel times its mean.
+void IrlsWeights(const Eigen::VectorXd& r, double floor_rel, Eigen::VectorXd* w) {
   const double delta = std::max(floor_rel * r.cwiseAbs().mean(), 1e-12);
-  return r.cwiseAbs().cwiseMax(delta).cwiseInverse();
+  *w = r.cwiseAbs().cwiseMax(delta).cwiseInverse();
 }
 
 // The Jacobian at z: a run with sensitivities when `jacobian` gives one
@@ -403,7 +403,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
       break;
     }
     ++res.iterations;
-    w = IrlsWeights(r, floor_rel);
+    IrlsWeights(r, floor_rel, &w);
     // One step past the last Jacobian its secant update stands in; still
     // where it was taken (a sharper weight floor after a rejected
     // iteration) only the weights change.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <random>
 #include <string>
 #include <utility>
@@ -197,6 +198,34 @@ TEST(LadFit, AParameterPinnedAtABoundDoesNotHoldBackTheOthers) {
   EXPECT_LT(res.evaluations, 50) << res.message;
 }
 
+// Residuals of two parameters over `rows` rows, r_i = residual(i, z), and
+// the Jacobian of rows gradient(i, z), which appends each point it is taken
+// at to *points (before its rows are written).
+struct RecordingModel {
+  ResidualFunction residuals;
+  JacobianFunction jacobian;
+};
+RecordingModel MakeRecordingModel(
+    std::size_t rows, std::function<double(std::size_t, const Eigen::VectorXd&)> residual,
+    std::function<Eigen::Vector2d(std::size_t, const Eigen::VectorXd&)> gradient,
+    std::vector<Eigen::VectorXd>* points) {
+  const auto n = static_cast<Eigen::Index>(rows);
+  RecordingModel m;
+  m.residuals = [n, residual](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
+    r->resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) (*r)(i) = residual(static_cast<std::size_t>(i), z);
+    return true;
+  };
+  m.jacobian = [n, gradient, points](const Eigen::VectorXd& z, const Eigen::VectorXd&,
+                                     Eigen::MatrixXd* jac) {
+    points->push_back(z);
+    jac->resize(n, 2);
+    for (Eigen::Index i = 0; i < n; ++i) jac->row(i) = gradient(static_cast<std::size_t>(i), z);
+    return true;
+  };
+  return m;
+}
+
 // The Jacobian is taken once per point: an iteration after a rejected one
 // (sharper weight floor, same point) reuses it. The result carries the
 // last Jacobian and how far the returned point is from where it was taken.
@@ -205,36 +234,25 @@ TEST(LadFit, AParameterPinnedAtABoundDoesNotHoldBackTheOthers) {
 TEST(LadFit, TakesEachJacobianOnceAndReturnsTheLast) {
   const std::vector<double> x = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
   const std::vector<double> y = {0.12, 0.31, 0.35, 0.52, 0.9, 0.93, 0.97};
-  const auto rows = static_cast<Eigen::Index>(y.size());
-  ResidualFunction f = [&](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
-    r->resize(rows);
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      (*r)(i) = z(0) + z(1) * x[static_cast<std::size_t>(i)] - y[static_cast<std::size_t>(i)];
-    }
-    return true;
-  };
   std::vector<Eigen::VectorXd> points;
-  JacobianFunction jacobian = [&](const Eigen::VectorXd& z, const Eigen::VectorXd&,
-                                  Eigen::MatrixXd* jac) {
-    points.push_back(z);
-    jac->resize(rows, 2);
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      (*jac)(i, 0) = 1.0;
-      (*jac)(i, 1) = x[static_cast<std::size_t>(i)];
-    }
-    (*jac)(0, 0) = 1.0 + static_cast<double>(points.size());  // tells the calls apart
-    return true;
-  };
+  const RecordingModel m = MakeRecordingModel(
+      y.size(), [&](std::size_t i, const Eigen::VectorXd& z) { return z(0) + z(1) * x[i] - y[i]; },
+      [&](std::size_t i, const Eigen::VectorXd&) {
+        // The first row's slope tells the calls apart.
+        const double d0 = i == 0 ? 1.0 + static_cast<double>(points.size()) : 1.0;
+        return Eigen::Vector2d(d0, x[i]);
+      },
+      &points);
   LadFitOptions o;
   o.ftol_rel = 1e-12;
   o.xtol = 1e-12;
   const LadFitResult res =
-      LadFit(f, Eigen::Vector2d(0.05, 0.05), Eigen::Vector2d::Zero(), o, jacobian);
+      LadFit(m.residuals, Eigen::Vector2d(0.05, 0.05), Eigen::Vector2d::Zero(), o, m.jacobian);
   ASSERT_GE(points.size(), 2u);
   EXPECT_LT(static_cast<int>(points.size()), res.iterations) << "no iteration reused a Jacobian";
   for (std::size_t k = 1; k < points.size(); ++k) EXPECT_NE(points[k], points[k - 1]) << k;
   EXPECT_DOUBLE_EQ(res.jacobian_distance, (res.z - points.back()).cwiseAbs().maxCoeff());
-  ASSERT_EQ(res.jacobian.rows(), rows);
+  ASSERT_EQ(res.jacobian.rows(), static_cast<Eigen::Index>(y.size()));
   EXPECT_DOUBLE_EQ(res.jacobian(0, 0), 1.0 + static_cast<double>(points.size()));
 }
 
@@ -255,38 +273,27 @@ TEST(LadFit, ASecantIterationAfterAShortStepSavesJacobians) {
     t[i] = 2.0 * static_cast<double>(i) / static_cast<double>(t.size());
     y[i] = 1.2 * std::exp(-1.5 * t[i]) + noise(rng);
   }
-  const auto rows = static_cast<Eigen::Index>(t.size());
-  ResidualFunction f = [&](const Eigen::VectorXd& z, Eigen::VectorXd* r) {
-    r->resize(rows);
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      (*r)(i) = 2.0 * z(0) * std::exp(-5.0 * z(1) * t[k]) - y[k];
-    }
-    return true;
-  };
   std::vector<Eigen::VectorXd> points;
-  JacobianFunction jacobian = [&](const Eigen::VectorXd& z, const Eigen::VectorXd&,
-                                  Eigen::MatrixXd* jac) {
-    points.push_back(z);
-    jac->resize(rows, 2);
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      const double e = std::exp(-5.0 * z(1) * t[k]);
-      (*jac)(i, 0) = 2.0 * e;
-      (*jac)(i, 1) = -10.0 * z(0) * t[k] * e;
-    }
-    return true;
-  };
+  const RecordingModel m = MakeRecordingModel(
+      t.size(),
+      [&](std::size_t i, const Eigen::VectorXd& z) {
+        return 2.0 * z(0) * std::exp(-5.0 * z(1) * t[i]) - y[i];
+      },
+      [&](std::size_t i, const Eigen::VectorXd& z) {
+        const double e = std::exp(-5.0 * z(1) * t[i]);
+        return Eigen::Vector2d(2.0 * e, -10.0 * z(0) * t[i] * e);
+      },
+      &points);
   LadFitOptions o;
   o.ftol_rel = 1e-10;
   o.jacobian_cost = 5;
   const Eigen::Vector2d start(0.66, 0.27);  // the optimum is near (0.6, 0.3)
   o.secant_max_step = 0.0;
-  const LadFitResult exact = LadFit(f, start, Eigen::Vector2d::Zero(), o, jacobian);
+  const LadFitResult exact = LadFit(m.residuals, start, Eigen::Vector2d::Zero(), o, m.jacobian);
   const std::size_t exact_jacobians = points.size();
   points.clear();
   o.secant_max_step = 0.05;
-  const LadFitResult secant = LadFit(f, start, Eigen::Vector2d::Zero(), o, jacobian);
+  const LadFitResult secant = LadFit(m.residuals, start, Eigen::Vector2d::Zero(), o, m.jacobian);
   std::printf("Jacobians %zu without the secant iteration, %zu with; iterations %d and %d\n",
               exact_jacobians, points.size(), exact.iterations, secant.iterations);
   EXPECT_NEAR(secant.final_cost, exact.final_cost, 1e-6 * exact.final_cost);

@@ -1477,7 +1477,14 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   summary.coarse_subset_days = coarse.subset_days;
   FineFit fine(obj, fs, meas, options, drivers.plant, coarse, best);
   fine.FitAll();
+  const auto t_fixing = std::chrono::steady_clock::now();
+  const int fine_runs_before_fixing = obj.simulations();
   fine.FixUnidentifiable(&summary.notes);
+  summary.fixing_runtime_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_fixing).count();
+  summary.fixing_coarse_evaluations = fine.TrialSimulations();
+  summary.fixing_evaluations =
+      obj.simulations() - fine_runs_before_fixing + summary.fixing_coarse_evaluations;
   fine.Polish();
   const FitOutcome& fit = fine.fit();
   summary.termination = fit.termination;

@@ -182,6 +182,8 @@ void RunJob(const Series& s, std::span<const SolarPosition> sun, const Plant& pl
   if (warm) ident.day_subset_stage = false;
   const IdentSummary summary = Identify(train.drivers, train.meas, start, ident);
   out->runtime_s = summary.runtime_s;
+  out->coarse_runtime_s = summary.coarse_runtime_s;
+  out->fixing_runtime_s = summary.fixing_runtime_s;
   out->evaluations = summary.evaluations;
   out->params = summary.params;
   if (!summary.ok) {

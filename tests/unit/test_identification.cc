@@ -479,6 +479,32 @@ TEST(IdentifySynthetic, AParameterItsTrialKeptFreeCostsMoreWhenFixed) {
   EXPECT_GE(kept, 1) << "no variant kept a weakly determined parameter free";
 }
 
+// The time split that `calibrate --timing` and `bench table6` print: the
+// rounds that decide which undetermined parameters to fix are a part of
+// the fine stage, with their runs (the trial fits' on the coarse data among
+// them), and nothing when the fit fixes nothing by itself. 1Nwr on these
+// data has weakly determined parameters, so its rounds run the model.
+TEST(IdentifySynthetic, TheFixingRoundsAreAPartOfTheFineStageWithTheirRuns) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 4, 60.0, /*seed=*/12, RealisticSensorNoise(13));
+  const auto [d, meas] = PrepareFor(c, plant, "1Nwr");
+  IdentOptions options;
+  const IdentSummary s = Identify(d, meas, StartParams(plant), options);
+  ASSERT_TRUE(s.ok) << s.BriefReport();
+  ASSERT_FALSE(s.notes.empty()) << "1Nwr on these data is expected to have fixing rounds";
+  EXPECT_GT(s.fixing_runtime_s, 0.0);
+  EXPECT_LE(s.fixing_runtime_s, s.runtime_s - s.coarse_runtime_s);
+  EXPECT_GT(s.fixing_evaluations, 0);
+  EXPECT_LE(s.fixing_coarse_evaluations, s.fixing_evaluations);
+  EXPECT_LE(s.fixing_evaluations, s.evaluations - s.coarse_evaluations);
+
+  options.fix_unidentifiable = false;
+  const IdentSummary f = Identify(d, meas, StartParams(plant), options);
+  ASSERT_TRUE(f.ok) << f.BriefReport();
+  EXPECT_EQ(f.fixing_evaluations, 0);
+  EXPECT_EQ(f.fixing_coarse_evaluations, 0);
+}
+
 TEST(IdentifyFailures, TooLittleDataIsAFailureWithReason) {
   const Plant plant = DesignExamplePlant();
   Case c = MakeCase(plant, "1N1C", 1, 600.0, 15, SensorNoise{});

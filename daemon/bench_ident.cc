@@ -158,11 +158,12 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, const std::s
           : std::string();
   std::printf(
       "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs%s) + fine %.1f "
-      "(%d model runs); %d of the runs with sensitivities, each counted as %d | write %.2f\n",
+      "(%d model runs; of it identifiability %.1f, %d runs); %d of the runs with "
+      "sensitivities, each counted as %d | write %.2f\n",
       1e3 * Median(parse), csv.size() / 1024, 1e3 * fit.runtime_s, 1e3 * fit.coarse_runtime_s,
       fit.coarse_evaluations, subset.c_str(), 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
-      fit.evaluations - fit.coarse_evaluations, fit.sensitivity_runs, kSensitivityRunCost,
-      1e3 * Median(write));
+      fit.evaluations - fit.coarse_evaluations, 1e3 * fit.fixing_runtime_s, fit.fixing_evaluations,
+      fit.sensitivity_runs, kSensitivityRunCost, 1e3 * Median(write));
 }
 
 // Wall time of this executable run with `args` (output to /dev/null) until

@@ -202,11 +202,11 @@ struct IdentSummary {
   // The days of the coarsest rung's first fit when the fit on all the days
   // started from its optimum (IdentOptions::day_subset_stage); 0 otherwise.
   int coarse_subset_days = 0;
-  // The fine stage's share in the identifiability analysis: the standard
-  // errors and the rounds that decide which undetermined parameters to fix
-  // (predicted costs, trial fits: FixUnidentifiable),
-  // with its evaluations, and of them those on the coarse stage's data
-  // (the trial fits run there when the fit had a coarse stage).
+  // The fine stage's share in the identifiability analysis (the standard
+  // errors and the rounds that decide which undetermined parameters to fix,
+  // with their predicted costs and trial fits: FixUnidentifiable), its
+  // evaluations, and of them those on the coarse stage's data (where the
+  // trial fits run when the fit had a coarse stage).
   double fixing_runtime_s = 0.0;
   int fixing_evaluations = 0;
   int fixing_coarse_evaluations = 0;

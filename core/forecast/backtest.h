@@ -122,7 +122,7 @@ struct BacktestDay {
   ErrorMetrics test;              // errors on the test day (when ok)
   double runtime_s = 0.0;         // calibration runtime (IdentSummary::runtime_s)
   double coarse_runtime_s = 0.0;  // its coarse stage (IdentSummary::coarse_runtime_s)
-  double fixing_runtime_s = 0.0;  // its fixing rounds (IdentSummary::fixing_runtime_s)
+  double fixing_runtime_s = 0.0;  // its identifiability (IdentSummary::fixing_runtime_s)
   int evaluations = 0;            // model simulations of the identification
   ParamVector params{};           // identified parameters (when identification ran)
 };

@@ -1064,6 +1064,7 @@ class FineFit {
         active_(fs.free.size(), true),
         se_(fs.free.size(), 0.0),
         rejected_(fs.free.size(), false),
+        kept_cost_(fs.free.size(), kNaN),
         best_(best) {
     // Floor of the residual spread for the standard errors: 0.1 % of the
     // mean measured power per m², so that noise-free data still expose
@@ -1201,6 +1202,14 @@ class FineFit {
       if (worst < 0 || act_se(a) > act_se(worst)) worst = a;
     }
     if (worst < 0) return false;
+    const Eigen::Index mirror = MirrorOfAKeptParameter(act_index, worst);
+    if (mirror >= 0) {
+      const std::size_t j = act_index[static_cast<std::size_t>(worst)];
+      rejected_[j] = true;
+      kept_cost_[j] = kept_cost_[act_index[static_cast<std::size_t>(mirror)]];
+      notes->push_back(FixNote(j, kept_cost_[j], false));
+      return true;
+    }
     ParamVector predicted;
     Eigen::VectorXd r_pred;
     double cost = PredictCostOfFixing(act_index, worst, &predicted, &r_pred);
@@ -1243,9 +1252,39 @@ class FineFit {
       Fix(worst, j, point, cost, point == predicted ? &r_pred : nullptr);
     } else {
       rejected_[j] = true;
+      kept_cost_[j] = cost;
     }
     notes->push_back(FixNote(j, cost, !rejected_[j]));
     return true;
+  }
+
+  // The active parameter (position in the Jacobian's columns) of which the
+  // active parameter `worst` is the mirror image, when a fixing round kept
+  // that one free: the same range, scale, reference value and value, and
+  // the same column of the Jacobian (1N and 1N1C see u_front_w_m2k and
+  // u_back_w_m2k only as their sum). Fixing `worst` is then the same fit
+  // with the two exchanged, and gets the same verdict and cost without
+  // another prediction or trial fit. -1 when there is none.
+  Eigen::Index MirrorOfAKeptParameter(const std::vector<std::size_t>& act_index,
+                                      Eigen::Index worst) const {
+    constexpr double kSame = 1e-9;  // relative, of the column's norm and of the unit range
+    const std::size_t k = act_index[static_cast<std::size_t>(worst)];
+    const ParamInfo& info_k = fs_.infos[k];
+    const auto idx_k = static_cast<std::size_t>(fs_.free[k]);
+    const double column_norm = jac_.col(worst).norm();
+    for (Eigen::Index a = 0; a < jac_.cols(); ++a) {
+      const std::size_t j = act_index[static_cast<std::size_t>(a)];
+      if (a == worst || !rejected_[j] || !std::isfinite(kept_cost_[j])) continue;
+      const ParamInfo& info_j = fs_.infos[j];
+      const auto idx_j = static_cast<std::size_t>(fs_.free[j]);
+      if (info_j.lower != info_k.lower || info_j.upper != info_k.upper ||
+          info_j.scale != info_k.scale || fs_.base[idx_j] != fs_.base[idx_k] ||
+          std::fabs(ToUnit(info_j, best_[idx_j]) - ToUnit(info_k, best_[idx_k])) > kSame) {
+        continue;
+      }
+      if ((jac_.col(a) - jac_.col(worst)).norm() <= kSame * column_norm) return a;
+    }
+    return -1;
   }
 
   // The cost of fixing the active parameter `worst` (position j in `free`)
@@ -1358,6 +1397,7 @@ class FineFit {
   std::vector<bool> active_;
   std::vector<double> se_;
   std::vector<bool> rejected_;
+  std::vector<double> kept_cost_;  // the cost that kept a rejected parameter free
   ParamVector best_;
   double best_cost_ = 0.0;
   bool any_fixed_ = false;

@@ -451,12 +451,13 @@ TEST(IdentifySynthetic, FlatDirectionIsReportedAndFixed) {
 // Which parameters a fit keeps free depends on its path, so the test takes
 // three misspecified variants that keep some (1Nwr and 2Nwr the fluid
 // resistance, 2N1CcolwrI the back loss, on these data) and asks for one at
-// least over all of them.
+// least over all of them. 1N keeps u_front_w_m2k and u_back_w_m2k, the
+// second without a trial of its own, as the mirror image of the first.
 TEST(IdentifySynthetic, AParameterItsTrialKeptFreeCostsMoreWhenFixed) {
   const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 4, 60.0, /*seed=*/12, RealisticSensorNoise(13));
   int kept = 0;
-  for (const std::string variant : {"1Nwr", "2Nwr", "2N1CcolwrI"}) {
+  for (const std::string variant : {"1N", "1Nwr", "2Nwr", "2N1CcolwrI"}) {
     const auto [d, meas] = PrepareFor(c, plant, variant);
     const IdentOptions options;
     const IdentSummary s = Identify(d, meas, StartParams(plant), options);
@@ -480,10 +481,11 @@ TEST(IdentifySynthetic, AParameterItsTrialKeptFreeCostsMoreWhenFixed) {
 }
 
 // The time split that `calibrate --timing` and `bench table6` print: the
-// rounds that decide which undetermined parameters to fix are a part of
-// the fine stage, with their runs (the trial fits' on the coarse data among
-// them), and nothing when the fit fixes nothing by itself. 1Nwr on these
-// data has weakly determined parameters, so its rounds run the model.
+// identifiability analysis (standard errors, the rounds that decide which
+// undetermined parameters to fix) is a part of the fine stage, with its
+// runs (the trial fits' on the coarse data among them), and runs nothing
+// when the fit fixes nothing by itself. 1Nwr on these data has weakly
+// determined parameters, so its rounds run the model.
 TEST(IdentifySynthetic, TheFixingRoundsAreAPartOfTheFineStageWithTheirRuns) {
   const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 4, 60.0, /*seed=*/12, RealisticSensorNoise(13));
@@ -503,6 +505,35 @@ TEST(IdentifySynthetic, TheFixingRoundsAreAPartOfTheFineStageWithTheirRuns) {
   ASSERT_TRUE(f.ok) << f.BriefReport();
   EXPECT_EQ(f.fixing_evaluations, 0);
   EXPECT_EQ(f.fixing_coarse_evaluations, 0);
+}
+
+// 1N sees u_front_w_m2k and u_back_w_m2k only as their sum: with the same
+// range, reference value and value, fixing either is the same fit with the
+// two exchanged. When a trial fit kept the first free, the second gets the
+// same verdict at the same cost without a trial of its own: the fixing
+// rounds run at most one trial's runs on the coarse data, where two trials
+// took twice that.
+TEST(IdentifySynthetic, TheMirrorOfAParameterKeptFreeIsKeptWithoutASecondTrial) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 4, 60.0, /*seed=*/12, RealisticSensorNoise(13));
+  const auto [d, meas] = PrepareFor(c, plant, "1N");
+  const IdentOptions options;
+  const IdentSummary s = Identify(d, meas, StartParams(plant), options);
+  ASSERT_TRUE(s.ok) << s.BriefReport();
+  std::vector<std::string> kept;
+  for (const std::string& note : s.notes) {
+    std::printf("%s\n", note.c_str());
+    if (note.find("kept free") != std::string::npos) kept.push_back(note);
+  }
+  ASSERT_EQ(kept.size(), 2u) << "u_front_w_m2k and u_back_w_m2k both kept free on these data";
+  const auto cost_in = [](const std::string& note) { return note.substr(note.rfind("by ")); };
+  EXPECT_EQ(cost_in(kept[0]), cost_in(kept[1]));
+  const int free_count = static_cast<int>(DefaultFreeParams(d.spec).count());
+  const int one_trial = 8 * (free_count + 2) + 2;  // its budget, its start and its pricing
+  std::printf("runs on the coarse data in the fixing rounds: %d (one trial at most %d)\n",
+              s.fixing_coarse_evaluations, one_trial);
+  EXPECT_GT(s.fixing_coarse_evaluations, 0);
+  EXPECT_LE(s.fixing_coarse_evaluations, one_trial);
 }
 
 TEST(IdentifyFailures, TooLittleDataIsAFailureWithReason) {

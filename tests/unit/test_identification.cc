@@ -529,7 +529,7 @@ TEST(IdentifySynthetic, TheMirrorOfAParameterKeptFreeIsKeptWithoutASecondTrial) 
   const auto cost_in = [](const std::string& note) { return note.substr(note.rfind("by ")); };
   EXPECT_EQ(cost_in(kept[0]), cost_in(kept[1]));
   const int free_count = static_cast<int>(DefaultFreeParams(d.spec).count());
-  const int one_trial = 8 * (free_count + 2) + 2;  // its budget, its start and its pricing
+  const int one_trial = 8 * (free_count + 2) + 2;  // its budget, and two runs to spare
   std::printf("runs on the coarse data in the fixing rounds: %d (one trial at most %d)\n",
               s.fixing_coarse_evaluations, one_trial);
   EXPECT_GT(s.fixing_coarse_evaluations, 0);

@@ -152,18 +152,16 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, const std::s
       "fit: the last run)\n",
       runs);
   // As `calibrate --timing` says it: only when the day subset stage was used.
-  const std::string subset =
-      fit.coarse_subset_days > 0
-          ? ", first on " + std::to_string(fit.coarse_subset_days) + " of the days"
-          : std::string();
+  const std::string subset_text = fit.CoarseSubsetText();
+  const std::string subset = subset_text.empty() ? "" : ", " + subset_text;
   std::printf(
       "  parse %.1f (%zu kB of CSV) | fit %.1f = coarse %.1f (%d model runs%s) + fine %.1f "
-      "(%d model runs; of it identifiability %.1f, %d runs); %d of the runs with "
-      "sensitivities, each counted as %d | write %.2f\n",
+      "(%d model runs; of it identifiability %.1f, %d runs, trial fits %.1f); %d of the runs "
+      "with sensitivities, each counted as %d | write %.2f\n",
       1e3 * Median(parse), csv.size() / 1024, 1e3 * fit.runtime_s, 1e3 * fit.coarse_runtime_s,
       fit.coarse_evaluations, subset.c_str(), 1e3 * (fit.runtime_s - fit.coarse_runtime_s),
       fit.evaluations - fit.coarse_evaluations, 1e3 * fit.fixing_runtime_s, fit.fixing_evaluations,
-      fit.sensitivity_runs, kSensitivityRunCost, 1e3 * Median(write));
+      1e3 * fit.trial_runtime_s, fit.sensitivity_runs, kSensitivityRunCost, 1e3 * Median(write));
 }
 
 // Wall time of this executable run with `args` (output to /dev/null) until

@@ -17,24 +17,40 @@ namespace pvtwin::cli {
 namespace {
 
 // Where each variant's identification time goes, summed over its days: the
-// coarse stage, the fine stage, and of the fine stage the identifiability
-// analysis: the standard errors and the rounds that decide which
-// undetermined parameters to fix (their trial fits included).
+// coarse stage, of it the fits on a day subset; the fine stage, of it the
+// identifiability analysis (the standard errors and the rounds that decide
+// which undetermined parameters to fix), and of that the rounds' trial fits.
 void PrintTimeSplit(const BacktestResult& result) {
   std::printf(
-      "time split per variant, s summed over the days: coarse + fine "
-      "(of it identifiability: standard errors and fixing rounds) = identification\n");
+      "time split per variant, s summed over the days: coarse (of it day subset) + fine (of it "
+      "identifiability: standard errors and fixing rounds; of that trial fits) = "
+      "identification\n");
+  struct Split {
+    double coarse = 0.0, subset = 0.0, fixing = 0.0, trials = 0.0, total = 0.0;
+    void Add(const Split& o) {
+      coarse += o.coarse;
+      subset += o.subset;
+      fixing += o.fixing;
+      trials += o.trials;
+      total += o.total;
+    }
+    void Print(const char* name) const {
+      std::printf("  %-12s %6.2f (%6.2f) + %6.2f (%6.2f; %6.2f) = %6.2f\n", name, coarse, subset,
+                  total - coarse, fixing, trials, total);
+    }
+  };
+  Split all;
   for (const BacktestAverage& a : result.averages) {
-    double coarse = 0.0, fixing = 0.0, total = 0.0;
+    Split v;
     for (const BacktestDay& d : result.days) {
       if (d.variant != a.variant || d.train_days != a.train_days) continue;
-      coarse += d.coarse_runtime_s;
-      fixing += d.fixing_runtime_s;
-      total += d.runtime_s;
+      v.Add({d.coarse_runtime_s, d.coarse_subset_runtime_s, d.fixing_runtime_s, d.trial_runtime_s,
+             d.runtime_s});
     }
-    std::printf("  %-12s %6.2f + %6.2f (%6.2f) = %6.2f\n", a.variant.c_str(), coarse,
-                total - coarse, fixing, total);
+    v.Print(a.variant.c_str());
+    all.Add(v);
   }
+  all.Print("all");
 }
 
 }  // namespace

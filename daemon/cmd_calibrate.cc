@@ -70,21 +70,19 @@ struct StageTimes {
 // counted against the budget; those served from an earlier run's outputs
 // took no time).
 void PrintTiming(const StageTimes& t, const IdentSummary& s) {
-  const std::string subset =
-      s.coarse_subset_days > 0
-          ? ", first on " + std::to_string(s.coarse_subset_days) + " of the days"
-          : std::string();
+  const std::string subset_text = s.CoarseSubsetText();
+  const std::string subset = subset_text.empty() ? "" : ", " + subset_text;
   std::fprintf(stderr,
                "timing: parse %.1f ms, prepare %.1f ms, fit %.1f ms (coarse %.1f ms, %d model "
                "runs%s; fine %.1f ms, %d model runs, of which identifiability (standard "
-               "errors, fixing rounds) %.1f ms, %d model runs, %d of them on the coarse data), "
-               "held-out %.1f ms, write %.1f ms; %d of the model runs with sensitivities (each "
-               "counted as %d); %d counted but served from an earlier run\n",
+               "errors, fixing rounds) %.1f ms, %d model runs, %d of them on the coarse data, "
+               "trial fits %.1f ms), held-out %.1f ms, write %.1f ms; %d of the model runs with "
+               "sensitivities (each counted as %d); %d counted but served from an earlier run\n",
                1e3 * t.parse_s, 1e3 * t.prepare_s, 1e3 * s.runtime_s, 1e3 * s.coarse_runtime_s,
                s.coarse_evaluations, subset.c_str(), 1e3 * (s.runtime_s - s.coarse_runtime_s),
                s.evaluations - s.coarse_evaluations, 1e3 * s.fixing_runtime_s, s.fixing_evaluations,
-               s.fixing_coarse_evaluations, 1e3 * t.held_out_s, 1e3 * t.write_s, s.sensitivity_runs,
-               kSensitivityRunCost, s.served_runs);
+               s.fixing_coarse_evaluations, 1e3 * s.trial_runtime_s, 1e3 * t.held_out_s,
+               1e3 * t.write_s, s.sensitivity_runs, kSensitivityRunCost, s.served_runs);
 }
 
 bool ResampleOrReport(const std::string& path, double step_s, Series* s) {

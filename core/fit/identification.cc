@@ -519,6 +519,20 @@ std::vector<std::string> IdentSummary::AtBounds() const {
   return names;
 }
 
+std::string IdentSummary::CoarseSubsetText() const {
+  char buf[96];
+  if (coarse_subset_days > 0) {
+    std::snprintf(buf, sizeof(buf), "first on %d of the days, %.1f ms", coarse_subset_days,
+                  1e3 * coarse_subset_runtime_s);
+  } else if (coarse_subset_runtime_s > 0.0) {
+    std::snprintf(buf, sizeof(buf), "a fit on a day subset not taken, %.1f ms",
+                  1e3 * coarse_subset_runtime_s);
+  } else {
+    return {};
+  }
+  return buf;
+}
+
 std::string IdentSummary::BriefReport() const {
   char buf[320];
   std::snprintf(buf, sizeof(buf),
@@ -851,6 +865,9 @@ struct CoarseFits {
   // The days of the subset whose optimum the first fit started from; 0
   // when it started from the start (IdentSummary::coarse_subset_days).
   int subset_days = 0;
+  // The time of the fits on a day subset, this rung's and a finer rung's
+  // (IdentSummary::coarse_subset_runtime_s).
+  double subset_runtime_s = 0.0;
   // The position in `fits` of the fit on all the days from the start that
   // followed a merge of the two nodes (MergedNodesWithBothCapacitancesFree);
   // 0 when there was none.
@@ -936,6 +953,7 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
     out.simulations += fit.evaluations + extra_runs;
     out.sensitivity_runs += fit.sensitivity_runs;
     out.served_runs += fit.served_runs;
+    out.subset_runtime_s += fit.coarse_subset_runtime_s;
   };
   Drivers& cd = out.drivers;
   Measurements& cm = out.meas;
@@ -966,6 +984,7 @@ CoarseFits FitCoarse(const Drivers& drivers, const Measurements& meas, const Ide
       subset.optimizer.ftol_rel = std::max(coarse.optimizer.ftol_rel, kSubsetFtol);
       const IdentSummary sub = Identify(sd, sm, fs.base, subset);
       add(sub, 0);
+      out.subset_runtime_s += sub.runtime_s;
       out.far = sub.ok && sub.final_cost_w_m2 <= 0.5 * sub.initial_cost_w_m2;
       if (out.far) {
         start = sub.params;
@@ -1115,6 +1134,8 @@ class FineFit {
   int TrialSimulations() const { return trial_obj_ ? trial_obj_->simulations() : 0; }
   int TrialSensitivityRuns() const { return trial_obj_ ? trial_obj_->sensitivity_runs() : 0; }
   int TrialServed() const { return trial_obj_ ? trial_obj_->served() : 0; }
+  // The time of the fixing rounds' trial fits (IdentSummary::trial_runtime_s).
+  double TrialRuntime() const { return trial_runtime_s_; }
   const FitOutcome& fit() const { return fit_; }
   const ParamVector& best() const { return best_; }
   const std::vector<bool>& active() const { return active_; }
@@ -1226,6 +1247,7 @@ class FineFit {
     // (core/fit/README.md compares it with the re-fit on the data as given).
     if (std::isfinite(cost) && cost > limit &&
         (cost <= 10.0 * limit - 9.0 * best_cost_ || se_[j] > 1.0)) {
+      const auto trial_start = std::chrono::steady_clock::now();
       std::vector<bool> trial_mask = active_;
       trial_mask[j] = false;
       const int trial_budget = 8 * (static_cast<int>(m) + 2);
@@ -1247,6 +1269,8 @@ class FineFit {
           cost = fine_cost;
         }
       }
+      trial_runtime_s_ +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - trial_start).count();
     }
     if (std::isfinite(cost) && cost <= limit) {
       Fix(worst, j, point, cost, point == predicted ? &r_pred : nullptr);
@@ -1403,6 +1427,7 @@ class FineFit {
   bool any_fixed_ = false;
   FitOutcome fit_;
   std::optional<Objective> trial_obj_;  // on the coarse stage's data
+  double trial_runtime_s_ = 0.0;        // TrialRuntime
   double trial_rows_ = 0.0;
   Eigen::MatrixXd jac_;  // columns: active parameters, in `free` order
   Eigen::VectorXd r_;
@@ -1515,6 +1540,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   const int coarse_sensitivity_runs = coarse.sensitivity_runs;
   summary.coarse_evaluations = coarse_simulations;
   summary.coarse_subset_days = coarse.subset_days;
+  summary.coarse_subset_runtime_s = coarse.subset_runtime_s;
   FineFit fine(obj, fs, meas, options, drivers.plant, coarse, best);
   fine.FitAll();
   const auto t_fixing = std::chrono::steady_clock::now();
@@ -1523,6 +1549,7 @@ IdentSummary Identify(const Drivers& drivers, const Measurements& meas, const Pa
   summary.fixing_runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_fixing).count();
   summary.fixing_coarse_evaluations = fine.TrialSimulations();
+  summary.trial_runtime_s = fine.TrialRuntime();
   summary.fixing_evaluations =
       obj.simulations() - fine_runs_before_fixing + summary.fixing_coarse_evaluations;
   fine.Polish();

@@ -202,6 +202,10 @@ struct IdentSummary {
   // The days of the coarsest rung's first fit when the fit on all the days
   // started from its optimum (IdentOptions::day_subset_stage); 0 otherwise.
   int coarse_subset_days = 0;
+  // Of coarse_runtime_s, the fits on a day subset (IdentOptions::
+  // day_subset_stage), whether the fit on all the days started from their
+  // optimum or not; 0 when there were none.
+  double coarse_subset_runtime_s = 0.0;
   // The fine stage's share in the identifiability analysis (the standard
   // errors and the rounds that decide which undetermined parameters to fix,
   // with their predicted costs and trial fits: FixUnidentifiable), its
@@ -210,6 +214,10 @@ struct IdentSummary {
   double fixing_runtime_s = 0.0;
   int fixing_evaluations = 0;
   int fixing_coarse_evaluations = 0;
+  // Of fixing_runtime_s, the trial fits (re-fits without the parameter when
+  // the predicted cost of fixing it does not decide, with the short fit on
+  // the data as given that may follow one).
+  double trial_runtime_s = 0.0;
   ParamVector params{};
   std::vector<ParamEstimate> estimates;  // the parameters the variant uses
   std::vector<std::string> notes;        // identifiability findings, in words
@@ -220,6 +228,11 @@ struct IdentSummary {
   // One line: variant, ok/FAILED, termination, cost start → end, evaluations,
   // runtime; "ok, but N parameters at bounds (names)" when any are.
   std::string BriefReport() const;
+  // The time-split printouts' words for the day subset's fit: "first on N
+  // of the days, T ms" when the fit on all the days started from its
+  // optimum (coarse_subset_days), "a fit on a day subset not taken, T ms"
+  // when it ran but did not halve its cost, else empty.
+  std::string CoarseSubsetText() const;
 };
 
 // What one model run with sensitivities is charged against the simulation

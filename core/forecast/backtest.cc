@@ -184,6 +184,8 @@ void RunJob(const Series& s, std::span<const SolarPosition> sun, const Plant& pl
   out->runtime_s = summary.runtime_s;
   out->coarse_runtime_s = summary.coarse_runtime_s;
   out->fixing_runtime_s = summary.fixing_runtime_s;
+  out->coarse_subset_runtime_s = summary.coarse_subset_runtime_s;
+  out->trial_runtime_s = summary.trial_runtime_s;
   out->evaluations = summary.evaluations;
   out->params = summary.params;
   if (!summary.ok) {

@@ -118,13 +118,15 @@ struct BacktestDay {
   int train_days = 0;            // n
   bool ok = false;
   BacktestFailure failure = BacktestFailure::kNone;
-  std::string failure_reason;     // when !ok
-  ErrorMetrics test;              // errors on the test day (when ok)
-  double runtime_s = 0.0;         // calibration runtime (IdentSummary::runtime_s)
-  double coarse_runtime_s = 0.0;  // its coarse stage (IdentSummary::coarse_runtime_s)
-  double fixing_runtime_s = 0.0;  // its identifiability (IdentSummary::fixing_runtime_s)
-  int evaluations = 0;            // model simulations of the identification
-  ParamVector params{};           // identified parameters (when identification ran)
+  std::string failure_reason;            // when !ok
+  ErrorMetrics test;                     // errors on the test day (when ok)
+  double runtime_s = 0.0;                // calibration runtime (IdentSummary::runtime_s)
+  double coarse_runtime_s = 0.0;         // its coarse stage (IdentSummary::coarse_runtime_s)
+  double fixing_runtime_s = 0.0;         // its identifiability (IdentSummary::fixing_runtime_s)
+  double coarse_subset_runtime_s = 0.0;  // IdentSummary::coarse_subset_runtime_s
+  double trial_runtime_s = 0.0;          // IdentSummary::trial_runtime_s
+  int evaluations = 0;                   // model simulations of the identification
+  ParamVector params{};                  // identified parameters (when identification ran)
 };
 
 // Means over the test days of one (variant, n).

@@ -277,6 +277,10 @@ TEST(IdentifySynthetic, TheDaySubsetStageEndsWhereTheFitWithoutItEnds) {
                                                     << before.BriefReport();
   EXPECT_EQ(with.coarse_subset_days, 4);
   EXPECT_EQ(reference.coarse_subset_days, 0);
+  // The subset's fit is a share of the coarse stage's time.
+  EXPECT_GT(with.coarse_subset_runtime_s, 0.0);
+  EXPECT_LT(with.coarse_subset_runtime_s, with.coarse_runtime_s);
+  EXPECT_EQ(reference.coarse_subset_runtime_s, 0.0);
   EXPECT_NEAR(with.final_cost_w_m2, reference.final_cost_w_m2, 2e-3 * reference.final_cost_w_m2);
   ASSERT_EQ(with.estimates.size(), reference.estimates.size());
   for (std::size_t i = 0; i < with.estimates.size(); ++i) {
@@ -291,6 +295,9 @@ TEST(IdentifySynthetic, TheDaySubsetStageEndsWhereTheFitWithoutItEnds) {
   const IdentSummary warm = Identify(c.drivers, c.meas, with.params, IdentOptions{});
   ASSERT_TRUE(warm.ok) << warm.BriefReport();
   EXPECT_EQ(warm.coarse_subset_days, 0);
+  // It ran, and its time is counted, though its optimum was not taken.
+  EXPECT_GT(warm.coarse_subset_runtime_s, 0.0);
+  EXPECT_LT(warm.coarse_subset_runtime_s, warm.coarse_runtime_s);
   EXPECT_LE(warm.final_cost_w_m2, with.final_cost_w_m2 * (1.0 + 1e-3));
 }
 
@@ -483,9 +490,10 @@ TEST(IdentifySynthetic, AParameterItsTrialKeptFreeCostsMoreWhenFixed) {
 // The time split that `calibrate --timing` and `bench table6` print: the
 // identifiability analysis (standard errors, the rounds that decide which
 // undetermined parameters to fix) is a part of the fine stage, with its
-// runs (the trial fits' on the coarse data among them), and runs nothing
-// when the fit fixes nothing by itself. 1Nwr on these data has weakly
-// determined parameters, so its rounds run the model.
+// runs (the trial fits' on the coarse data among them) and the trial fits'
+// time as a part of its own, and runs nothing when the fit fixes nothing by
+// itself. 1Nwr on these data has weakly determined parameters, so its
+// rounds run the model, a trial fit among them.
 TEST(IdentifySynthetic, TheFixingRoundsAreAPartOfTheFineStageWithTheirRuns) {
   const Plant plant = DesignExamplePlant();
   const Case c = MakeCase(plant, "2N1Ccolwr", 4, 60.0, /*seed=*/12, RealisticSensorNoise(13));
@@ -499,12 +507,17 @@ TEST(IdentifySynthetic, TheFixingRoundsAreAPartOfTheFineStageWithTheirRuns) {
   EXPECT_GT(s.fixing_evaluations, 0);
   EXPECT_LE(s.fixing_coarse_evaluations, s.fixing_evaluations);
   EXPECT_LE(s.fixing_evaluations, s.evaluations - s.coarse_evaluations);
+  // The trial fits run on the coarse data: their time is there when their
+  // runs are, and a share of the rounds' time.
+  EXPECT_EQ(s.trial_runtime_s > 0.0, s.fixing_coarse_evaluations > 0);
+  EXPECT_LT(s.trial_runtime_s, s.fixing_runtime_s);
 
   options.fix_unidentifiable = false;
   const IdentSummary f = Identify(d, meas, StartParams(plant), options);
   ASSERT_TRUE(f.ok) << f.BriefReport();
   EXPECT_EQ(f.fixing_evaluations, 0);
   EXPECT_EQ(f.fixing_coarse_evaluations, 0);
+  EXPECT_EQ(f.trial_runtime_s, 0.0);
 }
 
 // 1N sees u_front_w_m2k and u_back_w_m2k only as their sum: with the same

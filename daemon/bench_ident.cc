@@ -151,7 +151,7 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, const std::s
       "\ntime split of the default (lad_lm) at 1 min, ms (parse and write: median of %d runs; "
       "fit: the last run)\n",
       runs);
-  // As `calibrate --timing` says it: only when the day subset stage was used.
+  // As `calibrate --timing` says it: only when a fit on a day subset ran.
   const std::string subset_text = fit.CoarseSubsetText();
   const std::string subset = subset_text.empty() ? "" : ", " + subset_text;
   std::printf(

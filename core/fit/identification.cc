@@ -506,6 +506,8 @@ bool IdentOptions::IsValid(std::string* why) const {
   if (!(prior_weight_w_m2 >= 0.0))
     return fail("prior_weight_w_m2", prior_weight_w_m2, "must be >= 0");
   if (!(undetermined_se > 0.0)) return fail("undetermined_se", undetermined_se, "must be > 0");
+  if (!(polish_stop_prediction_factor >= 0.0))
+    return fail("polish_stop_prediction_factor", polish_stop_prediction_factor, "must be >= 0");
   if (min_rows < 1) return fail("min_rows", min_rows, "must be >= 1");
   if (threads < 1 || threads > 2) return fail("threads", threads, "must be 1 or 2");
   return true;
@@ -578,10 +580,12 @@ struct FitOutcome {
   Eigen::MatrixXd jacobian;  // at or near params when the method had it, else empty
 };
 
-// One fit of the active parameters from `from`.
+// One fit of the active parameters from `from`; lad_lm stops before a step
+// on `stop_prediction_factor` (LadFitOptions::stop_prediction_factor).
 FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
                   const std::vector<double>& z_ref, const ParamVector& from,
-                  const IdentOptions& options, int budget, double n_rows, double area_m2) {
+                  const IdentOptions& options, int budget, double n_rows, double area_m2,
+                  double stop_prediction_factor) {
   FitOutcome out;
   out.params = from;
   const std::vector<Param>& active = obj.free();
@@ -593,6 +597,7 @@ FitOutcome RunFit(Objective& obj, const std::vector<ParamInfo>& infos,
     lo.max_evaluations = budget;
     lo.ftol_rel = options.optimizer.ftol_rel;
     lo.xtol = options.optimizer.xtol_rel;
+    lo.stop_prediction_factor = stop_prediction_factor;
     lo.prior_weight = options.prior_weight_w_m2;
     lo.n_scale = n_rows;
     lo.threads = options.threads;
@@ -1098,9 +1103,12 @@ class FineFit {
     }
   }
 
-  // The fit from the best point so far (coarse stage or start).
+  // The fit from the best point so far (coarse stage or start); after a
+  // coarse stage a polish (IdentOptions::polish_stop_prediction_factor).
   void FitAll() {
-    fit_ = FitActive(obj_, n_rows_, active_, best_, &best_cost_);
+    fit_ = FitActive(obj_, n_rows_, active_, best_, &best_cost_, std::numeric_limits<int>::max(),
+                     trial_obj_ ? options_.polish_stop_prediction_factor
+                                : LadFitOptions{}.stop_prediction_factor);
     if (fit_.termination == Termination::kMaxEvaluations && fit_.message == "no evaluations left") {
       fit_.ok = true;  // nothing could be tried; the start stands (and is reported)
     }
@@ -1147,7 +1155,8 @@ class FineFit {
   // returns the outcome, and its data cost when data_cost is not null.
   FitOutcome FitActive(Objective& obj, double n_rows, const std::vector<bool>& act_mask,
                        const ParamVector& from_point, double* data_cost,
-                       int max_budget = std::numeric_limits<int>::max()) {
+                       int max_budget = std::numeric_limits<int>::max(),
+                       double stop_prediction_factor = LadFitOptions{}.stop_prediction_factor) {
     std::vector<Param> act;
     std::vector<ParamInfo> act_infos;
     std::vector<double> z_ref;
@@ -1173,7 +1182,8 @@ class FineFit {
       // One simulation stays reserved for the final check of the result.
       const int budget = std::min(Remaining() - 1, max_budget);
       if (budget >= 2) {
-        out = RunFit(obj, act_infos, z_ref, from, options_, budget, n_rows, area_m2_);
+        out = RunFit(obj, act_infos, z_ref, from, options_, budget, n_rows, area_m2_,
+                     stop_prediction_factor);
       } else {
         out.params = from;
         out.ok = true;

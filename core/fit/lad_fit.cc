@@ -416,7 +416,7 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     maj.Build(jac, secant, w, r, z, z_ref, o);
     const double promised = maj.Promised();
     // What the stop below asks of an undamped promise (of this cost).
-    const double small_promise = o.stop_promise_factor * o.ftol_rel * cost;
+    const double small_promise = o.stop_prediction_factor * o.ftol_rel * cost;
     // A step predicted to gain less than the stop below asks of a decrease
     // ends the fit before it is tried: the result then sits where its
     // Jacobian was taken, which the caller's identifiability analysis

@@ -34,11 +34,16 @@ struct LadFitOptions {
   // not stop a fit still walking along a curved valley, as the
   // r0_fluid/r1_fluid one is; a promise the steps keep not keeping (a flat
   // direction) holds it two steps at most. A fit also stops before a step
-  // predicted to gain less than this fraction of ftol_rel·O (the promise
-  // times the last accepted step's gain per unit of promise; at the
+  // predicted to gain less than stop_prediction_factor·ftol_rel·O (the
+  // promise times the last accepted step's gain per unit of promise; at the
   // initial weight floor only), so that it ends where its last Jacobian was
   // taken. 0 = stop on the decrease alone, and never before a step.
   double stop_promise_factor = 0.3;
+  // The fraction of ftol_rel·O below which a predicted gain stops the fit
+  // before its step (above), and below which an undamped promise is a
+  // polish that is not stretched. A fit that polishes an optimum found on
+  // coarser data takes 1 (IdentOptions::polish_stop_prediction_factor).
+  double stop_prediction_factor = 0.3;
   double xtol = 1e-7;           // … or moves z by less than this (max norm)
   double jacobian_step = 1e-4;  // forward-difference step in unit coordinates
   // δ = this × mean |r|: caps the IRLS weights 1/max(|r̂|, δ). A floor near

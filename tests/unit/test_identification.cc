@@ -520,6 +520,43 @@ TEST(IdentifySynthetic, TheFixingRoundsAreAPartOfTheFineStageWithTheirRuns) {
   EXPECT_EQ(f.trial_runtime_s, 0.0);
 }
 
+// After a coarse stage the fit on the data as given polishes its optimum
+// and ends before a step predicted to gain less than ftol_rel·O
+// (IdentOptions::polish_stop_prediction_factor 1), where a fit from the
+// start asks 0.3 of it. On these data 2N1Cpvwr (misspecified: the truth is
+// 2N1Ccolwr) walks a valley at 1 min: the polish takes fewer runs and ends
+// within 0.5 % of the cost of the fit that asks for the margin. Without a
+// coarse stage the fit starts at the start, and the factor does not apply:
+// the fit is the same to the bit.
+TEST(IdentifySynthetic, ThePolishAfterTheCoarseStageStopsBeforeAStepBelowFtol) {
+  const Plant plant = DesignExamplePlant();
+  const Case c = MakeCase(plant, "2N1Ccolwr", 10, 60.0, /*seed=*/21, RealisticSensorNoise(22));
+  const auto [d, meas] = PrepareFor(c, plant, "2N1Cpvwr");
+  IdentOptions margin;
+  margin.polish_stop_prediction_factor = LadFitOptions{}.stop_prediction_factor;
+  const IdentSummary polish = Identify(d, meas, StartParams(plant), IdentOptions{});
+  const IdentSummary tight = Identify(d, meas, StartParams(plant), margin);
+  ASSERT_TRUE(polish.ok && tight.ok) << polish.BriefReport() << "\n" << tight.BriefReport();
+  ASSERT_GT(polish.coarse_evaluations, 0);
+  // The fine stage's own fit: its runs without the coarse stage's and the
+  // fixing rounds'.
+  auto own = [](const IdentSummary& s) {
+    return s.evaluations - s.coarse_evaluations - s.fixing_evaluations;
+  };
+  EXPECT_EQ(polish.coarse_evaluations, tight.coarse_evaluations);
+  EXPECT_LT(own(polish), own(tight)) << polish.BriefReport() << "\n" << tight.BriefReport();
+  EXPECT_LE(polish.final_cost_w_m2, tight.final_cost_w_m2 * (1.0 + 5e-3));
+
+  IdentOptions no_coarse;
+  no_coarse.coarse_step_s = 0.0;
+  margin.coarse_step_s = 0.0;
+  const IdentSummary from_start = Identify(d, meas, StartParams(plant), no_coarse);
+  const IdentSummary from_start_margin = Identify(d, meas, StartParams(plant), margin);
+  ASSERT_TRUE(from_start.ok) << from_start.BriefReport();
+  EXPECT_EQ(from_start.coarse_evaluations, 0);
+  ExpectTheSameFit(from_start, from_start_margin);
+}
+
 // 1N sees u_front_w_m2k and u_back_w_m2k only as their sum: with the same
 // range, reference value and value, fixing either is the same fit with the
 // two exchanged. When a trial fit kept the first free, the second gets the

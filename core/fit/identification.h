@@ -126,8 +126,8 @@ struct IdentOptions {
   // the coarse optimum, and ends before a step predicted to gain less than
   // this fraction of ftol_rel·O. A fit from the start asks 0.3 of it, a
   // margin the polish does not need: at 1 the fine stage's own fits in the
-  // Table 6 protocol take a sixth less time, and its held-out MAEs move by
-  // at most 0.02 W/m² (core/fit/README.md). The stop on a small decrease
+  // Table 6 protocol take a fifth less time, and its mean MAEs move by at
+  // most 0.07 W/m², 0.3 % (core/fit/README.md). The stop on a small decrease
   // keeps its margin (LadFitOptions::stop_promise_factor), and the fixing
   // rounds' fits and the polish after them keep 0.3.
   double polish_stop_prediction_factor = 1.0;

@@ -415,12 +415,14 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     const double lambda_at_start = lambda;
     maj.Build(jac, secant, w, r, z, z_ref, o);
     const double promised = maj.Promised();
-    // What the stop below asks of an undamped promise (of this cost).
+    // What the stop before a step asks of a predicted gain (of this cost):
+    // stop_prediction_factor of ftol, 0.3 as the small-decrease rule below
+    // asks of a promise, 1 in a polish (LadFitOptions).
     const double small_promise = o.stop_prediction_factor * o.ftol_rel * cost;
-    // A step predicted to gain less than the stop below asks of a decrease
-    // ends the fit before it is tried: the result then sits where its
-    // Jacobian was taken, which the caller's identifiability analysis
-    // reuses, instead of one short step away. The prediction is the
+    // A step predicted to gain less than that ends the fit before it is
+    // tried: the result then sits where its Jacobian was taken, which the
+    // caller's identifiability analysis reuses, instead of one short step
+    // away. The prediction is the
     // undamped promise times what the last accepted step gained per unit
     // of its promise (the majoriser understates the gain, about 2.5 times
     // for noise-like residuals, far more while its weight floor smooths a

@@ -40,9 +40,10 @@ struct LadFitOptions {
   // taken. 0 = stop on the decrease alone, and never before a step.
   double stop_promise_factor = 0.3;
   // The fraction of ftol_rel·O below which a predicted gain stops the fit
-  // before its step (above), and below which an undamped promise is a
-  // polish that is not stretched. A fit that polishes an optimum found on
-  // coarser data takes 1 (IdentOptions::polish_stop_prediction_factor).
+  // before its step (above; only while stop_promise_factor is above 0), and
+  // below which an undamped promise is a polish that is not stretched. A
+  // fit that polishes an optimum found on coarser data takes 1
+  // (IdentOptions::polish_stop_prediction_factor).
   double stop_prediction_factor = 0.3;
   double xtol = 1e-7;           // … or moves z by less than this (max norm)
   double jacobian_step = 1e-4;  // forward-difference step in unit coordinates

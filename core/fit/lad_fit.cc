@@ -422,13 +422,13 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     // A step predicted to gain less than that ends the fit before it is
     // tried: the result then sits where its Jacobian was taken, which the
     // caller's identifiability analysis reuses, instead of one short step
-    // away. The prediction is the
-    // undamped promise times what the last accepted step gained per unit
-    // of its promise (the majoriser understates the gain, about 2.5 times
-    // for noise-like residuals, far more while its weight floor smooths a
-    // kink away); no prediction before the first accepted step, nor once
-    // the weight floor has been sharpened (the fit is then after a kink the
-    // smoothing hid, which no promise foresees).
+    // away. The prediction is the undamped promise times what the last
+    // accepted step gained per unit of its promise (the majoriser
+    // understates the gain, about 2.5 times for noise-like residuals, far
+    // more while its weight floor smooths a kink away); no prediction
+    // before the first accepted step, nor once the weight floor has been
+    // sharpened (the fit is then after a kink the smoothing hid, which no
+    // promise foresees).
     if (o.stop_promise_factor > 0.0 && floor_rel == o.weight_floor_rel &&
         promised * gain_per_promise <= small_promise) {
       res.converged = true;

@@ -415,20 +415,18 @@ LadFitResult LadFit(const ResidualFunction& residuals, const Eigen::VectorXd& z0
     const double lambda_at_start = lambda;
     maj.Build(jac, secant, w, r, z, z_ref, o);
     const double promised = maj.Promised();
-    // What the stop before a step asks of a predicted gain (of this cost):
-    // stop_prediction_factor of ftol, 0.3 as the small-decrease rule below
-    // asks of a promise, 1 in a polish (LadFitOptions).
+    // The stop before a step asks stop_prediction_factor of ftol of this cost
+    // (0.3 as the small-decrease rule asks of a promise, 1 in a polish).
     const double small_promise = o.stop_prediction_factor * o.ftol_rel * cost;
     // A step predicted to gain less than that ends the fit before it is
     // tried: the result then sits where its Jacobian was taken, which the
-    // caller's identifiability analysis reuses, instead of one short step
-    // away. The prediction is the undamped promise times what the last
-    // accepted step gained per unit of its promise (the majoriser
-    // understates the gain, about 2.5 times for noise-like residuals, far
-    // more while its weight floor smooths a kink away); no prediction
-    // before the first accepted step, nor once the weight floor has been
-    // sharpened (the fit is then after a kink the smoothing hid, which no
-    // promise foresees).
+    // caller's identifiability analysis reuses, not one short step away.
+    // The prediction is the undamped promise times what the last accepted
+    // step gained per unit of its promise (the majoriser understates the
+    // gain, about 2.5 times for noise-like residuals, far more while its
+    // weight floor smooths a kink away); none before the first accepted
+    // step, nor once the weight floor has been sharpened (the fit is then
+    // after a kink the smoothing hid, which no promise foresees).
     if (o.stop_promise_factor > 0.0 && floor_rel == o.weight_floor_rel &&
         promised * gain_per_promise <= small_promise) {
       res.converged = true;

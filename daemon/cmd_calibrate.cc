@@ -406,8 +406,9 @@ void RegisterCalibrate(CLI::App& app) {
   cmd->add_option("--ftol", args->ftol_rel,
                   "stop when an iteration lowers the MAE by less than this fraction and, for "
                   "lad_lm, its undamped step promised less than 0.3 times that, or before a "
-                  "step predicted to gain less (default 1e-3; on synthetic data 1e-4 takes "
-                  "longer for a held-out MAE within 0.05 % of the default's)")
+                  "step predicted to gain less than 0.3 times that (than this fraction itself "
+                  "in the polish after the coarse stage) (default 1e-3; on synthetic data 1e-4 "
+                  "takes longer for a held-out MAE within 0.05 % of the default's)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->threads,
                   "threads for the runs with exact derivatives, their columns split, for "

@@ -126,17 +126,42 @@ std::string PlusMinus(const ParamEstimate& e) {
   return buf;
 }
 
-// The ISO 9806 quasi-dynamic coefficients of the fit, for a datasheet.
-void PrintIsoEquivalents(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
-                         const Series& train) {
+// What the report after the fit reads of the training series, taken
+// before the fit so that the series can be released (RunCalibrate).
+struct TrainingWindow {
+  std::size_t rows = 0;
+  std::int64_t first_s = 0, last_s = 0;
+  double step_s = 0.0;
+  // The median flow of the rows with flow, NaN without any: the flow of the
+  // ISO 9806 equivalents.
+  double median_flow_kg_s = std::nan("");
+};
+
+TrainingWindow WindowOf(const Series& train) {
+  TrainingWindow w;
+  w.rows = train.size();
+  if (!train.time_s.empty()) {
+    w.first_s = train.time_s.front();
+    w.last_s = train.time_s.back();
+  }
+  w.step_s = train.step_s;
   std::vector<double> flows;
   for (const double f : train[Channel::kMdotKgS]) {
     if (f > 1e-4) flows.push_back(f);
   }
-  if (flows.empty()) return;
-  std::nth_element(flows.begin(), flows.begin() + static_cast<std::ptrdiff_t>(flows.size() / 2),
-                   flows.end());
-  const double flow_kg_s = flows[flows.size() / 2];
+  if (!flows.empty()) {
+    std::nth_element(flows.begin(), flows.begin() + static_cast<std::ptrdiff_t>(flows.size() / 2),
+                     flows.end());
+    w.median_flow_kg_s = flows[flows.size() / 2];
+  }
+  return w;
+}
+
+// The ISO 9806 quasi-dynamic coefficients of the fit, for a datasheet, at
+// the training data's median flow (none without flow).
+void PrintIsoEquivalents(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
+                         double flow_kg_s) {
+  if (std::isnan(flow_kg_s)) return;
   const Iso9806Equivalents iso = Iso9806EquivalentsOf(plant, spec, params, flow_kg_s);
   if (!iso.ok) return;
   std::printf(
@@ -219,6 +244,21 @@ std::uintmax_t FileBytes(const std::string& path) {
   return error ? 0 : bytes;
 }
 
+// The held-out data of --test-csv: its drivers and measurements, the series
+// released as the training one is (RunCalibrate). False after reporting a
+// bad file.
+bool LoadHeldOutOrReport(const CalibrateArgs& a, const Config& config, const ModelSpec& spec,
+                         StageTimes* times, Drivers* drivers, Measurements* meas) {
+  Series test;
+  if (!LoadCsvOrReport(a.test_csv, config, &test)) return false;
+  times->parse_s += times->Lap();
+  if (!ResampleOrReport(a.test_csv, a.step_s, &test)) return false;
+  if (!PrepareDriversOrReport(test, a.test_csv, config, spec, drivers)) return false;
+  *meas = MakeMeasurements(test, *drivers);
+  times->prepare_s += times->Lap();
+  return true;
+}
+
 int RunCalibrate(const CalibrateArgs& a) {
   if (!DieWithParent(a.parent_pid)) return kExitRuntime;
   Config config;
@@ -285,6 +325,14 @@ int RunCalibrate(const CalibrateArgs& a) {
   Drivers drivers;
   if (!PrepareDriversOrReport(train, a.csv, config, spec, &drivers)) return kExitBadInput;
   const Measurements meas = MakeMeasurements(train, drivers);
+  // The fit reads the drivers and the measurements only: the series is
+  // released, and its columns (some 30 MB for 14 days at 5 s) are the room
+  // the held-out data and the fit's Jacobians are carved from, where fresh
+  // pages would each have to be faulted in and cleared (UseHugePageHeap
+  // keeps freed memory; README, "Identification").
+  const TrainingWindow window = WindowOf(train);
+  train = Series{};
+  series = Series{};
   times.prepare_s += times.Lap();
   if (static_cast<int>(meas.rows.size()) < options.min_rows) {
     std::cerr << a.csv << ": training window " << FormatIsoUtc(t_begin) << " .. "
@@ -296,33 +344,28 @@ int RunCalibrate(const CalibrateArgs& a) {
   }
 
   // Held-out data, checked before the (long) fit.
-  Series test;
   Drivers test_drivers;
-  if (!a.test_csv.empty()) {
-    if (!LoadCsvOrReport(a.test_csv, config, &test)) return kExitBadInput;
-    times.parse_s += times.Lap();
-    if (!ResampleOrReport(a.test_csv, a.step_s, &test)) return kExitBadInput;
-    if (!PrepareDriversOrReport(test, a.test_csv, config, spec, &test_drivers)) {
-      return kExitBadInput;
-    }
-    times.prepare_s += times.Lap();
+  Measurements test_meas;
+  if (!a.test_csv.empty() &&
+      !LoadHeldOutOrReport(a, config, spec, &times, &test_drivers, &test_meas)) {
+    return kExitBadInput;
   }
 
   std::fprintf(stderr, "calibrating %s on %zu rows (%zu in the objective) of %s ...\n",
-               spec.Name().c_str(), train.size(), meas.rows.size(), a.csv.c_str());
+               spec.Name().c_str(), window.rows, meas.rows.size(), a.csv.c_str());
   times.Lap();
   const IdentSummary summary = Identify(drivers, meas, start, options);
   times.Lap();
   std::printf("%s\n", summary.BriefReport().c_str());
   std::printf("training data: %s, %s .. %s, step %.0f s\n", a.csv.c_str(),
-              FormatIsoUtc(train.time_s.front()).c_str(), FormatIsoUtc(train.time_s.back()).c_str(),
-              train.step_s);
+              FormatIsoUtc(window.first_s).c_str(), FormatIsoUtc(window.last_s).c_str(),
+              window.step_s);
   PrintErrors("errors (training):", summary.train, config.plant.area_m2);
   ErrorMetrics held_out;
   if (!a.test_csv.empty()) {
     SimOutputs sim;
     Simulate(test_drivers, summary.params, &sim);
-    held_out = ComputeErrors(MakeMeasurements(test, test_drivers), sim, config.plant.area_m2);
+    held_out = ComputeErrors(test_meas, sim, config.plant.area_m2);
     PrintErrors("errors (held out):", held_out, config.plant.area_m2);
     times.held_out_s = times.Lap();
   }
@@ -336,7 +379,7 @@ int RunCalibrate(const CalibrateArgs& a) {
                 e.value, PlusMinus(e).c_str(), std::string(info.unit).c_str(), e.start, range,
                 StatusOf(e).c_str());
   }
-  if (summary.ok) PrintIsoEquivalents(config.plant, spec, summary.params, train);
+  if (summary.ok) PrintIsoEquivalents(config.plant, spec, summary.params, window.median_flow_kg_s);
   for (const std::string& note : summary.notes) std::printf("note: %s\n", note.c_str());
   if (!summary.ok) {
     if (a.timing) PrintTiming(times, summary);

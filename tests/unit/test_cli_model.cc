@@ -1,7 +1,9 @@
 // pvtwin simulate and calibrate, run as real processes on the htw saar data.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -175,6 +177,96 @@ TEST_F(CliModel, CalibratePrintsParametersAtTheirBound) {
   EXPECT_EQ(lower[0].rfind("  eps_pvt ", 0), 0u) << lower[0];
   EXPECT_NE(lower[0].find(" 0.075 "), std::string::npos) << lower[0];
   EXPECT_NE(lower[0].find("at lower bound"), std::string::npos) << lower[0];
+}
+
+// calibrate releases the series it read before the fit (its working set
+// at 5 s); what it reports after the fit comes from the training window's
+// own rows and from the held-out file's. The training copy of day 3 has
+// twice the flow outside the window, in most of its rows: the ISO 9806
+// line's flow must be the window's median, not the file's. The held-out
+// errors on day 1 must be those of `simulate` on day 1 with the written
+// parameters, over the rows that a fit on day 1 itself counts.
+TEST_F(CliModel, CalibrateReportsTheWindowAndTheHeldOutDataFromTheirOwnRows) {
+  const std::string window_start = "2017-07-25T12:00:00Z", window_end = "2017-07-25T16:00:00Z";
+  std::vector<std::string> window_times;
+  std::vector<double> window_flows;
+  {
+    const std::vector<std::string> lines = Lines(ReadFile(kData / "day3_clear_medium_dT.csv"));
+    std::ofstream out(dir_ / "train.csv");
+    out << lines[0] << "\n";
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+      std::vector<std::string> cells;
+      std::istringstream row(lines[i]);
+      for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+      const bool inside = cells[0] >= window_start && cells[0] < window_end;  // ISO, one format
+      const double flow = std::stod(cells[3]);
+      if (inside) {
+        window_times.push_back(cells[0]);
+        if (flow > 1e-4) window_flows.push_back(flow);
+      } else {
+        cells[3] = std::to_string(2.0 * flow);
+      }
+      for (std::size_t c = 0; c < cells.size(); ++c) out << (c ? "," : "") << cells[c];
+      out << "\n";
+    }
+    ASSERT_GT(2 * window_times.size(), 30u);
+    ASSERT_LT(2 * window_times.size(), lines.size() - 1);  // most rows lie outside
+  }
+  std::sort(window_flows.begin(), window_flows.end());
+  char flow_text[64];
+  std::snprintf(flow_text, sizeof flow_text, "flow %.3g kg/s",
+                window_flows[window_flows.size() / 2]);
+
+  const ProcessResult run = RunPvtwin(
+      dir_, "calibrate --config " + Data("plant.toml") + " --csv train.csv --variant 1N1Cwr" +
+                " --train-start " + window_start + " --train-end " + window_end + " --test-csv " +
+                Data("day1_clear_low_dT.csv") + " --out params.json");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  EXPECT_NE(run.err.find("calibrating 1N1Cwr on " + std::to_string(window_times.size()) + " rows"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.out.find("training data: train.csv, " + window_times.front() + " .. " +
+                         window_times.back() + ", step 120 s"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find(flow_text), std::string::npos) << flow_text << "\n" << run.out;
+
+  // The held-out line: MAE P_el from simulate's predictions on day 1, and
+  // the rows a fit on day 1 counts in its training line.
+  const ProcessResult sim = RunPvtwin(
+      dir_, "simulate --config " + Data("plant.toml") + " --csv " + Data("day1_clear_low_dT.csv") +
+                " --variant 1N1Cwr --params params.json --out pred.csv");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const std::vector<std::string> meas = Lines(ReadFile(kData / "day1_clear_low_dT.csv"));
+  const std::vector<std::string> pred = Lines(ReadFile(dir_ / "pred.csv"));
+  ASSERT_EQ(meas.size(), pred.size());
+  double sum = 0.0;
+  int rows = 0;
+  for (std::size_t i = 1; i < meas.size(); ++i) {
+    std::vector<std::string> m, p;
+    std::istringstream ms(meas[i]), ps(pred[i]);
+    for (std::string cell; std::getline(ms, cell, ',');) m.push_back(cell);
+    for (std::string cell; std::getline(ps, cell, ',');) p.push_back(cell);
+    if (m.back() != "1") continue;                         // valid
+    sum += std::fabs(std::stod(p[1]) - std::stod(m[10]));  // p_el_w
+    ++rows;
+  }
+  const std::string day1_fit =
+      RunPvtwin(dir_, "calibrate --config " + Data("plant.toml") + " --csv " +
+                          Data("day1_clear_low_dT.csv") + " --variant 1N1Cwr")
+          .out;
+  const std::size_t counted = day1_fit.find(" rows\n");
+  ASSERT_NE(counted, std::string::npos) << day1_fit;
+  const std::string day1_rows = day1_fit.substr(day1_fit.rfind(' ', counted - 1) + 1,
+                                                counted - day1_fit.rfind(' ', counted - 1) - 1);
+  char held_out[96];
+  std::snprintf(held_out, sizeof held_out, "errors (held out):         MAE P_el %.2f W",
+                sum / rows);
+  const std::size_t line = run.out.find(held_out);
+  ASSERT_NE(line, std::string::npos) << held_out << "\n" << run.out;
+  const std::string held_out_line = run.out.substr(line, run.out.find('\n', line) - line);
+  EXPECT_TRUE(held_out_line.ends_with("; " + day1_rows + " rows")) << held_out_line << "\n"
+                                                                   << day1_fit;
 }
 
 TEST_F(CliModel, CalibrateOnTooLittleDataExitsTwo) {

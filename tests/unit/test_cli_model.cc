@@ -37,6 +37,34 @@ std::vector<std::string> Lines(const std::string& text) {
   return lines;
 }
 
+// The MAE of P_el in W over the valid rows of the htw saar file `day`: the
+// predictions of `simulate` with dir/params.json against the measured column.
+double SimulatedMaePElW(const fs::path& dir, const std::string& day, const std::string& variant) {
+  const std::string csv = "'" + (kData / day).string() + "'";
+  const ProcessResult run =
+      RunPvtwin(dir, "simulate --config '" + (kData / "plant.toml").string() + "' --csv " + csv +
+                         " --variant " + variant + " --params params.json --out pred.csv");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  const std::vector<std::string> meas = Lines(ReadFile(kData / day));
+  const std::vector<std::string> pred = Lines(ReadFile(dir / "pred.csv"));
+  EXPECT_EQ(meas.size(), pred.size());
+  double sum = 0.0;
+  int rows = 0;
+  for (std::size_t i = 1; i < meas.size() && i < pred.size(); ++i) {
+    std::vector<double> m, p;  // the cells after the time
+    std::istringstream ms(meas[i]), ps(pred[i]);
+    std::string cell;
+    std::getline(ms, cell, ',');
+    while (std::getline(ms, cell, ',')) m.push_back(std::stod(cell));
+    std::getline(ps, cell, ',');
+    while (std::getline(ps, cell, ',')) p.push_back(std::stod(cell));
+    if (m.back() != 1.0) continue;  // valid
+    sum += std::fabs(p[0] - m[9]);  // p_el_w
+    ++rows;
+  }
+  return sum / rows;
+}
+
 TEST_F(CliModel, SimulateWritesTheCanonicalPredictionColumns) {
   const ProcessResult run =
       RunPvtwin(dir_, "simulate --config " + Data("plant.toml") + " --csv " +
@@ -103,30 +131,9 @@ TEST_F(CliModel, CalibrateThenSimulateRoundTrip) {
   EXPECT_NE(params.find("\"algorithm\": \"lad_lm\""), std::string::npos) << params;
   EXPECT_NE(params.find("\"train\": {"), std::string::npos) << params;
 
-  run = RunPvtwin(dir_, "simulate --config " + Data("plant.toml") + " --csv " +
-                            Data("day3_clear_medium_dT.csv") +
-                            " --variant 1N1Cwr --params params.json --out pred.csv");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  // The training MAE of P_el printed by calibrate is reproduced from pred.csv
-  // over the valid rows.
-  const std::vector<std::string> meas = Lines(ReadFile(kData / "day3_clear_medium_dT.csv"));
-  const std::vector<std::string> pred = Lines(ReadFile(dir_ / "pred.csv"));
-  ASSERT_EQ(meas.size(), pred.size());
-  double sum = 0.0;
-  int rows = 0;
-  for (std::size_t i = 1; i < meas.size(); ++i) {
-    std::vector<double> m, p;
-    std::istringstream ms(meas[i]), ps(pred[i]);
-    std::string cell;
-    std::getline(ms, cell, ',');
-    while (std::getline(ms, cell, ',')) m.push_back(std::stod(cell));
-    std::getline(ps, cell, ',');
-    while (std::getline(ps, cell, ',')) p.push_back(std::stod(cell));
-    if (m.back() != 1.0) continue;  // valid
-    sum += std::fabs(p[0] - m[9]);  // p_el_w
-    ++rows;
-  }
-  const double mae_w = sum / rows;
+  // The training MAE of P_el printed by calibrate is reproduced from
+  // simulate's predictions over the valid rows.
+  const double mae_w = SimulatedMaePElW(dir_, "day3_clear_medium_dT.csv", "1N1Cwr");
   char expected[64];
   std::snprintf(expected, sizeof(expected), "MAE P_el %.2f W (%.2f W/m²)", mae_w, mae_w / 1.66);
   const std::string calib =
@@ -233,24 +240,7 @@ TEST_F(CliModel, CalibrateReportsTheWindowAndTheHeldOutDataFromTheirOwnRows) {
 
   // The held-out line: MAE P_el from simulate's predictions on day 1, and
   // the rows a fit on day 1 counts in its training line.
-  const ProcessResult sim = RunPvtwin(
-      dir_, "simulate --config " + Data("plant.toml") + " --csv " + Data("day1_clear_low_dT.csv") +
-                " --variant 1N1Cwr --params params.json --out pred.csv");
-  ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const std::vector<std::string> meas = Lines(ReadFile(kData / "day1_clear_low_dT.csv"));
-  const std::vector<std::string> pred = Lines(ReadFile(dir_ / "pred.csv"));
-  ASSERT_EQ(meas.size(), pred.size());
-  double sum = 0.0;
-  int rows = 0;
-  for (std::size_t i = 1; i < meas.size(); ++i) {
-    std::vector<std::string> m, p;
-    std::istringstream ms(meas[i]), ps(pred[i]);
-    for (std::string cell; std::getline(ms, cell, ',');) m.push_back(cell);
-    for (std::string cell; std::getline(ps, cell, ',');) p.push_back(cell);
-    if (m.back() != "1") continue;                         // valid
-    sum += std::fabs(std::stod(p[1]) - std::stod(m[10]));  // p_el_w
-    ++rows;
-  }
+  const double mae_w = SimulatedMaePElW(dir_, "day1_clear_low_dT.csv", "1N1Cwr");
   const std::string day1_fit =
       RunPvtwin(dir_, "calibrate --config " + Data("plant.toml") + " --csv " +
                           Data("day1_clear_low_dT.csv") + " --variant 1N1Cwr")
@@ -260,8 +250,7 @@ TEST_F(CliModel, CalibrateReportsTheWindowAndTheHeldOutDataFromTheirOwnRows) {
   const std::string day1_rows = day1_fit.substr(day1_fit.rfind(' ', counted - 1) + 1,
                                                 counted - day1_fit.rfind(' ', counted - 1) - 1);
   char held_out[96];
-  std::snprintf(held_out, sizeof held_out, "errors (held out):         MAE P_el %.2f W",
-                sum / rows);
+  std::snprintf(held_out, sizeof held_out, "errors (held out):         MAE P_el %.2f W", mae_w);
   const std::size_t line = run.out.find(held_out);
   ASSERT_NE(line, std::string::npos) << held_out << "\n" << run.out;
   const std::string held_out_line = run.out.substr(line, run.out.find('\n', line) - line);

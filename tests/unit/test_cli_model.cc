@@ -23,9 +23,12 @@ using testing::RunPvtwin;
 
 const fs::path kData = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
 
+// The htw saar file `name` as a quoted command-line argument.
+std::string DataArg(const std::string& name) { return "'" + (kData / name).string() + "'"; }
+
 class CliModel : public ::testing::Test {
  protected:
-  std::string Data(const char* name) const { return "'" + (kData / name).string() + "'"; }
+  std::string Data(const char* name) const { return DataArg(name); }
   testing::ScratchDir scratch_{"cli_model"};
   const fs::path dir_ = scratch_.path();
 };
@@ -40,9 +43,8 @@ std::vector<std::string> Lines(const std::string& text) {
 // The MAE of P_el in W over the valid rows of the htw saar file `day`: the
 // predictions of `simulate` with dir/params.json against the measured column.
 double SimulatedMaePElW(const fs::path& dir, const std::string& day, const std::string& variant) {
-  const std::string csv = "'" + (kData / day).string() + "'";
   const ProcessResult run =
-      RunPvtwin(dir, "simulate --config '" + (kData / "plant.toml").string() + "' --csv " + csv +
+      RunPvtwin(dir, "simulate --config " + DataArg("plant.toml") + " --csv " + DataArg(day) +
                          " --variant " + variant + " --params params.json --out pred.csv");
   EXPECT_EQ(run.exit_code, 0) << run.err;
   const std::vector<std::string> meas = Lines(ReadFile(kData / day));
@@ -247,8 +249,8 @@ TEST_F(CliModel, CalibrateReportsTheWindowAndTheHeldOutDataFromTheirOwnRows) {
           .out;
   const std::size_t counted = day1_fit.find(" rows\n");
   ASSERT_NE(counted, std::string::npos) << day1_fit;
-  const std::string day1_rows = day1_fit.substr(day1_fit.rfind(' ', counted - 1) + 1,
-                                                counted - day1_fit.rfind(' ', counted - 1) - 1);
+  const std::size_t count_from = day1_fit.rfind(' ', counted - 1) + 1;
+  const std::string day1_rows = day1_fit.substr(count_from, counted - count_from);
   char held_out[96];
   std::snprintf(held_out, sizeof held_out, "errors (held out):         MAE P_el %.2f W", mae_w);
   const std::size_t line = run.out.find(held_out);

@@ -51,4 +51,14 @@ void RunBoth(const std::function<void()>& first, const std::function<void()>& se
   if (second_failure) std::rethrow_exception(second_failure);
 }
 
+void ForRowHalves(std::size_t n, std::size_t min_rows,
+                  const std::function<void(std::size_t, std::size_t)>& f) {
+  if (n < min_rows || std::thread::hardware_concurrency() < 2) {
+    f(0, n);
+    return;
+  }
+  const std::size_t half = n / 2;
+  RunBoth([&] { f(0, half); }, [&] { f(half, n); });
+}
+
 }  // namespace pvtwin

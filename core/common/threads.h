@@ -3,6 +3,7 @@
 // on a plant controller at its thread limit), on fewer threads.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 
 namespace pvtwin {
@@ -16,5 +17,13 @@ void RunOnThreads(unsigned threads, const std::function<void()>& worker);
 // one, first() first, when the system refuses the thread. An exception of
 // either is thrown here once both have ended (first()'s when both throw).
 void RunBoth(const std::function<void()>& first, const std::function<void()>& second);
+
+// f(begin, end) over the rows [0, n): the first half on a helper thread
+// and the second on this one when n ≥ min_rows and the machine has two
+// cores, else f(0, n) here. For row-local work (each row's results read
+// that row's inputs only), whose result is then the same to the bit: each
+// row's arithmetic does not depend on its thread.
+void ForRowHalves(std::size_t n, std::size_t min_rows,
+                  const std::function<void(std::size_t, std::size_t)>& f);
 
 }  // namespace pvtwin

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/common/calendar.h"
+#include "core/common/threads.h"
 #include "core/common/units.h"
 #include "core/model/irradiance_drivers.h"
 #include "core/model/thermal_model.h"
@@ -44,29 +45,32 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
   d->g_beam_w_m2.assign(n, nan);
   d->g_ref_w_m2.assign(n, nan);
   const bool have_horizontal = s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2);
-  for (std::size_t i = 0; i < n; ++i) {
-    d->sun_azimuth_rad[i] = sun[i].azimuth_rad;
-    d->sun_elevation_rad[i] = sun[i].elevation_rad;
-    const double aoi_rad = d->aoi_rad[i];
-    double beam_w_m2 = nan;
-    if (have_horizontal) {
-      IsotropicSkyInput h;
-      h.ghi_w_m2 = s[Channel::kGhiWM2][i];
-      h.dhi_w_m2 = s[Channel::kDhiWM2][i];
-      h.zenith_rad = sun[i].zenith_rad;
-      h.aoi_rad = aoi_rad;
-      h.tilt_rad = plant.tilt_rad;
-      h.ground_albedo = plant.ground_albedo;
-      const PoaComponents poa = TransposeIsotropicSky(h);
-      d->g_ref_w_m2[i] = poa.global_w_m2();
-      beam_w_m2 = poa.beam_w_m2;
+  // Row-local: split between two threads for a long series (ForRowHalves).
+  ForRowHalves(n, kRowsToSplit, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      d->sun_azimuth_rad[i] = sun[i].azimuth_rad;
+      d->sun_elevation_rad[i] = sun[i].elevation_rad;
+      const double aoi_rad = d->aoi_rad[i];
+      double beam_w_m2 = nan;
+      if (have_horizontal) {
+        IsotropicSkyInput h;
+        h.ghi_w_m2 = s[Channel::kGhiWM2][i];
+        h.dhi_w_m2 = s[Channel::kDhiWM2][i];
+        h.zenith_rad = sun[i].zenith_rad;
+        h.aoi_rad = aoi_rad;
+        h.tilt_rad = plant.tilt_rad;
+        h.ground_albedo = plant.ground_albedo;
+        const PoaComponents poa = TransposeIsotropicSky(h);
+        d->g_ref_w_m2[i] = poa.global_w_m2();
+        beam_w_m2 = poa.beam_w_m2;
+      }
+      const double g_poa = s.At(Channel::kGPoaWM2, i);
+      const double diffuse = s.At(Channel::kGPoaDiffuseWM2, i);
+      if (!std::isnan(g_poa) && !std::isnan(diffuse)) beam_w_m2 = std::max(0.0, g_poa - diffuse);
+      if (spec.iam) beam_w_m2 *= IamSoukaSafwat(aoi_rad, plant.iam_b0);
+      d->g_beam_w_m2[i] = beam_w_m2;
     }
-    const double g_poa = s.At(Channel::kGPoaWM2, i);
-    const double diffuse = s.At(Channel::kGPoaDiffuseWM2, i);
-    if (!std::isnan(g_poa) && !std::isnan(diffuse)) beam_w_m2 = std::max(0.0, g_poa - diffuse);
-    if (spec.iam) beam_w_m2 *= IamSoukaSafwat(aoi_rad, plant.iam_b0);
-    d->g_beam_w_m2[i] = beam_w_m2;
-  }
+  });
   SetCleaningTimes({}, d);
 }
 
@@ -290,35 +294,34 @@ bool PrepareCheckedDrivers(const Series& s, const Plant& plant, const ModelSpec&
   }
 
   out.ln_wind.assign(n, 0.0);
-  if (spec.ReadsWind()) {
-    const auto& wind = s[Channel::kWindMS];
-    for (std::size_t i = 0; i < n; ++i) {
-      out.ln_wind[i] = wind[i] > 0.0 ? std::log(wind[i])
-                                     : (wind[i] == 0.0 || wind[i] < 0.0
-                                            ? -std::numeric_limits<double>::infinity()
-                                            : wind[i]);  // NaN stays NaN
-    }
-  }
   out.t_sky_k4.assign(n, 0.0);
-  if (spec.sky) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t_sky_k = CToK(out.t_sky_c[i]);
-      out.t_sky_k4[i] = t_sky_k * t_sky_k * t_sky_k * t_sky_k;
+  const std::vector<double>* wind = spec.ReadsWind() ? &s[Channel::kWindMS] : nullptr;
+  // Row-local: split between two threads for a long series (ForRowHalves).
+  ForRowHalves(n, kRowsToSplit, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (wind != nullptr) {
+        const double v = (*wind)[i];
+        out.ln_wind[i] = v > 0.0 ? std::log(v)
+                                 : (v == 0.0 || v < 0.0 ? -std::numeric_limits<double>::infinity()
+                                                        : v);  // NaN stays NaN
+      }
+      if (spec.sky) {
+        const double t_sky_k = CToK(out.t_sky_c[i]);
+        out.t_sky_k4[i] = t_sky_k * t_sky_k * t_sky_k * t_sky_k;
+      }
+      const double inputs[] = {
+          out.t_in_c[i],
+          out.mdot_kg_s[i],
+          out.t_amb_c[i],
+          out.t_back_c[i],
+          out.g_poa_w_m2[i],
+          out.g_abs_w_m2[i],
+          out.ln_wind[i] == -std::numeric_limits<double>::infinity() ? 0.0 : out.ln_wind[i],
+          out.t_sky_k4[i]};
+      out.usable[i] = std::all_of(std::begin(inputs), std::end(inputs),
+                                  [](double x) { return std::isfinite(x); });
     }
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const double inputs[] = {
-        out.t_in_c[i],
-        out.mdot_kg_s[i],
-        out.t_amb_c[i],
-        out.t_back_c[i],
-        out.g_poa_w_m2[i],
-        out.g_abs_w_m2[i],
-        out.ln_wind[i] == -std::numeric_limits<double>::infinity() ? 0.0 : out.ln_wind[i],
-        out.t_sky_k4[i]};
-    out.usable[i] = std::all_of(std::begin(inputs), std::end(inputs),
-                                [](double v) { return std::isfinite(v); });
-  }
+  });
   *d = std::move(out);
   return true;
 }
@@ -350,10 +353,12 @@ std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::s
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (note != nullptr) note->clear();
   std::vector<double> measured(n, nan), estimated(n, nan);
-  for (std::size_t i = 0; i < n; ++i) {
-    measured[i] = MeasuredSkyTemperatureC(s, i);
-    estimated[i] = KToC(SwinbankSkyTemperatureK(CToK(s.At(Channel::kTAmbC, i))));
-  }
+  ForRowHalves(n, kRowsToSplit, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      measured[i] = MeasuredSkyTemperatureC(s, i);
+      estimated[i] = KToC(SwinbankSkyTemperatureK(CToK(s.At(Channel::kTAmbC, i))));
+    }
+  });
   const char* kHow = "the sky temperature is estimated from the air temperature (Swinbank 1963)";
   if (plant.sky == SkySource::kMeasured) return measured;
   if (plant.sky == SkySource::kEstimated) {

@@ -4,8 +4,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/common/units.h"
@@ -348,6 +351,112 @@ TEST(Irradiance, ASliceWithItsPartOfTheSeriesSunPreparesAsTheSliceAlone) {
     Drivers wrong;
     EXPECT_FALSE(PrepareDrivers(slice, plant, spec, part.first(part.size() - 1), &wrong, &error));
     EXPECT_NE(error.find("2799 sun positions for 2800 rows"), std::string::npos) << error;
+  }
+}
+
+// PrepareDrivers splits its row-local work on a long series between two
+// threads (ForRowHalves): each row's drivers must be those of a slice
+// prepared alone on one thread, to the bit, in both halves and across the
+// seam (5 days at 5 s, the seam at noon of day 2; slices of 5000 rows, some
+// 7 hours of daylight each). Rows with a gap in g_poa (transposed from GHI
+// and DHI), calm wind (ln 0) and a missing inlet temperature (not usable)
+// take the loops' other branches; the sky temperature is measured or
+// estimated, as [plant] sky says, so that it too is row-local.
+TEST(Irradiance, TheDriversOfALongSeriesAreThoseOfItsSlicesPreparedAlone) {
+  Plant plant = DesignExamplePlant();
+  WeatherOptions weather;
+  weather.num_days = 5;
+  weather.step_s = 5.0;
+  weather.seed = 4;
+  const ParamVector truth = ReferenceTruthParams(plant);
+  Series s =
+      MakeSyntheticPlantData(plant, weather, testing::SpecOf("2N1CcolwrI"), truth, SensorNoise{});
+  ASSERT_GE(s.size(), kRowsToSplit);
+  ASSERT_TRUE(s.Has(Channel::kGhiWM2) && s.Has(Channel::kDhiWM2) && s.Has(Channel::kWindMS));
+  const std::size_t n_all = s.size();
+  const std::size_t seam = n_all / 2;
+  const std::size_t slices[] = {6000, seam - 2500, n_all - 10000};
+  for (std::size_t at :
+       {std::size_t{8000}, seam - 2000, seam - 1, seam, seam + 1500, n_all - 8000}) {
+    std::size_t sunny = at;  // the first sunny row from `at` on
+    while (sunny + 1 < n_all && !(s[Channel::kGPoaWM2][sunny] > 200.0)) ++sunny;
+    s[Channel::kGPoaWM2][sunny] = std::nan("");
+    s[Channel::kWindMS][at] = 0.0;
+    s[Channel::kTInC][at + 3] = std::nan("");
+  }
+  // "" when whole[begin + i] and alone[i] have the same bits for every i
+  // (or both are empty: a field the variant does not fill), else the first
+  // row that differs.
+  auto differs = [](const auto& whole, const auto& alone, std::size_t begin) -> std::string {
+    if (whole.empty() && alone.empty()) return "";
+    if (whole.size() < begin + alone.size() || alone.empty()) return "too few rows";
+    for (std::size_t i = 0; i < alone.size(); ++i) {
+      const auto w = whole[begin + i];
+      const auto a = alone[i];
+      if (std::memcmp(&w, &a, sizeof(w)) != 0) {
+        return "row " + std::to_string(begin + i) + ": " + std::to_string(w) + " against " +
+               std::to_string(a);
+      }
+    }
+    return "";
+  };
+  struct Case {
+    const char* variant;
+    SkySource sky;
+  };
+  for (const Case c :
+       {Case{"2N1CcolwrI", SkySource::kMeasured}, Case{"1Nwr", SkySource::kEstimated}}) {
+    SCOPED_TRACE(c.variant);
+    plant.sky = c.sky;
+    const ModelSpec spec = testing::SpecOf(c.variant);
+    Drivers whole;
+    std::string error;
+    ASSERT_TRUE(PrepareDrivers(s, plant, spec, &whole, &error)) << error;
+    std::size_t transposed = 0, calm = 0, unusable = 0;
+    for (const std::size_t begin : slices) {
+      const std::size_t end = begin + 5000;
+      SCOPED_TRACE(begin);
+      ASSERT_LT(end - begin, kSunRowsToSplit);
+      Drivers alone;
+      ASSERT_TRUE(PrepareDrivers(s.Slice(begin, end), plant, spec, &alone, &error)) << error;
+      const std::size_t n = end - begin;
+      const std::pair<const char*, std::vector<double> Drivers::*> fields[] = {
+          {"aoi_rad", &Drivers::aoi_rad},
+          {"g_poa_w_m2", &Drivers::g_poa_w_m2},
+          {"g_abs_w_m2", &Drivers::g_abs_w_m2},
+          {"sun_azimuth_rad", &Drivers::sun_azimuth_rad},
+          {"sun_elevation_rad", &Drivers::sun_elevation_rad},
+          {"g_beam_w_m2", &Drivers::g_beam_w_m2},
+          {"g_ref_w_m2", &Drivers::g_ref_w_m2},
+          {"t_sky_c", &Drivers::t_sky_c},
+          {"wind_m_s", &Drivers::wind_m_s},
+          {"ln_wind", &Drivers::ln_wind},
+          {"t_sky_k4", &Drivers::t_sky_k4},
+          {"capacity_flow_w_k", &Drivers::capacity_flow_w_k}};
+      for (const auto& [name, field] : fields) {
+        EXPECT_EQ(differs(whole.*field, alone.*field, begin), "") << name;
+      }
+      const Drivers::IamParts& w = whole.iam_parts;
+      const Drivers::IamParts& a = alone.iam_parts;
+      EXPECT_EQ(w.beam_w_m2.empty(), !spec.iam);
+      EXPECT_EQ(a.beam_w_m2.empty(), !spec.iam);
+      EXPECT_EQ(differs(w.beam_w_m2, a.beam_w_m2, begin), "");
+      EXPECT_EQ(differs(w.sky_w_m2, a.sky_w_m2, begin), "");
+      EXPECT_EQ(differs(w.ground_w_m2, a.ground_w_m2, begin), "");
+      EXPECT_EQ(differs(w.beam_excess, a.beam_excess, begin), "");
+      EXPECT_EQ(differs(w.paper_k_beam, a.paper_k_beam, begin), "");
+      EXPECT_EQ(differs(whole.usable, alone.usable, begin), "") << "usable";
+      for (std::size_t i = 0; i < n; ++i) {
+        transposed += std::isnan(s[Channel::kGPoaWM2][begin + i]) && alone.g_poa_w_m2[i] > 0.0;
+        calm += alone.ln_wind[i] == -std::numeric_limits<double>::infinity();
+        unusable += alone.usable[i] == 0;
+      }
+    }
+    // The loops' other branches were taken: transposed sun, calm rows (both
+    // variants read the wind), unusable rows.
+    EXPECT_GE(transposed, 3U);
+    EXPECT_GE(calm, 3U);
+    EXPECT_GE(unusable, 3U);
   }
 }
 

@@ -21,7 +21,8 @@ namespace pvtwin {
 // below which they gain less than the helper thread's start costs: with
 // them split from 8192 rows the prepare stage of `pvtwin calibrate
 // --timing` on 14 days at 1 min took 8.8 ms against 8.3 ms (medians of 15,
-// alternated), and at 5 s 73.6 against 81.0 ms (of 11).
+// alternated); split from this, 14 days at 5 s took 76.6 against 87.5 ms
+// (of 25; README, "Identification").
 inline constexpr std::size_t kSunRowsToSplit = 8192;
 inline constexpr std::size_t kRowsToSplit = 65536;
 

@@ -53,14 +53,7 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
       const double aoi_rad = d->aoi_rad[i];
       double beam_w_m2 = nan;
       if (have_horizontal) {
-        IsotropicSkyInput h;
-        h.ghi_w_m2 = s[Channel::kGhiWM2][i];
-        h.dhi_w_m2 = s[Channel::kDhiWM2][i];
-        h.zenith_rad = sun[i].zenith_rad;
-        h.aoi_rad = aoi_rad;
-        h.tilt_rad = plant.tilt_rad;
-        h.ground_albedo = plant.ground_albedo;
-        const PoaComponents poa = TransposeIsotropicSky(h);
+        const PoaComponents poa = TransposeRowIsotropicSky(s, plant, i, sun[i], aoi_rad);
         d->g_ref_w_m2[i] = poa.global_w_m2();
         beam_w_m2 = poa.beam_w_m2;
       }

@@ -35,6 +35,18 @@ std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant) 
   return sun;
 }
 
+PoaComponents TransposeRowIsotropicSky(const Series& s, const Plant& plant, std::size_t i,
+                                       const SolarPosition& sun, double aoi_rad) {
+  IsotropicSkyInput h;
+  h.ghi_w_m2 = s[Channel::kGhiWM2][i];
+  h.dhi_w_m2 = s[Channel::kDhiWM2][i];
+  h.zenith_rad = sun.zenith_rad;
+  h.aoi_rad = aoi_rad;
+  h.tilt_rad = plant.tilt_rad;
+  h.ground_albedo = plant.ground_albedo;
+  return TransposeIsotropicSky(h);
+}
+
 std::vector<double> AoiAtRows(const Series& s, const Plant& plant,
                               std::span<const SolarPosition> sun) {
   assert(sun.size() == s.size());
@@ -87,14 +99,7 @@ void ComputeIrradianceDrivers(const Series& s, const Plant& plant, const ModelSp
         poa = SplitMeasuredPoa(m);
         (*g_poa_w_m2)[i] = measured;
       } else if (have_horizontal) {
-        IsotropicSkyInput h;
-        h.ghi_w_m2 = s[Channel::kGhiWM2][i];
-        h.dhi_w_m2 = s[Channel::kDhiWM2][i];
-        h.zenith_rad = sun[i].zenith_rad;
-        h.aoi_rad = aoi_rad;
-        h.tilt_rad = plant.tilt_rad;
-        h.ground_albedo = plant.ground_albedo;
-        poa = TransposeIsotropicSky(h);
+        poa = TransposeRowIsotropicSky(s, plant, i, sun[i], aoi_rad);
         (*g_poa_w_m2)[i] = poa.global_w_m2();
       } else {
         continue;  // no irradiance for this row

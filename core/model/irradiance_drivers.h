@@ -11,6 +11,7 @@
 #include "core/common/plant.h"
 #include "core/common/series.h"
 #include "core/model/variant.h"
+#include "core/physics/irradiance.h"
 #include "core/physics/solar_position.h"
 
 namespace pvtwin {
@@ -29,6 +30,12 @@ inline constexpr std::size_t kRowsToSplit = 65536;
 // Sun position at the middle of each row (a row is the mean over
 // [t_k, t_k + step)), at the plant's site.
 std::vector<SolarPosition> SunAtRowMiddles(const Series& s, const Plant& plant);
+
+// Row i's GHI and DHI transposed to the collector plane (isotropic sky,
+// paper 2.5) with the sun `sun` and the angle of incidence `aoi_rad`; the
+// series must have both columns.
+PoaComponents TransposeRowIsotropicSky(const Series& s, const Plant& plant, std::size_t i,
+                                       const SolarPosition& sun, double aoi_rad);
 
 // Angle of incidence on the collector per row: the measured aoi where the
 // series has one, else from `sun` (SunAtRowMiddles).

@@ -20,10 +20,10 @@ namespace pvtwin {
 // threads (ForRowHalves). The sun's positions (some 0.4 µs a row) from
 // kSunRowsToSplit; the other loops (tens of ns a row) from kRowsToSplit,
 // below which they gain less than the helper thread's start costs: with
-// them split from 8192 rows the prepare stage of `pvtwin calibrate
-// --timing` on 14 days at 1 min took 8.8 ms against 8.3 ms (medians of 15,
-// alternated); split from this, 14 days at 5 s took 76.6 against 87.5 ms
-// (of 25; README, "Identification").
+// them split from 8192 rows (a build not committed) the prepare stage of
+// `pvtwin calibrate --timing` on 14 days at 1 min took 8.8 ms against
+// 8.3 ms (medians of 15, alternated); split from this, 14 days at 5 s took
+// 76.6 against 87.5 ms (of 25; README, "Identification").
 inline constexpr std::size_t kSunRowsToSplit = 8192;
 inline constexpr std::size_t kRowsToSplit = 65536;
 

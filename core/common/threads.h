@@ -20,7 +20,8 @@ void RunBoth(const std::function<void()>& first, const std::function<void()>& se
 
 // f(begin, end) over the rows [0, n): the first half on a helper thread
 // and the second on this one when n ≥ min_rows and the machine has two
-// cores, else f(0, n) here. For row-local work (each row's results read
+// cores (both halves here when the system refuses the thread, as RunBoth
+// does), else f(0, n) here. For row-local work (each row's results read
 // that row's inputs only), whose result is then the same to the bit: each
 // row's arithmetic does not depend on its thread.
 void ForRowHalves(std::size_t n, std::size_t min_rows,

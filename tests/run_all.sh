@@ -34,7 +34,7 @@ for name in "${harnesses[@]}"; do
   mkdir -p "$scratch"
   seeds=(tests/fuzz/corpus/"$name")
   case "$name" in
-    csv | model) seeds+=(tests/golden/csv ../shared/data/htwsaar-pvt) ;;
+    csv | model) seeds+=(tests/golden/csv tests/data/htwsaar-pvt) ;;
     config) seeds+=(tests/golden/config config/examples) ;;
     weather) seeds+=(tests/weather/data) ;;
   esac

@@ -555,7 +555,7 @@ TEST_F(BacktestCli, DataShorterThanTrainingPlusTestDayExitsTwo) {
 // two separate days that end at sunset): day 3 trains, day 1 is predicted,
 // at the data's own step.
 TEST_F(BacktestCli, RunsOnTheShippedHtwSaarDays) {
-  const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+  const fs::path data = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
   {
     std::ifstream day3(data / "day3_clear_medium_dT.csv"), day1(data / "day1_clear_low_dT.csv");
     std::ofstream both(dir_ / "htwsaar.csv");

@@ -21,7 +21,7 @@ using testing::ProcessResult;
 using testing::ReadFile;
 using testing::RunPvtwin;
 
-const fs::path kData = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+const fs::path kData = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
 
 // The htw saar file `name` as a quoted command-line argument.
 std::string DataArg(const std::string& name) { return "'" + (kData / name).string() + "'"; }

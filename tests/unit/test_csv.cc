@@ -1,5 +1,5 @@
 // Canonical CSV: time text, round trip through WriteCsv and the reader, and
-// the real htw saar test-bench days (../shared/data/htwsaar-pvt, PROVENANCE.md).
+// the real htw saar test-bench days (tests/data/htwsaar-pvt, PROVENANCE.md).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -23,7 +23,7 @@
 namespace pvtwin {
 namespace {
 
-const std::string kRealDataDir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
+const std::string kRealDataDir = std::string(PVTWIN_DATA_DIR) + "/htwsaar-pvt/";
 
 std::int64_t Parsed(std::string_view text) {
   std::int64_t unix_s = -1;

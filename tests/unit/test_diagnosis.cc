@@ -413,7 +413,7 @@ TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
 // The htw saar days in time order, day 3 (2017-07-25) then day 1
 // (2017-08-07), as one CSV.
 void WriteHtwDay3ThenDay1(const fs::path& csv) {
-  const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+  const fs::path data = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
   std::ofstream out(csv);
   out << testing::ReadFile(data / "day3_clear_medium_dT.csv");
   const std::string day1 = testing::ReadFile(data / "day1_clear_low_dT.csv");
@@ -426,7 +426,7 @@ void WriteHtwDay3ThenDay1(const fs::path& csv) {
 // row (+72 W against a 72 W MAE), which the report now states beside the MAE
 // (gap.bias_q_th_w, gap.bias_share_q_th) and the summary prints.
 TEST_F(DiagnoseCli, TheReportStatesTheBiasOfTheHeldOutErrorOnRealData) {
-  const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+  const fs::path data = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
   WriteHtwDay3ThenDay1(dir_ / "htw.csv");
   const testing::ProcessResult run = testing::RunPvtwin(
       dir_,
@@ -450,7 +450,7 @@ TEST_F(DiagnoseCli, TheReportStatesTheBiasOfTheHeldOutErrorOnRealData) {
 // effect makes an output worse; the implausible long-wave channel is a
 // sensor finding.
 TEST_F(DiagnoseCli, OnRealDataAnAblationIsNeverBlamedOnAnotherEffect) {
-  const fs::path data = fs::path(PVTWIN_SHARED_DATA_DIR) / "htwsaar-pvt";
+  const fs::path data = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
   WriteHtwDay3ThenDay1(dir_ / "htw.csv");
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"2N1CcolwrI", ""}, {"2N1Ccolwr", "iam"}, {"2N1CcolwI", "sky_radiation"}};

@@ -1,5 +1,5 @@
 // Identification on data with a known answer (synthetic, seeds recorded) and
-// on real data with provenance (../shared/data/htwsaar-pvt).
+// on real data with provenance (tests/data/htwsaar-pvt).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -710,7 +710,7 @@ constexpr double kBenchFlowKgS = 0.033;  // the test days' flow
 // 1.5 × what this model reaches (README, "Real data"), so a regression in
 // the physics or the fit fails here.
 TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
-  const std::string dir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
+  const std::string dir = std::string(PVTWIN_DATA_DIR) + "/htwsaar-pvt/";
   Config config;
   Diagnostics errors;
   ASSERT_TRUE(LoadConfig(dir + "plant.toml", &config, &errors));

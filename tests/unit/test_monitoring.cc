@@ -301,7 +301,7 @@ TEST(PowerCheck, TheDatasheetsOwnEquationPassesAndALossFails) {
 TEST(PowerCheck, TheHtwSaarCollectorAgainstItsDatasheet) {
   Config config;
   Diagnostics errors;
-  const std::string dir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
+  const std::string dir = std::string(PVTWIN_DATA_DIR) + "/htwsaar-pvt/";
   ASSERT_TRUE(LoadConfig(dir + "plant.toml", &config, &errors));
   CollectorDatasheet d;
   d.eta0 = 0.475;
@@ -340,7 +340,7 @@ TEST(PowerCheck, TheHtwSaarCollectorAgainstItsDatasheet) {
 TEST(SensorFaults, OnlyTheLongWaveChannelOnTheHtwSaarDays) {
   Config config;
   Diagnostics errors;
-  const std::string dir = std::string(PVTWIN_SHARED_DATA_DIR) + "/htwsaar-pvt/";
+  const std::string dir = std::string(PVTWIN_DATA_DIR) + "/htwsaar-pvt/";
   ASSERT_TRUE(LoadConfig(dir + "plant.toml", &config, &errors));
   for (const char* day : {"day1_clear_low_dT.csv", "day3_clear_medium_dT.csv"}) {
     Series s;

@@ -1,36 +1,82 @@
 #!/usr/bin/env bash
-# The whole test run (README "Run the tests", and what .ci/run runs):
-#   1. the suite, optimised build with warnings as errors (build/);
-#   2. every libFuzzer harness of tests/fuzz for PVTWIN_FUZZ_SECONDS each
+# The whole test run (README "Run the tests", and what .ci/run runs), in two
+# builds:
+#   1. the suite on an optimised GCC build with warnings as errors (build/);
+#   2. one clang build instrumented with AddressSanitizer,
+#      UndefinedBehaviorSanitizer and libFuzzer's coverage (build-check/):
+#      the suite again under the sanitizers, halting on the first error, then
+#      every libFuzzer harness of tests/fuzz for PVTWIN_FUZZ_SECONDS each
 #      (default 60) on its seeds, the golden inputs and the example configs,
-#      after replaying every kept crash (build-fuzz/, clang);
-#   3. the suite again under AddressSanitizer and UndefinedBehaviorSanitizer,
-#      halting on the first error (build-sanitize/).
-# Stops at the first failure. A crash the fuzzer finds is written to
-# build-fuzz/crashes/: copy it into tests/fuzz/corpus/<harness>/ once fixed,
-# where the replay keeps it as a regression case.
+#      after replaying every kept crash.
+# Neither build uses link-time optimisation (it buys the product a few per
+# cent and costs the test build minutes). Each stage's time is printed, and
+# a summary at the end. Stops at the first failure. A crash the fuzzer finds
+# is written to build-check/crashes/: copy it into tests/fuzz/corpus/<harness>/
+# once fixed, where the replay keeps it as a regression case.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 fuzz_seconds=${PVTWIN_FUZZ_SECONDS:-60}
 
-step() { printf '\n=== %s (%s)\n' "$1" "$(date -u +%H:%M:%S)"; }
+stage_names=()
+stage_seconds=()
+stage_name=""
+stage_start=0
+finish_stage() {
+  [ -n "$stage_name" ] || return 0
+  local took=$((SECONDS - stage_start))
+  stage_names+=("$stage_name")
+  stage_seconds+=("$took")
+  printf '=== %s: %d min %02d s\n' "$stage_name" $((took / 60)) $((took % 60))
+  stage_name=""
+}
+stage() {
+  finish_stage
+  stage_name=$1
+  stage_start=$SECONDS
+  printf '\n=== %s (started %s UTC)\n' "$1" "$(date -u +%H:%M:%S)"
+}
+summary() {
+  local status=$?
+  finish_stage
+  printf '\n=== time per stage\n'
+  local i
+  for i in "${!stage_names[@]}"; do
+    printf '%6d s  %s\n' "${stage_seconds[$i]}" "${stage_names[$i]}"
+  done
+  printf '%6d s  in all\n' "$SECONDS"
+  return $status
+}
+trap summary EXIT
 
-step "1/3 test suite"
-cmake -S . -B build -DPVTWIN_WERROR=ON
+stage "1/5 optimised build (GCC, warnings as errors)"
+cmake -S . -B build -DPVTWIN_WERROR=ON -DPVTWIN_LTO=OFF >/dev/null
 cmake --build build -j"$jobs"
+
+stage "2/5 test suite"
 ctest --test-dir build --output-on-failure -j"$jobs"
 
-step "2/3 fuzzing, ${fuzz_seconds} s per harness"
-CXX=clang++ cmake -S . -B build-fuzz -DPVTWIN_FUZZ=ON -DPVTWIN_LTO=OFF -DPVTWIN_BUILD_TESTS=OFF \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+stage "3/5 sanitizer and fuzzing build (clang, ASan, UBSan, libFuzzer)"
+# No -Werror here: build/ above enforces the warnings.
+CXX=clang++ cmake -S . -B build-check -DPVTWIN_WERROR=OFF -DPVTWIN_SANITIZE=ON -DPVTWIN_FUZZ=ON \
+  -DPVTWIN_LTO=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build-check -j"$jobs"
+
+stage "4/5 test suite under AddressSanitizer and UndefinedBehaviorSanitizer"
+# alloc_dealloc_mismatch=0: libstdc++ 12 frees std::stable_sort's temporary
+# buffer (stl_tempbuf.h, operator new(nothrow)) in a way ASan takes for
+# new/free, a false report on every stable_sort; fixed in GCC 13's headers.
+export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1:alloc_dealloc_mismatch=0
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+ctest --test-dir build-check --output-on-failure -j"$jobs" --timeout 900 -LE fuzz
+
+stage "5/5 fuzzing, ${fuzz_seconds} s per harness"
+ctest --test-dir build-check --output-on-failure -L fuzz  # every kept seed and crash
 harnesses=(modbus_reply csv config model weather)
-cmake --build build-fuzz -j"$jobs" --target "${harnesses[@]/#/fuzz_}"
-ctest --test-dir build-fuzz --output-on-failure -L fuzz  # every kept seed and crash
-mkdir -p build-fuzz/crashes
+mkdir -p build-check/crashes
 for name in "${harnesses[@]}"; do
   # New inputs go to the first directory (scratch); the others are read-only seeds.
-  scratch=build-fuzz/corpus-$name
+  scratch=build-check/corpus-$name
   mkdir -p "$scratch"
   seeds=(tests/fuzz/corpus/"$name")
   case "$name" in
@@ -41,22 +87,9 @@ for name in "${harnesses[@]}"; do
   existing=()
   for d in "${seeds[@]}"; do [ -d "$d" ] && existing+=("$d"); done
   echo "fuzz_$name: ${fuzz_seconds} s"
-  build-fuzz/tests/fuzz/fuzz_"$name" -max_total_time="$fuzz_seconds" -max_len=65536 \
-    -artifact_prefix=build-fuzz/crashes/"$name"- -print_final_stats=1 \
-    "$scratch" "${existing[@]}" 2>build-fuzz/fuzz_"$name".log ||
-    { tail -n 60 build-fuzz/fuzz_"$name".log; exit 1; }
-  grep -E '^stat::number_of_executed_units|^Done' build-fuzz/fuzz_"$name".log || true
+  build-check/tests/fuzz/fuzz_"$name" -max_total_time="$fuzz_seconds" -max_len=65536 \
+    -artifact_prefix=build-check/crashes/"$name"- -print_final_stats=1 \
+    "$scratch" "${existing[@]}" 2>build-check/fuzz_"$name".log ||
+    { tail -n 60 build-check/fuzz_"$name".log; exit 1; }
+  grep -E '^stat::number_of_executed_units|^Done' build-check/fuzz_"$name".log || true
 done
-
-step "3/3 test suite under AddressSanitizer and UndefinedBehaviorSanitizer"
-# No -Werror here: GCC 12 warns falsely (maybe-uninitialized in std::regex,
-# std::function) under -fsanitize; build/ above enforces the warnings.
-cmake -S . -B build-sanitize -DPVTWIN_WERROR=OFF -DPVTWIN_SANITIZE=ON -DPVTWIN_LTO=OFF \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build build-sanitize -j"$jobs"
-# alloc_dealloc_mismatch=0: GCC 12's libstdc++ frees std::stable_sort's
-# temporary buffer (stl_tempbuf.h, operator new(nothrow)) in a way ASan takes
-# for new/free, a false report on every stable_sort; fixed in GCC 13.
-export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1:alloc_dealloc_mismatch=0
-export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
-ctest --test-dir build-sanitize --output-on-failure -j"$jobs" --timeout 900

@@ -14,6 +14,9 @@ namespace pvtwin {
   X(PQclear) \
   X(PQconnectdb) \
   X(PQconnectdbParams) \
+  X(PQconnectPoll) \
+  X(PQconnectStartParams) \
+  X(PQconsumeInput) \
   X(PQconninfoFree) \
   X(PQconninfoParse) \
   X(PQdb) \
@@ -21,11 +24,13 @@ namespace pvtwin {
   X(PQexec) \
   X(PQexecParams) \
   X(PQfinish) \
+  X(PQflush) \
   X(PQfreemem) \
   X(PQgetResult) \
   X(PQgetisnull) \
   X(PQgetvalue) \
   X(PQhost) \
+  X(PQisBusy) \
   X(PQnfields) \
   X(PQntuples) \
   X(PQport) \
@@ -34,7 +39,11 @@ namespace pvtwin {
   X(PQresultErrorField) \
   X(PQresultErrorMessage) \
   X(PQresultStatus) \
+  X(PQsendQuery) \
+  X(PQsendQueryParams) \
   X(PQsetNoticeProcessor) \
+  X(PQsetnonblocking) \
+  X(PQsocket) \
   X(PQstatus)
 // clang-format on
 

@@ -33,6 +33,8 @@ struct UploadArgs {
   std::string db;
   bool once = false;
   bool init = false;
+  bool takeover = false;
+  bool resend = false;
   double progress_every_s = 10.0;
 };
 
@@ -44,6 +46,7 @@ UploadSettings SettingsFor(const Config& config) {
   s.plant_id = config.upload.plant_id;
   s.batch_rows = config.upload.batch_rows;
   s.forecast_days = config.upload.forecast_days;
+  s.stop = &g_upload_stop;
   return s;
 }
 
@@ -111,7 +114,9 @@ int RunOnce(Uploader& uploader, double progress_every_s) {
     std::int64_t rows = 0;
     PgError pg_error;
     if (!uploader.UploadBatches(&rows, &more, &pg_error)) {
-      uploader.RecordState(StateForFault(pg_error.fault), pg_error.message, false);
+      if (pg_error.fault != PgFault::kInterrupted) {
+        uploader.RecordState(StateForFault(pg_error.fault), pg_error.message, false);
+      }
       std::cerr << "upload: " << pg_error.message << " (" << done
                 << " rows uploaded before; the rest stays queued, a later run resumes)\n";
       return kExitRuntime;
@@ -145,7 +150,9 @@ int RunUpload(const UploadArgs& a) {
   sa.sa_handler = OnUploadStop;
   sigaction(SIGTERM, &sa, nullptr);
   sigaction(SIGINT, &sa, nullptr);
-  const UploadSettings settings = SettingsFor(config);
+  UploadSettings settings = SettingsFor(config);
+  settings.takeover = a.takeover;
+  settings.resend = a.resend;
   if (!a.once && !a.init) {
     UploadWorker worker(settings, config.upload.interval_s, LogLine);
     worker.Start();
@@ -161,7 +168,9 @@ int RunUpload(const UploadArgs& a) {
   }
   PgError pg_error;
   if (!uploader->Connect(&pg_error)) {
-    uploader->RecordState(StateForFault(pg_error.fault), pg_error.message, false);
+    if (pg_error.fault != PgFault::kInterrupted) {
+      uploader->RecordState(StateForFault(pg_error.fault), pg_error.message, false);
+    }
     std::cerr << "upload: " << pg_error.message << "\n";
     return kExitRuntime;
   }
@@ -186,11 +195,19 @@ void RegisterUpload(CLI::App& app) {
       "(resumable: a later run continues where this one stopped) and exits; without them it\n"
       "uploads every [upload] interval_s until SIGTERM, like the daemon's upload thread.\n"
       "[upload] defaults: interval_s = 60, batch_rows = 5000, forecast_days = 7.\n"
-      "Exit 0 success, 1 server unreachable or refusing, 2 bad config.");
+      "A stop (SIGTERM, SIGINT) ends any wait on the server at once; what was not sent stays\n"
+      "queued. A server that does not answer for 130 s counts as down.\n"
+      "Exit 0 success, 1 server unreachable or refusing, 2 bad config.\n"
+      "Example: pvtwin upload --once --config /etc/pvtwin/pvtwin.toml");
   cmd->add_option("--config", args->config, "the daemon's TOML config with [upload]")->required();
   cmd->add_option("--db", args->db, "SQLite file (overrides [storage] path)");
   cmd->add_flag("--once", args->once, "upload what is queued, then exit");
   cmd->add_flag("--init", args->init, "create or migrate the central schema, then exit");
+  cmd->add_flag("--takeover", args->takeover,
+                "bind [upload] plant_id centrally to this store although another store holds it "
+                "(the plant moved to new hardware)");
+  cmd->add_flag("--resend", args->resend,
+                "queue every row of the store again (after the central tables were lost)");
   cmd->add_option("--progress-every", args->progress_every_s,
                   "seconds between progress lines of --once when stderr is not a terminal")
       ->check(CLI::PositiveNumber);

@@ -18,7 +18,10 @@ std::string Seconds(double s) {
 }  // namespace
 
 UploadWorker::UploadWorker(const UploadSettings& settings, double interval_s, LogFn log)
-    : settings_(settings), interval_s_(interval_s), log_(std::move(log)) {}
+    : settings_(settings), interval_s_(interval_s), log_(std::move(log)) {
+  // A stop ends any wait on the server at once (io/pg_client.h PgWait).
+  settings_.stop = stop_.Flag();
+}
 
 UploadWorker::~UploadWorker() { Stop(); }
 
@@ -96,6 +99,7 @@ void UploadWorker::Loop() {
       stop_.WaitFor(interval_s_);
       continue;
     }
+    if (error.fault == PgFault::kInterrupted) break;  // the stop: no fault of the server
     Enter(StateForFault(error.fault), error);
     stop_.WaitFor(backoff.Next());
   }

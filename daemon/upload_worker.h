@@ -28,7 +28,8 @@ class UploadWorker {
   UploadWorker& operator=(const UploadWorker&) = delete;
 
   void Start();
-  // Asks the thread to stop after the batch it is sending, and joins it.
+  // Asks the thread to stop, and joins it: a batch in flight is abandoned at
+  // once, whatever the server does (its rows stay queued).
   void Stop();
 
   UploadState state() const { return state_.load(); }

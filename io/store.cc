@@ -268,12 +268,26 @@ std::vector<std::string> SchemaV6() {
   return s;
 }
 
+// Version 7: the store's identity, a random id made once when the schema
+// reaches version 7 (at creation, or at the migration of an older store).
+// The fleet upload sends it, so that two stores under one plant_id are told
+// apart centrally (io/upload.h).
+std::vector<std::string> SchemaV7() {
+  return {
+      "CREATE TABLE store_identity(id INTEGER PRIMARY KEY CHECK(id = 1), store_id TEXT NOT NULL, "
+      "created_at INTEGER NOT NULL)",
+      "INSERT INTO store_identity(id, store_id, created_at) VALUES(1, lower(hex(randomblob(16))), "
+      "CAST(strftime('%s', 'now') AS INTEGER))",
+  };
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
 const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3},
-                                 {4, &SchemaV4}, {5, &SchemaV5}, {6, &SchemaV6}};
+                                 {4, &SchemaV4}, {5, &SchemaV5}, {6, &SchemaV6},
+                                 {7, &SchemaV7}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 

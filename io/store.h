@@ -119,6 +119,15 @@
 //       kMinScoredMinutes (core/forecast/forecast.h) scored minutes (and where the reference is
 //       exact).
 //
+// Version 7 adds:
+//   store_identity(id = 1, store_id TEXT, created_at INTEGER)
+//       a random 128-bit id (32 hex digits) made once, when the store is
+//       created or migrated to version 7. The fleet upload sends it with
+//       plant_id, so that a second store under the same plant_id is refused
+//       centrally (io/upload.h). A copy of the file keeps the id: a store
+//       copied to another site must not upload under the original's
+//       plant_id.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -170,7 +179,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 6;
+inline constexpr int kStoreSchemaVersion = 7;
 // NULL in a row struct.
 inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 

@@ -262,12 +262,18 @@ struct Uploader::Impl {
     std::vector<Column> columns;
   };
   std::vector<Table> tables;
-  int commits = 0;  // central COMMITs of this process (test hook)
+  std::string store_id;  // the local store's store_identity
+  int commits = 0;       // central COMMITs of this process (test hook)
 
   bool PrepareLocal(std::string* error);
   bool InstallTable(const UploadTable& spec, std::string* error);
   bool ReadColumns(Table* table, std::string* error);
+  bool ForgetUploads(std::string* error);
+  bool ReadStoreId(std::string* error);
   bool CentralSchemaComplete(bool* complete, PgError* error);
+  bool CheckLostTables(const std::map<std::string, std::vector<std::string>>& central,
+                       PgError* error);
+  bool BindStore(PgError* error);
   bool MigrateCentral(PgError* error);
   std::string CentralTableDdl(const Table& t) const;
   std::string PlantLatestDdl(bool has_qc_event) const;
@@ -302,12 +308,17 @@ const char* const kLocalSchema[] = {
 }  // namespace
 
 bool Uploader::Impl::PrepareLocal(std::string* error) {
+  if (!ReadStoreId(error)) return false;
   if (!local.Exec("BEGIN IMMEDIATE", error)) return false;
   for (const char* sql : kLocalSchema) {
     if (!local.Exec(sql, error)) {
       local.Rollback();
       return false;
     }
+  }
+  if (settings.resend && !ForgetUploads(error)) {
+    local.Rollback();
+    return false;
   }
   for (const UploadTable& spec : UploadTables()) {
     bool exists = false;
@@ -330,6 +341,38 @@ bool Uploader::Impl::PrepareLocal(std::string* error) {
   }
   for (Table& t : tables) {
     if (!ReadColumns(&t, error)) return false;
+  }
+  return true;
+}
+
+// The store's id (io/store.h store_identity), sent with every upload.
+bool Uploader::Impl::ReadStoreId(std::string* error) {
+  store_id.clear();
+  if (!local.Query(
+          "SELECT store_id FROM store_identity WHERE id = 1", {},
+          [&](sqlite3_stmt* stmt) { store_id = ColumnText(stmt, 0); }, error)) {
+    return false;
+  }
+  if (store_id.empty()) {
+    *error = local.path() + ": the store has no store_identity row (open it with pvtwin first)";
+    return false;
+  }
+  return true;
+}
+
+// --resend: every table's triggers and queue go, and its counts restart,
+// so that InstallTable queues every stored row again.
+bool Uploader::Impl::ForgetUploads(std::string* error) {
+  for (const UploadTable& spec : UploadTables()) {
+    const std::string name(spec.name);
+    if (!local.Exec("DROP TRIGGER IF EXISTS upload_queue_" + name + "_insert; " +
+                        "DROP TRIGGER IF EXISTS upload_queue_" + name + "_update; " +
+                        "DELETE FROM upload_queue WHERE table_name = '" + name + "'; " +
+                        "UPDATE upload_state SET hwm = 0, rows_uploaded = 0 WHERE table_name = '" +
+                        name + "'",
+                    error)) {
+      return false;
+    }
   }
   return true;
 }
@@ -432,8 +475,12 @@ bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
   }
   std::map<std::string, std::vector<std::string>> central;
   for (const auto& r : rows) central[r[0]].push_back(r[1]);
-  *complete =
-      central.count("pvtwin_schema") && central.count("plant") && central.count("plant_latest");
+  if (!CheckLostTables(central, error)) return false;
+  const auto plant = central.find("plant");
+  *complete = central.count("pvtwin_schema") && plant != central.end() &&
+              std::find(plant->second.begin(), plant->second.end(), "store_id") !=
+                  plant->second.end() &&
+              central.count("plant_latest");
   for (const Table& t : tables) {
     const auto it = central.find(std::string(t.spec->name));
     if (it == central.end()) {
@@ -463,13 +510,92 @@ bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
   return true;
 }
 
+// Every uploaded table this plant has sent rows into must still be there
+// (on this server: a new, empty central database counts as lost too), with
+// its key columns.
+bool Uploader::Impl::CheckLostTables(const std::map<std::string, std::vector<std::string>>& central,
+                                     PgError* error) {
+  for (const Table& t : tables) {
+    const std::string name(t.spec->name);
+    std::int64_t uploaded = 0, pending = 0;
+    std::string local_error;
+    if (!local.Query(
+            "SELECT rows_uploaded, rows_pending FROM upload_status WHERE table_name = ?", {},
+            [&](sqlite3_stmt* stmt) {
+              uploaded = sqlite3_column_int64(stmt, 0);
+              pending = sqlite3_column_int64(stmt, 1);
+            },
+            &local_error, name)) {
+      *error = {PgFault::kLocal, local_error, ""};
+      return false;
+    }
+    const auto it = central.find(name);
+    const std::string counts = std::to_string(uploaded) + " rows of plant_id " +
+                               settings.plant_id + " were uploaded into it and " +
+                               std::to_string(pending) + " are queued";
+    if (it == central.end()) {
+      if (uploaded == 0) continue;  // new to this plant: MigrateCentral creates it
+      *error = {PgFault::kRefused,
+                "central table " + name + " is missing on " + server + ", although " + counts +
+                    " (renamed or dropped?): restore it, or send every row again with "
+                    "`pvtwin upload --once --resend`",
+                ""};
+      return false;
+    }
+    std::vector<std::string_view> keys = {"plant_id"};
+    keys.insert(keys.end(), t.spec->central_key.begin(), t.spec->central_key.end());
+    for (const std::string_view key : keys) {
+      if (std::find(it->second.begin(), it->second.end(), key) == it->second.end()) {
+        *error = {PgFault::kRefused,
+                  "central table " + name + " on " + server + " has no key column " +
+                      std::string(key) + " (" + counts + "): it is not pvtwin's table",
+                  ""};
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// Binds plant_id to this store centrally: the first store to upload (or a
+// plant row from before store ids) takes it; another store's plant_id is
+// refused unless takeover.
+bool Uploader::Impl::BindStore(PgError* error) {
+  const std::vector<std::string> ids = {settings.plant_id, store_id};
+  std::vector<std::vector<std::string>> rows;
+  if (!pg->Query("INSERT INTO plant(plant_id, first_upload_at, store_id) VALUES($1, "
+                 "extract(epoch FROM now())::bigint, $2) ON CONFLICT DO NOTHING",
+                 ids, nullptr, error) ||
+      !pg->Query("SELECT coalesce(store_id, ''), coalesce(last_upload_at::text, 'never') "
+                 "FROM plant WHERE plant_id = $1",
+                 {settings.plant_id}, &rows, error)) {
+    return false;
+  }
+  const std::string holder = rows.empty() ? "" : rows[0][0];
+  if (holder == store_id) return true;
+  if (!holder.empty() && !settings.takeover) {
+    *error = {PgFault::kRefused,
+              "plant_id " + settings.plant_id + " belongs centrally to another store (store_id " +
+                  holder + ", last upload at unix " + rows[0][1] + "), not to " + local.path() +
+                  " (store_id " + store_id +
+                  "): two sites with one plant_id would overwrite each other's rows. Give this "
+                  "site its own [upload] plant_id; if this store replaces the other one (new "
+                  "hardware), run `pvtwin upload --once --takeover` once",
+              ""};
+    return false;
+  }
+  return pg->Query("UPDATE plant SET store_id = $2 WHERE plant_id = $1", ids, nullptr, error);
+}
+
 bool Uploader::Impl::MigrateCentral(PgError* error) {
   std::string sql = "BEGIN; SELECT pg_advisory_xact_lock(" + std::string(kSchemaLockKey) +
                     ");"
                     "CREATE TABLE IF NOT EXISTS pvtwin_schema(version integer PRIMARY KEY, "
                     "applied_at timestamptz NOT NULL DEFAULT now());"
                     "CREATE TABLE IF NOT EXISTS plant(plant_id text PRIMARY KEY, "
-                    "first_upload_at bigint, last_upload_at bigint);";
+                    "first_upload_at bigint, last_upload_at bigint);"
+                    // Version 2: the store each plant_id belongs to.
+                    "ALTER TABLE plant ADD COLUMN IF NOT EXISTS store_id text;";
   bool has_qc_event = false;
   for (const Table& t : tables) {
     sql += CentralTableDdl(t);
@@ -670,11 +796,14 @@ bool Uploader::Connect(PgError* error) {
     *error = {PgFault::kAuth, why, ""};
     return false;
   }
-  u.pg = PgConnection::Connect(u.settings.url, password, kAppName, error);
+  PgWait wait;
+  wait.stop = u.settings.stop;
+  u.pg = PgConnection::Connect(u.settings.url, password, kAppName, wait, error);
   if (!u.pg) return false;
   u.server = u.pg->Describe();
   bool complete = false;
-  bool ok = u.pg->Exec("SET statement_timeout = '120s'", error) &&
+  bool ok = u.pg->Exec("SET statement_timeout = '" + std::to_string(kPgStatementTimeoutS) + "s'",
+                       error) &&
             u.CentralSchemaComplete(&complete, error) && (complete || u.MigrateCentral(error));
   // One uploader per plant_id at a time (session lock, ends with the
   // connection).
@@ -689,10 +818,7 @@ bool Uploader::Connect(PgError* error) {
               ""};
     ok = false;
   }
-  ok = ok && u.pg->Query(
-                 "INSERT INTO plant(plant_id, first_upload_at) VALUES($1, "
-                 "extract(epoch FROM now())::bigint) ON CONFLICT DO NOTHING",
-                 {u.settings.plant_id}, nullptr, error);
+  ok = ok && u.BindStore(error);
   if (!ok) u.pg.reset();
   return ok;
 }
@@ -734,8 +860,9 @@ void Uploader::RecordState(UploadState state, const std::string& last_error, boo
   const std::string now = std::to_string(NowS());
   // ?1 state, ?2 server, ?3 last error ('' keeps the previous one).
   std::string sql =
-      "INSERT INTO upload_connection(id, state, since, server) VALUES(1, ?1, " + now +
-      ", ?2) ON CONFLICT(id) DO UPDATE SET since = CASE WHEN state = ?1 THEN since ELSE " + now +
+      "INSERT INTO upload_connection(id, state, since, server, last_error, last_error_at) "
+      "VALUES(1, ?1, " + now + ", ?2, NULLIF(?3, ''), CASE WHEN ?3 = '' THEN NULL ELSE " + now +
+      " END) ON CONFLICT(id) DO UPDATE SET since = CASE WHEN state = ?1 THEN since ELSE " + now +
       " END, state = ?1, server = ?2, last_error = CASE WHEN ?3 = '' THEN last_error ELSE ?3 END, "
       "last_error_at = CASE WHEN ?3 = '' THEN last_error_at ELSE " +
       now + " END";

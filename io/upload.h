@@ -28,7 +28,12 @@
 // missing, under an advisory lock, so a role without CREATE can upload into
 // a schema made by `pvtwin upload --init`):
 //   pvtwin_schema(version, applied_at): version kCentralSchemaVersion.
-//   plant(plant_id PRIMARY KEY, first_upload_at, last_upload_at)
+//   plant(plant_id PRIMARY KEY, first_upload_at, last_upload_at, store_id)
+//       store_id (version 2) is the store_identity of the SQLite store that
+//       uploads as this plant_id: the first store to upload binds it, and a
+//       second store under the same plant_id (a config copied to another
+//       site) is refused with both ids named, unless UploadSettings::takeover
+//       (`pvtwin upload --takeover`: the plant moved to new hardware).
 //   <table>(plant_id TEXT, <the local table's columns, same names>,
 //           PRIMARY KEY(plant_id, <central key>)) for every table of
 //       UploadTables() that the local store has; SQLite INTEGER → bigint,
@@ -47,6 +52,13 @@
 // plant's rows (a second one, or two plants configured with one plant_id,
 // is refused with a message).
 //
+// Once the central schema exists, a missing uploaded table is created only
+// if this plant never uploaded into it: a table that held the plant's rows
+// and is gone (renamed or dropped by someone) is an error naming the rows
+// uploaded and queued, never silently re-created empty; `--resend`
+// (UploadSettings::resend) queues every local row again. A central table
+// without its key columns is an error too.
+//
 // Test hook: PVTWIN_UPLOAD_TEST_KILL_AFTER_COMMIT=N raises SIGKILL right
 // after the N-th central COMMIT of the process, before the high-water mark
 // moves (tests/unit/test_upload.cc).
@@ -64,7 +76,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kCentralSchemaVersion = 1;
+inline constexpr int kCentralSchemaVersion = 2;
 
 // One uploaded table. Adding a table of the store to the fleet is one entry
 // of UploadTables().
@@ -90,6 +102,13 @@ struct UploadSettings {
   std::string plant_id;
   int batch_rows = 5000;
   int forecast_days = 7;
+  // Set by a signal handler or the daemon's stop: every wait on the server
+  // ends at once (io/pg_client.h PgWait); the rows stay queued.
+  const std::atomic<bool>* stop = nullptr;
+  // Bind plant_id centrally to this store even if another store holds it.
+  bool takeover = false;
+  // Queue every local row again (after a central table was lost).
+  bool resend = false;
 };
 
 enum class UploadState { kStarting, kConnected, kDown, kAuthFailed, kRefused };

@@ -164,6 +164,7 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
                             "DROP TABLE diagnosis",
                             "ALTER TABLE weather_forecast DROP COLUMN source",
                             "DROP TABLE plant_config",
+                            "DROP TABLE store_identity",
                             "PRAGMA user_version = 1"}) {
       ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
     }
@@ -175,6 +176,31 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 3.0);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_interval"), 0.0);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM parameter_history"), 0.0);
+  // Version 7: the migrated store gets an identity of its own.
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM store_identity WHERE length(store_id) = 32"), 1.0);
+}
+
+TEST_F(StoreTest, EveryNewStoreGetsItsOwnIdentityAndKeepsItWhenReopened) {
+  std::string first;
+  {
+    auto store = OpenStore();
+    ASSERT_NE(store, nullptr);
+    RawDb db(DbPath());
+    first = db.Text("SELECT store_id FROM store_identity WHERE id = 1");
+  }
+  ASSERT_EQ(first.size(), 32u) << first;
+  EXPECT_EQ(first.find_first_not_of("0123456789abcdef"), std::string::npos) << first;
+  {
+    auto store = OpenStore();  // reopened: the same id
+    RawDb db(DbPath());
+    EXPECT_EQ(db.Text("SELECT store_id FROM store_identity"), first);
+  }
+  const std::string other_path = (dir_ / "other.db").string();
+  std::string error;
+  auto other = Store::Open(other_path, &error);
+  ASSERT_NE(other, nullptr) << error;
+  RawDb db(other_path);
+  EXPECT_NE(db.Text("SELECT store_id FROM store_identity"), first);
 }
 
 TEST_F(StoreTest, ReopeningKeepsDataAndANewerSchemaOrAForeignFileIsRefused) {
@@ -192,11 +218,14 @@ TEST_F(StoreTest, ReopeningKeepsDataAndANewerSchemaOrAForeignFileIsRefused) {
   }
   {
     RawDb db(DbPath());
-    ASSERT_EQ(db.Exec("PRAGMA user_version = 7"), SQLITE_OK);
+    ASSERT_EQ(db.Exec("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion + 1)),
+              SQLITE_OK);
   }
   std::string error;
   EXPECT_EQ(Store::Open(DbPath(), &error), nullptr);
-  EXPECT_NE(error.find("schema version 7 is newer"), std::string::npos) << error;
+  EXPECT_NE(error.find("schema version " + std::to_string(kStoreSchemaVersion + 1) + " is newer"),
+            std::string::npos)
+      << error;
 
   const std::string text_file = (dir_ / "notes.txt").string();
   FILE* f = std::fopen(text_file.c_str(), "w");

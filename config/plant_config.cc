@@ -112,6 +112,38 @@ bool PlantFromKeyValues(const std::vector<std::pair<std::string, double>>& value
   return true;
 }
 
+std::string PlantMismatch(const Plant& configured,
+                          const std::vector<std::pair<std::string, double>>& stored) {
+  if (stored.empty()) return "";
+  Plant recorded;
+  std::string error;
+  if (!PlantFromKeyValues(stored, &recorded, &error)) {
+    return "the store's plant_config cannot be read (" + error + ")";
+  }
+  // Great-circle distance (haversine) on a sphere of the Earth's mean radius.
+  constexpr double kEarthRadiusM = 6371000.0;
+  const double dlat = configured.latitude_rad - recorded.latitude_rad;
+  const double dlon = configured.longitude_rad - recorded.longitude_rad;
+  const double h = std::sin(dlat / 2) * std::sin(dlat / 2) +
+                   std::cos(configured.latitude_rad) * std::cos(recorded.latitude_rad) *
+                       std::sin(dlon / 2) * std::sin(dlon / 2);
+  const double distance_m = 2.0 * kEarthRadiusM * std::asin(std::min(1.0, std::sqrt(h)));
+  std::string differs;
+  auto degrees = [](double rad) { return FormatNumber(RadToDeg(rad)); };
+  if (distance_m > kSameSiteM) {
+    differs += "the site: the config's latitude_deg = " + degrees(configured.latitude_rad) +
+               ", longitude_deg = " + degrees(configured.longitude_rad) + ", the store's " +
+               degrees(recorded.latitude_rad) + ", " + degrees(recorded.longitude_rad) + " (" +
+               FormatNumber(std::round(distance_m / 100.0) / 10.0) + " km apart)";
+  }
+  if (std::fabs(configured.area_m2 - recorded.area_m2) > kSameAreaShare * recorded.area_m2) {
+    differs += std::string(differs.empty() ? "" : "; ") + "the area: the config's area_m2 = " +
+               FormatNumber(configured.area_m2) + ", the store's " +
+               FormatNumber(recorded.area_m2);
+  }
+  return differs;
+}
+
 namespace {
 
 struct UrlPlaceholder {

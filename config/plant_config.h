@@ -148,6 +148,18 @@ std::vector<std::pair<std::string, double>> PlantKeyValues(const Plant& plant);
 bool PlantFromKeyValues(const std::vector<std::pair<std::string, double>>& values, Plant* plant,
                         std::string* error);
 
+// Whether `configured` is another plant than the one a store recorded
+// (`stored`, its plant_config; empty: a new store, no plant yet): "" when
+// it is the same, else what differs, naming both values. Another site is
+// more than kSameSiteM apart (over 1 km the sun's position changes by less
+// than 0.01°, so within it a corrected coordinate is the same site);
+// another field an area that differs by more than kSameAreaShare (the
+// rounding of a nameplate area).
+inline constexpr double kSameSiteM = 1000.0;
+inline constexpr double kSameAreaShare = 0.01;
+std::string PlantMismatch(const Plant& configured,
+                          const std::vector<std::pair<std::string, double>>& stored);
+
 // [forecast] weather_url: an http:// or https:// URL whose placeholders are
 // {lat}, {lon} (degrees, north and east positive), {tilt} (degrees from
 // horizontal), {azimuth} (degrees from north, clockwise: pvtwin's),

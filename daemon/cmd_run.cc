@@ -76,6 +76,9 @@ void RegisterRun(CLI::App& app) {
                   "(default: now); give the simulator the same value to share its clock");
   cmd->add_option("--calibration-timeout", args->service.calibration_timeout_s,
                   "wall seconds after which a calibration is abandoned");
+  cmd->add_flag("--adopt-store", args->service.adopt_store,
+                "use a store whose plant_config records another site or area (the plant "
+                "changed); without it the daemon refuses such a store");
   cmd->callback([args] { SetExitCode(Run(*args)); });
 }
 

@@ -173,6 +173,7 @@ class Service {
   void StartUpload();
   // The [plant] in use into the store's plant_config, for commands given
   // only the store (import-weather --db).
+  bool StoreIsThisPlants();
   void RecordPlant();
   // Starts, restarts (after a reload changed them) or stops the weather
   // fetch to match [forecast] weather_url and the plant.
@@ -767,6 +768,29 @@ void Service::UpdateWeatherFetch() {
   weather_->Start();
 }
 
+// A daemon started on another plant's store would write this plant's
+// samples into that plant's history and fit one on the other's data.
+bool Service::StoreIsThisPlants() {
+  std::vector<std::pair<std::string, double>> stored;
+  std::string error;
+  if (!store_->ReadPlantConfig(&stored, &error)) {
+    LogToStderr(kWarning, "reading the store's plant_config failed: " + error);
+    return true;
+  }
+  const std::string differs = PlantMismatch(config_.plant, stored);
+  if (differs.empty()) return true;
+  if (options_.adopt_store) {
+    LogToStderr(kNotice, config_.storage.path + " recorded another plant (" + differs +
+                             "); adopted for " + options_.config_path + " (--adopt-store)");
+    return true;
+  }
+  LogToStderr(kErr, config_.storage.path + " belongs to another plant than " +
+                        options_.config_path + ": " + differs +
+                        ". Point [storage] path at this plant's store; if the plant itself "
+                        "changed, start once with --adopt-store");
+  return false;
+}
+
 void Service::RecordPlant() {
   std::string error;
   if (!store_->WritePlantConfig(PlantKeyValues(config_.plant), &error)) {
@@ -866,6 +890,7 @@ int Service::Run() {
     LogToStderr(kErr, error);
     return 1;
   }
+  if (!StoreIsThisPlants()) return 2;
   RecordPlant();
   work_dir_ = fs::path(config_.storage.path).parent_path() / "calibration";
   diagnosis_ =

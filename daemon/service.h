@@ -59,6 +59,10 @@ struct ServiceOptions {
   double calibration_ftol = 1e-4;
   // Calibrate at once when no accepted parameters exist and two days of data do.
   bool calibrate_when_uncalibrated = true;
+  // Take over a store whose plant_config records another plant (site or
+  // area, config/plant_config.h PlantMismatch); without it the daemon
+  // refuses to start on it (exit 2).
+  bool adopt_store = false;
   // pvtwin binary for the calibration child; empty = this executable.
   std::string exe_path;
   // Set by the signal handlers: stop (SIGTERM, SIGINT), reload (SIGHUP).
@@ -69,7 +73,8 @@ struct ServiceOptions {
 };
 
 // Runs until stopped. Returns the exit code: 0 after a clean stop, 2 when
-// the config is invalid (before READY), 1 when the store cannot be opened.
+// the config is invalid or belongs to another plant than the store (before
+// READY), 1 when the store cannot be opened.
 int RunService(const ServiceOptions& options);
 
 }  // namespace pvtwin

@@ -16,7 +16,9 @@
 #include "config/config_edit.h"
 #include "core/common/clock.h"
 #include "io/child_process.h"
+#include "io/pg_client.h"
 #include "io/pg_scratch_server.h"
+#include "io/upload.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
@@ -217,6 +219,41 @@ class Upload : public ::testing::Test {
     return t.empty() || t.starts_with("ERROR") ? -1 : std::stoll(t);
   }
 
+  // Holds an exclusive lock on a central table while it lives, so that an
+  // upload into it waits at a known point.
+  std::unique_ptr<PgConnection> LockTable(const std::string& table) {
+    PgError error;
+    auto conn = PgConnection::Connect(pg_.Conninfo("fleet"), pg_.password(), "test lock", {},
+                                      &error);
+    EXPECT_NE(conn, nullptr) << error.message;
+    if (conn) {
+      EXPECT_TRUE(conn->Exec("BEGIN; LOCK TABLE " + table + " IN ACCESS EXCLUSIVE MODE", &error))
+          << error.message;
+    }
+    return conn;
+  }
+  // The backend of pvtwin's upload once it waits for that lock, stopped
+  // with SIGSTOP: a server that vanished without closing the connection.
+  // The lock is released after, so nothing but the stopped backend holds
+  // the upload up. 0 when none was found.
+  int StallUploadBackend(std::unique_ptr<PgConnection>* lock) {
+    std::string pid;
+    const bool waiting = WaitFor(20, [&] {
+      pid = pg_.Text("SELECT pid FROM pg_stat_activity WHERE application_name = 'pvtwin upload' "
+                     "AND wait_event_type = 'Lock'");
+      return !pid.empty() && !pid.starts_with("ERROR");
+    });
+    EXPECT_TRUE(waiting) << pid;
+    if (!waiting) return 0;
+    stalled_ = std::stoi(pid);
+    ::kill(stalled_, SIGSTOP);
+    lock->reset();
+    return stalled_;
+  }
+  void TearDown() override {
+    if (stalled_ > 0) ::kill(stalled_, SIGCONT);  // so that the server can stop
+  }
+
   // measurement_1min, calibration and forecast (the newest issue per ts
   // within forecast_days of the newest issue) equal centrally and locally.
   void ExpectPlantEqual(const std::string& name, int forecast_days = 7) {
@@ -232,6 +269,7 @@ class Upload : public ::testing::Test {
 
   ScratchDir dir_{"upload"};
   PgScratchServer pg_;
+  int stalled_ = 0;  // a backend stopped with SIGSTOP
 };
 
 TEST_F(Upload, TwoDaemonsUploadTwoPlantsIntoOneDatabase) {
@@ -407,6 +445,7 @@ class UploadLive : public Upload {
   void TearDown() override {
     sim_.SendLine("quit");
     sim_.Stop(0, 5.0);
+    Upload::TearDown();
   }
   fs::path WriteLivePlant(const std::string& upload_extra) {
     DaemonSettings settings;
@@ -516,7 +555,10 @@ TEST_F(Upload, MissingSchemaPermissionIsAClearErrorAndInitLetsARestrictedRoleUpl
   // The administrator creates the schema; the role gets rights on the tables.
   const auto init = RunPvtwin(dir_.path(), "upload --init --config admin.toml");
   ASSERT_EQ(init.exit_code, 0) << init.err;
-  EXPECT_NE(init.err.find("central schema version 1 ready"), std::string::npos) << init.err;
+  EXPECT_NE(init.err.find("central schema version " + std::to_string(kCentralSchemaVersion) +
+                          " ready"),
+            std::string::npos)
+      << init.err;
   ASSERT_EQ(pg_.Text("GRANT SELECT, INSERT, UPDATE, DELETE ON ALL TABLES IN SCHEMA public TO plant",
                      "fleet"),
             "");
@@ -525,7 +567,10 @@ TEST_F(Upload, MissingSchemaPermissionIsAClearErrorAndInitLetsARestrictedRoleUpl
   EXPECT_NE(run.err.find("upload: 720 rows"), std::string::npos) << run.err;
   ExpectPlantEqual("plant");
   // A central schema from a newer pvtwin is refused, not migrated back.
-  ASSERT_EQ(pg_.Text("INSERT INTO pvtwin_schema(version) VALUES(2)", "fleet"), "");
+  ASSERT_EQ(pg_.Text("INSERT INTO pvtwin_schema(version) VALUES(" +
+                         std::to_string(kCentralSchemaVersion + 1) + ")",
+                     "fleet"),
+            "");
   run = UploadOnce("plant");
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find("newer than this pvtwin knows"), std::string::npos) << run.err;
@@ -570,6 +615,135 @@ TEST_F(Upload, UnreachableServerIsExitCodeOneAndBadConfigIsTwo) {
   EXPECT_NE(run.err.find("url = (value not shown): holds a password"), std::string::npos)
       << run.err;
   EXPECT_EQ(run.err.find("hunter2"), std::string::npos) << run.err;
+}
+
+TEST_F(Upload, AStalledServerMidUploadEndsAtSigtermWithinSecondsAndTheRowsStayQueued) {
+  WritePlant("plant", "batch_rows = 100\n");
+  Import("plant", kMorning - 86400, 1, 60, 1, 360);
+  ASSERT_EQ(UploadOnce("plant").exit_code, 0);
+  Import("plant", kMorning - 86400, 1, 60, 1, 720);
+  const double queued = Pending("plant");  // the import replaced the first 360 too
+  ASSERT_GE(queued, 360);
+  auto lock = LockTable("measurement_1min");
+  ChildProcess upload;
+  std::string error;
+  ASSERT_TRUE(upload.Start(
+      {PVTWIN_BINARY, "upload", "--once", "--config", (dir_ / "plant.toml").string()},
+      (dir_ / "plant.log").string(), &error))
+      << error;
+  ASSERT_GT(StallUploadBackend(&lock), 0) << Log("plant");
+  int exit_code = 0;
+  // Stalled: it neither finishes nor fails on its own within seconds.
+  EXPECT_FALSE(WaitFor(2, [&] { return upload.Finished(&exit_code); })) << Log("plant");
+  const double sent = WallNowS();
+  ::kill(upload.pid(), SIGTERM);
+  ASSERT_TRUE(WaitFor(5, [&] { return upload.Finished(&exit_code); })) << Log("plant");
+  EXPECT_LT(WallNowS() - sent, 3.0);
+  EXPECT_EQ(exit_code, 1) << Log("plant");
+  EXPECT_NE(Log("plant").find("interrupted by a stop request"), std::string::npos) << Log("plant");
+  EXPECT_EQ(Pending("plant"), queued) << Log("plant");
+  // The server back: the next run sends them, nothing lost or doubled.
+  ::kill(stalled_, SIGCONT);
+  stalled_ = 0;
+  ASSERT_EQ(UploadOnce("plant").exit_code, 0);
+  EXPECT_EQ(Central("SELECT count(*) FROM measurement_1min"), 720);
+  ExpectPlantEqual("plant");
+}
+
+TEST_F(Upload, ADaemonWhoseServerStalledStopsWithinItsStopTimeout) {
+  WritePlant("plant", "batch_rows = 100\n");
+  Import("plant", kMorning - 86400, 1, 60, 1, 360);
+  ChildProcess daemon;
+  ASSERT_TRUE(StartDaemon(&daemon, "plant"));
+  ASSERT_TRUE(WaitFor(30, [&] {
+    return Central("SELECT count(*) FROM measurement_1min") == 360 && Pending("plant") == 0;
+  })) << Log("plant");
+  auto lock = LockTable("measurement_1min");
+  Import("plant", kMorning - 86400, 1, 60, 1, 720);  // the next upload round waits
+  ASSERT_GT(StallUploadBackend(&lock), 0) << Log("plant");
+  const double sent = WallNowS();
+  // systemd's TimeoutStopSec is 30 s; the daemon needs a few.
+  EXPECT_EQ(daemon.Stop(SIGTERM, 10.0), 0) << Log("plant");
+  EXPECT_LT(WallNowS() - sent, 5.0);
+  EXPECT_EQ(Log("plant").find("upload: server down"), std::string::npos) << Log("plant");
+  EXPECT_GE(Pending("plant"), 360);
+}
+
+TEST_F(Upload, ASecondStoreUnderTheSamePlantIdIsRefusedUntilItTakesOver) {
+  WritePlant("site", "");
+  Import("site", kMorning - 86400, 1, 60, 1, 720);
+  ASSERT_EQ(UploadOnce("site").exit_code, 0);
+  // The config copied to a second site: the same plant_id, its own store.
+  std::string text = ReadFile(dir_ / "site.toml");
+  text.replace(text.find("site.db"), 7, "copy.db");
+  std::ofstream(dir_ / "copy.toml") << text;
+  Import("copy", kMorning - 86400, 1, 60, 2, 720);
+  auto run = UploadOnce("copy");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("plant_id site belongs centrally to another store"), std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("--takeover"), std::string::npos) << run.err;
+  ExpectSameRows(pg_, Db("site"), "site", "measurement_1min", "", "ts");  // untouched
+  {
+    RawDb db(Db("copy"));
+    EXPECT_EQ(db.Text("SELECT state FROM upload_connection"), "refused");
+    EXPECT_NE(db.Text("SELECT last_error FROM upload_status LIMIT 1").find("another store"),
+              std::string::npos);
+    EXPECT_GT(db.Number("SELECT last_error_at FROM upload_status LIMIT 1"), 0.0);
+    EXPECT_EQ(db.Number("SELECT sum(rows_pending) FROM upload_status"), 720);
+  }
+  // A deliberate move to new hardware.
+  run = RunCommand(dir_.path(), "'" + std::string(PVTWIN_BINARY) +
+                                    "' upload --once --takeover --config copy.toml");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(ExpectSameRows(pg_, Db("copy"), "site", "measurement_1min", "", "ts"), 720u);
+  RawDb db(Db("copy"));
+  EXPECT_EQ(pg_.Text("SELECT store_id FROM plant WHERE plant_id = 'site'", "fleet"),
+            db.Text("SELECT store_id FROM store_identity"));
+  // Now the first store is the stranger.
+  EXPECT_EQ(UploadOnce("site").exit_code, 1);
+}
+
+TEST_F(Upload, ACentralTableRenamedByADbaIsAnErrorWithTheCountsNeverRecreatedEmpty) {
+  WritePlant("plant", "batch_rows = 100\n");
+  Import("plant", kMorning - 86400, 1, 60, 1, 360);
+  ASSERT_EQ(UploadOnce("plant").exit_code, 0);
+  ASSERT_EQ(pg_.Text("ALTER TABLE measurement_1min RENAME TO m1_old", "fleet"), "");
+  Import("plant", kMorning - 86400, 1, 60, 1, 410);
+  RawDb local(Db("plant"));
+  const std::string queued =
+      local.Text("SELECT rows_pending FROM upload_status WHERE table_name = 'measurement_1min'");
+  auto run = UploadOnce("plant");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("central table measurement_1min is missing"), std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("360 rows of plant_id plant were uploaded into it and " + queued +
+                         " are queued"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(Central("SELECT count(*) FROM measurement_1min"), -1);  // not re-created
+  EXPECT_EQ(Central("SELECT count(*) FROM m1_old"), 360);
+  EXPECT_EQ(local.Text("SELECT rows_pending FROM upload_status WHERE table_name = "
+                       "'measurement_1min'"),
+            queued);
+  // Sending everything again into a new table, on purpose.
+  run = RunCommand(dir_.path(),
+                   "'" + std::string(PVTWIN_BINARY) + "' upload --once --resend --config plant.toml");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(Central("SELECT count(*) FROM measurement_1min"), 410);
+  ExpectPlantEqual("plant");
+}
+
+// A central table that lost its key columns is not pvtwin's.
+TEST_F(Upload, ACentralTableWithoutItsKeyColumnsIsAnError) {
+  WritePlant("plant", "");
+  Import("plant", kMorning - 86400, 1, 60, 1, 60);
+  ASSERT_EQ(UploadOnce("plant").exit_code, 0);
+  ASSERT_EQ(pg_.Text("ALTER TABLE calibration RENAME COLUMN id TO calibration_no", "fleet"), "");
+  const auto run = UploadOnce("plant");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("central table calibration"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("has no key column id"), std::string::npos) << run.err;
 }
 
 }  // namespace

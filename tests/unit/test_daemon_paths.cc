@@ -175,6 +175,54 @@ TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
   EXPECT_EQ(daemon_.Stop(0, 10.0), 0) << Log();
 }
 
+// A daemon started on the store of another plant (a copied config pointing
+// at the wrong file) would write its samples into that plant's history.
+TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
+  const auto write = [&](const std::string& file, const std::string& latitude,
+                         const std::string& area) {
+    std::string text, error;
+    const std::string plant = "[plant]\nlatitude_deg = " + latitude +
+                              "\nlongitude_deg = 16.128\ntilt_deg = 20\nazimuth_deg = 180\n"
+                              "area_m2 = " +
+                              area + "\n";
+    ASSERT_TRUE(EditConfig(plant, {}, Settings(), &text, &error)) << error;
+    std::ofstream(dir_ / file) << text;
+  };
+  write("pvtwin.toml", "47.358", "1.8");
+  StartDaemon(kJune1, 1.0);  // the store records this plant
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+
+  // Another site 60 km north, and the same site with another area.
+  for (const bool other_site : {true, false}) {
+    write("other.toml", other_site ? "47.9" : "47.358", other_site ? "1.8" : "3.6");
+    const auto run = RunPvtwin(dir_.path(), "run --config other.toml");
+    EXPECT_EQ(run.exit_code, 2) << run.err;
+    EXPECT_NE(run.err.find("belongs to another plant"), std::string::npos) << run.err;
+    const std::string both =
+        other_site ? "latitude_deg = 47.9, longitude_deg = 16.128, the store's 47.358"
+                   : "area_m2 = 3.6, the store's 1.8";
+    EXPECT_NE(run.err.find(both), std::string::npos) << run.err;
+    Db db(DbPath());
+    EXPECT_EQ(db.Number("SELECT value FROM plant_config WHERE key = 'area_m2'"), 1.8);
+    EXPECT_EQ(db.Number("SELECT value FROM plant_config WHERE key = 'latitude_deg'"), 47.358);
+  }
+  // A corrected coordinate 100 m away is the same site.
+  write("pvtwin.toml", "47.359", "1.8");
+  fs::remove(dir_ / "daemon.log");
+  StartDaemon(kJune1, 1.0);
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(Log().find("belongs to another plant"), std::string::npos) << Log();
+
+  // --adopt-store takes it over, and the store records the new plant.
+  write("pvtwin.toml", "47.358", "3.6");
+  fs::remove(dir_ / "daemon.log");
+  StartDaemon(kJune1, 1.0, {"--adopt-store"});
+  EXPECT_NE(Log().find("adopted for"), std::string::npos) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  Db db(DbPath());
+  EXPECT_EQ(db.Number("SELECT value FROM plant_config WHERE key = 'area_m2'"), 3.6);
+}
+
 TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
   ImportHistory(kJune1, 4);
   WriteConfig(Settings());

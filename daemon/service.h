@@ -11,7 +11,7 @@
 // failed fit) are logged once per change of state and re-armed; the daemon
 // keeps the last accepted parameters.
 //
-// Calibration (DESIGN.md "The job"): at [calibration] at, local time in
+// Calibration (doc/contracts.md "The job"): at [calibration] at, local time in
 // [calibration] timezone (io/local_time.h), the last window_days of 1-min
 // rows are split into training days and the most recent day, held out. The
 // variant is fitted on the training days (warm-started from the current

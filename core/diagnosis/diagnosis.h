@@ -1,5 +1,5 @@
 // Sim-to-real gap diagnosis: where a calibrated model's error lies, which
-// unmodelled effect of the catalogue (DESIGN.md's vocabulary) causes it, and
+// unmodelled effect of the catalogue (doc/contracts.md's vocabulary) causes it, and
 // how far the error shrinks once that effect is added.
 //
 // Protocol (all on local mean solar days, core/forecast/backtest.h):

@@ -55,7 +55,7 @@ struct ServiceOptions {
   // Wall-clock limit of one calibration child.
   double calibration_timeout_s = 1800.0;
   // Stop criterion of the optimiser for the nightly fit (calibrate --ftol):
-  // the daemon has the night, so it fits to the noise floor (see README).
+  // the daemon has the night, so it fits to the noise floor (doc/performance.md).
   double calibration_ftol = 1e-4;
   // Calibrate at once when no accepted parameters exist and two days of data do.
   bool calibrate_when_uncalibrated = true;

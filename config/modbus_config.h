@@ -1,4 +1,4 @@
-// The Modbus register map of the daemon's config (DESIGN.md, "Modbus register
+// The Modbus register map of the daemon's config (doc/contracts.md, "Modbus register
 // map"): devices, and points that say which registers of which device feed
 // which canonical channel, and how to decode them.
 //

@@ -1,6 +1,6 @@
 // The pvtwin configuration file (TOML): schema, parser and validator.
 //
-// Sections (DESIGN.md, "Plant section" and "Daemon sections"):
+// Sections (doc/contracts.md, "Plant section" and "Daemon sections"):
 //   [plant]        required; the collector field (core/plant.h). Required keys:
 //                  latitude_deg, longitude_deg, tilt_deg, azimuth_deg, area_m2;
 //                  the others default to the values of core/plant.h.
@@ -110,7 +110,7 @@ struct SimConfig {
   double brine_max_c = 10.0;             // [-20, 30]
 };
 
-// [upload]: the fleet database (DESIGN.md "Fleet contract"). The password
+// [upload]: the fleet database (doc/contracts.md "Fleet contract"). The password
 // never sits in the config: it comes from password_file, from the systemd
 // credential $CREDENTIALS_DIRECTORY/pgpassword, or from libpq's own
 // PGPASSFILE / ~/.pgpass, in that order.

@@ -3,7 +3,7 @@
 // libpq (the fleet upload) and libcurl (the weather fetch) are used by few
 // commands, but a linked library is mapped and relocated by every pvtwin
 // process, with all its dependencies: the two bring 34 more, most of the
-// binary's start-up time (README, "Performance"). Loaded on demand, they cost
+// binary's start-up time (doc/performance.md). Loaded on demand, they cost
 // a `calibrate` or a `simulate` nothing.
 //
 // The headers still come from the -dev packages at build time, so each

@@ -55,7 +55,7 @@ double MedianTime(int repeats, const Run& run) {
 
 // Milliseconds of a fixed workload on the calling thread: a chain of 1e7
 // dependent multiply-adds, which neither memory nor the compiler can
-// shorten (about 20 ms on the AMD EPYC behind README.md's figures).
+// shorten (about 20 ms on the AMD EPYC behind doc/performance.md's figures).
 double FixedWorkloadMs() {
   volatile double seed = 1.0;
   double x = seed;

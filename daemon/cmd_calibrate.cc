@@ -329,7 +329,7 @@ int RunCalibrate(const CalibrateArgs& a) {
   // released, and its columns (some 30 MB for 14 days at 5 s) are the room
   // the held-out data and the fit's Jacobians are carved from, where fresh
   // pages would each have to be faulted in and cleared (UseHugePageHeap
-  // keeps freed memory; README, "Identification").
+  // keeps freed memory; doc/performance.md).
   const TrainingWindow window = WindowOf(train);
   train = Series{};
   series = Series{};

@@ -131,7 +131,7 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
   return kExitOk;
 }
 
-// The diagnosis row of the store (Store::DiagnosisRow, DESIGN.md).
+// The diagnosis row of the store (Store::DiagnosisRow, doc/contracts.md).
 bool RecordDiagnosis(Store& store, const DiagnosisResult& r, std::int64_t from_ts,
                      std::int64_t to_ts, const DiagnoseArgs& a) {
   Store::DiagnosisRow row;
@@ -414,7 +414,8 @@ void RegisterDiagnose(CLI::App& app) {
       "there are fewer than 5 held-out days, reported as low confidence); the ladder of\n"
       "accepted effects; and a verdict: an effect, 'none' (nothing significant, error near the\n"
       "sensor-noise floor) or 'unknown' (error far above noise that no effect removes).\n"
-      "Progress on stderr, a summary on stdout, DIR/report.json (DESIGN.md) and DIR/report.html\n"
+      "Progress on stderr, a summary on stdout, DIR/report.json (doc/contracts.md) and "
+      "DIR/report.html\n"
       "with --report. Exit 0 success, 2 bad input, 1 the base fit failed or the report could\n"
       "not be written.");
   cmd->add_option("--config", args->config, "TOML config with the [plant] section")->required();

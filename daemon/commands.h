@@ -6,7 +6,7 @@
 
 namespace pvtwin::cli {
 
-// Exit codes (DESIGN.md): 0 success, 1 runtime failure, 2 bad input or config.
+// Exit codes (doc/contracts.md): 0 success, 1 runtime failure, 2 bad input or config.
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitRuntime = 1;
 inline constexpr int kExitBadInput = 2;

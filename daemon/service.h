@@ -11,7 +11,7 @@
 // failed fit) are logged once per change of state and re-armed; the daemon
 // keeps the last accepted parameters.
 //
-// Calibration (DESIGN.md "The job"): at [calibration] at, local time in
+// Calibration (doc/contracts.md "The job"): at [calibration] at, local time in
 // [calibration] timezone (io/local_time.h), the last window_days of 1-min
 // rows are split into training days and the most recent day, held out. The
 // variant is fitted on the training days (warm-started from the current
@@ -55,7 +55,7 @@ struct ServiceOptions {
   // Wall-clock limit of one calibration child.
   double calibration_timeout_s = 1800.0;
   // Stop criterion of the optimiser for the nightly fit (calibrate --ftol):
-  // the daemon has the night, so it fits to the noise floor (see README).
+  // the daemon has the night, so it fits to the noise floor (doc/performance.md).
   double calibration_ftol = 1e-4;
   // Calibrate at once when no accepted parameters exist and two days of data do.
   bool calibrate_when_uncalibrated = true;

@@ -1,4 +1,4 @@
-// The canonical CSV of DESIGN.md: reader and writer.
+// The canonical CSV of doc/contracts.md: reader and writer.
 //
 // Reading: a header row, comma separated, '.' decimal, column order free.
 //   * `time`: ISO 8601 with Z or an offset, or unix seconds, decided per cell

@@ -1,6 +1,6 @@
 // The reports of `pvtwin diagnose` (core/diagnosis.h).
 //
-// report.json, the contract of DESIGN.md ("Diagnosis report"), extended with
+// report.json, the contract of doc/contracts.md ("Diagnosis report"), extended with
 // more fields, never renamed:
 //   { "base_variant": "1N1Cwr",
 //     "gap": {"mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th",     held-out, base model

@@ -1,6 +1,6 @@
 // The SQLite store of the daemon: raw 5 s samples, 1-min measurements,
 // calibration runs and forecasts. SQL is pvtwin's user interface, so the
-// schema below is a contract (DESIGN.md "SQLite"): extend it, never rename.
+// schema below is a contract (doc/contracts.md "SQLite"): extend it, never rename.
 //
 // Schema (version 1, PRAGMA user_version = 1):
 //   sample_5s(ts INTEGER PRIMARY KEY, <channel> REAL ..., rejected_mask INTEGER)

@@ -1,5 +1,5 @@
 // Time stamps as text, at the I/O edge: the `time` column of the canonical
-// CSV (DESIGN.md). Inside pvtwin a time is unix seconds UTC (int64).
+// CSV (doc/contracts.md). Inside pvtwin a time is unix seconds UTC (int64).
 #pragma once
 
 #include <cstdint>

@@ -21,7 +21,7 @@
 namespace pvtwin {
 
 const std::vector<UploadTable>& UploadTables() {
-  // Tables of the store (io/store.h and DESIGN.md "Operation contracts");
+  // Tables of the store (io/store.h and doc/contracts.md "Operation contracts");
   // those the local store does not have are left out.
   static const std::vector<UploadTable> tables = {
       {"measurement_1min", {"ts"}, {"ts"}, {}, {}},

@@ -1,5 +1,5 @@
 // Replication of the plant's SQLite store into a central PostgreSQL (the
-// fleet contract of DESIGN.md). The SQLite file stays the source of truth;
+// fleet contract of doc/contracts.md). The SQLite file stays the source of truth;
 // the central database holds the same tables with a leading plant_id.
 //
 // Which rows to send (local side, created by Uploader::Open, idempotent):

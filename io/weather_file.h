@@ -20,7 +20,7 @@
 //
 // Canonical CSV: `time` plus any of weather_forecast's columns (g_poa_w_m2,
 // ghi_w_m2, dhi_w_m2, t_amb_c, wind_m_s at the collector, t_sky_c,
-// lw_down_w_m2); each row is the mean over [time, time + step) (DESIGN.md).
+// lw_down_w_m2); each row is the mean over [time, time + step) (doc/contracts.md).
 //
 // Bad input is an error naming file, field (with array index or line) and
 // what was expected: missing arrays, arrays of another length than `time`,

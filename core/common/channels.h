@@ -1,4 +1,4 @@
-// The canonical measurement channels of pvtwin (DESIGN.md, "Canonical CSV").
+// The canonical measurement channels of pvtwin (doc/contracts.md, "Canonical CSV").
 // One table names every channel once; the CSV reader, the SQLite store and the
 // Modbus register map all refer to it, so a channel is spelled the same
 // everywhere.
@@ -40,7 +40,7 @@ struct ChannelInfo {
   std::string_view unit;
 };
 
-// Column names as in DESIGN.md. kMdotKgS and kAoiRad are stored in SI/radians;
+// Column names as in doc/contracts.md. kMdotKgS and kAoiRad are stored in SI/radians;
 // their CSV spellings are flow_kg_s and aoi_deg (converted at the I/O edge).
 inline constexpr std::array<ChannelInfo, kNumChannels> kChannels = {{
     {Channel::kTInC, "t_in_c", "°C"},

@@ -43,7 +43,7 @@ struct InputRequirement {
 //  3. transform_outputs, after the integration (e.g. what a sensor behind a
 //     pipe sees).
 struct ModelExtension {
-  std::string_view name;  // DESIGN.md vocabulary; "+name" in a variant
+  std::string_view name;  // doc/contracts.md vocabulary; "+name" in a variant
   int variant_order = 0;  // position among the "+name" parts of a canonical name
   // Parameters its equations use; identification frees them by default.
   std::vector<Param> params;

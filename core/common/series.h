@@ -1,7 +1,7 @@
 // A time series of measured (or simulated) channels, stored column-wise.
 //
 // time_s[i] is unix seconds UTC and marks the start of row i's interval
-// (DESIGN.md); a row covers [time_s[i], time_s[i] + step_s). A channel that
+// (doc/contracts.md); a row covers [time_s[i], time_s[i] + step_s). A channel that
 // the source did not provide has an empty column; a missing cell in a present
 // column is NaN.
 #pragma once

@@ -53,7 +53,7 @@ constexpr std::uint32_t QcChannelMissingBit(Channel c) {
   return 1u << (kQcChannelMissingShift + static_cast<unsigned>(c));
 }
 
-// "Required" (kQcRequiredMissing) follows DESIGN.md's canonical CSV: t_in_c,
+// "Required" (kQcRequiredMissing) follows doc/contracts.md's canonical CSV: t_in_c,
 // flow_kg_s, t_amb_c, p_el_w, t_out_c or q_th_w, g_poa_w_m2 or ghi_w_m2 +
 // dhi_w_m2.
 bool RequiredChannelsPresent(std::uint32_t qc_flags);

@@ -1,5 +1,5 @@
 // Averaging a series onto a coarser, aligned time grid (5 s samples → 1 min
-// measurements, DESIGN.md "sample_5s → measurement_1min").
+// measurements, doc/contracts.md "sample_5s → measurement_1min").
 #pragma once
 
 #include <string>

@@ -1,5 +1,5 @@
 // The candidate effects of the gap diagnosis: which catalogued effects
-// (DESIGN.md's vocabulary) can be added to a model, the model with the effect
+// (doc/contracts.md's vocabulary) can be added to a model, the model with the effect
 // added, and the per-row signature its residual evidence is correlated with.
 // A thin layer over the effect library (core/effects/effects.h: the
 // registry, CanAddEffect with the data's channels, WithEffect,

@@ -1,4 +1,4 @@
-// core/effects/: one module per effect of DESIGN.md's effect vocabulary
+// core/effects/: one module per effect of doc/contracts.md's effect vocabulary
 // (capacitance, second_node, …, irradiance_bias), the registration list
 // (registry.cc) and the generic library functions that ask the modules
 // (effects.h).
@@ -113,7 +113,7 @@ struct OtherFormTruth {
 double UnitDraw(std::uint64_t seed, std::int64_t key);
 
 struct EffectModule {
-  std::string_view name;     // DESIGN.md vocabulary, e.g. "pv_clipping"
+  std::string_view name;     // doc/contracts.md vocabulary, e.g. "pv_clipping"
   std::string_view physics;  // one paragraph of physics, for the report
   std::string_view source;   // where the equations come from (paper section, reference)
   // Parameters the effect adds (their rows: Info(Param)).

@@ -1,4 +1,4 @@
-// The registration list of the effect modules: every effect of DESIGN.md's
+// The registration list of the effect modules: every effect of doc/contracts.md's
 // vocabulary, in the vocabulary's order (the order the diagnosis tries them
 // and reports ties in).
 #pragma once

@@ -1,4 +1,4 @@
-// 24 h forecasts of a calibrated model (issue 5, DESIGN.md table `forecast`).
+// 24 h forecasts of a calibrated model (issue 5, doc/contracts.md table `forecast`).
 //
 // A forecast runs the calibrated variant over the horizon on the best inputs
 // available for each row, after a warm-up on measured data so that the

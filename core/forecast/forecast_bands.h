@@ -1,4 +1,4 @@
-// Uncertainty bands of a forecast (issue 15; DESIGN.md `forecast` columns
+// Uncertainty bands of a forecast (issue 15; doc/contracts.md `forecast` columns
 // p_el_w_p10, p_el_w_p90, q_th_w_p10, q_th_w_p90): empirical quantiles of
 // the errors the same model's day-ahead forecasts made over the recent
 // window, by regime and by weather source.

@@ -23,7 +23,7 @@ namespace pvtwin {
 // them split from 8192 rows (a build not committed) the prepare stage of
 // `pvtwin calibrate --timing` on 14 days at 1 min took 8.8 ms against
 // 8.3 ms (medians of 15, alternated); split from this, 14 days at 5 s took
-// 76.6 against 87.5 ms (of 25; README, "Identification").
+// 76.6 against 87.5 ms (of 25).
 inline constexpr std::size_t kSunRowsToSplit = 8192;
 inline constexpr std::size_t kRowsToSplit = 65536;
 

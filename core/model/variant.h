@@ -3,11 +3,11 @@
 // Grammar (paper Table 6, extended):
 //   variant   := base ("+" effect)*
 //   base      := ("1N" ["1C"] | "2N" ["1Cpv" | "1Ccol" | "2C"]) ["w"] ["r"] ["I"]
-//   effect    := any name of DESIGN.md's effect vocabulary (core/effects/registry.h)
+//   effect    := any name of doc/contracts.md's effect vocabulary (core/effects/registry.h)
 // Letters: w = wind dependence of the front loss in the paper's printed form,
 // r = long-wave exchange with the sky, I = beam/diffuse split with the
 // incidence-angle modifier. "1C" on a one-node model is a capacitance on the
-// PV node. Effects beyond the paper use the names of DESIGN.md's effect
+// PV node. Effects beyond the paper use the names of doc/contracts.md's effect
 // vocabulary; "sky_radiation" and "iam" are the same as the letters r and I,
 // "capacitance" adds the next missing capacitance (1N → 1N1C, 2N → 2N1Ccol,
 // 2N1Cpv/2N1Ccol → 2N2C) and "second_node" turns 1N into 2N (a capacitance on

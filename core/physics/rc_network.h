@@ -133,7 +133,7 @@ namespace rc_step {
 // λb = mean − radius. The rotation comes from the half-angle formulas with
 // cos 2θ = (m00 − m11)/(2·radius) and sin 2θ = m01/radius instead of atan2,
 // cos and sin, which were 13 % of the instructions of a 2N2Cwr calibrate
-// (callgrind, README's performance log): the larger of |c|, |s| from
+// (callgrind): the larger of |c|, |s| from
 // √((1 ± cos 2θ)/2), which has no cancellation,
 // the other from sin 2θ = 2·s·c. θ lies in (−π/2, π/2], so c ≥ 0 and s has
 // the sign of m01 (as atan2 gives it, −0 included).

@@ -30,7 +30,7 @@ struct SensorNoise {
 
 inline SensorNoise RealisticSensorNoise(std::uint64_t seed) { return {0.05, 0.005, 5.0, seed}; }
 
-// The plant of DESIGN.md's example [plant] section: 47.358° N, 16.128° E,
+// The plant of doc/contracts.md's example [plant] section: 47.358° N, 16.128° E,
 // 20° tilt facing south, 1.8 m², the paper's fluid and PV reference data.
 Plant DesignExamplePlant();
 

@@ -2,8 +2,8 @@
 # Hostile inputs against the real pvtwin binary: malformed and impossible CSV
 # and weather-forecast files, bad configs, foreign, damaged, read-only and
 # deleted stores, two daemons on one store. Prints a Markdown table (case,
-# what was tried, what pvtwin must do, what it did) — the README's
-# reliability table — and exits 1
+# what was tried, what pvtwin must do, what it did) — the
+# reliability table (doc/reliability.md) — and exits 1
 # if any case is not handled as it must be.
 #
 #   tests/hostile/run.sh [BUILD_DIR]        (default: build)

@@ -3,7 +3,7 @@
 #     and what it may depend on;
 #  2. the dependency direction is one-way: a file in core/<folder>/ includes
 #     only core/ folders listed for it below;
-#  3. no file of core/ outside core/effects/ spells an effect of DESIGN.md's
+#  3. no file of core/ outside core/effects/ spells an effect of doc/contracts.md's
 #     vocabulary as a string literal: generic code asks the effect's module
 #     (core/effects/effect_module.h), it never tests a name.
 # Run: cmake -DSOURCE_DIR=<repo> -P tests/structure/check_core_structure.cmake

@@ -87,7 +87,7 @@ TEST(ConfigLoad, OmittedKeysTakeTheDocumentedDefaults) {
   EXPECT_DOUBLE_EQ(p.latitude_rad, 47.358 * kPi / 180);
   EXPECT_DOUBLE_EQ(p.azimuth_rad, kPi);
   EXPECT_EQ(p.elevation_m, 0.0);
-  // DESIGN.md's [plant] example values, which core/common/plant.h also uses.
+  // doc/contracts.md's [plant] example values, which core/common/plant.h also uses.
   EXPECT_EQ(p.fluid_cp_j_kgk, 3650);
   EXPECT_EQ(p.fluid_density_kg_m3, 1040);
   EXPECT_EQ(p.ground_albedo, 0.2);
@@ -98,7 +98,7 @@ TEST(ConfigLoad, OmittedKeysTakeTheDocumentedDefaults) {
   EXPECT_EQ(p.pv_irr_coeff_m2_w, 3.6e-5);
   EXPECT_EQ(p.fluid_cp_j_kgk, defaults.fluid_cp_j_kgk);
   EXPECT_EQ(p.pv_irr_coeff_m2_w, defaults.pv_irr_coeff_m2_w);
-  // DESIGN.md's daemon section defaults.
+  // doc/contracts.md's daemon section defaults.
   EXPECT_EQ(config.storage.path, "/var/lib/pvtwin/pvtwin.db");
   EXPECT_EQ(config.storage.raw_retention_days, 30);
   EXPECT_EQ(config.poll.period_s, 5);

@@ -1,6 +1,6 @@
 // Gap diagnosis: its statistics against hand-computed and closed-form cases,
 // localisation on residuals whose answer is known analytically, the
-// report.json keys of DESIGN.md, and `pvtwin diagnose` end to end on
+// report.json keys of doc/contracts.md, and `pvtwin diagnose` end to end on
 // synthetic data with one withheld effect.
 #include <gtest/gtest.h>
 
@@ -253,7 +253,7 @@ TEST(GapLocalisation, UniformErrorFlagsNothing) {
 }
 
 // ---------------------------------------------------------------------------
-// report.json keys (DESIGN.md, "Diagnosis report").
+// report.json keys (doc/contracts.md, "Diagnosis report").
 
 TEST(DiagnosisReport, JsonHasTheDesignKeys) {
   DiagnosisResult r;

@@ -1,5 +1,5 @@
 // The effect registry (core/effects/registry.h): every module is complete —
-// a name of DESIGN.md's vocabulary, a paragraph of physics with a source,
+// a name of doc/contracts.md's vocabulary, a paragraph of physics with a source,
 // parameters whose bounds contain their start and truth values, a signature
 // and an advice sentence — and the registry holds the whole vocabulary once.
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 namespace pvtwin {
 namespace {
 
-// DESIGN.md's effect vocabulary, spelled and ordered as there.
+// doc/contracts.md's effect vocabulary, spelled and ordered as there.
 constexpr std::string_view kVocabulary[] = {"capacitance",     "second_node",  "wind",
                                             "sky_radiation",   "iam",          "flow_dependent_u",
                                             "transport_delay", "pv_clipping",  "shading",

@@ -46,7 +46,7 @@ ParamVector ConstantEta(const Plant& plant) {
   return p;
 }
 
-// One summer day of generated weather at the DESIGN.md plant (sun geometry,
+// One summer day of generated weather at the doc/contracts.md plant (sun geometry,
 // beam and diffuse), sampled every 10 min.
 Series SummerDay() {
   WeatherOptions w;

@@ -707,7 +707,7 @@ constexpr double kBenchFlowKgS = 0.033;  // the test days' flow
 
 // Real data (htw saar, PROVENANCE.md): identify on the day with the fluid
 // ~8 K above ambient, predict the day near ambient. Thresholds are about
-// 1.5 × what this model reaches (README, "Real data"), so a regression in
+// 1.5 × what this model reaches (doc/validation.md), so a regression in
 // the physics or the fit fails here.
 TEST(IdentifyRealData, HtwSaarDay3PredictsDay1) {
   const std::string dir = std::string(PVTWIN_DATA_DIR) + "/htwsaar-pvt/";

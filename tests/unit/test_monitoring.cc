@@ -297,7 +297,7 @@ TEST(PowerCheck, TheDatasheetsOwnEquationPassesAndALossFails) {
 // measured against the datasheet's estimate they give 0.76 (day 1, inlet
 // near ambient) and 0.71 (day 3, inlet 7 K above): the collector delivered
 // about a quarter less heat than its datasheet at these conditions, and less
-// the warmer it ran (its identified η0 is 10 % below the datasheet's, README).
+// the warmer it ran (its identified η0 is 10 % below the datasheet's, doc/validation.md).
 TEST(PowerCheck, TheHtwSaarCollectorAgainstItsDatasheet) {
   Config config;
   Diagnostics errors;

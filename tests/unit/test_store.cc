@@ -66,7 +66,7 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   EXPECT_EQ(db.Number("PRAGMA user_version"), static_cast<double>(kStoreSchemaVersion));
   EXPECT_EQ(db.Rows("PRAGMA journal_mode")[0][0], "wal");
   // sample_5s and measurement_1min: every canonical channel, named as in
-  // core/common/channels.h (DESIGN.md "SQLite").
+  // core/common/channels.h (doc/contracts.md "SQLite").
   EXPECT_EQ(db.Columns("sample_5s"), WithChannels({"ts"}, {"rejected_mask"}));
   EXPECT_EQ(db.Columns("measurement_1min"), WithChannels({"ts"}, {"n_samples", "qc_flags"}));
   EXPECT_EQ(db.Columns("sample_5s")[8], "aoi_deg");
@@ -104,7 +104,7 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   EXPECT_EQ(db.Columns("parameter_history"),
             (std::vector<std::string>{"run_at", "calibration_id", "accepted", "name", "value",
                                       "std_error", "unit", "status"}));
-  // Version 4: monitoring (DESIGN.md "Operation contracts").
+  // Version 4: monitoring (doc/contracts.md "Operation contracts").
   EXPECT_EQ(
       db.Columns("performance_daily"),
       (std::vector<std::string>{"day", "e_el_meas_wh", "e_el_model_wh", "e_th_meas_wh",

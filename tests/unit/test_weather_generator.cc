@@ -13,7 +13,7 @@
 namespace pvtwin {
 namespace {
 
-// The plant of DESIGN.md's example config: 47.358° N, 16.128° E, 20° tilt,
+// The plant of doc/contracts.md's example config: 47.358° N, 16.128° E, 20° tilt,
 // facing south.
 Plant ExamplePlant() {
   Plant plant;

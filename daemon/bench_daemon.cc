@@ -17,7 +17,7 @@
 #include "core/common/clock.h"
 #include "daemon/bench.h"
 #include "daemon/demo_config.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 
 namespace pvtwin::cli {
 

@@ -42,7 +42,7 @@
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "io/csv.h"
 #include "io/params_json.h"
 

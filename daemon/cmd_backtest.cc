@@ -17,10 +17,10 @@
 #include "daemon/inputs.h"
 #include "daemon/weather_import.h"
 #include "io/backtest_report.h"
-#include "io/local_time.h"
+#include "io/platform/local_time.h"
 #include "io/params_json.h"
-#include "io/quantity_text.h"
-#include "io/time_format.h"
+#include "io/platform/quantity_text.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

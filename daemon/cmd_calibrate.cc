@@ -19,8 +19,8 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/params_json.h"
-#include "io/quantity_text.h"
-#include "io/time_format.h"
+#include "io/platform/quantity_text.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

@@ -33,13 +33,13 @@
 #include "daemon/demo_config.h"
 #include "daemon/inputs.h"
 #include "daemon/service.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "io/csv.h"
-#include "io/local_time.h"
+#include "io/platform/local_time.h"
 #include "io/params_json.h"
-#include "io/quantity_text.h"
+#include "io/platform/quantity_text.h"
 #include "io/store.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

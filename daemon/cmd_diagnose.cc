@@ -21,9 +21,9 @@
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"
 #include "io/diagnosis_report.h"
-#include "io/quantity_text.h"
+#include "io/platform/quantity_text.h"
 #include "io/store.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

@@ -17,7 +17,7 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "io/csv.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"
 

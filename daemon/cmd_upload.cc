@@ -18,7 +18,7 @@
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"
 #include "daemon/upload_worker.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/upload.h"
 
 namespace pvtwin::cli {

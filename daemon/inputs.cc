@@ -9,7 +9,7 @@
 
 #include "core/common/clock.h"
 #include "io/csv.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

@@ -11,7 +11,7 @@
 #include "core/common/series.h"
 #include "core/model/thermal_model.h"
 #include "core/model/variant.h"
-#include "io/local_time.h"
+#include "io/platform/local_time.h"
 
 namespace pvtwin::cli {
 

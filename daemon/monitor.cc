@@ -5,9 +5,9 @@
 #include <cstdio>
 
 #include "core/monitor/monitoring.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/params_json.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "core/common/clock.h"
-#include "io/log.h"
-#include "io/time_format.h"
+#include "io/platform/log.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "config/plant_config.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "io/store.h"
 
 namespace pvtwin::cli {

@@ -31,16 +31,16 @@
 #include "daemon/store_cli.h"
 #include "daemon/upload_worker.h"
 #include "daemon/weather_worker.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "io/csv.h"
 #include "io/http_client.h"
-#include "io/local_time.h"
-#include "io/log.h"
+#include "io/platform/local_time.h"
+#include "io/platform/log.h"
 #include "io/modbus_poller.h"
 #include "io/params_json.h"
 #include "io/store.h"
 #include "io/store_lock.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin {
 

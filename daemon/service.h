@@ -12,7 +12,7 @@
 // keeps the last accepted parameters.
 //
 // Calibration (doc/contracts.md "The job"): at [calibration] at, local time in
-// [calibration] timezone (io/local_time.h), the last window_days of 1-min
+// [calibration] timezone (io/platform/local_time.h), the last window_days of 1-min
 // rows are split into training days and the most recent day, held out. The
 // variant is fitted on the training days (warm-started from the current
 // parameters); the new parameters replace the current ones only if their

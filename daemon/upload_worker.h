@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "daemon/worker_thread.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/upload.h"
 
 namespace pvtwin {

@@ -1,7 +1,7 @@
 #include "daemon/weather_import.h"
 
 #include "core/forecast/weather_resample.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
 

@@ -19,7 +19,7 @@
 
 #include "core/common/plant.h"
 #include "daemon/worker_thread.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/store.h"
 
 namespace pvtwin {

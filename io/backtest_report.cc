@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/model/variant.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin {
 

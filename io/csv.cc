@@ -25,7 +25,7 @@
 #include "core/common/units.h"
 #include "core/data/physical_limits.h"
 #include "core/data/qc.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin {
 namespace {

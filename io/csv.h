@@ -2,7 +2,7 @@
 //
 // Reading: a header row, comma separated, '.' decimal, column order free.
 //   * `time`: ISO 8601 with Z or an offset, or unix seconds, decided per cell
-//     (io/time_format.h); it marks the start of the row's interval. Rows must
+//     (io/platform/time_format.h); it marks the start of the row's interval. Rows must
 //     be strictly increasing in time.
 //   * Every other known column goes to its Channel (core/channels.h).
 //     `flow_l_h` becomes kMdotKgS: kg/s = L/h · ρ / 3.6e6, with ρ from
@@ -50,7 +50,7 @@ struct CsvReadOptions {
   // Collector area for the area-scaled physical limits (flow, P_el, Q_u);
   // 0: unknown, the widest limits (core/physical_limits.h).
   double area_m2 = 0.0;
-  // Zone of `time` cells without Z or offset (io/local_time.h); null: such
+  // Zone of `time` cells without Z or offset (io/platform/local_time.h); null: such
   // cells are an error, a local time says nothing about its instant.
   const NaiveTimeZone* naive_time_zone = nullptr;
   // A weather file (pvtwin import-weather): required are only `time`,

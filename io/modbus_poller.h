@@ -51,7 +51,7 @@
 #include "config/modbus_config.h"
 #include "core/common/clock.h"
 #include "core/common/sample.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/read_plan.h"
 
 namespace pvtwin {

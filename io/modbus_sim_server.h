@@ -34,7 +34,7 @@
 
 #include "config/modbus_config.h"
 #include "core/common/clock.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/plant_source.h"
 
 namespace pvtwin {

@@ -11,8 +11,8 @@
 
 #include "core/data/physical_limits.h"
 #include "io/csv.h"
-#include "io/local_time.h"
-#include "io/time_format.h"
+#include "io/platform/local_time.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin {
 

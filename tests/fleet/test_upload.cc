@@ -15,7 +15,7 @@
 
 #include "config/config_edit.h"
 #include "core/common/clock.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "io/pg_client.h"
 #include "io/pg_scratch_server.h"
 #include "io/upload.h"

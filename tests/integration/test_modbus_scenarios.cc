@@ -50,7 +50,7 @@
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"
 #include "io/register_codec.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 #include "tests/support/child_process.h"
 #include "tests/support/files.h"
 

@@ -1,4 +1,4 @@
-// Checks that printed powers follow the one convention of io/quantity_text.h:
+// Checks that printed powers follow the one convention of io/platform/quantity_text.h:
 // "71.70 W (39.83 W/m²)", the collector's figure first and the per-m² figure
 // of the same quantity beside it.
 #pragma once

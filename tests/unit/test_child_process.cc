@@ -5,7 +5,7 @@
 #include <csignal>
 #include <string>
 
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 
 namespace pvtwin {
 namespace {

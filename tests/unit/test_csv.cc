@@ -17,8 +17,8 @@
 #include "config/plant_config.h"
 #include "core/common/units.h"
 #include "io/csv.h"
-#include "io/local_time.h"
-#include "io/time_format.h"
+#include "io/platform/local_time.h"
+#include "io/platform/time_format.h"
 
 namespace pvtwin {
 namespace {

@@ -13,7 +13,7 @@
 
 #include "config/config_edit.h"
 #include "core/common/clock.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
 

@@ -10,7 +10,7 @@
 
 #include "core/synth/synthetic_plant.h"
 #include "daemon/monitor.h"
-#include "io/log.h"
+#include "io/platform/log.h"
 #include "io/params_json.h"
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"

@@ -1,7 +1,7 @@
-// The nightly schedule (io/local_time.h) in Europe/Vienna across both DST
+// The nightly schedule (io/platform/local_time.h) in Europe/Vienna across both DST
 // changes of 2024 (EU rule: last Sunday of March and October, 01:00 UTC).
 // Expected instants are written as UTC calendar times.
-#include "io/local_time.h"
+#include "io/platform/local_time.h"
 
 #include <gtest/gtest.h>
 

@@ -10,7 +10,7 @@
 
 #include "core/common/units.h"
 #include "io/csv.h"
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
 

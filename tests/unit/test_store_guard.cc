@@ -16,7 +16,7 @@
 #include <thread>
 
 #include "core/common/clock.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "io/store.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"

@@ -19,7 +19,7 @@
 #include "config/plant_config.h"
 #include "core/common/clock.h"
 #include "daemon/weather_worker.h"
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 #include "io/http_client.h"
 #include "io/store.h"
 #include "tests/support/files.h"

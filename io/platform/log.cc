@@ -1,4 +1,4 @@
-#include "io/log.h"
+#include "io/platform/log.h"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "io/child_process.h"
+#include "io/platform/child_process.h"
 
 #include <fcntl.h>
 #include <poll.h>

@@ -1,4 +1,4 @@
-#include "io/quantity_text.h"
+#include "io/platform/quantity_text.h"
 
 #include <cmath>
 #include <cstdio>

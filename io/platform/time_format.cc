@@ -1,10 +1,10 @@
-#include "io/time_format.h"
+#include "io/platform/time_format.h"
 
 #include <charconv>
 #include <chrono>
 #include <cstdio>
 
-#include "io/local_time.h"
+#include "io/platform/local_time.h"
 
 namespace pvtwin {
 namespace {

@@ -1,4 +1,4 @@
-#include "io/local_time.h"
+#include "io/platform/local_time.h"
 
 #include <charconv>
 #include <cstdlib>

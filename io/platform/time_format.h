@@ -19,7 +19,7 @@ namespace pvtwin {
 // sets *error to the rule that was broken; *unix_s is untouched.
 bool ParseTime(std::string_view text, std::int64_t* unix_s, std::string* error);
 
-class NaiveTimeZone;  // io/local_time.h
+class NaiveTimeZone;  // io/platform/local_time.h
 
 // As ParseTime, but an ISO 8601 date-time without Z or offset is the local
 // time of zone (when zone is not null): in the hour the clocks repeat in

@@ -43,8 +43,8 @@
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 #include "io/platform/child_process.h"
-#include "io/csv.h"
-#include "io/params_json.h"
+#include "io/files/csv.h"
+#include "io/files/params_json.h"
 
 namespace pvtwin::cli {
 

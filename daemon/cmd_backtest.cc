@@ -18,7 +18,7 @@
 #include "daemon/weather_import.h"
 #include "io/backtest_report.h"
 #include "io/platform/local_time.h"
-#include "io/params_json.h"
+#include "io/files/params_json.h"
 #include "io/platform/quantity_text.h"
 #include "io/platform/time_format.h"
 

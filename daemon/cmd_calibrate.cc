@@ -18,7 +18,7 @@
 #include "core/fit/iso9806.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
-#include "io/params_json.h"
+#include "io/files/params_json.h"
 #include "io/platform/quantity_text.h"
 #include "io/platform/time_format.h"
 

@@ -8,7 +8,7 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/store.h"
 
 namespace pvtwin::cli {

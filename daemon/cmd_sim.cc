@@ -16,7 +16,7 @@
 #include "core/data/resample.h"
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/platform/log.h"
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"

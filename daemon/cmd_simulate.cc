@@ -3,8 +3,8 @@
 
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
-#include "io/csv.h"
-#include "io/params_json.h"
+#include "io/files/csv.h"
+#include "io/files/params_json.h"
 
 namespace pvtwin::cli {
 

@@ -8,7 +8,7 @@
 #include <iostream>
 
 #include "core/common/clock.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/platform/time_format.h"
 
 namespace pvtwin::cli {

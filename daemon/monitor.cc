@@ -6,7 +6,7 @@
 
 #include "core/monitor/monitoring.h"
 #include "io/platform/log.h"
-#include "io/params_json.h"
+#include "io/files/params_json.h"
 #include "io/platform/time_format.h"
 
 namespace pvtwin::cli {

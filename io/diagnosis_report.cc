@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "io/params_json.h"
+#include "io/files/params_json.h"
 #include "io/svg_plot.h"
 
 namespace pvtwin {

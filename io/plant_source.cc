@@ -6,7 +6,7 @@
 #include "core/effects/effects.h"
 #include "core/effects/registry.h"
 #include "core/synth/synthetic_plant.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 
 namespace pvtwin {
 

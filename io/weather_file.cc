@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "core/data/physical_limits.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/platform/local_time.h"
 #include "io/platform/time_format.h"
 

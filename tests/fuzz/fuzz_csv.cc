@@ -1,4 +1,4 @@
-// libFuzzer harness for the canonical CSV reader (io/csv.h), which reads
+// libFuzzer harness for the canonical CSV reader (io/files/csv.h), which reads
 // whatever a user or a logger export hands to import, calibrate, simulate,
 // backtest and diagnose. It must never crash, and what it accepts must hold
 // the reader's promises: strictly increasing times, one value per row in
@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "core/data/physical_limits.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 
 namespace {
 

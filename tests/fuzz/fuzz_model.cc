@@ -15,7 +15,7 @@
 #include "core/model/thermal_model.h"
 #include "core/model/variant.h"
 #include "core/synth/synthetic_plant.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "config/plant_config.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "tests/support/files.h"
 
 namespace pvtwin::testing {

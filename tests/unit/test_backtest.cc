@@ -22,7 +22,7 @@
 #include "core/forecast/backtest.h"
 #include "core/model/variant.h"
 #include "core/synth/synthetic_plant.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/synthetic_series.h"
 #include "tests/support/unit_labels.h"

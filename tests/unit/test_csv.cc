@@ -16,7 +16,7 @@
 
 #include "config/plant_config.h"
 #include "core/common/units.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/platform/local_time.h"
 #include "io/platform/time_format.h"
 

@@ -29,7 +29,7 @@ TEST_P(CsvGoldenTest, ReportMatchesExpected) {
   EXPECT_EQ(actual, ReadFile(dir / "expected.txt"));
 }
 
-// The reading of a large file on two threads (io/csv.h), here made to take
+// The reading of a large file on two threads (io/files/csv.h), here made to take
 // every case: the same series and the same diagnostics, errors included.
 TEST_P(CsvGoldenTest, ReadOnTwoThreadsAsInOnePiece) {
   const fs::path dir = kGoldenCsvDir / GetParam();

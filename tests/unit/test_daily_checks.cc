@@ -11,7 +11,7 @@
 #include "core/synth/synthetic_plant.h"
 #include "daemon/monitor.h"
 #include "io/platform/log.h"
-#include "io/params_json.h"
+#include "io/files/params_json.h"
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"

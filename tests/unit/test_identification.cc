@@ -16,7 +16,7 @@
 #include "core/fit/lad_fit.h"
 #include "core/model/sensitivities.h"
 #include "core/synth/synthetic_plant.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/synth/synthetic_plant.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"
 #include "tests/support/child_process.h"

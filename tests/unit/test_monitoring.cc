@@ -14,7 +14,7 @@
 #include "core/physics/iam.h"
 #include "core/physics/solar_position.h"
 #include "core/synth/synthetic_plant.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {

@@ -10,7 +10,7 @@
 #include "core/common/units.h"
 #include "core/data/aggregate.h"
 #include "core/data/physical_limits.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/store.h"
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"

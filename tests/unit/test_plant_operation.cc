@@ -20,7 +20,7 @@
 #include "core/synth/pump_controller.h"
 #include "core/synth/synthetic_plant.h"
 #include "core/synth/weather_generator.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/plant_source.h"
 #include "tests/support/run_pvtwin.h"
 

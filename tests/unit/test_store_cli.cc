@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/common/units.h"
-#include "io/csv.h"
+#include "io/files/csv.h"
 #include "io/platform/time_format.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"

@@ -1,4 +1,4 @@
-#include "io/params_json.h"
+#include "io/files/params_json.h"
 
 #include <cerrno>
 #include <cmath>

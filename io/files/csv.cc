@@ -1,4 +1,4 @@
-#include "io/csv.h"
+#include "io/files/csv.h"
 
 #include <algorithm>
 #include <array>

@@ -40,7 +40,7 @@ namespace pvtwin {
 enum class RegisterTable { kInput, kHolding };  // function code 4 | 3
 enum class RegisterType { kU16, kI16, kU32, kI32, kF32, kF64 };
 // Byte order of a value on the wire, written for 32 bits with A the most
-// significant byte (see io/register_codec.h for 16 and 64 bits).
+// significant byte (see io/modbus/register_codec.h for 16 and 64 bits).
 enum class WordOrder { kABCD, kCDAB, kBADC, kDCBA };
 
 std::string_view TableName(RegisterTable table);

@@ -26,7 +26,7 @@
 
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
-#include "io/modbus_poller.h"
+#include "io/modbus/modbus_poller.h"
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"
 

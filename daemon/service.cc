@@ -36,7 +36,7 @@
 #include "io/http_client.h"
 #include "io/platform/local_time.h"
 #include "io/platform/log.h"
-#include "io/modbus_poller.h"
+#include "io/modbus/modbus_poller.h"
 #include "io/files/params_json.h"
 #include "io/store.h"
 #include "io/store_lock.h"

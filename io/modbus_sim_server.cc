@@ -16,7 +16,7 @@
 #include <cstring>
 #include <limits>
 
-#include "io/register_codec.h"
+#include "io/modbus/register_codec.h"
 
 namespace pvtwin {
 

@@ -1,4 +1,4 @@
-// libFuzzer harness for the Modbus TCP reply check (io/modbus_frame.h), the
+// libFuzzer harness for the Modbus TCP reply check (io/modbus/modbus_frame.h), the
 // first code that sees bytes from the network. Input: 8 bytes of request
 // (transaction id hi/lo, unit id, function, address hi/lo, count hi/lo; any
 // values, not only the 3/4 and 1..125 the poller sends), then the reply ADU.
@@ -11,7 +11,7 @@
 #include <cstring>
 #include <span>
 
-#include "io/modbus_frame.h"
+#include "io/modbus/modbus_frame.h"
 
 namespace {
 

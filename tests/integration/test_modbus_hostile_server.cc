@@ -40,9 +40,9 @@
 #include <vector>
 
 #include "config/plant_config.h"
-#include "io/modbus_poller.h"
+#include "io/modbus/modbus_poller.h"
 #include "io/modbus_sim_server.h"
-#include "io/register_codec.h"
+#include "io/modbus/register_codec.h"
 #include "tests/support/files.h"
 
 namespace pvtwin {

@@ -1,6 +1,6 @@
 // Integration through real Modbus: `pvtwin sim` as a separate process serving
 // on loopback (RTU: through a socat pseudo-terminal pair), the poller of
-// io/modbus_poller.h in this process, both on one accelerated clock.
+// io/modbus/modbus_poller.h in this process, both on one accelerated clock.
 //
 // Each folder scenarios/NN-name/ holds scenario.toml: the config (plant and
 // register map), the simulated start, the sky, the faults given to the
@@ -46,10 +46,10 @@
 
 #include "config/plant_config.h"
 #include "core/common/clock.h"
-#include "io/modbus_poller.h"
+#include "io/modbus/modbus_poller.h"
 #include "io/modbus_sim_server.h"
 #include "io/plant_source.h"
-#include "io/register_codec.h"
+#include "io/modbus/register_codec.h"
 #include "io/platform/time_format.h"
 #include "tests/support/child_process.h"
 #include "tests/support/files.h"

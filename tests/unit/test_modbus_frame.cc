@@ -1,4 +1,4 @@
-// The Modbus TCP read codec (io/modbus_frame.h) against the worked example of
+// The Modbus TCP read codec (io/modbus/modbus_frame.h) against the worked example of
 // the Modbus Application Protocol V1.1b3, §6.3 "Read Holding Registers":
 // request PDU 03 00 6B 00 03 (registers 108-110, PDU address 0x006B), reply
 // PDU 03 06 02 2B 00 00 00 64 (555, 0, 100), wrapped in the MBAP header of
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "io/modbus_frame.h"
+#include "io/modbus/modbus_frame.h"
 
 namespace pvtwin {
 namespace {

@@ -1,11 +1,11 @@
-// Coalescing of register-map points into reads (io/read_plan.h).
+// Coalescing of register-map points into reads (io/modbus/read_plan.h).
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
 #include "config/plant_config.h"
-#include "io/read_plan.h"
+#include "io/modbus/read_plan.h"
 #include "tests/support/files.h"
 
 namespace pvtwin {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/common/units.h"
-#include "io/register_codec.h"
+#include "io/modbus/register_codec.h"
 
 namespace pvtwin {
 namespace {

@@ -1,11 +1,11 @@
 // One Modbus TCP read transaction (function 3 or 4) on a socket that
-// libmodbus connected: send the request ADU of io/modbus_frame.h, read the
+// libmodbus connected: send the request ADU of io/modbus/modbus_frame.h, read the
 // 7-byte MBAP header, refuse it (before any body is read) unless its ids and
 // length belong to the request, read exactly the announced rest, check the
 // whole reply. The poller uses it instead of modbus_read_registers() because
 // libmodbus 3.1.6 does not check the unit id, the protocol id or the MBAP
 // length of a TCP reply (issue 17); libmodbus still opens, flushes and closes
-// the connection. Depends on POSIX sockets and io/modbus_frame.h only.
+// the connection. Depends on POSIX sockets and io/modbus/modbus_frame.h only.
 //
 // The socket is non-blocking (libmodbus opens it so): every wait is a poll()
 // against one deadline, timeout_ms of wall-clock time for the whole
@@ -17,7 +17,7 @@
 #include <span>
 #include <string>
 
-#include "io/modbus_frame.h"
+#include "io/modbus/modbus_frame.h"
 
 namespace pvtwin {
 

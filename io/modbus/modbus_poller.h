@@ -9,12 +9,12 @@
 // slow, dead or still inside a timeout never delays another device or the
 // delivery: its channels are simply missing (NaN, QC bit clear) in that
 // period. A value read for period k is never reported in another period.
-// Decoded values that fail the point's QC (io/register_codec.h) are NaN with
+// Decoded values that fail the point's QC (io/modbus/register_codec.h) are NaN with
 // the Sample's QC bit set.
 //
 // Failures: a response timeout, a reply that does not match the request
 // (TCP: transaction id, protocol id, MBAP length, unit id, function or byte
-// count, checked by io/modbus_frame.h; RTU: slave id, CRC, function or byte
+// count, checked by io/modbus/modbus_frame.h; RTU: slave id, CRC, function or byte
 // count, checked by libmodbus) or a broken connection: nothing of that read's
 // reply is used, and the connection is flushed and closed; it is re-opened on
 // a later period with capped exponential backoff (1, 2, 4 …
@@ -28,7 +28,7 @@
 // libmodbus error); failed polls in the same state are counted, not logged.
 //
 // Read-only by construction: requests are function codes 3 (holding) and 4
-// (input registers) only, sent by io/modbus_tcp_read.h on the socket that
+// (input registers) only, sent by io/modbus/modbus_tcp_read.h on the socket that
 // libmodbus connected (TCP: libmodbus 3.1.6 would accept a reply from another
 // unit, with a non-zero protocol id or a wrong MBAP length) or by libmodbus's
 // read calls (RTU). libmodbus opens, flushes and closes every connection.
@@ -52,7 +52,7 @@
 #include "core/common/clock.h"
 #include "core/common/sample.h"
 #include "io/platform/log.h"
-#include "io/read_plan.h"
+#include "io/modbus/read_plan.h"
 
 namespace pvtwin {
 

@@ -1,4 +1,4 @@
-#include "io/register_codec.h"
+#include "io/modbus/register_codec.h"
 
 #include <bit>
 #include <cassert>

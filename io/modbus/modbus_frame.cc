@@ -1,6 +1,6 @@
 // The Modbus TCP read codec: request ADU and reply checks. The frame layout,
 // the limits and why libmodbus is not trusted with this are in modbus_frame.h.
-#include "io/modbus_frame.h"
+#include "io/modbus/modbus_frame.h"
 
 #include <cassert>
 #include <cstdarg>

@@ -1,6 +1,6 @@
 // One Modbus TCP read transaction on a non-blocking socket; see
 // modbus_tcp_read.h for the order of reads and checks and the timeout rule.
-#include "io/modbus_tcp_read.h"
+#include "io/modbus/modbus_tcp_read.h"
 
 #include <poll.h>
 #include <sys/socket.h>

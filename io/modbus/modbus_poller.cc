@@ -1,4 +1,4 @@
-#include "io/modbus_poller.h"
+#include "io/modbus/modbus_poller.h"
 
 #include <modbus/modbus.h>
 
@@ -9,8 +9,8 @@
 #include <cmath>
 
 #include "core/data/physical_limits.h"
-#include "io/modbus_tcp_read.h"
-#include "io/register_codec.h"
+#include "io/modbus/modbus_tcp_read.h"
+#include "io/modbus/register_codec.h"
 
 namespace pvtwin {
 

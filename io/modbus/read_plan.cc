@@ -1,4 +1,4 @@
-#include "io/read_plan.h"
+#include "io/modbus/read_plan.h"
 
 #include <algorithm>
 #include <cassert>

@@ -2,7 +2,7 @@
 //
 // The register map has 2 devices × 40 points (every type and word order,
 // input and holding registers, so 2 reads per device). The simulator's server
-// (io/modbus_sim_server.h, real libmodbus TCP) runs in a forked child process,
+// (io/sim/modbus_sim_server.h, real libmodbus TCP) runs in a forked child process,
 // so getrusage of this process counts the poller alone.
 //   * CPU: the poller at the real 5 s period for a while, CPU time over wall
 //     time = share of one core (this includes the clock's idle wake-ups).
@@ -27,8 +27,8 @@
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 #include "io/modbus/modbus_poller.h"
-#include "io/modbus_sim_server.h"
-#include "io/plant_source.h"
+#include "io/sim/modbus_sim_server.h"
+#include "io/sim/plant_source.h"
 
 namespace pvtwin::cli {
 

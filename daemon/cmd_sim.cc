@@ -1,6 +1,6 @@
 // pvtwin sim: the plant simulator. Serves every point of the config's Modbus
-// register map from a simulated PVT plant (io/modbus_sim_server.h,
-// io/plant_source.h), or writes that plant's history as canonical CSV.
+// register map from a simulated PVT plant (io/sim/modbus_sim_server.h,
+// io/sim/plant_source.h), or writes that plant's history as canonical CSV.
 #include <poll.h>
 #include <unistd.h>
 
@@ -18,8 +18,8 @@
 #include "daemon/inputs.h"
 #include "io/files/csv.h"
 #include "io/platform/log.h"
-#include "io/modbus_sim_server.h"
-#include "io/plant_source.h"
+#include "io/sim/modbus_sim_server.h"
+#include "io/sim/plant_source.h"
 
 namespace pvtwin::cli {
 

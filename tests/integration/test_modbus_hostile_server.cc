@@ -41,7 +41,7 @@
 
 #include "config/plant_config.h"
 #include "io/modbus/modbus_poller.h"
-#include "io/modbus_sim_server.h"
+#include "io/sim/modbus_sim_server.h"
 #include "io/modbus/register_codec.h"
 #include "tests/support/files.h"
 

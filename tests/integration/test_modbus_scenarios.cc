@@ -20,7 +20,7 @@
 // 7 or a wrong MBAP length, come from the raw server of
 // test_modbus_hostile_server.cc.
 // check_values: every value equals what the simulator served, computed here
-// from the same deterministic plant (io/plant_source.h) through the point's
+// from the same deterministic plant (io/sim/plant_source.h) through the point's
 // encoding and decoding: the value of the period's row, or of the next row
 // when the request landed after it began (it must not be older: never stale).
 #include <gtest/gtest.h>
@@ -47,8 +47,8 @@
 #include "config/plant_config.h"
 #include "core/common/clock.h"
 #include "io/modbus/modbus_poller.h"
-#include "io/modbus_sim_server.h"
-#include "io/plant_source.h"
+#include "io/sim/modbus_sim_server.h"
+#include "io/sim/plant_source.h"
 #include "io/modbus/register_codec.h"
 #include "io/platform/time_format.h"
 #include "tests/support/child_process.h"

@@ -11,8 +11,8 @@
 
 #include "core/synth/synthetic_plant.h"
 #include "io/files/csv.h"
-#include "io/modbus_sim_server.h"
-#include "io/plant_source.h"
+#include "io/sim/modbus_sim_server.h"
+#include "io/sim/plant_source.h"
 #include "tests/support/child_process.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"

@@ -1,6 +1,6 @@
 // The simulated plant's operation (core/synth/pump_controller.h,
 // core/synth/absorber_sensor.h, PumpControl in core/synth/weather_generator.h,
-// io/plant_source.h): the ΔT thermostat on hand-checkable cases, the absorber
+// io/sim/plant_source.h): the ΔT thermostat on hand-checkable cases, the absorber
 // sensor against its analytic steady state and step response, heat from the
 // heat-pump source in November and June at the example plant through
 // `pvtwin sim --export` with the demo's config, and one continuous run
@@ -21,7 +21,7 @@
 #include "core/synth/synthetic_plant.h"
 #include "core/synth/weather_generator.h"
 #include "io/files/csv.h"
-#include "io/plant_source.h"
+#include "io/sim/plant_source.h"
 #include "tests/support/run_pvtwin.h"
 
 namespace pvtwin {
@@ -329,7 +329,7 @@ TEST(HeatPumpSourceExport, JuneMakesHeatOnSunnyHours) {
 }
 
 // ---------------------------------------------------------------------------
-// One continuous run across midnight (io/plant_source.h).
+// One continuous run across midnight (io/sim/plant_source.h).
 
 PlantSourceOptions ContinuousSource(PumpControl control) {
   PlantSourceOptions o;

@@ -1,4 +1,4 @@
-#include "io/modbus_sim_server.h"
+#include "io/sim/modbus_sim_server.h"
 
 #include <arpa/inet.h>
 #include <modbus/modbus.h>

@@ -35,7 +35,7 @@
 #include "config/modbus_config.h"
 #include "core/common/clock.h"
 #include "io/platform/log.h"
-#include "io/plant_source.h"
+#include "io/sim/plant_source.h"
 
 namespace pvtwin {
 

@@ -1,4 +1,4 @@
-#include "io/plant_source.h"
+#include "io/sim/plant_source.h"
 
 #include <algorithm>
 #include <cmath>

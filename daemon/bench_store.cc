@@ -26,7 +26,7 @@
 #include "core/data/aggregate.h"
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
-#include "io/store.h"
+#include "io/store/store.h"
 
 namespace pvtwin::cli {
 

@@ -19,7 +19,7 @@
 #include "core/synth/synthetic_plant.h"
 #include "daemon/bench.h"
 #include "io/pg_scratch_server.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "io/upload.h"
 
 namespace pvtwin::cli {

@@ -38,7 +38,7 @@
 #include "io/platform/local_time.h"
 #include "io/files/params_json.h"
 #include "io/platform/quantity_text.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "io/platform/time_format.h"
 
 namespace pvtwin::cli {

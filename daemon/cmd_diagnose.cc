@@ -22,7 +22,7 @@
 #include "daemon/store_cli.h"
 #include "io/diagnosis_report.h"
 #include "io/platform/quantity_text.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "io/platform/time_format.h"
 
 namespace pvtwin::cli {

@@ -9,7 +9,7 @@
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"
 #include "io/files/csv.h"
-#include "io/store.h"
+#include "io/store/store.h"
 
 namespace pvtwin::cli {
 

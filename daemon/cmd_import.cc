@@ -14,7 +14,7 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"
-#include "io/store.h"
+#include "io/store/store.h"
 
 namespace pvtwin::cli {
 

@@ -13,7 +13,7 @@
 
 #include "config/plant_config.h"
 #include "core/model/variant.h"
-#include "io/store.h"
+#include "io/store/store.h"
 
 namespace pvtwin::cli {
 

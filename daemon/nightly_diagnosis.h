@@ -14,7 +14,7 @@
 
 #include "config/plant_config.h"
 #include "io/platform/child_process.h"
-#include "io/store.h"
+#include "io/store/store.h"
 
 namespace pvtwin::cli {
 

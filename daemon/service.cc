@@ -38,8 +38,8 @@
 #include "io/platform/log.h"
 #include "io/modbus/modbus_poller.h"
 #include "io/files/params_json.h"
-#include "io/store.h"
-#include "io/store_lock.h"
+#include "io/store/store.h"
+#include "io/store/store_lock.h"
 #include "io/platform/time_format.h"
 
 namespace pvtwin {

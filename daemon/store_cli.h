@@ -5,7 +5,7 @@
 #include <string>
 
 #include "config/plant_config.h"
-#include "io/store.h"
+#include "io/store/store.h"
 
 namespace pvtwin::cli {
 

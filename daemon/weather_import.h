@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/common/plant.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "io/weather_file.h"
 
 namespace pvtwin::cli {

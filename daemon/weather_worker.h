@@ -20,7 +20,7 @@
 #include "core/common/plant.h"
 #include "daemon/worker_thread.h"
 #include "io/platform/log.h"
-#include "io/store.h"
+#include "io/store/store.h"
 
 namespace pvtwin {
 

@@ -21,7 +21,7 @@
 namespace pvtwin {
 
 const std::vector<UploadTable>& UploadTables() {
-  // Tables of the store (io/store.h and doc/contracts.md "Operation contracts");
+  // Tables of the store (io/store/store.h and doc/contracts.md "Operation contracts");
   // those the local store does not have are left out.
   static const std::vector<UploadTable> tables = {
       {"measurement_1min", {"ts"}, {"ts"}, {}, {}},
@@ -345,7 +345,7 @@ bool Uploader::Impl::PrepareLocal(std::string* error) {
   return true;
 }
 
-// The store's id (io/store.h store_identity), sent with every upload.
+// The store's id (io/store/store.h store_identity), sent with every upload.
 bool Uploader::Impl::ReadStoreId(std::string* error) {
   store_id.clear();
   if (!local.Query(

@@ -2,7 +2,7 @@
 // the performance index of a day (measured over expected energy), a drift
 // of identified parameters across calibrations, and sensor faults. Pure
 // computation; the daemon stores the results (performance_daily,
-// monitor_event, qc_event in io/store.h).
+// monitor_event, qc_event in io/store/store.h).
 #pragma once
 
 #include <cstdint>

@@ -11,7 +11,7 @@
 #include "core/data/aggregate.h"
 #include "core/data/physical_limits.h"
 #include "io/files/csv.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/common/units.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "tests/support/sqlite_db.h"
 
 namespace pvtwin {

@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "io/store.h"
+#include "io/store/store.h"
 #include "tests/support/sqlite_db.h"
 
 namespace pvtwin {

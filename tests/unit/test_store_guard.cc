@@ -17,7 +17,7 @@
 
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/wait.h"

@@ -21,7 +21,7 @@
 #include "daemon/weather_worker.h"
 #include "io/platform/child_process.h"
 #include "io/http_client.h"
-#include "io/store.h"
+#include "io/store/store.h"
 #include "tests/support/files.h"
 #include "tests/support/http_server.h"
 #include "tests/support/run_pvtwin.h"

@@ -1,4 +1,4 @@
-#include "io/store_lock.h"
+#include "io/store/store_lock.h"
 
 #include <fcntl.h>
 #include <sys/file.h>

@@ -1,6 +1,6 @@
 // The SQLite store; the design (schema, units, time, WAL and crash behaviour,
-// retention) is described at the head of io/store.h.
-#include "io/store.h"
+// retention) is described at the head of io/store/store.h.
+#include "io/store/store.h"
 
 #include <sqlite3.h>
 #include <unistd.h>
@@ -77,7 +77,7 @@ std::string ColumnDefs(std::span<const Channel> channels) {
   return s;
 }
 
-// Schema version 1 (io/store.h). Each later version appends one Migration
+// Schema version 1 (io/store/store.h). Each later version appends one Migration
 // whose statements turn version N-1 into N; Open runs the missing ones in
 // order, each in its own transaction together with the user_version update.
 std::vector<std::string> SchemaV1() {

@@ -33,7 +33,7 @@
 #include "daemon/weather_worker.h"
 #include "io/platform/child_process.h"
 #include "io/files/csv.h"
-#include "io/http_client.h"
+#include "io/weather/http_client.h"
 #include "io/platform/local_time.h"
 #include "io/platform/log.h"
 #include "io/modbus/modbus_poller.h"

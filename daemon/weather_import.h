@@ -1,5 +1,5 @@
 // A weather-forecast file or HTTP body into table weather_forecast: parse
-// (io/weather_file.h), bring to 1 min (core/forecast/weather_resample.h),
+// (io/weather/weather_file.h), bring to 1 min (core/forecast/weather_resample.h),
 // write with its source. Shared by `pvtwin import-weather` and the daemon's
 // fetch (daemon/weather_worker.h), so both read a file the same way.
 #pragma once
@@ -9,7 +9,7 @@
 
 #include "core/common/plant.h"
 #include "io/store/store.h"
-#include "io/weather_file.h"
+#include "io/weather/weather_file.h"
 
 namespace pvtwin::cli {
 

@@ -8,7 +8,7 @@
 #include "core/common/clock.h"
 #include "core/common/diagnostic.h"
 #include "daemon/weather_import.h"
-#include "io/http_client.h"
+#include "io/weather/http_client.h"
 
 namespace pvtwin {
 

@@ -1,9 +1,9 @@
 // The daemon's fetch of a weather forecast ([forecast] weather_url, issue 15)
 // as a thread of its own: every weather_refresh_min it GETs the URL
-// (io/http_client.h: connect and total time limits), reads the body as
+// (io/weather/http_client.h: connect and total time limits), reads the body as
 // import-weather reads a file (daemon/weather_import.h) and writes 1-min
 // rows to weather_forecast with the source "fetch <url>" (credential-like
-// query parameters shown as ***, io/http_client.h UrlForLogs), on its own
+// query parameters shown as ***, io/weather/http_client.h UrlForLogs), on its own
 // store connection. The daemon's loop never waits for it: polling goes on while
 // the server is slow or down. A failed fetch (unreachable, timed out,
 // HTTP error, a body that is not a forecast) is retried with exponential

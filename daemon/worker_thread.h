@@ -23,7 +23,7 @@ class StopRequest {
     wake_.notify_all();
   }
   bool IsSet() const { return flag_.load(); }
-  // For calls that poll a flag during long operations (io/http_client.h).
+  // For calls that poll a flag during long operations (io/weather/http_client.h).
   const std::atomic<bool>* Flag() const { return &flag_; }
   // Sleeps s seconds or until Set; true when stopped.
   bool WaitFor(double s) {

@@ -95,7 +95,7 @@
 //       where the row came from: "import-weather <file> (<format>)" or
 //       "fetch <url> (<format>)"; NULL for rows other programs wrote.
 //       import-weather and the daemon's fetch write 1-min rows, each fetch
-//       or import replacing the rows of its minutes (io/weather_file.h,
+//       or import replacing the rows of its minutes (io/weather/weather_file.h,
 //       core/forecast/weather_resample.h).
 //   plant_config(key TEXT PRIMARY KEY, value REAL)
 //       the [plant] keys of the config the daemon (or import-weather

@@ -1,4 +1,4 @@
-// libFuzzer harness for the weather-forecast reader (io/weather_file.h),
+// libFuzzer harness for the weather-forecast reader (io/weather/weather_file.h),
 // which reads what a user hands to import-weather and what a weather server
 // answers the daemon: Open-Meteo JSON or a canonical CSV. It must never
 // crash, every diagnostic must be printable, and what it accepts must be
@@ -11,7 +11,7 @@
 #include <string>
 
 #include "core/forecast/weather_resample.h"
-#include "io/weather_file.h"
+#include "io/weather/weather_file.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Weather-forecast files (io/weather_file.h): the recorded Open-Meteo
+// Weather-forecast files (io/weather/weather_file.h): the recorded Open-Meteo
 // answers and a canonical CSV in tests/weather/data, and malformed variants
 // of them; every error names the file, the field (with its index) and what
 // was expected.
@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "io/weather_file.h"
+#include "io/weather/weather_file.h"
 #include "tests/support/files.h"
 
 namespace pvtwin {

@@ -20,7 +20,7 @@
 #include "core/common/clock.h"
 #include "daemon/weather_worker.h"
 #include "io/platform/child_process.h"
-#include "io/http_client.h"
+#include "io/weather/http_client.h"
 #include "io/store/store.h"
 #include "tests/support/files.h"
 #include "tests/support/http_server.h"

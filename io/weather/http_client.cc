@@ -1,4 +1,4 @@
-#include "io/http_client.h"
+#include "io/weather/http_client.h"
 
 #include <curl/curl.h>
 

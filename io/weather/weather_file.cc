@@ -1,4 +1,4 @@
-#include "io/weather_file.h"
+#include "io/weather/weather_file.h"
 
 #include <algorithm>
 #include <cmath>

@@ -22,7 +22,7 @@
 //                  operation, pump_dt_on_k, pump_dt_off_k, brine_below_ambient_k,
 //                  brine_min_c, brine_max_c (SimConfig). Ignored by the daemon.
 //   [upload]       optional; replication of the store into a central
-//                  PostgreSQL (io/upload.h): url, password_file, plant_id
+//                  PostgreSQL (io/fleet/upload.h): url, password_file, plant_id
 //                  (required with [upload]), interval_s, batch_rows,
 //                  forecast_days. The url must not hold a password.
 //   [[modbus.*]]   the Modbus register map (config/modbus_config.h).

@@ -20,7 +20,7 @@
 #include "daemon/bench.h"
 #include "io/pg_scratch_server.h"
 #include "io/store/store.h"
-#include "io/upload.h"
+#include "io/fleet/upload.h"
 
 namespace pvtwin::cli {
 

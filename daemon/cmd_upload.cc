@@ -1,5 +1,5 @@
 // pvtwin upload: the store's rows into the central PostgreSQL of [upload]
-// (io/upload.h). --init creates or migrates the central schema; --once
+// (io/fleet/upload.h). --init creates or migrates the central schema; --once
 // sends everything queued and exits (cron, and the backfill of a year of
 // history: resumable, since the high-water mark moves after every batch);
 // without either it keeps uploading every interval_s until SIGTERM/SIGINT,
@@ -19,7 +19,7 @@
 #include "daemon/store_cli.h"
 #include "daemon/upload_worker.h"
 #include "io/platform/log.h"
-#include "io/upload.h"
+#include "io/fleet/upload.h"
 
 namespace pvtwin::cli {
 

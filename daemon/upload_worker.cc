@@ -19,7 +19,7 @@ std::string Seconds(double s) {
 
 UploadWorker::UploadWorker(const UploadSettings& settings, double interval_s, LogFn log)
     : settings_(settings), interval_s_(interval_s), log_(std::move(log)) {
-  // A stop ends any wait on the server at once (io/pg_client.h PgWait).
+  // A stop ends any wait on the server at once (io/fleet/pg_client.h PgWait).
   settings_.stop = stop_.Flag();
 }
 

@@ -1,5 +1,5 @@
 // The upload of the store into the central PostgreSQL as a thread of its
-// own (io/upload.h does the work): the daemon's loop never waits for the
+// own (io/fleet/upload.h does the work): the daemon's loop never waits for the
 // server. While the server is down, unreachable or refusing, the thread
 // retries with exponential backoff (1 s doubling up to
 // clamp(5·interval_s, 5 s, 300 s)) and the rows wait in the store's queue;
@@ -16,7 +16,7 @@
 
 #include "daemon/worker_thread.h"
 #include "io/platform/log.h"
-#include "io/upload.h"
+#include "io/fleet/upload.h"
 
 namespace pvtwin {
 

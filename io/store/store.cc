@@ -271,7 +271,7 @@ std::vector<std::string> SchemaV6() {
 // Version 7: the store's identity, a random id made once when the schema
 // reaches version 7 (at creation, or at the migration of an older store).
 // The fleet upload sends it, so that two stores under one plant_id are told
-// apart centrally (io/upload.h).
+// apart centrally (io/fleet/upload.h).
 std::vector<std::string> SchemaV7() {
   return {
       "CREATE TABLE store_identity(id INTEGER PRIMARY KEY CHECK(id = 1), store_id TEXT NOT NULL, "

@@ -124,7 +124,7 @@
 //       a random 128-bit id (32 hex digits) made once, when the store is
 //       created or migrated to version 7. The fleet upload sends it with
 //       plant_id, so that a second store under the same plant_id is refused
-//       centrally (io/upload.h). A copy of the file keeps the id: a store
+//       centrally (io/fleet/upload.h). A copy of the file keeps the id: a store
 //       copied to another site must not upload under the original's
 //       plant_id.
 //

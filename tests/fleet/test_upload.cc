@@ -1,4 +1,4 @@
-// The upload into a central PostgreSQL (io/upload.h) against a real server
+// The upload into a central PostgreSQL (io/fleet/upload.h) against a real server
 // (io/pg_scratch_server.h) and the real pvtwin processes: daemons
 // (`pvtwin run`, some polling `pvtwin sim` on loopback) and `pvtwin upload
 // --once`. Every scenario ends by comparing the central rows with the
@@ -16,9 +16,9 @@
 #include "config/config_edit.h"
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
-#include "io/pg_client.h"
+#include "io/fleet/pg_client.h"
 #include "io/pg_scratch_server.h"
-#include "io/upload.h"
+#include "io/fleet/upload.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"

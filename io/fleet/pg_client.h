@@ -1,4 +1,4 @@
-// A PostgreSQL connection for the upload (io/upload.h), behind one file:
+// A PostgreSQL connection for the upload (io/fleet/upload.h), behind one file:
 // libpq's handles are freed by their owners, every failure is a PgError
 // that says what was done, the server's message and what kind of fault it
 // is (the upload's states: down, auth failure, refused).

@@ -72,7 +72,7 @@
 #include <string_view>
 #include <vector>
 
-#include "io/pg_client.h"
+#include "io/fleet/pg_client.h"
 
 namespace pvtwin {
 
@@ -103,7 +103,7 @@ struct UploadSettings {
   int batch_rows = 5000;
   int forecast_days = 7;
   // Set by a signal handler or the daemon's stop: every wait on the server
-  // ends at once (io/pg_client.h PgWait); the rows stay queued.
+  // ends at once (io/fleet/pg_client.h PgWait); the rows stay queued.
   const std::atomic<bool>* stop = nullptr;
   // Bind plant_id centrally to this store even if another store holds it.
   bool takeover = false;

@@ -1,5 +1,5 @@
-// The PostgreSQL connection of the upload; see io/pg_client.h.
-#include "io/pg_client.h"
+// The PostgreSQL connection of the upload; see io/fleet/pg_client.h.
+#include "io/fleet/pg_client.h"
 
 #include <poll.h>
 

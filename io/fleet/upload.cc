@@ -1,6 +1,6 @@
 // The upload of the store into PostgreSQL; the design (queue, high-water
-// mark, central schema) is described at the head of io/upload.h.
-#include "io/upload.h"
+// mark, central schema) is described at the head of io/fleet/upload.h.
+#include "io/fleet/upload.h"
 
 #include <signal.h>
 #include <sqlite3.h>

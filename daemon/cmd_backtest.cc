@@ -16,7 +16,7 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "daemon/weather_import.h"
-#include "io/backtest_report.h"
+#include "io/report/backtest_report.h"
 #include "io/platform/local_time.h"
 #include "io/files/params_json.h"
 #include "io/platform/quantity_text.h"

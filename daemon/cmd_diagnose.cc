@@ -20,7 +20,7 @@
 #include "daemon/commands.h"
 #include "daemon/inputs.h"
 #include "daemon/store_cli.h"
-#include "io/diagnosis_report.h"
+#include "io/report/diagnosis_report.h"
 #include "io/platform/quantity_text.h"
 #include "io/store/store.h"
 #include "io/platform/time_format.h"

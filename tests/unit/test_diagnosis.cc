@@ -19,7 +19,7 @@
 #include "core/diagnosis/gap_localisation.h"
 #include "core/synth/synthetic_plant.h"
 #include "io/files/csv.h"
-#include "io/diagnosis_report.h"
+#include "io/report/diagnosis_report.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/unit_labels.h"
 

@@ -1,4 +1,4 @@
-#include "io/backtest_report.h"
+#include "io/report/backtest_report.h"
 
 #include <cmath>
 #include <nlohmann/json.hpp>

@@ -1,4 +1,4 @@
-#include "io/diagnosis_report.h"
+#include "io/report/diagnosis_report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "io/files/params_json.h"
-#include "io/svg_plot.h"
+#include "io/report/svg_plot.h"
 
 namespace pvtwin {
 

@@ -1,4 +1,4 @@
-#include "io/svg_plot.h"
+#include "io/report/svg_plot.h"
 
 #include <algorithm>
 #include <cmath>

@@ -643,8 +643,9 @@ TEST(IdentifyFailures, EvaluationCapNeverReturnsAWorseFit) {
 TEST(IdentifyWarmStart, AStartThatFitsBetterThanTheResultIsKept) {
   const Plant plant = DesignExamplePlant();
   int reached = 0;
-  for (const auto& [variant, seed] :
+  for (const auto& [variant_name, seed] :
        std::vector<std::pair<std::string, unsigned>>{{"1Nwr", 2}, {"1N", 4}, {"2Nwr", 9}}) {
+    const std::string variant = variant_name;  // a lambda below captures it (clang 14)
     WeatherOptions weather;
     weather.num_days = 6;
     weather.step_s = 300.0;

@@ -2,7 +2,6 @@
 // mark, central schema) is described at the head of io/fleet/upload.h.
 #include "io/fleet/upload.h"
 
-#include <signal.h>
 #include <sqlite3.h>
 
 #include <algorithm>
@@ -263,7 +262,6 @@ struct Uploader::Impl {
   };
   std::vector<Table> tables;
   std::string store_id;  // the local store's store_identity
-  int commits = 0;       // central COMMITs of this process (test hook)
 
   bool PrepareLocal(std::string* error);
   bool InstallTable(const UploadTable& spec, std::string* error);
@@ -282,7 +280,6 @@ struct Uploader::Impl {
                  std::int64_t* max_seq, std::int64_t* settled, std::int64_t* keep_from,
                  std::string* error);
   bool SendBatch(const Table& t, const std::string& copy, std::int64_t keep_from, PgError* error);
-  void MaybeKillForTest();
 };
 
 namespace {
@@ -729,12 +726,6 @@ bool Uploader::Impl::SendBatch(const Table& t, const std::string& copy, std::int
   return ok;
 }
 
-void Uploader::Impl::MaybeKillForTest() {
-  ++commits;
-  const char* when = std::getenv("PVTWIN_UPLOAD_TEST_KILL_AFTER_COMMIT");
-  if (when != nullptr && std::atoi(when) == commits) ::raise(SIGKILL);
-}
-
 bool Uploader::Impl::UploadBatch(const Table& t, std::int64_t* settled, bool* full,
                                  PgError* error) {
   const std::string name(t.spec->name);
@@ -759,7 +750,7 @@ bool Uploader::Impl::UploadBatch(const Table& t, std::int64_t* settled, bool* fu
   if (*settled == 0) return true;
   if (rows_sent > 0) {
     if (!SendBatch(t, copy, keep_from, error)) return false;
-    MaybeKillForTest();
+    if (settings.after_central_commit) settings.after_central_commit();
   }
   // After the central COMMIT only: raise the mark, forget the entries.
   const std::string update = "UPDATE upload_state SET hwm = max(hwm, " + std::to_string(max_seq) +

@@ -58,10 +58,6 @@
 // uploaded and queued, never silently re-created empty; `--resend`
 // (UploadSettings::resend) queues every local row again. A central table
 // without its key columns is an error too.
-//
-// Test hook: PVTWIN_UPLOAD_TEST_KILL_AFTER_COMMIT=N raises SIGKILL right
-// after the N-th central COMMIT of the process, before the high-water mark
-// moves (tests/unit/test_upload.cc).
 #pragma once
 
 #include <atomic>
@@ -109,6 +105,10 @@ struct UploadSettings {
   bool takeover = false;
   // Queue every local row again (after a central table was lost).
   bool resend = false;
+  // Called after each central COMMIT, before the high-water mark moves: the
+  // moment a crash must lose and duplicate nothing (the tests end the
+  // process there). Unset in the product.
+  std::function<void()> after_central_commit;
 };
 
 enum class UploadState { kStarting, kConnected, kDown, kAuthFailed, kRefused };

@@ -1,11 +1,13 @@
 // The upload into a central PostgreSQL (io/fleet/upload.h) against a real server
-// (io/pg_scratch_server.h) and the real pvtwin processes: daemons
+// (tests/support/pg_scratch_server.h) and the real pvtwin processes: daemons
 // (`pvtwin run`, some polling `pvtwin sim` on loopback) and `pvtwin upload
 // --once`. Every scenario ends by comparing the central rows with the
 // plant's SQLite rows, value by value.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -17,7 +19,7 @@
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
 #include "io/fleet/pg_client.h"
-#include "io/pg_scratch_server.h"
+#include "tests/support/pg_scratch_server.h"
 #include "io/fleet/upload.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
@@ -307,18 +309,37 @@ TEST_F(Upload, TwoDaemonsUploadTwoPlantsIntoOneDatabase) {
   EXPECT_NE(Log("north").find("upload: connected to"), std::string::npos) << Log("north");
 }
 
-TEST_F(Upload, DaemonKilledBetweenCentralCommitAndHighWaterMarkLeavesNoDuplicateAndNoGap) {
+TEST_F(Upload, AnUploaderKilledBetweenCentralCommitAndHighWaterMarkLeavesNoDuplicateAndNoGap) {
   WritePlant("plant", "batch_rows = 500\n");
   Import("plant", kMorning - 86400, 1, 60, 1);
-  ChildProcess daemon;
-  // The second central COMMIT ends the process before its mark moves.
-  ::setenv("PVTWIN_UPLOAD_TEST_KILL_AFTER_COMMIT", "2", 1);
-  const bool started = StartDaemon(&daemon, "plant");
-  ::unsetenv("PVTWIN_UPLOAD_TEST_KILL_AFTER_COMMIT");
-  ASSERT_TRUE(started);
-  int exit_code = 0;
-  ASSERT_TRUE(WaitFor(30, [&] { return daemon.Finished(&exit_code); })) << Log("plant");
-  EXPECT_EQ(exit_code, -SIGKILL);
+  // An uploading process of its own that the second central COMMIT ends
+  // before its mark moves: the injected after_central_commit.
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    UploadSettings settings;
+    settings.store_path = Db("plant").string();
+    settings.url = pg_.Conninfo("fleet");
+    settings.password_file = (dir_ / "pgpassword").string();
+    settings.plant_id = "plant";
+    settings.batch_rows = 500;
+    int commits = 0;
+    settings.after_central_commit = [&commits] {
+      if (++commits == 2) ::raise(SIGKILL);
+    };
+    std::string error;
+    auto uploader = Uploader::Open(settings, &error);
+    std::int64_t rows = 0;
+    bool more = true;
+    PgError pg_error;
+    while (uploader && more && uploader->UploadBatches(&rows, &more, &pg_error)) {
+    }
+    ::_exit(3);  // not killed: the test fails below
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGKILL);
   // The central database holds rows the store still counts as pending.
   const long long central = Central(
       "SELECT (SELECT count(*) FROM measurement_1min) + "
@@ -330,6 +351,7 @@ TEST_F(Upload, DaemonKilledBetweenCentralCommitAndHighWaterMarkLeavesNoDuplicate
     EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
   }
   EXPECT_GT(central, static_cast<long long>(uploaded));
+  ChildProcess daemon;
   ASSERT_TRUE(StartDaemon(&daemon, "plant"));
   // The daemon records a (skipped) calibration a loop pass after its start.
   ASSERT_TRUE(WaitFor(30, [&] {

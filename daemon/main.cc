@@ -3,7 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
-#include "daemon/commands.h"
+#include "daemon/commands/commands.h"
 
 int main(int argc, char** argv) {
   CLI::App app{

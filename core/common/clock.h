@@ -24,6 +24,11 @@ class Clock {
   virtual bool SleepUntil(double t_s, const std::atomic<bool>& stop) const = 0;
 };
 
+// Seconds of the steady clock since start (for durations, progress, ETAs).
+inline double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 inline double WallNowS() {
   using namespace std::chrono;
   return duration<double>(system_clock::now().time_since_epoch()).count();

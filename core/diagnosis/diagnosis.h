@@ -57,7 +57,7 @@ namespace pvtwin {
 // relative cost tolerance of 1e-4 instead of 1e-3. The test compares fits
 // that differ by one effect; a base fit stopped 3–5 % above its optimum lets
 // any extended fit (started from it) "improve" by converging further, which
-// is not an effect. `pvtwin bench ident`: 1e-4 reaches the noise floor.
+// is not an effect. `pvtwin-bench ident`: 1e-4 reaches the noise floor.
 IdentOptions DiagnosisIdentOptions();
 
 struct DiagnosisOptions {

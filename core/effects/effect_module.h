@@ -21,6 +21,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -132,6 +133,9 @@ struct EffectModule {
   // A realistic magnitude for synthetic truth data (applied on top of
   // ReferenceTruthParams, core/synth/synthetic_plant.h).
   std::vector<std::pair<Param, double>> typical_truth;
+  // The parameter whose fitted value against its truth tells best whether a
+  // fit found the effect (pvtwin-bench effects); unset: the first of params.
+  std::optional<Param> compared_param;
 
   // --- How it shows in a variant ---
   // "+name" in the model, with its hooks; null for an effect that the

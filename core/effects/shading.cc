@@ -375,6 +375,8 @@ const EffectModule& ShadingEffect() {
                        {Param::kShadeWidthRad, DegToRad(40.0)},
                        {Param::kShadeElevationRad, DegToRad(35.0)},
                        {Param::kShadeMismatch, 0.6}};
+    // The window's far edge is not determined by summer data; the mismatch is.
+    m.compared_param = Param::kShadeMismatch;
     m.signature = "beam irradiance in the plane, W/m² (localise by sun azimuth × elevation)";
     m.advice =
         "Look for the obstacle in the sun's path at the azimuth and elevation the fit "

@@ -73,7 +73,7 @@ enum class IdentMethod {
 
 struct IdentOptions {
   // Search method. The default is the one that reached the lowest held-out
-  // MAE for the least time in `pvtwin bench ident` (doc/performance.md).
+  // MAE for the least time in `pvtwin-bench ident` (doc/performance.md).
   IdentMethod method = IdentMethod::kLadLm;
   // Budget and tolerances (both methods: max_evaluations, ftol_rel,
   // xtol_rel); algorithm and its settings for kNlopt.

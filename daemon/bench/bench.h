@@ -1,15 +1,28 @@
-// Benchmarks of pvtwin bench, shared helpers.
+// The benchmarks of pvtwin-bench (daemon/bench/main.cc), shared helpers.
+// pvtwin-bench is built with the tree but never installed: benchmarks and
+// the scratch PostgreSQL server they start (tests/support/) stay out of the
+// product.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "core/common/clock.h"
+
 namespace pvtwin::cli {
 
 double Median(std::vector<double> v);
-double SecondsSince(std::chrono::steady_clock::time_point start);
+using pvtwin::SecondsSince;  // core/common/clock.h
+
+// The pvtwin executable the benchmarks start as child processes (`run`,
+// `calibrate`): the one built beside pvtwin-bench.
+std::string PvtwinExecutable();
+
+// The benchmarks' command line on the top level of pvtwin-bench.
+void ConfigureBench(CLI::App& app);
 
 // data_dir: where to write the 1-min training and held-out CSVs ("" = nowhere).
 void BenchIdentification(int repeats, std::uint64_t seed, const std::string& data_dir);

@@ -1,4 +1,4 @@
-// pvtwin bench daemon: the daemon's steady cost at 5 s polling, measured on
+// pvtwin-bench daemon: the daemon's steady cost at 5 s polling, measured on
 // the real processes: `pvtwin sim` serving the example plant (two devices)
 // on loopback and `pvtwin run` polling it in real time. CPU time and memory
 // come from /proc/<pid> of the daemon.
@@ -15,7 +15,7 @@
 
 #include "config/config_edit.h"
 #include "core/common/clock.h"
-#include "daemon/bench.h"
+#include "daemon/bench/bench.h"
 #include "daemon/demo_config.h"
 #include "io/platform/child_process.h"
 
@@ -59,7 +59,7 @@ void BenchDaemon(double seconds) {
   std::string tmpl = (fs::temp_directory_path() / "pvtwin-bench-XXXXXX").string();
   if (::mkdtemp(tmpl.data()) == nullptr) return;
   const fs::path dir = tmpl;
-  const std::string exe = SelfExecutable();
+  const std::string exe = PvtwinExecutable();
   std::ofstream(dir / "sim.toml") << kDemoPlantConfig;
   ChildProcess sim, daemon;
   std::string error;

@@ -1,4 +1,4 @@
-// pvtwin bench diagnose: wall time of one gap diagnosis over the whole effect
+// pvtwin-bench diagnose: wall time of one gap diagnosis over the whole effect
 // library, 14 training + 7 held-out days at 1 min, both cores.
 #include <chrono>
 #include <cstdio>
@@ -8,7 +8,7 @@
 #include "core/data/qc.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
+#include "daemon/bench/bench.h"
 
 namespace pvtwin::cli {
 

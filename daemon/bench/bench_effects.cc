@@ -1,4 +1,4 @@
-// pvtwin bench effects: the cost and the payoff of each effect of the
+// pvtwin-bench effects: the cost and the payoff of each effect of the
 // library on synthetic data with a known answer. For every effect: 21 days
 // at 1 min of a truth = base + effect (TruthParamsFor, realistic noise, the
 // paper's data defects corrected as the import does), the first 14 days
@@ -16,7 +16,7 @@
 #include "core/effects/effects.h"
 #include "core/fit/identification.h"
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
+#include "daemon/bench/bench.h"
 
 namespace pvtwin::cli {
 
@@ -25,13 +25,16 @@ namespace {
 constexpr int kTrainDays = 14;
 constexpr int kHeldOutDays = 7;
 
-// The base model each effect is added to: 1N1Cwr, or the variant just
-// without the effect's letter.
-const char* BaseFor(const EffectModule& e) {
-  if (e.name == "capacitance") return "1Nwr";
-  if (e.name == "wind") return "1N1Cr";
-  if (e.name == "sky_radiation") return "1N1Cw";
-  return "1N1Cwr";
+// The base model each effect is added to: 1N1Cwr, or for an effect that
+// 1N1Cwr has (a letter of the paper's), 1N1Cwr without that letter.
+ModelSpec BaseFor(const EffectModule& e) {
+  for (const char* variant : {"1N1Cwr", "1Nwr", "1N1Cr", "1N1Cw"}) {
+    ModelSpec spec;
+    std::string error;
+    ParseVariant(variant, &spec, &error);
+    if (!HasEffect(spec, e)) return spec;
+  }
+  return {};
 }
 
 struct Scored {
@@ -97,12 +100,7 @@ void BenchEffects(int repeats, std::uint64_t seed) {
   double total_s = 0.0;
   for (const EffectModule* effect : EffectRegistry()) {
     const EffectModule& info = *effect;
-    const ModelSpec base = [&] {
-      ModelSpec spec;
-      std::string error;
-      ParseVariant(BaseFor(info), &spec, &error);
-      return spec;
-    }();
+    const ModelSpec base = BaseFor(info);
     const ModelSpec with = WithEffect(base, info);
     SyntheticOptions options;
     std::string error;
@@ -121,12 +119,12 @@ void BenchEffects(int repeats, std::uint64_t seed) {
     const Scored fit = FitAndScore(data, split, plant, with, repeats, nullptr);
     const Scored without = FitAndScore(data, split, plant, base, 1, nullptr);
     total_s += fit.runtime_s;
-    // The parameter to compare: the first of the effect's, except shading's
-    // mismatch (the window's far edge is not determined by summer data) and
-    // irradiance_bias, which the drivers estimate from GHI/DHI.
+    // The parameter to compare: the module's compared_param (the first of
+    // its parameters unless it names one), except for an effect that the
+    // drivers estimate (irradiance_bias, from GHI/DHI).
     std::string param = "-";
     if (!info.params.empty()) {
-      const Param p = info.name == "shading" ? Param::kShadeMismatch : info.params.front();
+      const Param p = info.compared_param.value_or(info.params.front());
       const double value = info.sensor_estimate != nullptr
                                ? fit.irradiance_bias
                                : fit.params[static_cast<std::size_t>(p)];

@@ -1,4 +1,4 @@
-// pvtwin bench ident: the figures behind the choice of the identification
+// pvtwin-bench ident: the figures behind the choice of the identification
 // algorithm (IdentOptions::method). Synthetic data with a known answer:
 // 17 days of a 2N1Ccolwr "truth" (ReferenceTruthParams) with realistic
 // sensor noise; the first 14 days train, the last 3 are held out. Every
@@ -41,7 +41,7 @@
 #include "core/fit/identification.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
+#include "daemon/bench/bench.h"
 #include "io/platform/child_process.h"
 #include "io/files/csv.h"
 #include "io/files/params_json.h"
@@ -167,7 +167,7 @@ void PrintTimeSplit(const SplitData& data, const IdentSummary& fit, const std::s
 // Wall time of this executable run with `args` (output to /dev/null) until
 // it ends; NaN when it cannot be started or does not exit with 0.
 double ProcessSeconds(const std::vector<std::string>& args) {
-  std::vector<std::string> argv{SelfExecutable()};
+  std::vector<std::string> argv{PvtwinExecutable()};
   argv.insert(argv.end(), args.begin(), args.end());
   ChildProcess child;
   std::string error;
@@ -182,7 +182,7 @@ double ProcessSeconds(const std::vector<std::string>& args) {
 // file, checked against it: false (and a printed reason) if the two differ.
 bool WriteExamplePlantConfig(const std::string& path) {
   const std::string text =
-      "# DesignExamplePlant (core/synth/synthetic_plant.h), written by pvtwin bench ident\n"
+      "# DesignExamplePlant (core/synth/synthetic_plant.h), written by pvtwin-bench ident\n"
       "[plant]\nlatitude_deg = 47.358\nlongitude_deg = 16.128\ntilt_deg = 20\n"
       "azimuth_deg = 180\narea_m2 = 1.8\n";
   std::string error;

@@ -1,4 +1,4 @@
-// pvtwin bench poll: the Modbus poller against a simulator on loopback.
+// pvtwin-bench poll: the Modbus poller against a simulator on loopback.
 //
 // The register map has 2 devices × 40 points (every type and word order,
 // input and holding registers, so 2 reads per device). The simulator's server
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
+#include "daemon/bench/bench.h"
 #include "io/modbus/modbus_poller.h"
 #include "io/sim/modbus_sim_server.h"
 #include "io/sim/plant_source.h"

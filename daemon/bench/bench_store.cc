@@ -1,4 +1,4 @@
-// pvtwin bench store: the SQLite store at the daemon's data rates, on 14
+// pvtwin-bench store: the SQLite store at the daemon's data rates, on 14
 // days of synthetic 5 s samples (2N1Ccolwr truth with realistic sensor noise,
 // MakeSyntheticPlantData) in a fresh database file under the temp folder.
 //
@@ -25,7 +25,7 @@
 
 #include "core/data/aggregate.h"
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
+#include "daemon/bench/bench.h"
 #include "io/store/store.h"
 
 namespace pvtwin::cli {

@@ -1,4 +1,4 @@
-// pvtwin bench table6: the protocol of the paper's Table 6 on synthetic data
+// pvtwin-bench table6: the protocol of the paper's Table 6 on synthetic data
 // with a known answer: 14 + 29 days at 1 min of a 2N1Ccolwr "truth" with
 // realistic sensor noise, the nine variants identified on the 14 days before
 // each of the 29 test days, on every core. Prints the wall time and the table,
@@ -11,7 +11,7 @@
 
 #include "core/forecast/backtest.h"
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
+#include "daemon/bench/bench.h"
 
 namespace pvtwin::cli {
 namespace {

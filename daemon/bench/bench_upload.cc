@@ -1,7 +1,7 @@
-// pvtwin bench upload: the upload of a 30-day backlog of 1-min rows (43 200
+// pvtwin-bench upload: the upload of a 30-day backlog of 1-min rows (43 200
 // rows of measurement_1min, synthetic 2N1Ccolwr truth with sensor noise)
 // into a PostgreSQL server that the bench starts itself in a temporary
-// directory (io/pg_scratch_server.h, unix socket only). The uploader runs
+// directory (tests/support/pg_scratch_server.h, unix socket only). The uploader runs
 // in this process as it runs in the daemon's upload thread, so the process
 // CPU time printed is the daemon's share; the server's own CPU is not in it.
 //
@@ -17,8 +17,8 @@
 #include <string>
 
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
-#include "io/pg_scratch_server.h"
+#include "daemon/bench/bench.h"
+#include "tests/support/pg_scratch_server.h"
 #include "io/store/store.h"
 #include "io/fleet/upload.h"
 

@@ -1,4 +1,4 @@
-// pvtwin bench: speed figures of the model and of identification, printed
+// pvtwin-bench: speed figures of the model and of identification, printed
 // as medians over repeated runs on synthetic data with a recorded seed.
 #include <pthread.h>
 #include <sched.h>
@@ -15,8 +15,8 @@
 #include "core/model/sensitivities.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
-#include "daemon/bench.h"
-#include "daemon/commands.h"
+#include "daemon/bench/bench.h"
+#include "daemon/commands/commands.h"
 
 namespace pvtwin::cli {
 
@@ -26,9 +26,6 @@ double Median(std::vector<double> v) {
   return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
 }
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 namespace {
 
@@ -179,11 +176,11 @@ void BenchSimulation(const BenchArgs& a) {
 
 }  // namespace
 
-void RegisterBench(CLI::App& app) {
+void ConfigureBench(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "bench",
-      "Print speed figures (medians over repeated runs, one core unless noted) on synthetic data,\n"
+  CLI::App* cmd = &app;
+  cmd->description(
+      "pvtwin-bench: print speed figures (medians over repeated runs, one core unless noted) on synthetic data,\n"
       "before and after each core's time for a fixed workload (cores of a shared machine may\n"
       "differ in speed, and drift):\n"
       "  sim    one 14-day 1-min simulation of each variant\n"

@@ -9,7 +9,7 @@
 
 #include "config/plant_config.h"
 #include "core/common/units.h"
-#include "daemon/commands.h"
+#include "daemon/commands/commands.h"
 
 namespace pvtwin::cli {
 namespace {

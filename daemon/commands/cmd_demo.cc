@@ -5,7 +5,7 @@
 //   2. 14 days of history from the simulator's truth model (`pvtwin sim
 //      --export`), imported as 1-min rows;
 //   3. `pvtwin sim` serving the plant over Modbus TCP on loopback, and the
-//      daemon loop (daemon/service.h) polling it, both on one accelerated
+//      daemon loop (daemon/service/service.h) polling it, both on one accelerated
 //      clock;
 //   4. the daemon calibrates (it has no parameters yet), accepts the fit and
 //      writes a 24 h forecast while polling goes on;
@@ -29,10 +29,10 @@
 #include "core/common/units.h"
 #include "core/forecast/forecast_backtest.h"
 #include "core/model/variant.h"
-#include "daemon/commands.h"
+#include "daemon/commands/commands.h"
 #include "daemon/demo_config.h"
-#include "daemon/inputs.h"
-#include "daemon/service.h"
+#include "daemon/commands/inputs.h"
+#include "daemon/service/service.h"
 #include "io/platform/child_process.h"
 #include "io/files/csv.h"
 #include "io/platform/local_time.h"

@@ -5,9 +5,9 @@
 #include <vector>
 
 #include "core/data/aggregate.h"
-#include "daemon/commands.h"
-#include "daemon/inputs.h"
-#include "daemon/store_cli.h"
+#include "daemon/commands/commands.h"
+#include "daemon/commands/inputs.h"
+#include "daemon/service/store_cli.h"
 #include "io/files/csv.h"
 #include "io/store/store.h"
 

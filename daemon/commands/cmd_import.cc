@@ -11,9 +11,9 @@
 #include <iostream>
 #include <optional>
 
-#include "daemon/commands.h"
-#include "daemon/inputs.h"
-#include "daemon/store_cli.h"
+#include "daemon/commands/commands.h"
+#include "daemon/commands/inputs.h"
+#include "daemon/service/store_cli.h"
 #include "io/store/store.h"
 
 namespace pvtwin::cli {

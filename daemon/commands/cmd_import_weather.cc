@@ -1,6 +1,6 @@
 // pvtwin import-weather: a weather forecast (Open-Meteo JSON, hourly or
 // 15-min, or a canonical CSV) into table weather_forecast at 1 min, for the
-// daemon's next forecast (daemon/weather_import.h says how). The plant comes
+// daemon's next forecast (daemon/service/weather_import.h says how). The plant comes
 // from --config, else from the store's plant_config (written by `pvtwin run`).
 #include <filesystem>
 #include <fstream>
@@ -8,10 +8,10 @@
 #include <sstream>
 
 #include "config/plant_config.h"
-#include "daemon/commands.h"
-#include "daemon/inputs.h"
-#include "daemon/store_cli.h"
-#include "daemon/weather_import.h"
+#include "daemon/commands/commands.h"
+#include "daemon/commands/inputs.h"
+#include "daemon/service/store_cli.h"
+#include "daemon/service/weather_import.h"
 
 namespace pvtwin::cli {
 

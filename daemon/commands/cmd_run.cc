@@ -1,13 +1,13 @@
-// pvtwin run: the daemon (daemon/service.h) under systemd or in a terminal.
+// pvtwin run: the daemon (daemon/service/service.h) under systemd or in a terminal.
 #include <signal.h>
 
 #include <atomic>
 #include <cstring>
 #include <iostream>
 
-#include "daemon/commands.h"
-#include "daemon/inputs.h"
-#include "daemon/service.h"
+#include "daemon/commands/commands.h"
+#include "daemon/commands/inputs.h"
+#include "daemon/service/service.h"
 
 namespace pvtwin::cli {
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "core/data/resample.h"
-#include "daemon/commands.h"
-#include "daemon/inputs.h"
+#include "daemon/commands/commands.h"
+#include "daemon/commands/inputs.h"
 #include "io/files/csv.h"
 #include "io/platform/log.h"
 #include "io/sim/modbus_sim_server.h"

@@ -1,8 +1,8 @@
 // pvtwin simulate: run one variant with given parameters over measured inputs.
 #include <iostream>
 
-#include "daemon/commands.h"
-#include "daemon/inputs.h"
+#include "daemon/commands/commands.h"
+#include "daemon/commands/inputs.h"
 #include "io/files/csv.h"
 #include "io/files/params_json.h"
 

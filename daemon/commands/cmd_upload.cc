@@ -13,11 +13,11 @@
 #include <cstdio>
 #include <iostream>
 
-#include "daemon/bench.h"
-#include "daemon/commands.h"
-#include "daemon/inputs.h"
-#include "daemon/store_cli.h"
-#include "daemon/upload_worker.h"
+#include "core/common/clock.h"
+#include "daemon/commands/commands.h"
+#include "daemon/commands/inputs.h"
+#include "daemon/service/store_cli.h"
+#include "daemon/service/upload_worker.h"
 #include "io/platform/log.h"
 #include "io/fleet/upload.h"
 

@@ -1,4 +1,4 @@
-#include "daemon/commands.h"
+#include "daemon/commands/commands.h"
 
 #include <string>
 #include <utility>
@@ -29,7 +29,6 @@ const std::vector<std::pair<std::string, std::string>>& Examples() {
       {"simulate",
        "pvtwin simulate --config plant.toml --csv day1.csv --variant 2N1CcolwrI "
        "--params params.json --out pred.csv"},
-      {"bench", "pvtwin bench sim ident"},
       {"backtest",
        "pvtwin backtest --config plant.toml --csv data.csv --variants paper --train-days 14"},
       {"import",
@@ -74,7 +73,6 @@ void RegisterCommands(CLI::App& app) {
   RegisterCheckConfig(app);
   RegisterCalibrate(app);
   RegisterSimulate(app);
-  RegisterBench(app);
   RegisterBacktest(app);
   RegisterImport(app);
   RegisterImportWeather(app);

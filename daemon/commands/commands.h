@@ -20,7 +20,6 @@ void SetExitCode(int code);
 void RegisterCheckConfig(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
 void RegisterCalibrate(CLI::App& app);
-void RegisterBench(CLI::App& app);
 void RegisterBacktest(CLI::App& app);
 void RegisterImport(CLI::App& app);
 void RegisterImportWeather(CLI::App& app);

@@ -1,4 +1,4 @@
-#include "daemon/inputs.h"
+#include "daemon/commands/inputs.h"
 
 #include <sys/prctl.h>
 #include <unistd.h>

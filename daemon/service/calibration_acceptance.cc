@@ -1,4 +1,4 @@
-#include "daemon/calibration_acceptance.h"
+#include "daemon/service/calibration_acceptance.h"
 
 #include <cmath>
 #include <cstdio>

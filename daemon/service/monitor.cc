@@ -1,4 +1,4 @@
-#include "daemon/monitor.h"
+#include "daemon/service/monitor.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "daemon/nightly_diagnosis.h"
+#include "daemon/service/nightly_diagnosis.h"
 
 #include <unistd.h>
 

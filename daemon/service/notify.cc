@@ -1,4 +1,4 @@
-#include "daemon/notify.h"
+#include "daemon/service/notify.h"
 
 #include <systemd/sd-daemon.h>
 

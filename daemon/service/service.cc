@@ -1,4 +1,4 @@
-#include "daemon/service.h"
+#include "daemon/service/service.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -24,13 +24,13 @@
 #include "core/forecast/forecast_bands.h"
 #include "core/model/thermal_model.h"
 #include "core/model/variant.h"
-#include "daemon/calibration_acceptance.h"
-#include "daemon/monitor.h"
-#include "daemon/nightly_diagnosis.h"
-#include "daemon/notify.h"
-#include "daemon/store_cli.h"
-#include "daemon/upload_worker.h"
-#include "daemon/weather_worker.h"
+#include "daemon/service/calibration_acceptance.h"
+#include "daemon/service/monitor.h"
+#include "daemon/service/nightly_diagnosis.h"
+#include "daemon/service/notify.h"
+#include "daemon/service/store_cli.h"
+#include "daemon/service/upload_worker.h"
+#include "daemon/service/weather_worker.h"
 #include "io/platform/child_process.h"
 #include "io/files/csv.h"
 #include "io/weather/http_client.h"
@@ -157,9 +157,9 @@ class Service {
   void FinishRefit(int exit_code);
   // Daily checks and the diagnosis, once the night's calibration is done.
   void AfterCalibration();
-  // performance_daily, sensor faults, drift and alarms (daemon/monitor.h).
+  // performance_daily, sensor faults, drift and alarms (daemon/service/monitor.h).
   void DailyChecks(bool accepted_now);
-  // The nightly diagnosis child (daemon/nightly_diagnosis.h), when due.
+  // The nightly diagnosis child (daemon/service/nightly_diagnosis.h), when due.
   void MaybeStartDiagnosis();
   // Inserts the row and returns its id (0 when it could not be stored).
   std::int64_t RecordCalibration(Store::CalibrationRow row);

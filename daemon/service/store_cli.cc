@@ -1,4 +1,4 @@
-#include "daemon/store_cli.h"
+#include "daemon/service/store_cli.h"
 
 #include <iostream>
 

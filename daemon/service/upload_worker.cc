@@ -1,4 +1,4 @@
-#include "daemon/upload_worker.h"
+#include "daemon/service/upload_worker.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -14,7 +14,7 @@
 #include <string>
 #include <thread>
 
-#include "daemon/worker_thread.h"
+#include "daemon/service/worker_thread.h"
 #include "io/platform/log.h"
 #include "io/fleet/upload.h"
 

@@ -1,4 +1,4 @@
-#include "daemon/weather_import.h"
+#include "daemon/service/weather_import.h"
 
 #include "core/forecast/weather_resample.h"
 #include "io/platform/time_format.h"

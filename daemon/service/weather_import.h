@@ -1,7 +1,7 @@
 // A weather-forecast file or HTTP body into table weather_forecast: parse
 // (io/weather/weather_file.h), bring to 1 min (core/forecast/weather_resample.h),
 // write with its source. Shared by `pvtwin import-weather` and the daemon's
-// fetch (daemon/weather_worker.h), so both read a file the same way.
+// fetch (daemon/service/weather_worker.h), so both read a file the same way.
 #pragma once
 
 #include <cstdint>

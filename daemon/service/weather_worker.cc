@@ -1,4 +1,4 @@
-#include "daemon/weather_worker.h"
+#include "daemon/service/weather_worker.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,7 +7,7 @@
 
 #include "core/common/clock.h"
 #include "core/common/diagnostic.h"
-#include "daemon/weather_import.h"
+#include "daemon/service/weather_import.h"
 #include "io/weather/http_client.h"
 
 namespace pvtwin {

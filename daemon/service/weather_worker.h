@@ -1,7 +1,7 @@
 // The daemon's fetch of a weather forecast ([forecast] weather_url, issue 15)
 // as a thread of its own: every weather_refresh_min it GETs the URL
 // (io/weather/http_client.h: connect and total time limits), reads the body as
-// import-weather reads a file (daemon/weather_import.h) and writes 1-min
+// import-weather reads a file (daemon/service/weather_import.h) and writes 1-min
 // rows to weather_forecast with the source "fetch <url>" (credential-like
 // query parameters shown as ***, io/weather/http_client.h UrlForLogs), on its own
 // store connection. The daemon's loop never waits for it: polling goes on while
@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "core/common/plant.h"
-#include "daemon/worker_thread.h"
+#include "daemon/service/worker_thread.h"
 #include "io/platform/log.h"
 #include "io/store/store.h"
 

@@ -157,7 +157,7 @@
 // views use are kept for each ts (the newest issue, shown by
 // forecast_latest, and the newest issue before the day began, scored by
 // forecast_skill): hourly 24 h forecasts would otherwise add 1440 rows per
-// hour (about 3 MiB a day, pvtwin bench store), and both views return the
+// hour (about 3 MiB a day, pvtwin-bench store), and both views return the
 // same rows before and after pruning.
 //
 // Threads: one Store is one connection, guarded by a mutex; another thread

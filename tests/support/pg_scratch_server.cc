@@ -1,4 +1,4 @@
-#include "io/pg_scratch_server.h"
+#include "tests/support/pg_scratch_server.h"
 
 #include <stdlib.h>
 #include <sys/stat.h>

@@ -1,5 +1,5 @@
 // ChildProcess::Wait: the blocking end of a child started with Start, as
-// `pvtwin bench ident` times `pvtwin calibrate` with it.
+// `pvtwin-bench ident` times `pvtwin calibrate` with it.
 #include <gtest/gtest.h>
 
 #include <csignal>

@@ -12,10 +12,10 @@ namespace pvtwin {
 namespace {
 
 TEST(CliHelp, EveryVerbShowsAnExampleAndItsDefaults) {
-  const std::string verbs[] = {"check-config",  "calibrate", "simulate", "bench",
-                               "backtest",      "import",    "export",   "sim",
-                               "run",           "demo",      "diagnose", "diagnose-selftest",
-                               "import-weather"};
+  const std::string verbs[] = {"check-config", "calibrate", "simulate", "backtest",
+                               "import",       "export",    "sim",      "run",
+                               "demo",         "diagnose",  "diagnose-selftest",
+                               "import-weather", "upload"};
   for (const std::string& verb : verbs) {
     const testing::ProcessResult r = testing::RunPvtwin(".", verb + " --help");
     EXPECT_EQ(r.exit_code, 0) << verb;
@@ -26,6 +26,13 @@ TEST(CliHelp, EveryVerbShowsAnExampleAndItsDefaults) {
   EXPECT_NE(testing::RunPvtwin(".", "demo --help").out.find("--speed FLOAT:FLOAT in [1 - 600]=60"),
             std::string::npos);
   EXPECT_NE(testing::RunPvtwin(".", "export --help").out.find("--to TEXT=now"), std::string::npos);
+}
+
+// The benchmarks are an executable of their own, never part of the product.
+TEST(CliHelp, TheInstalledBinaryHasNoBenchmarks) {
+  const testing::ProcessResult r = testing::RunPvtwin(".", "bench sim");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(testing::RunPvtwin(".", "--help").out.find("bench"), std::string::npos);
 }
 
 TEST(CliHelp, VerbsTakingAVariantExplainTheGrammarAndListEveryEffect) {

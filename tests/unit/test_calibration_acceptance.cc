@@ -1,8 +1,8 @@
-// The daemon's rule for taking a new calibration (daemon/calibration_acceptance.h).
+// The daemon's rule for taking a new calibration (daemon/service/calibration_acceptance.h).
 #include <gtest/gtest.h>
 
 #include "core/synth/synthetic_plant.h"
-#include "daemon/calibration_acceptance.h"
+#include "daemon/service/calibration_acceptance.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin::cli {

@@ -1,4 +1,4 @@
-// daemon/monitor.h on a real SQLite file: a week of synthetic 1-min data from
+// daemon/service/monitor.h on a real SQLite file: a week of synthetic 1-min data from
 // a known truth, of which the last four days lost 15 % of P_el and one
 // night's air temperature froze, and the truth's parameters as the accepted
 // calibration. The daily checks score every day, raise the performance alarm
@@ -9,7 +9,7 @@
 #include <cmath>
 
 #include "core/synth/synthetic_plant.h"
-#include "daemon/monitor.h"
+#include "daemon/service/monitor.h"
 #include "io/platform/log.h"
 #include "io/files/params_json.h"
 #include "tests/support/files.h"

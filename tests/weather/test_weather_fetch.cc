@@ -18,7 +18,7 @@
 #include "config/config_edit.h"
 #include "config/plant_config.h"
 #include "core/common/clock.h"
-#include "daemon/weather_worker.h"
+#include "daemon/service/weather_worker.h"
 #include "io/platform/child_process.h"
 #include "io/weather/http_client.h"
 #include "io/store/store.h"

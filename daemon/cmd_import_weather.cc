@@ -85,6 +85,9 @@ int RunImportWeather(const ImportWeatherArgs& a) {
       break;
   }
   for (const std::string& origin : r.summary.origins) std::cerr << "  " << origin << "\n";
+  // Physically impossible irradiance is a warning, not an error: the rows
+  // are stored clipped and marked (weather_import.h), the exit code stays 0.
+  for (const std::string& warning : r.Warnings()) std::cerr << "warning: " << warning << "\n";
   std::cerr << r.SummaryLine(source) << " into " << store->path() << "\n";
   return kExitOk;
 }

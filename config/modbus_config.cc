@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <map>
+#include <string>
 #include <utility>
 
 #include "config/toml_reader.h"
@@ -151,6 +155,46 @@ void ReadDevice(SectionReader& r, const std::string& file, ModbusDevice* d, Diag
   r.Integer("timeout_ms", kOptional, Closed(10, 60000), &d->timeout_ms);
 }
 
+// "" when the register type can hold the raw sentinel *raw, so that a
+// decoded register can equal it; else the rule it breaks. An f32 sentinel is
+// rounded to float (the decoder compares the float it read, widened to
+// double: 0.1 would never match 0.1f), and the spellings of ±FLT_MAX that
+// round to it (3.4028235e38) are taken.
+std::string SentinelRule(RegisterType type, double* raw) {
+  const auto integer_within = [raw, type](double lo, double hi) -> std::string {
+    if (*raw >= lo && *raw <= hi && std::trunc(*raw) == *raw) return "";
+    return "must be an integer within [" + FormatNumber(lo) + ", " + FormatNumber(hi) +
+           "], the range of " + std::string(TypeName(type));
+  };
+  switch (type) {
+    case RegisterType::kU16:
+      return integer_within(0, std::numeric_limits<std::uint16_t>::max());
+    case RegisterType::kI16:
+      return integer_within(std::numeric_limits<std::int16_t>::min(),
+                            std::numeric_limits<std::int16_t>::max());
+    case RegisterType::kU32:
+      return integer_within(0, std::numeric_limits<std::uint32_t>::max());
+    case RegisterType::kI32:
+      return integer_within(std::numeric_limits<std::int32_t>::min(),
+                            std::numeric_limits<std::int32_t>::max());
+    case RegisterType::kF32: {
+      // Halfway between FLT_MAX and 2^128, the next binade: above it a
+      // double rounds to infinity as a float.
+      const double max = std::numeric_limits<float>::max();
+      const double overflow = std::ldexp(1.0, 128) - std::ldexp(1.0, 103);
+      if (!(std::abs(*raw) < overflow)) {
+        return "must be within the range of f32, |x| <= " + FormatNumber(max);
+      }
+      *raw = std::abs(*raw) > max ? std::copysign(max, *raw)
+                                  : static_cast<double>(static_cast<float>(*raw));
+      return "";
+    }
+    case RegisterType::kF64:
+      return "";
+  }
+  return "";
+}
+
 // Reads one point; returns false when a key the cross-checks need is bad.
 bool ReadPoint(SectionReader& r, const std::vector<ModbusDevice>& devices, ModbusPoint* p) {
   bool ok = true;
@@ -184,7 +228,8 @@ bool ReadPoint(SectionReader& r, const std::vector<ModbusDevice>& devices, Modbu
   } else {
     ok = false;
   }
-  if (r.Choice("type", kRequired, Choices(kTypeNames), &text)) {
+  const bool type_ok = r.Choice("type", kRequired, Choices(kTypeNames), &text);
+  if (type_ok) {
     p->type = FromName<RegisterType>(kTypeNames, text);
   } else {
     ok = false;
@@ -211,7 +256,14 @@ bool ReadPoint(SectionReader& r, const std::vector<ModbusDevice>& devices, Modbu
     r.Reject("valid_max", "must be > valid_min");
   }
   double sentinel = 0.0;
-  if (r.Number("nan_value", kOptional, Interval{}, &sentinel)) p->nan_value = sentinel;
+  if (r.Number("nan_value", kOptional, Interval{}, &sentinel) && type_ok) {
+    const std::string rule = SentinelRule(p->type, &sentinel);
+    if (rule.empty()) {
+      p->nan_value = sentinel;
+    } else {
+      r.Reject("nan_value", rule);
+    }
+  }
   return ok;
 }
 

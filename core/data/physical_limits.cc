@@ -13,6 +13,9 @@ namespace {
 constexpr double kFlowKgSM2 = 1.0;
 constexpr double kPElLoWM2 = -50.0, kPElHiWM2 = 600.0;
 constexpr double kQThLoWM2 = -5000.0, kQThHiWM2 = 2500.0;
+// Short-wave irradiance (physical_limits.h says why): the largest zero
+// offset of a pyranometer below, the BSRN limit with cloud enhancement above.
+constexpr double kIrradianceLoWM2 = -30.0, kIrradianceHiWM2 = 2500.0;
 
 std::string Format(double x) {
   char buf[32];
@@ -36,7 +39,7 @@ PhysicalLimit PhysicalLimitOf(Channel c, double area_m2) {
     case Channel::kGhiWM2:
     case Channel::kDhiWM2:
     case Channel::kGPoaDiffuseWM2:
-      return {-50.0, 2500.0};
+      return {kIrradianceLoWM2, kIrradianceHiWM2};
     case Channel::kAoiRad:
       return {0.0, kPi};
     case Channel::kTAmbC:

@@ -12,10 +12,15 @@
 //    (Long & Dutton, BSRN Global Network recommended QC tests, V2.0):
 //    1.5·S_a·cos(θz)^1.2 + 100 W/m² ≤ 2150 W/m² for GHI; 2000 W/m² in the
 //    collector plane with cloud enhancement is already rare, 2500 W/m² is
-//    not reached. The lower limit −50 W/m² is far below the night-time
-//    thermal offset of a thermopile pyranometer (ISO 9060:2018 allows
-//    ±7 W/m² zero offset for class A, a few tens for unventilated class C),
-//    so night rows keep their small negative readings as logged.
+//    not reached. The lower limit −30 W/m² is the largest night-time
+//    thermal offset a pyranometer may show: ISO 9060's zero off-set a)
+//    (the response to 200 W/m² net thermal radiation) is at most ±7 W/m²
+//    for a secondary standard, ±15 W/m² for a first-class and ±30 W/m² for
+//    a second-class instrument (the WMO/ISO 9060:1990 classification table,
+//    reprinted e.g. in the Kipp & Zonen CM 11 manual, appendix I; ISO
+//    9060:2018's classes A, B, C roughly correspond to these three). Night
+//    rows keep their small negative readings as logged; a reading below
+//    −30 W/m² is no offset but a broken sensor or a wrong scale.
 //  * long-wave irradiance: BSRN physically possible limits 40–700 W/m².
 //  * air temperature: −90 … 60 °C (the recorded extremes are −89.2 °C and
 //    56.7 °C); sky temperature −120 … 60 °C.

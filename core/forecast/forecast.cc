@@ -134,9 +134,13 @@ std::string ForecastInputUse::Describe() const {
   if (!pump_rule.empty()) text += "; " + pump_rule;
   if (table_used && !weather_sources.empty()) {
     text += "; weather_forecast source: ";
+    bool above_clear_sky = false;
     for (std::size_t i = 0; i < weather_sources.size(); ++i) {
       text += (i ? " | " : "") + weather_sources[i];
+      above_clear_sky =
+          above_clear_sky || weather_sources[i].find(kAboveClearSkyMark) != std::string::npos;
     }
+    if (above_clear_sky) text += "; " + std::string(kAboveClearSkyInputs);
   }
   return text;
 }

@@ -97,7 +97,10 @@ struct ForecastInputUse {
   // "weather: forecast 1440/1440, persistence 0/1440, missing 0/1440; operation: plan 0/1440,
   // typical day 1440/1440; channels: g_poa_w_m2=weather_forecast 1440, t_sky_c=persistence
   // 1440, t_in_c=typical_day 1440, ...; weather_forecast source: fetch https://... (Open-Meteo
-  // JSON, hourly)".
+  // JSON, hourly)". When a source carries kAboveClearSkyMark (rows of an
+  // interval whose irradiance was above its clear sky, stored clipped; core/
+  // forecast/weather_resample.h) the line ends with "; " +
+  // kAboveClearSkyInputs ("weather_warning=irradiance_above_clear_sky").
   std::string Describe() const;
 };
 

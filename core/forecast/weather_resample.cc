@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/common/units.h"
+#include "core/data/physical_limits.h"
 #include "core/physics/clear_sky.h"
 #include "core/physics/irradiance.h"
 #include "core/physics/sky_radiation.h"
@@ -49,11 +50,66 @@ void SpreadOverDaylight(const ClearSkyGrid& g, std::size_t first, std::size_t la
   }
 }
 
-// Interval means to minutes through the clear-sky index of each interval
-// (see the header): the minutes' mean equals the interval's value.
+// The most each minute of channel c can hold (see the header): its physical
+// limit, and max_clear_sky_index × clear + the allowance.
+std::vector<double> MinuteBounds(Channel c, const std::vector<double>& clear,
+                                 const WeatherResampleOptions& options) {
+  const double limit = PhysicalLimitOf(c, 0.0).hi;
+  std::vector<double> bound(clear.size());
+  for (std::size_t k = 0; k < clear.size(); ++k) {
+    bound[k] = std::min(limit, options.max_clear_sky_index * std::max(0.0, clear[k]) +
+                                   options.clear_sky_allowance_w_m2);
+  }
+  return bound;
+}
+
+// Lowers the minutes [first, last) of *out to their bounds and gives what was
+// cut, evenly, to the minutes that may receive light (those with the sun up,
+// all when none has it) and are below their bounds, until it is placed or
+// every such minute is at its bound. Returns the bounds' sum over the
+// receiving minutes divided by the interval's minutes: the largest mean the
+// interval can keep.
+double FitUnderBounds(const ClearSkyGrid& g, std::size_t first, std::size_t last,
+                      const std::vector<double>& bound, std::vector<double>* out) {
+  std::vector<double>& x = *out;
+  bool daylight = false;
+  for (std::size_t k = first; k < last; ++k) daylight = daylight || g.zenith_rad[k] < kPi / 2;
+  const auto receives = [&](std::size_t k) { return !daylight || g.zenith_rad[k] < kPi / 2; };
+  double capacity = 0.0, excess = 0.0;
+  for (std::size_t k = first; k < last; ++k) {
+    if (receives(k)) capacity += bound[k];
+    if (x[k] > bound[k]) {
+      excess += x[k] - bound[k];
+      x[k] = bound[k];
+    }
+  }
+  // Each round places everything or fills at least one minute to its bound.
+  for (std::size_t round = first; excess > 0.0 && round <= last; ++round) {
+    std::size_t open = 0;
+    for (std::size_t k = first; k < last; ++k) open += receives(k) && x[k] < bound[k] ? 1 : 0;
+    if (open == 0) break;
+    const double share = excess / static_cast<double>(open);
+    excess = 0.0;
+    for (std::size_t k = first; k < last; ++k) {
+      if (!receives(k) || !(x[k] < bound[k])) continue;
+      if (x[k] + share >= bound[k]) {
+        excess += share - (bound[k] - x[k]);
+        x[k] = bound[k];
+      } else {
+        x[k] += share;
+      }
+    }
+  }
+  return capacity / static_cast<double>(last - first);
+}
+
+// Interval means of channel c to minutes through the clear-sky index of
+// each interval, within the minutes' bounds (see the header): the minutes'
+// mean equals the interval's value wherever the bounds allow.
 std::vector<double> IntervalMeansToMinutes(const ProviderWeather& in, const ClearSkyGrid& g,
-                                           const std::vector<double>& values,
+                                           Channel c, const std::vector<double>& values,
                                            const std::vector<double>& shape,
+                                           const std::vector<double>& bound,
                                            const WeatherResampleOptions& options,
                                            WeatherResampleSummary* summary) {
   std::vector<double> out(g.time_s.size(), kNaN);
@@ -70,10 +126,17 @@ std::vector<double> IntervalMeansToMinutes(const ProviderWeather& in, const Clea
         shape_mean < options.min_clear_sky_mean_w_m2 || !(index <= options.max_clear_sky_index);
     if (!flat) {
       for (std::size_t k = first; k < last; ++k) out[k] = index * shape[k];
-      continue;
+    } else {
+      if (values[i] > 0.0) ++summary->flat_intervals;
+      SpreadOverDaylight(g, first, last, values[i], &out);
     }
-    if (values[i] > 0.0) ++summary->flat_intervals;
-    SpreadOverDaylight(g, first, last, values[i], &out);
+    const double most = FitUnderBounds(g, first, last, bound, &out);
+    // Above by more than rounding: the interval's energy does not fit.
+    if (!(values[i] > most * (1.0 + 1e-12) + 1e-9)) continue;
+    summary->above_clear_sky.push_back(
+        {c, in.time_s[i] + offset, in.time_s[i] + offset + step, values[i], shape_mean, most});
+    summary->above_clear_sky_rows.resize(g.time_s.size(), 0);
+    for (std::size_t k = first; k < last; ++k) summary->above_clear_sky_rows[k] = 1;
   }
   return out;
 }
@@ -162,8 +225,10 @@ bool HasIrradiance(const ProviderWeather& in) {
   return !in.gti_w_m2.empty() || !in.ghi_w_m2.empty();
 }
 
-// g_poa_w_m2 and g_poa_diffuse_w_m2 from 1-min GHI/DHI (isotropic sky).
-void Transpose(const Plant& plant, const ClearSkyGrid& g, Series* out) {
+// g_poa_w_m2 and g_poa_diffuse_w_m2 from 1-min GHI/DHI (isotropic sky),
+// each at most the plane's bound (the diffuse at most the global).
+void Transpose(const Plant& plant, const ClearSkyGrid& g, const std::vector<double>& bound,
+               Series* out, WeatherResampleSummary* summary) {
   const std::vector<double>& ghi = (*out)[Channel::kGhiWM2];
   const std::vector<double>& dhi = (*out)[Channel::kDhiWM2];
   std::vector<double> poa(ghi.size(), kNaN), poa_diffuse(ghi.size(), kNaN);
@@ -179,6 +244,11 @@ void Transpose(const Plant& plant, const ClearSkyGrid& g, Series* out) {
     const PoaComponents c = TransposeIsotropicSky(p);
     poa[k] = c.global_w_m2();
     poa_diffuse[k] = c.sky_diffuse_w_m2 + c.ground_diffuse_w_m2;
+    if (poa[k] > bound[k]) {
+      poa[k] = bound[k];
+      poa_diffuse[k] = std::min(poa_diffuse[k], poa[k]);
+      ++summary->capped_poa_minutes;
+    }
   }
   (*out)[Channel::kGPoaWM2] = std::move(poa);
   (*out)[Channel::kGPoaDiffuseWM2] = std::move(poa_diffuse);
@@ -188,6 +258,12 @@ void ResampleIrradiance(const Plant& plant, const ProviderWeather& in, const Cle
                         const WeatherResampleOptions& options, Series* out,
                         WeatherResampleSummary* summary) {
   summary->irradiance_intervals = in.time_s.size();
+  const std::vector<double> ghi_bound = MinuteBounds(Channel::kGhiWM2, g.clear_ghi_w_m2, options);
+  std::vector<double> plane_clear(g.time_s.size());
+  for (std::size_t k = 0; k < plane_clear.size(); ++k) {
+    plane_clear[k] = std::max(g.clear_poa_w_m2[k], g.clear_ghi_w_m2[k]);
+  }
+  const std::vector<double> poa_bound = MinuteBounds(Channel::kGPoaWM2, plane_clear, options);
   if (!in.ghi_w_m2.empty()) {
     std::vector<double> dhi = in.dhi_w_m2;
     std::string dhi_origin = "dhi_w_m2 from diffuse_radiation";
@@ -195,21 +271,21 @@ void ResampleIrradiance(const Plant& plant, const ProviderWeather& in, const Cle
       dhi = DiffuseFromBeam(in, g);
       dhi_origin = "dhi_w_m2 = GHI - DNI cos(zenith)";
     }
-    (*out)[Channel::kGhiWM2] =
-        IntervalMeansToMinutes(in, g, in.ghi_w_m2, g.clear_ghi_w_m2, options, summary);
+    (*out)[Channel::kGhiWM2] = IntervalMeansToMinutes(
+        in, g, Channel::kGhiWM2, in.ghi_w_m2, g.clear_ghi_w_m2, ghi_bound, options, summary);
     summary->origins.push_back("ghi_w_m2 by the clear-sky index");
     if (!dhi.empty()) {
-      (*out)[Channel::kDhiWM2] =
-          IntervalMeansToMinutes(in, g, dhi, g.clear_ghi_w_m2, options, summary);
+      (*out)[Channel::kDhiWM2] = IntervalMeansToMinutes(
+          in, g, Channel::kDhiWM2, dhi, g.clear_ghi_w_m2, ghi_bound, options, summary);
       summary->origins.push_back(dhi_origin + " by the clear-sky index");
     }
   }
   if (!in.gti_w_m2.empty()) {
-    (*out)[Channel::kGPoaWM2] =
-        IntervalMeansToMinutes(in, g, in.gti_w_m2, g.clear_poa_w_m2, options, summary);
+    (*out)[Channel::kGPoaWM2] = IntervalMeansToMinutes(
+        in, g, Channel::kGPoaWM2, in.gti_w_m2, g.clear_poa_w_m2, poa_bound, options, summary);
     summary->origins.push_back("g_poa_w_m2 from the tilted irradiance by the clear-sky index");
   } else if (out->Has(Channel::kGhiWM2) && out->Has(Channel::kDhiWM2)) {
-    Transpose(plant, g, out);
+    Transpose(plant, g, poa_bound, out, summary);
     summary->origins.push_back("g_poa_w_m2, g_poa_diffuse_w_m2 from GHI/DHI (isotropic sky)");
   }
 }
@@ -330,6 +406,7 @@ bool ResampleWeatherTo1Min(const Plant& plant, const ProviderWeather& in,
         Shortest(in.wind_height_m) + " m to " + Shortest(options.collector_height_m) + " m)");
   }
   ResampleLongWave(plant, in, g, &result, summary);
+  summary->outside_limits = ApplyPhysicalLimits(&result, 0.0).Total();
   summary->rows = result.size();
   *out = std::move(result);
   return true;

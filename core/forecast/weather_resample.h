@@ -17,9 +17,28 @@
 //                provider's and our sun disagree on), the value is spread
 //                evenly over the interval's minutes with the sun above the
 //                horizon (over all of them if none): also exact in energy.
+//                No minute exceeds its bound: the physical limit of the
+//                channel (core/data/physical_limits.h) and
+//                max_clear_sky_index × the minute's clear sky +
+//                clear_sky_allowance_w_m2 (the plane's bound takes the larger
+//                of its clear sky and the clear-sky GHI, as the diffuse on a
+//                plane the sun is behind can reach the horizontal's). A
+//                minute above is lowered to its bound and what it loses goes
+//                to the interval's other minutes below theirs (daylight ones
+//                when it has daylight), so the interval keeps its energy
+//                whenever the bounds can hold it. An interval carrying more
+//                than that (value > the mean of its minutes' bounds) is
+//                physically impossible where it is: mostly a file in local
+//                time labelled UTC, or stamps shifted by hours. It is stored
+//                at its bounds and listed in the summary (above_clear_sky),
+//                for a warning and for the rows' source (kAboveClearSkyMark).
+//                The index path (k ≤ max_clear_sky_index) never exceeds the
+//                bound, so a physical forecast keeps every value.
 //                Without GTI, g_poa_w_m2 (and g_poa_diffuse_w_m2) are GHI/DHI
 //                transposed with the model's isotropic sky (paper 2.5,
-//                core/physics/irradiance.h). DHI missing but DNI given:
+//                core/physics/irradiance.h), capped at the plane's bound
+//                (1/cos θ_z near the horizon turns a few W/m² of horizontal
+//                beam into thousands on the plane). DHI missing but DNI given:
 //                DHI = GHI − DNI·mean cos θ_z over the interval, within
 //                [0, GHI].
 //   temperature, linear between the provider's time stamps, taken at each
@@ -41,6 +60,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/common/plant.h"
@@ -91,8 +111,40 @@ struct WeatherResampleOptions {
   double hellmann_exponent = 1.0 / 7;  // α of the power law
   double linke_turbidity = 3.0;        // of the clear-sky shape (a typical rural value)
   double min_clear_sky_mean_w_m2 = 5.0;
+  // The largest clear-sky index a minute can have, against the clear sky
+  // above (T_L = 3). Cloud enhancement lifts 1-min irradiance to about 1.5×
+  // the clear sky (Yordanov et al. 2013, IEEE J. Photovoltaics 3(1):271,
+  // "over 1.5 times"; bursts last seconds to minutes); the cleanest air
+  // (T_L = 2) gives exp(c2·AM) times the T_L = 3 clear GHI at sea level by
+  // the Ineichen & Perez formula (core/physics/clear_sky.h): 1.08 at air
+  // mass 2, 1.21 at air mass 5, so 1.5 · 1.21 = 1.8 < 2; lower suns, where
+  // the factor grows, are covered by the allowance below.
   double max_clear_sky_index = 2.0;
+  // Added to each minute's bound: at low sun the clear sky of a minute is a
+  // few W/m² and the provider's sun and ours differ by minutes. 50 W/m² is
+  // the additive term of the BSRN "extremely rare" GHI limit
+  // 1.2·S_a·cos(θz)^1.2 + 50 W/m² (Long & Dutton, BSRN recommended QC
+  // tests), which has the same purpose.
+  double clear_sky_allowance_w_m2 = 50.0;
 };
+
+// An irradiance interval of the provider carrying more than its minutes can
+// hold (see the header): physically impossible at that time.
+struct IrradianceAboveClearSky {
+  Channel channel = Channel::kGhiWM2;
+  std::int64_t from_s = 0, to_s = 0;  // the interval [from_s, to_s)
+  double value_w_m2 = 0.0;            // the provider's mean over it
+  double clear_sky_w_m2 = 0.0;        // the clear sky's mean over it
+  double bound_w_m2 = 0.0;            // the bounds' mean: what was stored
+};
+
+// Appended to weather_forecast.source for the rows of the minutes of an
+// interval above its clear sky (import-weather, the daemon's fetch), and what
+// a forecast driven by such rows says in its inputs (core/forecast/
+// forecast.h).
+inline constexpr std::string_view kAboveClearSkyMark = " [clipped: irradiance above clear sky]";
+inline constexpr std::string_view kAboveClearSkyInputs =
+    "weather_warning=irradiance_above_clear_sky";
 
 struct WeatherResampleSummary {
   std::size_t rows = 0;
@@ -102,6 +154,16 @@ struct WeatherResampleSummary {
   // Where each written channel came from, e.g. "g_poa_w_m2 from GHI/DHI
   // (isotropic sky)", in channel order.
   std::vector<std::string> origins;
+  // Intervals above their clear sky, in channel and time order; per output
+  // row 1 where the row lies in one of them (empty when there is none).
+  std::vector<IrradianceAboveClearSky> above_clear_sky;
+  std::vector<std::uint8_t> above_clear_sky_rows;
+  // Minutes of g_poa_w_m2 transposed from GHI/DHI that were lowered to the
+  // plane's bound.
+  std::size_t capped_poa_minutes = 0;
+  // Cells outside the physical limits after resampling (long-wave and
+  // temperatures from the sky model, wind): made missing.
+  std::size_t outside_limits = 0;
 };
 
 // Rows of whole minutes covering every irradiance interval (or, without

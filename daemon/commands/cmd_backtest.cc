@@ -150,6 +150,7 @@ int RunForecastBacktestCommand(const BacktestArgs& a, const Config& config, cons
     }
     std::cerr << "weather forecast " << a.weather << " (" << r.file.format
               << "): " << weather.size() << " 1-min rows\n";
+    for (const std::string& warning : r.Warnings()) std::cerr << "warning: " << warning << "\n";
   }
   const std::int64_t offset_s = SolarDayOffsetS(config.plant);
   const std::int64_t first_day =

@@ -85,6 +85,9 @@ int RunImportWeather(const ImportWeatherArgs& a) {
       break;
   }
   for (const std::string& origin : r.summary.origins) std::cerr << "  " << origin << "\n";
+  // Physically impossible irradiance is a warning, not an error: the rows
+  // are stored clipped and marked (weather_import.h), the exit code stays 0.
+  for (const std::string& warning : r.Warnings()) std::cerr << "warning: " << warning << "\n";
   std::cerr << r.SummaryLine(source) << " into " << store->path() << "\n";
   return kExitOk;
 }
@@ -100,6 +103,8 @@ void RegisterImportWeather(CLI::App& app) {
       "or shortwave/diffuse/direct radiation, temperature_2m, wind_speed_10m in m/s or km/h,\n"
       "dew_point_2m or relative_humidity_2m, cloud_cover) or a canonical CSV (time and\n"
       "weather_forecast's columns). Irradiance keeps each interval's energy (clear-sky index),\n"
+      "no minute above 2x its clear sky + 50 W/m²: an interval carrying more (a time-zone\n"
+      "error) is stored clipped, marked in `source` and named in a warning (exit code 0);\n"
       "temperatures and wind are interpolated, wind is brought from 10 m to [plant]\n"
       "collector_height_m (power law, 1/7), the sky temperature comes from Brunt's sky model\n"
       "with cloud cover when the file has no long-wave. Rows of the same minutes are replaced.\n"

@@ -4,8 +4,10 @@
 // fetch (daemon/service/weather_worker.h), so both read a file the same way.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/common/plant.h"
 #include "io/store/store.h"
@@ -23,7 +25,16 @@ struct WeatherImportResult {
   // "wrote 2880 1-min rows into weather_forecast (2026-06-20T00:00:00Z ..
   // 2026-06-22T00:00:00Z) from <source>; 2 missing values".
   std::string SummaryLine(const std::string& source) const;
+  // One line per irradiance interval above its clear sky (core/forecast/
+  // weather_resample.h), the first kNamedAboveClearSky of them, then one
+  // counting the rest: "ghi_w_m2 2026-11-29T06:00:00Z .. 2026-11-29T07:00:00Z:
+  // 312 W/m² (312 Wh/m²) is more than its clear sky gives (clear sky
+  // 3.1 W/m², at most 56 W/m² with cloud enhancement); stored clipped to that
+  // (time stamps in local time labelled UTC?)". Empty for a physical file.
+  std::vector<std::string> Warnings() const;
 };
+
+inline constexpr std::size_t kNamedAboveClearSky = 5;
 
 // Parses and resamples without writing: the 1-min rows into *rows; false
 // (result->status kBadInput, result->errors) on bad input.
@@ -31,7 +42,10 @@ bool WeatherTextTo1Min(const Plant& plant, const std::string& text, const std::s
                        WeatherImportResult* result, Series* rows);
 
 // source: what weather_forecast.source records, e.g. "import-weather
-// forecast.json" or "fetch https://api.open-meteo.com/...".
+// forecast.json" or "fetch https://api.open-meteo.com/...". The rows of
+// intervals above their clear sky get the source with kAboveClearSkyMark
+// appended, written after the others (two transactions: a reader between
+// them sees those minutes as they were before).
 WeatherImportResult ImportWeatherText(Store& store, const Plant& plant, const std::string& text,
                                       const std::string& name, const std::string& source);
 

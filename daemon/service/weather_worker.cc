@@ -75,6 +75,7 @@ WeatherWorker::Outcome WeatherWorker::FetchOnce() {
       break;
   }
   for (const std::string& note : r.file.notes) log_(kWarning, "weather: " + note);
+  for (const std::string& warning : r.Warnings()) log_(kWarning, "weather: " + warning);
   return {true, "", r.SummaryLine(source)};
 }
 

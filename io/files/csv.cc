@@ -31,6 +31,11 @@ namespace pvtwin {
 namespace {
 
 constexpr std::string_view kTimeColumn = "time";
+// A measurement time a logger can have written: from 1980-01-01T00:00:00Z
+// (before any PVT field was logged, and the zero of a clock that lost its
+// battery, 1970, or a relative time like -5 lies below) to
+// 2200-01-01T00:00:00Z (the weather import's bound as well).
+constexpr std::int64_t kEarliestTimeS = 315532800, kLatestTimeS = 7258118400;
 constexpr std::string_view kFlowLitrePerHourColumn = "flow_l_h";
 constexpr double kLitrePerHourTimesDensityToKgS = 1.0 / 3.6e6;  // (L/h)·(kg/m³) → kg/s
 // Values outside the physical limits named one by one per column; the rest
@@ -448,6 +453,12 @@ class CsvParser {
           series_.time_s.empty() ? std::numeric_limits<std::int64_t>::min() : series_.time_s.back();
       if (!ParseTimeIn(cell, options_.naive_time_zone, after_s, &time_s, &rule)) {
         Error(line_no, kTimeColumn, cell, rule);
+        return;
+      }
+      if (time_s < kEarliestTimeS || time_s > kLatestTimeS) {
+        Error(line_no, kTimeColumn, cell,
+              "not a plausible measurement time: must be within 1980-01-01T00:00:00Z .. "
+              "2200-01-01T00:00:00Z");
         return;
       }
       if (!series_.time_s.empty() && time_s <= series_.time_s.back()) {

@@ -2,8 +2,10 @@
 //
 // Reading: a header row, comma separated, '.' decimal, column order free.
 //   * `time`: ISO 8601 with Z or an offset, or unix seconds, decided per cell
-//     (io/platform/time_format.h); it marks the start of the row's interval. Rows must
-//     be strictly increasing in time.
+//     (io/platform/time_format.h); it marks the start of the row's interval.
+//     Rows must be strictly increasing in time, each within
+//     1980-01-01T00:00:00Z .. 2200-01-01T00:00:00Z (a time before is a clock
+//     at its zero or a relative time, e.g. -5, not a measurement).
 //   * Every other known column goes to its Channel (core/channels.h).
 //     `flow_l_h` becomes kMdotKgS: kg/s = L/h · ρ / 3.6e6, with ρ from
 //     CsvReadOptions; `aoi_deg` becomes kAoiRad in radians. `valid` is 0 or 1.

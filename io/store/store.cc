@@ -501,7 +501,8 @@ struct Store::Impl {
   // Deletes the forecast rows in [from_ts, to_ts) that neither view uses.
   DbStatus PruneForecasts(std::int64_t from_ts, std::int64_t to_ts);
   bool ReadInputTable(const std::string& table, std::span<const Channel> channels,
-                      std::int64_t from, std::int64_t to, Series* out, std::string* error);
+                      std::int64_t from, std::int64_t to, Series* out, std::string* error,
+                      TextCells* text_cells);
 };
 
 namespace {
@@ -1489,29 +1490,84 @@ bool Store::ReadForecastSkill(std::int64_t from_day, std::int64_t to_day,
       out, error);
 }
 
+namespace {
+
+// A forecast input cell: NULL is missing; INTEGER and REAL are numbers; TEXT
+// and BLOB (which sqlite3_column_double would turn into 0, or into the
+// number a text starts with) are missing unless the whole text, blanks
+// around it aside, is a finite decimal number. *text is set for a cell read
+// as missing because it held text.
+double InputCell(sqlite3_stmt* stmt, int index, bool* text) {
+  *text = false;
+  const int type = sqlite3_column_type(stmt, index);
+  if (type == SQLITE_NULL) return std::nan("");
+  if (type != SQLITE_TEXT && type != SQLITE_BLOB) return sqlite3_column_double(stmt, index);
+  const auto* chars = reinterpret_cast<const char*>(sqlite3_column_text(stmt, index));
+  std::string cell(chars == nullptr ? "" : chars,
+                   static_cast<std::size_t>(sqlite3_column_bytes(stmt, index)));
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  while (!cell.empty() && blank(cell.back())) cell.pop_back();
+  std::size_t first = 0;
+  while (first < cell.size() && blank(cell[first])) ++first;
+  cell.erase(0, first);
+  // Decimal digits, sign, point and exponent only: no hex, inf or nan,
+  // which strtod would also take.
+  const bool decimal =
+      !cell.empty() && cell.find_first_not_of("0123456789+-.eE") == std::string::npos;
+  char* end = nullptr;
+  const double value = decimal ? std::strtod(cell.c_str(), &end) : 0.0;
+  if (decimal && end == cell.c_str() + cell.size() && std::isfinite(value)) return value;
+  *text = true;
+  return std::nan("");
+}
+
+}  // namespace
+
+std::size_t Store::TextCells::Total() const {
+  std::size_t total = 0;
+  for (const std::size_t n : count) total += n;
+  return total;
+}
+
+std::string Store::TextCells::Warning(const std::string& table) const {
+  std::string list;
+  for (std::size_t c = 0; c < kNumChannels; ++c) {
+    if (count[c] == 0) continue;
+    list += list.empty() ? std::to_string(count[c]) + " cells of "
+                         : ", " + std::to_string(count[c]) + " of ";
+    list += std::string(ChannelName(static_cast<Channel>(c)));
+  }
+  return list.empty() ? "" : table + ": " + list + " hold text, read as missing";
+}
+
 bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Channel> channels,
                                  std::int64_t from, std::int64_t to, Series* out,
-                                 std::string* error) {
+                                 std::string* error, TextCells* text_cells) {
   Impl& db = *this;
   std::string sql = "SELECT ts";
   for (const Channel c : channels) sql += ", " + std::string(ChannelName(c));
   sql += " FROM " + table + " WHERE ts >= ? AND ts < ? ORDER BY ts";
   Series result;
+  TextCells texts;
   const bool ok = db.Run(
       false, "read " + table,
       [&]() -> DbStatus {
         result = Series{};
-        auto on_row = [&result, channels](sqlite3_stmt* stmt) {
+        texts = TextCells{};
+        auto on_row = [&result, &texts, channels](sqlite3_stmt* stmt) {
           result.time_s.push_back(sqlite3_column_int64(stmt, 0));
           for (std::size_t k = 0; k < channels.size(); ++k) {
-            result[channels[k]].push_back(
-                FromSql(channels[k], ColumnReal(stmt, static_cast<int>(k) + 1)));
+            bool text = false;
+            const double value = InputCell(stmt, static_cast<int>(k) + 1, &text);
+            texts.count[static_cast<std::size_t>(channels[k])] += text ? 1 : 0;
+            result[channels[k]].push_back(FromSql(channels[k], value));
           }
         };
         return db.SelectRange(sql, from, to, on_row, "read " + table);
       },
       error);
   if (!ok) return false;
+  if (text_cells != nullptr) *text_cells = texts;
   ApplyPhysicalLimits(&result, options.aggregate.area_m2);
   DropEmptyColumns(&result);
   result.step_s = 0.0;
@@ -1523,15 +1579,18 @@ bool Store::Impl::ReadInputTable(const std::string& table, std::span<const Chann
   return true;
 }
 
-bool Store::ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out,
-                                std::string* error) {
+bool Store::ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out, std::string* error,
+                                TextCells* text_cells) {
   std::lock_guard lock(impl_->mutex);
-  return impl_->ReadInputTable("weather_forecast", kWeatherChannels, from, to, out, error);
+  return impl_->ReadInputTable("weather_forecast", kWeatherChannels, from, to, out, error,
+                               text_cells);
 }
 
-bool Store::ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error) {
+bool Store::ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error,
+                              TextCells* text_cells) {
   std::lock_guard lock(impl_->mutex);
-  return impl_->ReadInputTable("operation_plan", kOperationChannels, from, to, out, error);
+  return impl_->ReadInputTable("operation_plan", kOperationChannels, from, to, out, error,
+                               text_cells);
 }
 
 bool Store::WriteWeatherForecast(const Series& rows, const std::string& source,

@@ -353,11 +353,30 @@ class Store {
   bool ReadForecastSkill(std::int64_t from_day, std::int64_t to_day, std::vector<SkillRow>* out,
                          std::string* error);
 
+  // Cells of weather_forecast or operation_plan that hold text (or a blob)
+  // where a number belongs: what `sqlite3 .import` writes for an empty CSV
+  // cell (''), or "12,5" or "n/a". Such a cell is read as missing, never as
+  // the 0 SQLite would turn it into; a text that is a whole finite decimal
+  // number ("12.5", "-3e2", blanks around it) is read as that number and not
+  // counted.
+  struct TextCells {
+    std::array<std::size_t, kNumChannels> count{};  // per channel
+
+    std::size_t Total() const;
+    // One line for the caller to warn with, "" when no cell held text:
+    // "weather_forecast: 1440 cells of t_amb_c, 12 of wind_m_s hold text,
+    // read as missing".
+    std::string Warning(const std::string& table) const;
+  };
+
   // weather_forecast / operation_plan rows with from <= ts < to as a Series
   // (step_s = the smallest spacing of the rows, 0 for fewer than 2); a column
-  // that is NULL in every row is absent.
-  bool ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out, std::string* error);
-  bool ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error);
+  // that is NULL in every row is absent. *text_cells (may be null) gets the
+  // cells that held text (TextCells), for the caller to warn once per read.
+  bool ReadWeatherForecast(std::int64_t from, std::int64_t to, Series* out, std::string* error,
+                           TextCells* text_cells = nullptr);
+  bool ReadOperationPlan(std::int64_t from, std::int64_t to, Series* out, std::string* error,
+                         TextCells* text_cells = nullptr);
   // Upserts 1-min weather_forecast rows (the table's channels of `rows`,
   // NULL for the absent ones) with their source, in one transaction.
   bool WriteWeatherForecast(const Series& rows, const std::string& source, std::string* error);

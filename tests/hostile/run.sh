@@ -90,6 +90,18 @@ printf '%s\n2024-06-01T10:01:00Z,%s\n2024-06-01T10:00:00Z,%s\n' "$header" "$good
 expect_exit 2 "$pvtwin" import --config plant.toml --csv order.csv --db x.db
 row "time going back" "a row earlier than the one before" "exit 2 naming both lines" $? "$said"
 
+printf '%s\n-5,%s\n2024-06-01T10:01:00Z,%s\n' "$header" "$good" "$good" >epoch.csv
+expect_exit 2 "$pvtwin" import --config plant.toml --csv epoch.csv --db x.db
+ok=$?
+grep -q 'not a plausible measurement time' err.txt || ok=1
+row "time before 1980" "time = -5 (unix seconds: 1970)" "exit 2 naming line and rule" $ok "$said"
+
+printf '%s\n2024-06-01T10:00:00Z,27.87,30.76,0.0332,-50,27.03,177.78\n2024-06-01T10:01:00Z,%s\n' "$header" "$good" >offset.csv
+expect_exit 0 "$pvtwin" import --config plant.toml --csv offset.csv --db offset.db
+ok=$?
+grep -q 'g_poa_w_m2 = -50: outside the physical limits \[-30, 2500\]' err.txt || ok=1
+row "irradiance below any offset" "g_poa_w_m2 = -50 (ISO 9060 allows at most -30)" "read as missing, warn with line and value" $ok "$said"
+
 : >empty.csv
 expect_exit 2 "$pvtwin" import --config plant.toml --csv empty.csv --db x.db
 row "empty file" "0 bytes" "exit 2" $? "$said"
@@ -114,6 +126,16 @@ ok=$?
 [ "$(sqlite3 w.db "SELECT COUNT(*) FROM weather_forecast WHERE ts >= 1717239600 AND ts < 1717243200 AND ghi_w_m2 IS NULL")" = 60 ] || ok=1
 row "weather: null value" "shortwave_radiation null at 12:00" "that hour missing, not zero; counted" $ok "$(grep -h -m1 'null values' err.txt)"
 
+# The recorded GMT answer labelled UTC-3: every value lands 3 h late, June's
+# evening light after sunset.
+sed 's/"utc_offset_seconds":0,"timezone":"GMT","timezone_abbreviation":"GMT"/"utc_offset_seconds":-10800,"timezone":"Etc\/GMT+3","timezone_abbreviation":"-03"/' "$weather" >late.json
+expect_exit 0 "$pvtwin" import-weather --config plant.toml --db late.db late.json
+ok=$?
+grep -q 'is more than its clear sky gives' err.txt || ok=1
+[ "$(sqlite3 late.db "SELECT MAX(ghi_w_m2) <= 2500 AND MAX(g_poa_w_m2) <= 2500 FROM weather_forecast")" = 1 ] || ok=1
+[ "$(sqlite3 late.db "SELECT COUNT(*) > 0 FROM weather_forecast WHERE source LIKE '%[clipped: irradiance above clear sky]'")" = 1 ] || ok=1
+row "weather: hours shifted" "a GMT answer labelled UTC-3 (values 3 h late)" "clipped to the clear sky, warning naming the interval, rows marked, exit 0" $ok "$(grep -h -m1 'clear sky gives' err.txt)"
+
 # --- config ------------------------------------------------------------------
 config_case() {  # NAME TEXT MUST-CONTAIN
   { plant; printf '%b' "$2"; } >bad.toml
@@ -129,6 +151,7 @@ config_case "variant" '[calibration]\nvariant = "9Z"\n' "bad.toml:8: variant"
 config_case "unknown effect" '[calibration]\nvariant = "1N1Cwr+teleport"\n' "unknown effect"
 config_case "retention" '[storage]\nraw_retention_days = 100000\n' "raw_retention_days"
 config_case "unknown key" '[poll]\nperiod = 5\n' "unknown key"
+config_case "sentinel outside its type" '[[modbus.device]]\nname = "d"\nhost = "127.0.0.1"\n[[modbus.point]]\ndevice = "d"\nchannel = "t_in_c"\ntable = "input"\naddress = 0\ntype = "i16"\nnan_value = 1e9\n' "nan_value = 1e9: must be an integer within \[-32768, 32767\], the range of i16"
 
 # --- store -------------------------------------------------------------------
 sqlite3 foreign.db "CREATE TABLE inventory(id INTEGER PRIMARY KEY, item TEXT); INSERT INTO inventory(item) VALUES ('pump');"

@@ -6,6 +6,7 @@
 
 #include "config/plant_config.h"
 #include "core/common/units.h"
+#include "io/modbus/register_codec.h"
 
 namespace pvtwin {
 namespace {
@@ -174,6 +175,42 @@ TEST(ConfigLoad, BoundariesOfTheRanges) {
   EXPECT_EQ(errors_for("[diagnosis]\nenabled = false\nevery_days = 1\ntimeout_s = 1\nkeep = 1\n"
                        "[monitor]\ndrift_days = 2\nalarm_days = 60\n"),
             0u);
+}
+
+// A Modbus sentinel must be a raw value the register can hold. An f32
+// sentinel is kept as the float it names: 0.1 in the config is the register
+// 0x3DCCCCCD (0.1f, IEEE 754 single), which widened is 0.100000001490116…,
+// not the double 0.1, so the reading it marks is rejected only if the config
+// keeps the float. The golden folder modbus_nan_value_outside_type has the
+// messages for values no register of the type holds.
+TEST(ConfigLoad, ModbusSentinelIsTheRegisterTypesValue) {
+  const std::string map =
+      "[[modbus.device]]\nname = \"d\"\nhost = \"127.0.0.1\"\n"
+      "[[modbus.point]]\ndevice = \"d\"\nchannel = \"t_in_c\"\ntable = \"input\"\n"
+      "address = 0\ntype = \"f32\"\nnan_value = 0.1\n"
+      "[[modbus.point]]\ndevice = \"d\"\nchannel = \"t_out_c\"\ntable = \"input\"\n"
+      "address = 2\ntype = \"i16\"\nnan_value = ";
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(
+      ParseConfig(std::string(kMinimalPlant) + map + "-32768\n", "config.toml", &config, &errors))
+      << errors.front().ToString();
+  ASSERT_EQ(config.modbus.points.size(), 2u);
+  const ModbusPoint& f32 = config.modbus.points[0];
+  EXPECT_EQ(*f32.nan_value, static_cast<double>(0.1f));
+  const std::uint16_t sentinel[] = {0x3DCC, 0xCCCD};
+  EXPECT_TRUE(DecodePoint(f32, sentinel).rejected);
+  const std::uint16_t one[] = {0x3F80, 0x0000};  // 1.0f
+  EXPECT_FALSE(DecodePoint(f32, one).rejected);
+  EXPECT_EQ(*config.modbus.points[1].nan_value, -32768.0);
+
+  errors.clear();
+  EXPECT_FALSE(
+      ParseConfig(std::string(kMinimalPlant) + map + "1e9\n", "config.toml", &config, &errors));
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].ToString(),
+            "config.toml:23: nan_value = 1e9: must be an integer within [-32768, 32767], the "
+            "range of i16");
 }
 
 // The [diagnosis] and [monitor] sections: defaults, values, and each bad

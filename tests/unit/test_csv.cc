@@ -7,6 +7,7 @@
 #include <bit>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -22,6 +23,11 @@
 
 namespace pvtwin {
 namespace {
+
+// 2024-06-01T00:00:00Z: rows of the tests below start here, a plausible
+// measurement time (the reader refuses times before 1980).
+constexpr std::int64_t kT0 = 1717200000;
+std::string At(std::int64_t offset_s) { return std::to_string(kT0 + offset_s); }
 
 const std::string kRealDataDir = std::string(PVTWIN_DATA_DIR) + "/htwsaar-pvt/";
 
@@ -236,14 +242,14 @@ bool ParseText(const std::string& text, Series* series, Diagnostics* errors,
 TEST(CsvRead, AcceptsCrlfByteOrderMarkSpacesAndEmptyLines) {
   const std::string text =
       "\xEF\xBB\xBFtime, t_in_c ,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\r\n"
-      "0,1,2,0.03,500, 20 ,+100\r\n"
+      "1717200000,1,2,0.03,500, 20 ,+100\r\n"
       "\r\n"
-      "60,1,2,0.03,,20,nan\r\n";
+      "1717200060,1,2,0.03,,20,nan\r\n";
   Series s;
   Diagnostics errors;
   ASSERT_TRUE(ParseText(text, &s, &errors)) << errors.front().ToString();
   ASSERT_EQ(s.size(), 2u);
-  EXPECT_EQ(s.time_s[1], 60);
+  EXPECT_EQ(s.time_s[1], kT0 + 60);
   EXPECT_EQ(s[Channel::kTInC][0], 1.0);
   EXPECT_EQ(s[Channel::kTAmbC][0], 20.0);
   EXPECT_EQ(s[Channel::kPElW][0], 100.0);
@@ -258,10 +264,10 @@ TEST(CsvRead, AcceptsCrlfByteOrderMarkSpacesAndEmptyLines) {
 // cell's text (which then is no number).
 TEST(CsvRead, RowsWithAndWithoutQuotesReadAlike) {
   const std::string header = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
-  const std::string plain = "0, 1.5 ,2,0.03,\t500\t,,100\n60,1,2,0.03,500,20,\n";
-  const std::string quoted =
-      "\"0\", \"1.5\" ,\"2\",\"0.03\",\t\"500\"\t,\"\",\"100\"\n"
-      "\"60\",\"1\",\"2\",\"0.03\",\"500\",\"20\",\"\"\n";
+  const std::string plain = At(0) + ", 1.5 ,2,0.03,\t500\t,,100\n" + At(60) + ",1,2,0.03,500,20,\n";
+  const std::string quoted = "\"" + At(0) +
+                             "\", \"1.5\" ,\"2\",\"0.03\",\t\"500\"\t,\"\",\"100\"\n\"" + At(60) +
+                             "\",\"1\",\"2\",\"0.03\",\"500\",\"20\",\"\"\n";
   Series a, b;
   Diagnostics errors;
   ASSERT_TRUE(ParseText(header + plain, &a, &errors)) << errors.front().ToString();
@@ -283,7 +289,7 @@ TEST(CsvRead, RowsWithAndWithoutQuotesReadAlike) {
   EXPECT_TRUE(std::isnan(a[Channel::kPElW][1]));
   Series c;
   errors.clear();
-  EXPECT_FALSE(ParseText(header + "0,1,2,0.03,5\"00,20,100\n", &c, &errors));
+  EXPECT_FALSE(ParseText(header + At(0) + ",1,2,0.03,5\"00,20,100\n", &c, &errors));
   ASSERT_FALSE(errors.empty());
   EXPECT_EQ(errors.front().field, "g_poa_w_m2");
   EXPECT_EQ(errors.front().value, "5\"00");
@@ -304,10 +310,11 @@ TEST(CsvRead, AStreamThatCannotSeekReadsAsAFileDoes) {
   // The reader reserves room for the rows from the bytes left after the
   // first row; a pipe tells no size, and rows longer than the first would
   // outgrow the estimate.
-  std::string text = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n0,1,2,0,0,9,0\n";
+  std::string text =
+      "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n" + At(0) + ",1,2,0,0,9,0\n";
   for (int i = 1; i < 3000; ++i) {
-    text += std::to_string(60 * i) + ",21.125,22.5,0.0316,812.75,19.0625," +
-            std::to_string(100 + i % 7) + ".5\n";
+    text +=
+        At(60 * i) + ",21.125,22.5,0.0316,812.75,19.0625," + std::to_string(100 + i % 7) + ".5\n";
   }
   Series from_string;
   Diagnostics errors;
@@ -473,7 +480,7 @@ TEST(CsvRead, ALargeFileWithErrorsReportsThemInLineOrderAsOnePieceDoes) {
 
 TEST(CsvRead, FlowInLitresPerHourUsesTheConfiguredDensity) {
   const std::string text =
-      "time,t_in_c,t_out_c,flow_l_h,g_poa_w_m2,t_amb_c,p_el_w\n0,1,2,360,500,20,100\n";
+      "time,t_in_c,t_out_c,flow_l_h,g_poa_w_m2,t_amb_c,p_el_w\n1717200000,1,2,360,500,20,100\n";
   Series s;
   Diagnostics errors;
   ASSERT_TRUE(ParseText(text, &s, &errors, CsvReadOptions{.fluid_density_kg_m3 = 1000}));
@@ -482,7 +489,7 @@ TEST(CsvRead, FlowInLitresPerHourUsesTheConfiguredDensity) {
 
 TEST(CsvRead, StopsAfterTooManyErrors) {
   std::string text = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
-  for (int i = 0; i < 1000; ++i) text += std::to_string(i) + ",x,2,0.03,500,20,100\n";
+  for (int i = 0; i < 1000; ++i) text += At(i) + ",x,2,0.03,500,20,100\n";
   Series s;
   Diagnostics errors;
   EXPECT_FALSE(ParseText(text, &s, &errors));
@@ -544,7 +551,7 @@ TEST(CsvRead, NumbersReadAsStdFromCharsReadsThem) {
     const bool ok = ec == std::errc() && end == cell.data() + cell.size();
     std::vector<std::string>& list = ok ? accepted : rejected;
     (ok ? accepted_text : rejected_text) +=
-        std::to_string(60 * list.size()) + ",1,2,0.03,500," + cell + ",100\n";
+        At(60 * static_cast<std::int64_t>(list.size())) + ",1,2,0.03,500," + cell + ",100\n";
     list.push_back(cell);
     if (ok) expected.push_back(v);
   }

@@ -144,6 +144,28 @@ TEST(Forecast, InputsNameTheSourceOfEachChannel) {
   EXPECT_EQ(persisted.inputs.Describe().find("source:"), std::string::npos);
 }
 
+// Weather rows stored clipped because their interval carried more
+// irradiance than its clear sky gives (import-weather marks their source):
+// the forecast's inputs say so; rows of a physical file do not.
+TEST(Forecast, InputsWarnOfWeatherAboveItsClearSky) {
+  const Case c;
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  Forecast f;
+  std::string error;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), c.From(c.t_forecast),
+                           Series{}, request, &f, &error))
+      << error;
+  const std::string plain = "import-weather shifted.json (Open-Meteo JSON, hourly)";
+  f.inputs.weather_sources = {plain};
+  EXPECT_EQ(f.inputs.Describe().find("weather_warning"), std::string::npos) << f.inputs.Describe();
+  f.inputs.weather_sources = {plain, plain + " [clipped: irradiance above clear sky]"};
+  const std::string text = f.inputs.Describe();
+  EXPECT_NE(text.find("; weather_warning=irradiance_above_clear_sky"), std::string::npos) << text;
+  EXPECT_NE(text.find("| " + plain + " [clipped: irradiance above clear sky]"), std::string::npos)
+      << text;
+}
+
 TEST(Forecast, RefusesHistoryShorterThanADay) {
   const Case c;
   ForecastRequest request;

@@ -32,6 +32,16 @@ TEST(PhysicalLimits, TheTableHoldsThePublishedLimitsAndScalesWithTheArea) {
   EXPECT_EQ(PhysicalLimitOf(Channel::kPElW, 0.0).hi, 600.0 * kMaxAreaM2);  // area unknown
   EXPECT_FALSE(PhysicalLimitOf(Channel::kAoiRad, 2.0).Contains(DegToRad(500.0)));
   EXPECT_EQ(DescribeLimit(Channel::kAoiRad, 2.0), "[0, 180] °");
+  // Irradiance: down to the ±30 W/m² zero offset a) of the least accurate
+  // pyranometer class of ISO 9060, no further; a night reading of −30 W/m²
+  // is an offset, −30.5 or −50 W/m² is not.
+  for (const Channel c :
+       {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2}) {
+    EXPECT_TRUE(PhysicalLimitOf(c, 2.0).Contains(-30.0)) << ChannelName(c);
+    EXPECT_FALSE(PhysicalLimitOf(c, 2.0).Contains(-30.5)) << ChannelName(c);
+    EXPECT_FALSE(PhysicalLimitOf(c, 2.0).Contains(-50.0)) << ChannelName(c);
+    EXPECT_TRUE(PhysicalLimitOf(c, 2.0).Contains(2500.0)) << ChannelName(c);
+  }
   for (const ChannelInfo& info : kChannels) {
     const PhysicalLimit limit = PhysicalLimitOf(info.channel, 1.8);
     EXPECT_LT(limit.lo, limit.hi) << info.name;

@@ -671,6 +671,68 @@ TEST_F(StoreTest, ForecastInputsWrittenBySqlAreReadAsSeries) {
   EXPECT_EQ(plan[Channel::kMdotKgS], (std::vector<double>{0.03, 0.0}));
 }
 
+// `sqlite3 .import` writes an empty CSV cell as the text '' into a REAL
+// column (SQLite keeps text that is no number as text); sqlite3_column_double
+// turns it into 0 °C and 0 m/s. Text is missing and counted, unless it is a
+// whole number: a numeric text in a REAL column becomes REAL on insert
+// (typeof() says so below), the same text stored as a BLOB stays one.
+TEST_F(StoreTest, TextInForecastInputsIsMissingAndCounted) {
+  auto store = OpenStore();
+  const std::string t0 = std::to_string(kMinute0);
+  {
+    RawDb db(DbPath());
+    ASSERT_EQ(db.Exec("INSERT INTO weather_forecast(ts, g_poa_w_m2, t_amb_c, wind_m_s) VALUES "
+                      "(" +
+                      t0 + ", 500, '', ''), (" + t0 + " + 60, 510, 'abc', '3,5'), (" + t0 +
+                      " + 120, 520, '12.5', CAST('2.5' AS BLOB)), (" + t0 +
+                      " + 180, 530, ' 13 ', 'n/a'), (" + t0 + " + 240, 540, 14, 2)"),
+              SQLITE_OK);
+    ASSERT_EQ(db.Text("SELECT typeof(t_amb_c) FROM weather_forecast WHERE ts = " + t0), "text");
+    ASSERT_EQ(db.Text("SELECT typeof(t_amb_c) FROM weather_forecast WHERE ts = " + t0 + " + 120"),
+              "real");
+    ASSERT_EQ(db.Text("SELECT typeof(wind_m_s) FROM weather_forecast WHERE ts = " + t0 + " + 120"),
+              "blob");
+    ASSERT_EQ(db.Exec("INSERT INTO operation_plan(ts, t_in_c, flow_kg_s) VALUES (" + t0 +
+                      ", '', 0.03), (" + t0 + " + 60, 'x', 'y'), (" + t0 + " + 120, 25, 0.02)"),
+              SQLITE_OK);
+  }
+  Series weather, plan;
+  Store::TextCells text;
+  std::string error;
+  ASSERT_TRUE(store->ReadWeatherForecast(kMinute0, kMinute0 + 300, &weather, &error, &text))
+      << error;
+  ASSERT_EQ(weather.size(), 5u);
+  const std::vector<double>& t_amb = weather[Channel::kTAmbC];
+  const std::vector<double>& wind = weather[Channel::kWindMS];
+  EXPECT_TRUE(std::isnan(t_amb[0]) && std::isnan(t_amb[1])) << t_amb[0] << " " << t_amb[1];
+  EXPECT_EQ(t_amb[2], 12.5);
+  EXPECT_EQ(t_amb[3], 13.0);
+  EXPECT_EQ(t_amb[4], 14.0);
+  EXPECT_TRUE(std::isnan(wind[0]) && std::isnan(wind[1]) && std::isnan(wind[3]));
+  EXPECT_EQ(wind[2], 2.5);  // the BLOB '2.5' is a whole number
+  EXPECT_EQ(wind[4], 2.0);
+  EXPECT_EQ(weather[Channel::kGPoaWM2][0], 500.0);
+  EXPECT_EQ(text.count[static_cast<std::size_t>(Channel::kTAmbC)], 2u);
+  EXPECT_EQ(text.count[static_cast<std::size_t>(Channel::kWindMS)], 3u);
+  EXPECT_EQ(text.Total(), 5u);
+  EXPECT_EQ(text.Warning("weather_forecast"),
+            "weather_forecast: 2 cells of t_amb_c, 3 of wind_m_s hold text, read as missing");
+
+  ASSERT_TRUE(store->ReadOperationPlan(kMinute0, kMinute0 + 300, &plan, &error, &text)) << error;
+  ASSERT_EQ(plan.size(), 3u);
+  EXPECT_TRUE(std::isnan(plan[Channel::kTInC][0]) && std::isnan(plan[Channel::kTInC][1]));
+  EXPECT_TRUE(std::isnan(plan[Channel::kMdotKgS][1]));
+  EXPECT_EQ(plan[Channel::kMdotKgS][0], 0.03);
+  EXPECT_EQ(plan[Channel::kTInC][2], 25.0);
+  EXPECT_EQ(text.Total(), 3u);
+  EXPECT_EQ(text.Warning("operation_plan"),
+            "operation_plan: 2 cells of t_in_c, 1 of flow_kg_s hold text, read as missing");
+  // A read without text: no warning.
+  ASSERT_TRUE(store->ReadOperationPlan(kMinute0 + 120, kMinute0 + 300, &plan, &error, &text));
+  EXPECT_EQ(text.Total(), 0u);
+  EXPECT_EQ(text.Warning("operation_plan"), "");
+}
+
 TEST_F(StoreTest, WeatherForecastRowsKeepTheirSourceAndAreReplacedPerMinute) {
   auto store = OpenStore();
   Series rows;

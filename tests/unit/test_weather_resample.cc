@@ -7,6 +7,7 @@
 
 #include "core/common/units.h"
 #include "core/forecast/weather_resample.h"
+#include "core/physics/clear_sky.h"
 #include "core/physics/sky_radiation.h"
 #include "core/physics/wind.h"
 
@@ -59,6 +60,27 @@ double MeanOver(const Series& s, Channel c, std::int64_t from, std::int64_t to) 
   }
   EXPECT_EQ(n, (to - from) / 60);
   return sum / n;
+}
+
+// The bound of each minute from physics alone (the header's rule, not the
+// code's vectors): 2 × the minute's clear sky + 50 W/m², at most the 2500
+// W/m² physical limit. For the plane the clear sky is the larger of the
+// plane's and the horizontal's.
+std::vector<double> BoundOf(const ClearSkyGrid& g, bool plane) {
+  std::vector<double> bound(g.time_s.size());
+  for (std::size_t k = 0; k < bound.size(); ++k) {
+    const double clear =
+        plane ? std::max(g.clear_poa_w_m2[k], g.clear_ghi_w_m2[k]) : g.clear_ghi_w_m2[k];
+    bound[k] = std::min(2500.0, 2.0 * clear + 50.0);
+  }
+  return bound;
+}
+
+// BSRN's physically possible GHI (Long & Dutton): 1.5·S_a·cos(θz)^1.2 +
+// 100 W/m², 100 W/m² with the sun down.
+double BsrnPossibleGhi(double zenith_rad, double time_s) {
+  const double mu = std::max(0.0, std::cos(zenith_rad));
+  return 1.5 * ExtraterrestrialNormalWM2(DayOfYearUtc(time_s)) * std::pow(mu, 1.2) + 100.0;
 }
 
 // The power law with α = 1/7, by hand: (2 m / 10 m)^(1/7) = exp(ln 0.2 / 7)
@@ -120,26 +142,121 @@ TEST(WeatherResample, EveryIntervalKeepsItsEnergy) {
     EXPECT_LE(out[Channel::kDhiWM2][k], out[Channel::kGhiWM2][k] + 1e-9) << k;
     EXPECT_GE(out[Channel::kGhiWM2][k], 0.0) << k;
   }
+  // A physical day: nothing above its clear sky, nothing flagged.
+  EXPECT_TRUE(summary.above_clear_sky.empty());
+  EXPECT_TRUE(summary.above_clear_sky_rows.empty());
 }
 
 // 18:00-19:00 UTC holds the sunset (about 18:47 UTC at the plant on 1 June).
-// A value the clear sky cannot shape (index above 2) is spread over the
-// minutes with the sun up: the hour's energy kept, nothing after sunset.
+// A value the clear sky cannot shape (index above 2) but the minutes' bounds
+// can hold is spread over the minutes with the sun up, within their bounds:
+// the hour's energy kept, nothing after sunset, nothing flagged. A value
+// beyond the bounds (100 W/m² in an hour whose clear sky gives a few W/m²)
+// is flagged and stored at the bounds: its mean is their mean.
 TEST(WeatherResample, AnUnshapeableSunsetHourKeepsItsEnergyInDaylight) {
+  const std::int64_t from = kDay + 18 * 3600, to = kDay + 19 * 3600;
+  const ClearSkyGrid g = MakeClearSkyGrid(ExamplePlant(), kDay - 3600, kDay + 23 * 3600, 3.0);
+  const std::vector<double> bound = BoundOf(g, false);
+  const std::size_t first = static_cast<std::size_t>((from - g.time_s[0]) / 60);
+  double clear_mean = 0.0, bound_mean = 0.0;
+  int daylight = 0;
+  for (std::size_t k = first; k < first + 60; ++k) {
+    clear_mean += g.clear_ghi_w_m2[k] / 60.0;
+    const bool up = g.zenith_rad[k] < kPi / 2;
+    bound_mean += up ? bound[k] / 60.0 : 0.0;
+    daylight += up ? 1 : 0;
+  }
+  ASSERT_GT(daylight, 40);
+  ASSERT_LT(daylight, 60);
+  // Index above 2, below the bounds' mean (which is 2·clear_mean +
+  // 50·daylight/60 W/m²).
+  const double fits = 2.0 * clear_mean + 25.0 * daylight / 60.0;
+  ASSERT_GT(bound_mean, fits);
+  for (const double value : {fits, 100.0}) {
+    ProviderWeather w = HourlyDay();
+    w.ghi_w_m2[19] = value;
+    w.dhi_w_m2[19] = 0.9 * value;
+    Series out;
+    WeatherResampleSummary summary;
+    std::string error;
+    ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error)) << error;
+    ASSERT_EQ(out.time_s, g.time_s);
+    EXPECT_GE(summary.flat_intervals, 1u);
+    EXPECT_GT(out[Channel::kGhiWM2][first], std::min(value, bound_mean));  // daylight carries it
+    EXPECT_EQ(out[Channel::kGhiWM2][first + 59], 0.0);                     // 18:59, after sunset
+    for (std::size_t k = first; k < first + 60; ++k) {
+      EXPECT_LE(out[Channel::kGhiWM2][k], bound[k] + 1e-9) << k;
+      EXPECT_LE(out[Channel::kDhiWM2][k], bound[k] + 1e-9) << k;
+    }
+    if (value == fits) {
+      EXPECT_NEAR(MeanOver(out, Channel::kGhiWM2, from, to), value, 1e-9);
+      EXPECT_NEAR(MeanOver(out, Channel::kDhiWM2, from, to), 0.9 * value, 1e-9);
+      EXPECT_TRUE(summary.above_clear_sky.empty());
+      continue;
+    }
+    ASSERT_GT(100.0, bound_mean);
+    EXPECT_NEAR(MeanOver(out, Channel::kGhiWM2, from, to), bound_mean, 1e-9);
+    ASSERT_FALSE(summary.above_clear_sky.empty());
+    const IrradianceAboveClearSky& a = summary.above_clear_sky.front();
+    EXPECT_EQ(a.channel, Channel::kGhiWM2);
+    EXPECT_EQ(a.from_s, from);
+    EXPECT_EQ(a.to_s, to);
+    EXPECT_EQ(a.value_w_m2, 100.0);
+    EXPECT_NEAR(a.clear_sky_w_m2, clear_mean, 1e-9);
+    EXPECT_NEAR(a.bound_w_m2, bound_mean, 1e-9);
+  }
+}
+
+// The hand-chosen clear June day, as a provider in local time (UTC+3)
+// labelled UTC would send it: each value 3 h late. The evening hours then
+// carry 430, 270, 120 W/m² after our sunset (18:47 UTC): no minute may hold
+// that, each such interval is named, and nothing above the bound is stored.
+TEST(WeatherResample, AnswerShiftedByHoursIsClippedToItsClearSkyAndNamed) {
   ProviderWeather w = HourlyDay();
-  w.ghi_w_m2[19] = 100.0;
-  w.dhi_w_m2[19] = 90.0;
+  w.gti_w_m2 = kGhi;
+  for (double& v : w.gti_w_m2) v *= 1.1;
+  for (std::vector<double>* c : {&w.ghi_w_m2, &w.dhi_w_m2, &w.gti_w_m2}) {
+    std::vector<double> shifted(c->size(), 0.0);
+    for (std::size_t i = 3; i < c->size(); ++i) shifted[i] = (*c)[i - 3];
+    *c = shifted;
+  }
   Series out;
   WeatherResampleSummary summary;
   std::string error;
   ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error)) << error;
-  EXPECT_GE(summary.flat_intervals, 1u);
-  const std::int64_t from = kDay + 18 * 3600, to = kDay + 19 * 3600;
-  EXPECT_NEAR(MeanOver(out, Channel::kGhiWM2, from, to), 100.0, 1e-9);
-  EXPECT_NEAR(MeanOver(out, Channel::kDhiWM2, from, to), 90.0, 1e-9);
-  const std::size_t first = static_cast<std::size_t>((from - out.time_s[0]) / 60);
-  EXPECT_GT(out[Channel::kGhiWM2][first], 100.0);     // daylight minutes carry the hour
-  EXPECT_EQ(out[Channel::kGhiWM2][first + 59], 0.0);  // 18:59, after sunset
+  const ClearSkyGrid g =
+      MakeClearSkyGrid(ExamplePlant(), out.time_s.front(), out.time_s.back() + 60, 3.0);
+  const std::vector<double> ghi_bound = BoundOf(g, false), poa_bound = BoundOf(g, true);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    EXPECT_LE(out[Channel::kGhiWM2][k], ghi_bound[k] + 1e-9) << k;
+    EXPECT_LE(out[Channel::kDhiWM2][k], ghi_bound[k] + 1e-9) << k;
+    EXPECT_LE(out[Channel::kGPoaWM2][k], poa_bound[k] + 1e-9) << k;
+    EXPECT_LE(out[Channel::kGhiWM2][k], BsrnPossibleGhi(g.zenith_rad[k], g.time_s[k] + 30.0)) << k;
+  }
+  // 19:00-20:00 UTC (stamped 20:00) is night for the whole hour at the
+  // plant: its 270 W/m² (kGhi[17]) cannot be there.
+  const std::int64_t night_from = kDay + 19 * 3600, night_to = kDay + 20 * 3600;
+  bool named = false;
+  for (const IrradianceAboveClearSky& a : summary.above_clear_sky) {
+    EXPECT_GT(a.value_w_m2, a.bound_w_m2);
+    EXPECT_LT(a.clear_sky_w_m2, a.value_w_m2);
+    if (a.channel == Channel::kGhiWM2 && a.from_s == night_from && a.to_s == night_to) {
+      named = true;
+      EXPECT_EQ(a.value_w_m2, 270.0);
+      EXPECT_EQ(a.clear_sky_w_m2, 0.0);
+      EXPECT_NEAR(a.bound_w_m2, 50.0, 1e-9);  // the allowance, the sun being down
+    }
+  }
+  EXPECT_TRUE(named);
+  ASSERT_EQ(summary.above_clear_sky_rows.size(), out.size());
+  const std::size_t night = static_cast<std::size_t>((night_from - out.time_s[0]) / 60);
+  EXPECT_EQ(summary.above_clear_sky_rows[night], 1);
+  EXPECT_EQ(summary.above_clear_sky_rows[night + 59], 1);
+  // 09:00-10:00 UTC (stamped 10:00) carries kGhi[7] = 430 W/m², a value its
+  // clear sky can give: kept exactly, not flagged.
+  const std::int64_t from = kDay + 9 * 3600, to = kDay + 10 * 3600;
+  EXPECT_NEAR(MeanOver(out, Channel::kGhiWM2, from, to), w.ghi_w_m2[10], 1e-9);
+  EXPECT_EQ(summary.above_clear_sky_rows[static_cast<std::size_t>((from - out.time_s[0]) / 60)], 0);
 }
 
 TEST(WeatherResample, GhiDhiAreTransposedToThePlaneWithoutTiltedIrradiance) {

@@ -13,15 +13,17 @@
 #include <fstream>
 #include <functional>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "config/config_edit.h"
 #include "config/plant_config.h"
 #include "core/common/clock.h"
+#include "core/forecast/weather_resample.h"
 #include "daemon/service/weather_worker.h"
 #include "io/platform/child_process.h"
-#include "io/weather/http_client.h"
 #include "io/store/store.h"
+#include "io/weather/http_client.h"
 #include "tests/support/files.h"
 #include "tests/support/http_server.h"
 #include "tests/support/run_pvtwin.h"
@@ -42,6 +44,23 @@ LoopbackHttpServer::Answer Recorded(const std::string& file) {
   LoopbackHttpServer::Answer a;
   a.body = ReadFile(kData / file);
   return a;
+}
+
+// The recorded hourly answer (2024-06-01/02, GMT) with its time stamps
+// rewritten: `first` is the first stamp "YYYY-MM-DDTHH:00" of 48 hourly ones,
+// the values unchanged. 2025-12-20T00:00 puts June's light into December's
+// short days; 2024-06-01T03:00 is the answer 3 h late, as a provider in UTC+3
+// local time would send it labelled GMT.
+std::string Restamped(int year, int month, int day, int hour) {
+  nlohmann::json j = nlohmann::json::parse(ReadFile(kData / "open-meteo-hourly.json"));
+  nlohmann::json& times = j["hourly"]["time"];
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    const int h = hour + static_cast<int>(i);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:00", year, month, day + h / 24, h % 24);
+    times[i] = buf;
+  }
+  return j.dump();
 }
 
 bool WaitFor(double timeout_s, const std::function<bool()>& done) {
@@ -252,6 +271,32 @@ TEST_F(WeatherWorkerTest, WrongUnitsAreLoggedWithTheField) {
   EXPECT_EQ(Rows(), 0);
 }
 
+// An answer 3 h late puts June's evening light after sunset: the fetch logs
+// each interval above its clear sky, writes the rows clipped and marks their
+// source.
+TEST_F(WeatherWorkerTest, IrradianceAboveItsClearSkyIsLoggedAndMarked) {
+  LoopbackHttpServer server;
+  LoopbackHttpServer::Answer late;
+  late.body = Restamped(2024, 6, 1, 3);
+  server.SetAnswer("/v1/forecast", late);
+  std::string error;
+  ASSERT_TRUE(server.Start(0, &error)) << error;
+  WeatherWorker worker(Settings(server.port()), Log());
+  worker.Start();
+  ASSERT_TRUE(WaitFor(20, [&] { return Rows() == 2880; })) << LogText();
+  worker.Stop();
+  EXPECT_GE(CountLines("is more than its clear sky gives"), 1) << LogText();
+  EXPECT_NE(LogText().find("weather: ghi_w_m2 2024-06-01T19:00:00Z .. 2024-06-01T20:00:00Z: "),
+            std::string::npos)
+      << LogText();
+  auto store = Store::Open((dir_ / "w.db").string(), &error);
+  std::vector<std::string> sources;
+  ASSERT_TRUE(store->ReadWeatherSources(0, 4102444800, &sources, &error)) << error;
+  ASSERT_EQ(sources.size(), 2u);
+  EXPECT_EQ(sources[1], sources[0] + std::string(kAboveClearSkyMark)) << sources[0] << "\n"
+                                                                      << sources[1];
+}
+
 // HTTP errors and a truncated body are failures with their reason, never rows.
 TEST_F(WeatherWorkerTest, HttpErrorsAndCutBodiesWriteNothing) {
   LoopbackHttpServer server;
@@ -326,6 +371,98 @@ TEST(ImportWeatherCommand, ImportsEachFormatAndRefusesBadInputWithExit2) {
   const auto cut = RunPvtwin(dir.path(), "import-weather --config plant.toml --db w.db cut.json");
   EXPECT_EQ(cut.exit_code, 2);
   EXPECT_NE(cut.err.find("cut.json: truncated JSON"), std::string::npos) << cut.err;
+}
+
+// The rows of weather_forecast: time, ghi_w_m2, g_poa_w_m2 and source, as
+// stored (not through Store, whose reads drop values beyond the limits).
+struct StoredMinute {
+  std::int64_t ts = 0;
+  double ghi = 0.0, g_poa = 0.0;
+  std::string source;
+};
+std::vector<StoredMinute> StoredMinutes(const fs::path& db_path) {
+  std::vector<StoredMinute> rows;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(db,
+                           "SELECT ts, ghi_w_m2, g_poa_w_m2, source FROM weather_forecast "
+                           "ORDER BY ts",
+                           -1, &st, nullptr) == SQLITE_OK) {
+      while (sqlite3_step(st) == SQLITE_ROW) {
+        const unsigned char* source = sqlite3_column_text(st, 3);
+        rows.push_back({sqlite3_column_int64(st, 0), sqlite3_column_double(st, 1),
+                        sqlite3_column_double(st, 2),
+                        source ? reinterpret_cast<const char*>(source) : ""});
+      }
+    }
+    sqlite3_finalize(st);
+  }
+  sqlite3_close(db);
+  return rows;
+}
+
+// Every stored minute within its bound from physics (core/forecast/
+// weather_resample.h): 2 × its clear sky (Ineichen & Perez, T_L = 3) +
+// 50 W/m², the plane's clear sky the larger of the plane's and the
+// horizontal's, never above the 2500 W/m² limit. Returns the rows whose
+// source carries the mark.
+std::size_t ExpectWithinClearSkyBounds(const fs::path& db_path) {
+  const std::vector<StoredMinute> rows = StoredMinutes(db_path);
+  EXPECT_EQ(rows.size(), 2880u);
+  if (rows.empty()) return 0;
+  const ClearSkyGrid g =
+      MakeClearSkyGrid(ExamplePlant(), rows.front().ts, rows.back().ts + 60, 3.0);
+  std::size_t marked = 0;
+  for (const StoredMinute& r : rows) {
+    const auto k = static_cast<std::size_t>((r.ts - rows.front().ts) / 60);
+    const double ghi_bound = std::min(2500.0, 2.0 * g.clear_ghi_w_m2[k] + 50.0);
+    const double poa_bound =
+        std::min(2500.0, 2.0 * std::max(g.clear_poa_w_m2[k], g.clear_ghi_w_m2[k]) + 50.0);
+    EXPECT_LE(r.ghi, ghi_bound + 1e-9) << r.ts;
+    EXPECT_LE(r.g_poa, poa_bound + 1e-9) << r.ts;
+    marked += r.source.ends_with(kAboveClearSkyMark) ? 1 : 0;
+  }
+  return marked;
+}
+
+// Irradiance a minute cannot hold (the recorded June answer stamped into
+// December; the same answer 3 h late) is stored clipped to its clear-sky
+// bound with a warning naming the interval, and exit code 0: the file is
+// readable, only its time is suspect. The recorded answer as it is: no
+// warning, nothing marked.
+TEST(ImportWeatherCommand, IrradianceAboveItsClearSkyIsClippedAndNamed) {
+  ScratchDir dir("import-weather-clear-sky");
+  fs::copy_file(kExampleMap, dir / "plant.toml");
+  std::ofstream(dir / "december.json") << Restamped(2025, 12, 20, 0);
+  std::ofstream(dir / "late.json") << Restamped(2024, 6, 1, 3);
+
+  const auto good = RunPvtwin(dir.path(), "import-weather --config plant.toml --db good.db " +
+                                              (kData / "open-meteo-hourly.json").string());
+  EXPECT_EQ(good.exit_code, 0) << good.err;
+  EXPECT_EQ(good.err.find("warning"), std::string::npos) << good.err;
+  EXPECT_EQ(ExpectWithinClearSkyBounds(dir / "good.db"), 0u);
+
+  const auto december =
+      RunPvtwin(dir.path(), "import-weather --config plant.toml --db december.db december.json");
+  EXPECT_EQ(december.exit_code, 0) << december.err;
+  // On 20 December the sun is up from about 06:40 to 15:05 UTC at the plant;
+  // June's light, 03:00 to 19:00 UTC, does not fit into that day.
+  EXPECT_NE(december.err.find("warning: ghi_w_m2 2025-12-20T"), std::string::npos) << december.err;
+  EXPECT_NE(december.err.find("is more than its clear sky gives (clear sky "), std::string::npos)
+      << december.err;
+  EXPECT_NE(december.err.find("irradiance intervals above their clear sky stored clipped"),
+            std::string::npos)
+      << december.err;
+  EXPECT_GT(ExpectWithinClearSkyBounds(dir / "december.db"), 0u);
+
+  const auto late =
+      RunPvtwin(dir.path(), "import-weather --config plant.toml --db late.db late.json");
+  EXPECT_EQ(late.exit_code, 0) << late.err;
+  EXPECT_NE(late.err.find("warning: ghi_w_m2 2024-06-01T19:00:00Z .. 2024-06-01T20:00:00Z: "),
+            std::string::npos)
+      << late.err;
+  EXPECT_GT(ExpectWithinClearSkyBounds(dir / "late.db"), 0u);
 }
 
 // Without --config the plant comes from the store, which the daemon fills.

@@ -231,6 +231,7 @@ class Service {
   // errors for the bands): recomputed on a new UTC day or calibration.
   ForecastWindowStats forecast_stats_;
   std::int64_t forecast_stats_day_ = -1;
+  std::string text_cells_warned_;  // the forecast inputs' text cells last warned of
   std::int64_t forecast_stats_params_id_ = -1;
   void UpdateForecastStats(const Series& history, const ForecastRequest& request);
   double next_retention_s_ = 0.0;
@@ -662,12 +663,23 @@ void Service::IssueForecast() {
   Series history, weather, plan;
   std::string error;
   const std::int64_t history_from = request.issued_at_s - config_.calibration.window_days * kDayS;
+  Store::TextCells weather_text, plan_text;
   if (!store_->ReadMinutes(history_from, request.issued_at_s, &history, &error) ||
-      !store_->ReadWeatherForecast(request.issued_at_s, horizon_end, &weather, &error) ||
-      !store_->ReadOperationPlan(request.issued_at_s, horizon_end, &plan, &error)) {
+      !store_->ReadWeatherForecast(request.issued_at_s, horizon_end, &weather, &error,
+                                   &weather_text) ||
+      !store_->ReadOperationPlan(request.issued_at_s, horizon_end, &plan, &error, &plan_text)) {
     LogToStderr(kErr, "forecast inputs could not be read: " + error);
     return;
   }
+  // Text where a number belongs (an `sqlite3 .import` of empty cells): read
+  // as missing, said once for as long as it stays the same.
+  const std::string text_warning = weather_text.Warning("weather_forecast") +
+                                   (weather_text.Total() && plan_text.Total() ? "; " : "") +
+                                   plan_text.Warning("operation_plan");
+  if (text_warning != text_cells_warned_ && !text_warning.empty()) {
+    LogToStderr(kWarning, "forecast inputs: " + text_warning);
+  }
+  text_cells_warned_ = text_warning;
   UpdateForecastStats(history, request);
   BandedForecast banded;
   if (!MakeBandedForecast(config_.plant, spec_, params_, history, weather, plan, request,

@@ -16,6 +16,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 
 namespace pvtwin {
 
@@ -275,6 +276,7 @@ struct Uploader::Impl {
   bool MigrateCentral(PgError* error);
   std::string CentralTableDdl(const Table& t) const;
   std::string PlantLatestDdl(bool has_qc_event) const;
+  static std::string EventDdl(const std::set<std::string>& present);
   bool UploadBatch(const Table& t, std::int64_t* settled, bool* full, PgError* error);
   bool ReadBatch(const Table& t, std::int64_t hwm, std::string* copy, std::int64_t* rows_sent,
                  std::int64_t* max_seq, std::int64_t* settled, std::int64_t* keep_from,
@@ -461,6 +463,33 @@ std::string Uploader::Impl::PlantLatestDdl(bool has_qc_event) const {
          "AND x.accepted <> 0 ORDER BY x.run_at DESC, x.id DESC LIMIT 1) c ON true;";
 }
 
+// view event(plant_id, ts, kind, severity, message): the store's event view
+// (io/store/store.h) over every plant, from the tables that exist.
+std::string Uploader::Impl::EventDdl(const std::set<std::string>& present) {
+  const std::vector<std::pair<std::string, std::string>> branches = {
+      {"monitor_event", "SELECT plant_id, ts, kind, severity, message FROM monitor_event"},
+      {"qc_event",
+       "SELECT plant_id, start_ts, 'qc_' || kind, 'warning', channel || ': ' || detail "
+       "FROM qc_event"},
+      {"calibration",
+       "SELECT plant_id, run_at, 'calibration_' || status, CASE WHEN accepted = 1 THEN 'info' "
+       "ELSE 'warning' END, 'calibration ' || id || ' (' || variant || '): ' || status || "
+       "COALESCE(': ' || reason, '') FROM calibration"},
+      {"diagnosis",
+       "SELECT plant_id, run_at, 'diagnosis', CASE WHEN verdict = 'none' THEN 'info' ELSE "
+       "'warning' END, 'diagnosis of ' || base_variant || ': ' || verdict || CASE WHEN "
+       "low_confidence = 1 THEN ' (low confidence)' ELSE '' END FROM diagnosis"},
+  };
+  std::string body;
+  for (const auto& [table, select] : branches) {
+    if (present.count(table)) body += (body.empty() ? "" : " UNION ALL ") + select;
+  }
+  if (body.empty()) {
+    body = "SELECT NULL::text, NULL::bigint, NULL::text, NULL::text, NULL::text WHERE false";
+  }
+  return "CREATE OR REPLACE VIEW event(plant_id, ts, kind, severity, message) AS " + body + ";";
+}
+
 // True when the schema version, every table and column and the view exist
 // (then a role without CREATE can upload).
 bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
@@ -477,7 +506,7 @@ bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
   *complete = central.count("pvtwin_schema") && plant != central.end() &&
               std::find(plant->second.begin(), plant->second.end(), "store_id") !=
                   plant->second.end() &&
-              central.count("plant_latest");
+              central.count("plant_latest") && central.count("event");
   for (const Table& t : tables) {
     const auto it = central.find(std::string(t.spec->name));
     if (it == central.end()) {
@@ -593,20 +622,22 @@ bool Uploader::Impl::MigrateCentral(PgError* error) {
                     "first_upload_at bigint, last_upload_at bigint);"
                     // Version 2: the store each plant_id belongs to.
                     "ALTER TABLE plant ADD COLUMN IF NOT EXISTS store_id text;";
-  bool has_qc_event = false;
-  for (const Table& t : tables) {
-    sql += CentralTableDdl(t);
-    has_qc_event = has_qc_event || t.spec->name == "qc_event";
-  }
-  // Another plant may have brought qc_event before this one.
+  // The tables there will be: this plant's, and those other plants brought.
   std::vector<std::vector<std::string>> rows;
-  if (!pg->Query("SELECT 1 FROM information_schema.columns WHERE table_schema = "
-                 "current_schema() AND table_name = 'qc_event' AND column_name = 'end_ts'",
+  if (!pg->Query("SELECT table_name FROM information_schema.tables WHERE table_schema = "
+                 "current_schema()",
                  {}, &rows, error)) {
     return false;
   }
-  has_qc_event = has_qc_event || !rows.empty();
-  sql += PlantLatestDdl(has_qc_event);
+  std::set<std::string> present;
+  for (const auto& r : rows) present.insert(r[0]);
+  for (const Table& t : tables) {
+    sql += CentralTableDdl(t);
+    present.insert(std::string(t.spec->name));
+  }
+  sql += PlantLatestDdl(present.count("qc_event") > 0);
+  // Version 3: the event view, as the store's.
+  sql += EventDdl(present);
   sql += "INSERT INTO pvtwin_schema(version) VALUES(" + std::to_string(kCentralSchemaVersion) +
          ") ON CONFLICT DO NOTHING; COMMIT;";
   if (pg->Exec(sql, error)) return true;

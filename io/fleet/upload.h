@@ -48,6 +48,9 @@
 //       open_alarms): per plant the newest 1-min row, the newest forecast
 //       issue, the newest accepted calibration and the qc_event rows without
 //       end_ts (NULL when no plant uploads qc_event).
+//   view event(plant_id, ts, kind, severity, message) (version 3): the
+//       store's event view over every plant (monitor_event, qc_event,
+//       calibration, diagnosis, as far as they exist centrally).
 // A session advisory lock per plant_id lets one uploader at a time send a
 // plant's rows (a second one, or two plants configured with one plant_id,
 // is refused with a message).
@@ -72,7 +75,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kCentralSchemaVersion = 2;
+inline constexpr int kCentralSchemaVersion = 3;
 
 // One uploaded table. Adding a table of the store to the fleet is one entry
 // of UploadTables().

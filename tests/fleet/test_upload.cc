@@ -15,6 +15,8 @@
 #include <map>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "config/config_edit.h"
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
@@ -766,6 +768,83 @@ TEST_F(Upload, ACentralTableWithoutItsKeyColumnsIsAnError) {
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find("central table calibration"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("has no key column id"), std::string::npos) << run.err;
+}
+
+// The Grafana dashboards of doc/grafana: every panel's query, with Grafana's
+// macros as the time picker fills them, runs on a real store that a daemon
+// calibrated and forecast in, and on the fleet database it uploaded to.
+std::string FillMacros(std::string sql, std::int64_t from, std::int64_t to) {
+  for (const auto& [macro, value] :
+       {std::pair<std::string, std::string>{"$__unixEpochFrom()", std::to_string(from)},
+        {"$__unixEpochTo()", std::to_string(to)},
+        {"$plant", "dash"}}) {
+    for (std::size_t at = sql.find(macro); at != std::string::npos; at = sql.find(macro, at)) {
+      sql.replace(at, macro.size(), value);
+    }
+  }
+  return sql;
+}
+
+TEST_F(Upload, TheGrafanaDashboardsQueriesRunOnTheStoreAndTheFleetDatabase) {
+  WritePlant("dash", "");
+  Import("dash", kMorning - 2 * 86400, 2, 60, 1);
+  ChildProcess daemon;
+  // The daemon's clock at the end of the history.
+  ASSERT_TRUE(StartDaemon(&daemon, "dash",
+                          {"--speed", "60", "--sim-start", std::to_string(kMorning),
+                           "--wall-anchor", std::to_string(WallNowS())}));
+  // Calibrated at once (two days), a forecast issued, everything uploaded.
+  ASSERT_TRUE(WaitFor(90, [&] {
+    RawDb db(Db("dash"));
+    return db.Number("SELECT count(*) FROM forecast") > 0 && Pending("dash") == 0 &&
+           Central("SELECT count(*) FROM forecast") > 0;
+  })) << Log("dash");
+  EXPECT_EQ(daemon.Stop(SIGTERM, 10.0), 0) << Log("dash");
+  const std::int64_t from = kMorning - 2 * 86400;
+  const std::int64_t to = kMorning + 2 * 86400;
+
+  const auto store =
+      nlohmann::json::parse(ReadFile(fs::path(PVTWIN_SOURCE_DIR) / "doc" / "grafana" /
+                                     "pvtwin-plant-sqlite.json"));
+  int queries = 0;
+  RawDb db(Db("dash"));
+  for (const auto& panel : store.at("panels")) {
+    for (const auto& target : panel.at("targets")) {
+      const std::string sql = FillMacros(target.at("rawQueryText"), from, to);
+      const auto rows = db.Rows(sql);  // fails the test when it does not prepare
+      ++queries;
+      const std::string title = panel.at("title");
+      if (title.starts_with("Electrical power") || title.starts_with("Events")) {
+        EXPECT_FALSE(rows.empty()) << title << ": " << sql;
+      }
+    }
+  }
+  EXPECT_GE(queries, 8);
+
+  const auto fleet =
+      nlohmann::json::parse(ReadFile(fs::path(PVTWIN_SOURCE_DIR) / "doc" / "grafana" /
+                                     "pvtwin-fleet-postgresql.json"));
+  queries = 0;
+  for (const auto& variable : fleet.at("templating").at("list")) {
+    const auto rows = pg_.Query(variable.at("query"), "fleet");
+    ASSERT_FALSE(rows.empty());
+    EXPECT_FALSE(rows[0][0].starts_with("ERROR")) << rows[0][0];
+    EXPECT_EQ(rows[0][0], "dash");
+  }
+  for (const auto& panel : fleet.at("panels")) {
+    for (const auto& target : panel.at("targets")) {
+      const std::string sql = FillMacros(target.at("rawSql"), from, to);
+      const auto rows = pg_.Query(sql, "fleet");
+      ++queries;
+      ASSERT_FALSE(rows.empty()) << panel.at("title") << ": " << sql;
+      EXPECT_FALSE(rows[0][0].starts_with("ERROR")) << sql << ": " << rows[0][0];
+    }
+  }
+  EXPECT_GE(queries, 6);
+  // The central event view holds the calibration the store's does.
+  EXPECT_GE(Central("SELECT count(*) FROM event WHERE plant_id = 'dash' AND kind LIKE "
+                    "'calibration_%'"),
+            1);
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 #include "io/platform/log.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cinttypes>
+#include <cstdio>
 #include <cstdlib>
 #include <ctime>
 
@@ -26,11 +29,24 @@ const char* PriorityName(int priority) {
 
 }  // namespace
 
+bool StderrIsTheJournal() {
+  // systemd sets JOURNAL_STREAM to "<device>:<inode>" of the stream it
+  // connected; a child that inherited the variable but writes elsewhere (a
+  // terminal, a file) must not use the journal's prefix.
+  const char* stream = std::getenv("JOURNAL_STREAM");
+  if (stream == nullptr) return false;
+  std::uintmax_t device = 0, inode = 0;
+  if (std::sscanf(stream, "%ju:%ju", &device, &inode) != 2) return false;
+  struct stat st {};
+  if (::fstat(STDERR_FILENO, &st) != 0) return false;
+  return static_cast<std::uintmax_t>(st.st_dev) == device &&
+         static_cast<std::uintmax_t>(st.st_ino) == inode;
+}
+
 void LogToStderr(int priority, const std::string& line) {
-  // Under systemd stderr is a journal stream (JOURNAL_STREAM is set) and the
-  // "<N>" prefix carries the priority; on a terminal the time and the
-  // priority's name read better.
-  static const bool journal = std::getenv("JOURNAL_STREAM") != nullptr;
+  // Under systemd stderr is a journal stream and the "<N>" prefix carries the
+  // priority; elsewhere the date, time (UTC) and the priority's name.
+  static const bool journal = StderrIsTheJournal();
   std::string text;
   if (journal) {
     text = "<" + std::to_string(priority) + ">" + line + "\n";
@@ -39,7 +55,7 @@ void LogToStderr(int priority, const std::string& line) {
     std::tm tm{};
     ::gmtime_r(&now, &tm);
     char stamp[32];
-    std::strftime(stamp, sizeof(stamp), "%H:%M:%SZ", &tm);
+    std::strftime(stamp, sizeof(stamp), "%Y-%m-%dT%H:%M:%SZ", &tm);
     text = std::string(stamp) + " " + PriorityName(priority) + ": " + line + "\n";
   }
   // One write(2): lines from several threads do not interleave.

@@ -12,8 +12,14 @@ enum LogPriority { kErr = 3, kWarning = 4, kNotice = 5, kInfo = 6, kDebug = 7 };
 
 using LogFn = std::function<void(int priority, const std::string& line)>;
 
+// Whether stderr is the journal stream systemd connected: JOURNAL_STREAM
+// names its device and inode, and stderr is that file (not merely a process
+// that inherited the variable and writes to a terminal or a file).
+bool StderrIsTheJournal();
+
 // One line on stderr, one write per line (safe from several threads): "<N>line"
-// under systemd (journald reads the priority), "HH:MM:SSZ level: line" otherwise.
+// on the journal (journald reads the priority), "YYYY-MM-DDTHH:MM:SSZ level:
+// line" otherwise.
 void LogToStderr(int priority, const std::string& line);
 
 }  // namespace pvtwin

@@ -34,7 +34,7 @@ row() {
   if [ "$4" != 0 ]; then verdict="**NOT HANDLED**"; failed=1; fi
   local said=${5//|/\\|}
   said=${said//$work\//}                                      # the scratch directory
-  said=$(printf '%s' "$said" | sed -E 's/^[0-9:]{8}Z [a-z]+: //')  # the log's time and level
+  said=$(printf '%s' "$said" | sed -E 's/^([0-9]{4}-[0-9]{2}-[0-9]{2}T)?[0-9:]{8}Z [a-z]+: //')  # the log's time and level
   said=$(printf '%s' "$said" | head -c 160 | tr '\n' ' ')
   echo "| $n | $1 | $2 | $3 | $verdict | \`$said\` |"
 }

@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <sqlite3.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -221,6 +222,38 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
   ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
   Db db(DbPath());
   EXPECT_EQ(db.Number("SELECT value FROM plant_config WHERE key = 'area_m2'"), 3.6);
+}
+
+// The journal's "<N>" prefix only where stderr is the stream systemd
+// connected (JOURNAL_STREAM names its device and inode); a daemon that
+// inherited the variable but writes to a terminal or a file writes dated
+// lines.
+TEST_F(DaemonPaths, TheJournalPrefixOnlyOnTheJournalStreamAndDatedLinesElsewhere) {
+  WriteConfig(Settings());
+  ::setenv("JOURNAL_STREAM", "8:12345", 1);  // another stream than stderr
+  StartDaemon(kJune1, 1.0);
+  ::unsetenv("JOURNAL_STREAM");
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_TRUE(std::regex_search(Log(), std::regex("(^|\n)20[0-9]{2}-[0-9]{2}-[0-9]{2}T[0-9]{2}:"
+                                                   "[0-9]{2}:[0-9]{2}Z info: ready: ")))
+      << Log();
+  EXPECT_EQ(Log().find("<6>"), std::string::npos) << Log();
+
+  // stderr is the file JOURNAL_STREAM names: the priority prefix, no stamp.
+  fs::remove(dir_ / "daemon.log");
+  std::ofstream(dir_ / "daemon.log").close();
+  struct stat st {};
+  ASSERT_EQ(::stat((dir_ / "daemon.log").c_str(), &st), 0);
+  const std::string stream = std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  ::setenv("JOURNAL_STREAM", stream.c_str(), 1);
+  std::vector<std::string> argv = {PVTWIN_BINARY, "run", "--config",
+                                   (dir_ / "pvtwin.toml").string()};
+  std::string error;
+  const bool started = daemon_.Start(argv, (dir_ / "daemon.log").string(), &error);
+  ::unsetenv("JOURNAL_STREAM");
+  ASSERT_TRUE(started) << error;
+  ASSERT_TRUE(WaitFor(20, [&] { return Log().find("<6>ready: ") != std::string::npos; })) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
 }
 
 TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {

@@ -16,6 +16,7 @@ namespace pvtwin {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr std::int64_t kDayS = 86400;
 constexpr double kIrradianceEdgesWM2[] = {20.0, 200.0, 600.0};
 constexpr double kClearIndex = 0.6;
@@ -26,30 +27,35 @@ std::int64_t DayStart(std::int64_t t) { return t - ((t % kDayS) + kDayS) % kDayS
 // Regime levels, finest first: which features a level's key keeps.
 constexpr int kLevels = 5;
 std::uint32_t KeyAt(const ForecastRegime& r, int level) {
-  const bool sky = level <= 1, time = level == 0, pump = level <= 2, irradiance = level <= 3;
-  std::uint32_t key = static_cast<std::uint32_t>(level) << 16;
+  const bool sky = level <= 1, time = level == 0, pump = level <= 2, irradiance = level <= 3,
+             lead = level <= 1;
+  std::uint32_t key = static_cast<std::uint32_t>(level) << 20;
   if (irradiance) key |= static_cast<std::uint32_t>(r.irradiance + 1);
   if (sky) key |= static_cast<std::uint32_t>(r.sky + 1) << 4;
   if (time) key |= static_cast<std::uint32_t>(r.time + 1) << 8;
   if (pump) key |= static_cast<std::uint32_t>(r.pump + 1) << 12;
+  if (lead) key |= static_cast<std::uint32_t>(r.lead + 1) << 16;
   return key;
 }
 
 struct Quantiles {
-  double p_lo = kNaN, p_hi = kNaN, q_lo = kNaN, q_hi = kNaN;
+  double p_lo = kNaN, p_mid = kNaN, p_hi = kNaN, q_lo = kNaN, q_mid = kNaN, q_hi = kNaN;
 };
 
 // Per regime key (all levels) of one source: the quantiles of the keys
 // holding at least min_samples errors of an output.
-std::map<std::uint32_t, Quantiles> QuantileTable(const std::vector<ForecastError>& errors,
-                                                 const BandOptions& options) {
+// skip_issue: leave out the errors of the forecast issued then.
+std::map<std::uint32_t, Quantiles> QuantileTable(
+    const std::vector<ForecastError>& errors, const BandOptions& options,
+    std::int64_t skip_issue = std::numeric_limits<std::int64_t>::min()) {
   struct Samples {
     std::vector<double> p, q;
     std::set<std::int64_t> p_days, q_days;
   };
   std::map<std::uint32_t, Samples> samples;
   for (const ForecastError& e : errors) {
-    const std::int64_t day = DayStart(e.time_s);
+    if (e.issued_at_s == skip_issue) continue;
+    const std::int64_t day = e.issued_at_s;
     for (int level = 0; level < kLevels; ++level) {
       Samples& s = samples[KeyAt(e.regime, level)];
       if (std::isfinite(e.p_el_w)) {
@@ -69,39 +75,36 @@ std::map<std::uint32_t, Quantiles> QuantileTable(const std::vector<ForecastError
       return v.size() >= options.min_samples && (all_rows || d.size() >= options.min_days);
     };
     Quantiles& out = table[key];
-    // The days are the exchangeable units (a day's minutes err together):
-    // split-conformal's n/(n+1) moves the levels outward for n days, so that
-    // a new day is covered as often as the levels say, not less.
-    const auto levels = [&options](std::size_t days) {
-      const double shrink = static_cast<double>(days) / static_cast<double>(days + 1);
-      return std::pair{options.lower_quantile * shrink,
-                       1.0 - (1.0 - options.upper_quantile) * shrink};
-    };
+    // The levels themselves: the calibration on held-out days (BandsFor)
+    // corrects the width for what a new day does.
     if (enough(s.p, s.p_days)) {
-      const auto [lo, hi] = levels(s.p_days.size());
-      out.p_lo = SampleQuantile(&s.p, lo);
-      out.p_hi = SampleQuantile(&s.p, hi);
+      out.p_lo = SampleQuantile(&s.p, options.lower_quantile);
+      out.p_mid = SampleQuantile(&s.p, 0.5);
+      out.p_hi = SampleQuantile(&s.p, options.upper_quantile);
     }
     if (enough(s.q, s.q_days)) {
-      const auto [lo, hi] = levels(s.q_days.size());
-      out.q_lo = SampleQuantile(&s.q, lo);
-      out.q_hi = SampleQuantile(&s.q, hi);
+      out.q_lo = SampleQuantile(&s.q, options.lower_quantile);
+      out.q_mid = SampleQuantile(&s.q, 0.5);
+      out.q_hi = SampleQuantile(&s.q, options.upper_quantile);
     }
   }
   return table;
 }
 
-// The finest level's quantiles of one output (lo, hi) for a regime.
-std::pair<double, double> Lookup(const std::map<std::uint32_t, Quantiles>& table,
-                                 const ForecastRegime& r, bool p_el) {
+// The finest level's quantiles of one output for a regime.
+struct Offsets {
+  double lo = kNaN, mid = kNaN, hi = kNaN;
+};
+Offsets Lookup(const std::map<std::uint32_t, Quantiles>& table, const ForecastRegime& r,
+               bool p_el) {
   for (int level = 0; level < kLevels; ++level) {
     const auto it = table.find(KeyAt(r, level));
     if (it == table.end()) continue;
     const Quantiles& q = it->second;
-    const double lo = p_el ? q.p_lo : q.q_lo, hi = p_el ? q.p_hi : q.q_hi;
-    if (!std::isnan(lo)) return {lo, hi};
+    const Offsets o = p_el ? Offsets{q.p_lo, q.p_mid, q.p_hi} : Offsets{q.q_lo, q.q_mid, q.q_hi};
+    if (!std::isnan(o.lo)) return o;
   }
-  return {kNaN, kNaN};
+  return {};
 }
 
 // Errors of one replayed forecast against the measured rows, into *out.
@@ -117,7 +120,7 @@ void Score(const Forecast& f, const std::vector<ForecastRegime>& regimes, const 
     if (it == history.time_s.end() || *it != t) continue;
     const auto i = static_cast<std::size_t>(it - history.time_s.begin());
     if (has_valid && history[Channel::kValid][i] == 0.0) continue;
-    ForecastError e{regimes[h], t, p[i] - f.rows[Channel::kPElW][h],
+    ForecastError e{regimes[h], t, f.rows.time_s.front(), p[i] - f.rows[Channel::kPElW][h],
                     q[i] - f.rows[Channel::kQThW][h]};
     if (std::isfinite(e.p_el_w) || std::isfinite(e.q_th_w)) out->push_back(e);
   }
@@ -160,6 +163,8 @@ std::vector<ForecastRegime> RegimesOf(const Plant& plant, const Series& inputs) 
     r.time = solar_h < 10.0 ? 0 : (solar_h < 14.0 ? 1 : 2);
     const double flow = inputs.Has(Channel::kMdotKgS) ? inputs[Channel::kMdotKgS][k] : kNaN;
     r.pump = std::isfinite(flow) && flow > 0.0 ? 1 : 0;
+    const std::int64_t lead_s = inputs.time_s[k] - inputs.time_s.front();
+    r.lead = lead_s < 3600 ? 0 : (lead_s < 6 * 3600 ? 1 : 2);
   }
   return regimes;
 }
@@ -184,17 +189,19 @@ Series WithoutRows(const Series& s, std::int64_t from, std::int64_t to) {
   return out;
 }
 
-// Calls per_day(request of the day, history before it; its operation
-// learned from the history's other days) for each UTC day of
-// the history with a full day of history before it, until it returns false.
+// Calls per_day(request of the replayed day, history before it; its
+// operation learned from the history's other days) for each UTC day D of the
+// history with a full day of history before D + the request's time of day
+// (the replayed issue), until it returns false.
 template <class PerDay>
 void ForEachReplayDay(const Series& history, const ForecastRequest& request, PerDay per_day) {
   if (history.size() == 0) return;
   ForecastRequest day = request;
   day.horizon_s = static_cast<double>(kDayS);
   day.with_reference = false;
+  const std::int64_t time_of_day = request.issued_at_s - DayStart(request.issued_at_s);
   const std::int64_t first_day = DayStart(history.time_s.front()) + kDayS;
-  for (std::int64_t d = first_day; d <= history.time_s.back(); d += kDayS) {
+  for (std::int64_t d = first_day + time_of_day; d <= history.time_s.back(); d += kDayS) {
     const auto end = static_cast<std::size_t>(
         std::lower_bound(history.time_s.begin(), history.time_s.end(), d) - history.time_s.begin());
     const Series before = history.Slice(0, end);
@@ -343,19 +350,82 @@ bool MakeBandedForecast(const Plant& plant, const ModelSpec& spec, const ParamVe
   return true;
 }
 
+namespace {
+
+// The split-conformal scale of one source's band edges for one output
+// (forecast_bands.h): each issue's errors against the quantiles of the other
+// issues; 1 when the scores are too few.
+struct Scale {
+  double lo = 1.0, hi = 1.0;
+  std::size_t scores = 0;
+};
+std::array<Scale, 2> ConformalScales(const std::vector<ForecastError>& errors,
+                                     const BandOptions& options) {
+  std::set<std::int64_t> issues;
+  for (const ForecastError& e : errors) issues.insert(e.issued_at_s);
+  std::array<std::vector<double>, 2> above, below;  // per output
+  std::array<std::size_t, 2> scored{};
+  for (const std::int64_t issue : issues) {
+    const std::map<std::uint32_t, Quantiles> table = QuantileTable(errors, options, issue);
+    for (const ForecastError& e : errors) {
+      if (e.issued_at_s != issue) continue;
+      for (int o = 0; o < 2; ++o) {
+        const double err = o ? e.q_th_w : e.p_el_w;
+        if (!std::isfinite(err)) continue;
+        const Offsets q = Lookup(table, e.regime, o == 0);
+        if (std::isnan(q.lo)) continue;
+        const double a = std::min(0.0, q.lo), b = std::max(0.0, q.hi);
+        if (!(b > a)) continue;  // no band here (P_el at night)
+        ++scored[o];
+        // The scale that just reaches the error, on its side; an error on
+        // the side without width can never be reached.
+        if (err > 0.0) above[o].push_back(b > 0.0 ? err / b : kInfinity);
+        if (err < 0.0) below[o].push_back(a < 0.0 ? err / a : kInfinity);
+      }
+    }
+  }
+  std::array<Scale, 2> scales;
+  for (int o = 0; o < 2; ++o) {
+    scales[o].scores = scored[o];
+    if (issues.size() < 2 || scored[o] < options.min_samples) continue;
+    // The scale λ with a share upper (lower) of all scored errors at or below
+    // λ·b (at or above λ·a): the errors on the other side count as below.
+    const auto level = [&](std::vector<double>* side, double share_outside) {
+      const double n = static_cast<double>(scored[o]);
+      const double inside_needed =
+          n * (1.0 - share_outside) - (n - static_cast<double>(side->size()));
+      if (inside_needed <= 0.0 || side->empty()) return 0.0;
+      const double q = std::min(1.0, inside_needed / static_cast<double>(side->size()));
+      const double v = SampleQuantile(side, q);  // sorts
+      if (std::isfinite(v)) return v;
+      // Beyond the errors no scale reaches: the largest that one reaches.
+      const auto reachable = std::lower_bound(side->begin(), side->end(), kInfinity);
+      return reachable == side->begin() ? 1.0 : *(reachable - 1);
+    };
+    scales[o].hi = level(&above[o], 1.0 - options.upper_quantile);
+    scales[o].lo = level(&below[o], options.lower_quantile);
+  }
+  return scales;
+}
+
+}  // namespace
+
 ForecastBands BandsFor(const Plant& plant, const Forecast& forecast, const ForecastErrors& errors,
                        const BandOptions& options) {
   const std::size_t n = forecast.rows.size();
   ForecastBands b;
-  b.p_el_p10.assign(n, kNaN);
-  b.p_el_p90.assign(n, kNaN);
-  b.q_th_p10.assign(n, kNaN);
-  b.q_th_p90.assign(n, kNaN);
+  for (std::vector<double>* v :
+       {&b.p_el_p10, &b.p_el_p50, &b.p_el_p90, &b.q_th_p10, &b.q_th_p50, &b.q_th_p90}) {
+    v->assign(n, kNaN);
+  }
   std::array<std::map<std::uint32_t, Quantiles>, kWeatherSources> tables;
+  std::array<std::array<Scale, 2>, kWeatherSources> scales;
   std::array<bool, kWeatherSources> usable{};
   for (std::size_t s = 0; s < kWeatherSources; ++s) {
-    tables[s] = QuantileTable(errors.by_source[s], options);
     usable[s] = errors.by_source[s].size() >= options.min_samples;
+    if (!usable[s]) continue;
+    tables[s] = QuantileTable(errors.by_source[s], options);
+    scales[s] = ConformalScales(errors.by_source[s], options);
   }
   const std::vector<ForecastRegime> regimes = RegimesOf(plant, forecast.inputs_used);
   bool substituted = false;
@@ -368,20 +438,34 @@ ForecastBands BandsFor(const Plant& plant, const Forecast& forecast, const Forec
     }
     if (!usable[s]) continue;
     ++b.rows_from[s];
-    const auto [p_lo, p_hi] = Lookup(tables[s], regimes[h], true);
-    const auto [q_lo, q_hi] = Lookup(tables[s], regimes[h], false);
-    const double p = forecast.rows[Channel::kPElW][h], q = forecast.rows[Channel::kQThW][h];
-    b.p_el_p10[h] = std::max(0.0, p + p_lo);
-    b.p_el_p90[h] = std::max(0.0, p + p_hi);
-    b.q_th_p10[h] = q + q_lo;
-    b.q_th_p90[h] = q + q_hi;
+    for (int o = 0; o < 2; ++o) {
+      const Offsets q = Lookup(tables[s], regimes[h], o == 0);
+      const double f = forecast.rows[o ? Channel::kQThW : Channel::kPElW][h];
+      if (std::isnan(q.lo) || !std::isfinite(f)) continue;
+      double lo = f + scales[s][o].lo * std::min(0.0, q.lo);
+      double hi = f + scales[s][o].hi * std::max(0.0, q.hi);
+      if (o == 0) {
+        lo = std::max(0.0, lo);
+        hi = std::max(0.0, hi);
+      }
+      const double mid = std::clamp(f + q.mid, lo, hi);
+      (o ? b.q_th_p10 : b.p_el_p10)[h] = lo;
+      (o ? b.q_th_p50 : b.p_el_p50)[h] = mid;
+      (o ? b.q_th_p90 : b.p_el_p90)[h] = hi;
+    }
   }
-  char buf[160];
+  char buf[240];
   b.note = "bands:";
   for (std::size_t s = 0; s < kWeatherSources; ++s) {
-    std::snprintf(buf, sizeof buf, "%s %s errors of %zu days (%zu rows)", s ? ";" : "",
+    std::snprintf(buf, sizeof buf, "%s %s errors of %zu days (%zu rows", s ? ";" : "",
                   WeatherSourceName(static_cast<WeatherSource>(s)), errors.days[s], b.rows_from[s]);
     b.note += buf;
+    if (usable[s]) {
+      std::snprintf(buf, sizeof buf, ", conformal scale P_el %.2f/%.2f, Q_u %.2f/%.2f",
+                    scales[s][0].lo, scales[s][0].hi, scales[s][1].lo, scales[s][1].hi);
+      b.note += buf;
+    }
+    b.note += ")";
   }
   if (substituted) b.note += "; weather_forecast rows banded with persistence errors";
   return b;

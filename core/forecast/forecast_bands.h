@@ -1,18 +1,20 @@
-// Uncertainty bands of a forecast (issue 15; doc/contracts.md `forecast` columns
-// p_el_w_p10, p_el_w_p90, q_th_w_p10, q_th_w_p90): empirical quantiles of
-// the errors the same model's day-ahead forecasts made over the recent
-// window, by regime and by weather source.
+// Uncertainty bands of a forecast (issue 15, issue 53; doc/contracts.md
+// `forecast` columns p_el_w_p10, p_el_w_p50, p_el_w_p90, q_th_w_p10, …):
+// split-conformal bands from the same model's held-out day-ahead errors over
+// the recent window, by lead time and regime and by weather source.
 //
-// Replay: for each UTC day D of the history with a full day of history
-// before it, a forecast is issued at 00:00 of D from the history before D
-// (MakeForecast, as the daemon does it) and scored against the measured
-// rows of D: error = measured − forecast, per output, on every minute with a
-// valid measurement. Two replays per day, kept apart because a weather
-// forecast errs differently from persistence: without the weather forecast
-// table (source `persistence`), and with the rows the table holds for D
-// (source `weather_forecast`, as earlier imports and fetches left them; a
-// minute counts there only when all of its irradiance came from the table).
-// The operation is forecast as in the daemon (plan, else the typical day).
+// Replay: for each day D of the history with a full day of history before
+// it, a forecast is issued at D + the issue's own time of day (so that the
+// replayed errors have the lead times of the forecast they band) from the
+// history before it (MakeForecast, as the daemon does it) and scored against
+// the measured rows of the 24 h after: error = measured − forecast, per
+// output, on every minute with a valid measurement. Two replays per day,
+// kept apart because a weather forecast errs differently from persistence:
+// without the weather forecast table (source `persistence`), and with the
+// rows the table holds for the day (source `weather_forecast`, as earlier
+// imports and fetches left them; a minute counts there only when all of its
+// irradiance came from the table). The operation is forecast as in the
+// daemon (plan, else the typical day).
 //
 // Regime of a row, from the forecast's own inputs (known at issue time):
 //   irradiance  in-plane (else horizontal) < 20, 20–200, 200–600, ≥ 600 W/m²
@@ -20,15 +22,25 @@
 //               (core/forecast/weather_resample.h), else cloudy
 //   time        local solar hour < 10, 10–14, ≥ 14
 //   pump        flow > 0 or not
+//   lead        time since the issue < 1 h, 1–6 h, ≥ 6 h
 // A row takes the quantiles of the finest regime that holds at least
-// min_samples errors from min_days days, coarsening in the order: all four
-// → irradiance, sky, pump → irradiance, pump → irradiance → every row of the
-// source (which needs min_samples only).
+// min_samples errors from min_days days, coarsening in the order: all five
+// → irradiance, sky, pump, lead → irradiance, pump → irradiance → every row
+// of the source (which needs min_samples only).
 //
-// Band: p10 = forecast + q_lower(error), p90 = forecast + q_upper(error)
-// (q = the sample quantile, linear between order statistics); P_el's lower
-// edge is not below 0. Minutes where the model's output is exact (P_el at
-// night) get a band of zero width.
+// Band of a row with forecast f and regime quantiles q10 ≤ q50 ≤ q90 of the
+// errors: p10 = f + λ_lo·min(0, q10), p90 = f + λ_hi·max(0, q90), so the
+// forecast lies inside its band by construction; p50 = f + q50 (the median,
+// where the forecast f is the model's run on the expected inputs), within
+// the band. λ_lo and λ_hi (per source and output) are the split-conformal
+// calibration on held-out days: each replayed day's errors are scored
+// against the quantiles of the other days (leave one day out; a day's
+// minutes err together, so days are the units), s = e / max(0, q90) above
+// and e / min(0, q10) below, and λ_hi is the upper_quantile of the scores
+// above (λ_lo the 1 − lower_quantile of those below): on days the quantiles
+// were not taken from, 10 % of the minutes lie above p90 and 10 % below p10.
+// P_el's edges are not below 0. Minutes where the model's output is exact
+// (P_el at night) get a band of zero width.
 #pragma once
 
 #include <array>
@@ -64,15 +76,18 @@ struct ForecastRegime {
   std::uint8_t sky = 0;         // 0 clear, 1 cloudy
   std::uint8_t time = 0;        // 0 … 2
   std::uint8_t pump = 0;        // 0 off, 1 on
+  std::uint8_t lead = 0;        // 0 < 1 h, 1 1–6 h, 2 ≥ 6 h after the first row
 };
 
-// The regimes of a forecast's horizon rows from its inputs_used.
+// The regimes of a forecast's horizon rows from its inputs_used (whose first
+// row is the issue).
 std::vector<ForecastRegime> RegimesOf(const Plant& plant, const Series& inputs);
 
 struct ForecastError {
   ForecastRegime regime;
   std::int64_t time_s = 0;
-  double p_el_w = 0.0;  // measured − forecast; NaN where one was missing
+  std::int64_t issued_at_s = 0;  // of the replayed forecast: the unit of the calibration
+  double p_el_w = 0.0;           // measured − forecast; NaN where one was missing
   double q_th_w = 0.0;
 };
 
@@ -91,10 +106,12 @@ bool ReplayForecastErrors(const Plant& plant, const ModelSpec& spec, const Param
                           const ForecastRequest& request, ForecastErrors* out, std::string* error);
 
 struct ForecastBands {
-  std::vector<double> p_el_p10, p_el_p90, q_th_p10, q_th_p90;  // per horizon row, NaN: none
-  std::array<std::size_t, kWeatherSources> rows_from{};        // rows banded from each source
+  // Per horizon row, NaN: none. p10 ≤ forecast ≤ p90 and p10 ≤ p50 ≤ p90.
+  std::vector<double> p_el_p10, p_el_p50, p_el_p90, q_th_p10, q_th_p50, q_th_p90;
+  std::array<std::size_t, kWeatherSources> rows_from{};  // rows banded from each source
   // For the forecast row's `inputs`: e.g. "bands: persistence errors of 13
-  // days (1440 rows); weather_forecast errors of 4 days (1440 rows)".
+  // days (1440 rows, conformal scale P_el 1.21/1.35, Q_u 1.10/1.42);
+  // weather_forecast errors of 4 days (0 rows)".
   std::string note;
 };
 

@@ -143,8 +143,12 @@ void PrintForecastSkill(Store* store, const Config& config, const Store::Calibra
   }
   options.fixed_params = true;
   options.params = params.values;
-  options.window_days = 7;
   constexpr int kDays = 3;
+  // The daemon's window, as far as the history before the first test day
+  // holds it: the bands learn from the window's days.
+  const int history_days =
+      static_cast<int>((history.time_s.back() - history.time_s.front()) / 86400) - kDays;
+  options.window_days = std::clamp(config.calibration.window_days, 2, std::max(2, history_days));
   for (std::int64_t t = history.time_s.back() - (kDays + 1) * 86400;
        options.issue_times_s.size() < kDays;) {
     t = NextLocalTime(t, 0, 0);
@@ -170,6 +174,11 @@ void PrintForecastSkill(Store* store, const Config& config, const Store::Calibra
       "and %.0f %% (Q_u) of the measured minutes\n",
       result.days_ok, result.total_p_el.skill, result.total_q_th.skill,
       100.0 * result.total_p_el.coverage, 100.0 * result.total_q_th.coverage);
+  std::printf(
+      "        (the band: where a minute's measurement falls 8 times in 10, judged by the "
+      "model's own errors on the %d-day window's held-out days; it always holds the "
+      "forecast, p50 is the median)\n",
+      options.window_days);
 }
 
 // What the daily checks and the diagnosis left in the store.

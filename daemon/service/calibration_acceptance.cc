@@ -37,13 +37,11 @@ AcceptanceDecision DecideCalibration(double fresh_w_m2, std::optional<double> cu
     d.reason = "first parameters of this database" + bounds_note;
     return d;
   }
-  const bool tolerate = at_bounds.empty() && tolerance_w_m2 > 0.0;
-  const double limit_w_m2 = !at_bounds.empty() ? (1.0 - kAtBoundsMargin) * *current_w_m2
-                                               : *current_w_m2 + (tolerate ? tolerance_w_m2 : 0.0);
+  const bool tolerate = tolerance_w_m2 > 0.0;
+  const double limit_w_m2 = *current_w_m2 + (tolerate ? tolerance_w_m2 : 0.0);
   d.accept = fresh_w_m2 <= limit_w_m2;
   const std::string comparison = "held-out MAE (P_el + Q_u) " + Watts(fresh_w_m2, area_m2) +
-                                 (d.accept ? " ≤ " : " exceeds ") +
-                                 (at_bounds.empty() ? "the current " : "2 % below the current ") +
+                                 (d.accept ? " ≤ " : " exceeds ") + "the current " +
                                  Watts(*current_w_m2, area_m2) +
                                  (tolerate ? " + " + Watts(tolerance_w_m2, area_m2) +
                                                  " (the standard error of the hourly differences)"

@@ -228,9 +228,10 @@ class Service {
   // Forecast and housekeeping.
   double next_forecast_s_ = 0.0;
   // What the forecasts learn from the window (operation choice, replayed
-  // errors for the bands): recomputed on a new UTC day or calibration.
+  // errors for the bands, replayed at the issue's time of day): recomputed
+  // for each issue.
   ForecastWindowStats forecast_stats_;
-  std::int64_t forecast_stats_day_ = -1;
+  std::int64_t forecast_stats_issued_at_ = -1;
   std::string text_cells_warned_;  // the forecast inputs' text cells last warned of
   std::int64_t forecast_stats_params_id_ = -1;
   void UpdateForecastStats(const Series& history, const ForecastRequest& request);
@@ -704,6 +705,8 @@ void Service::IssueForecast() {
     r.p_el_w_p90 = banded.bands.p_el_p90[i];
     r.q_th_w_p10 = banded.bands.q_th_p10[i];
     r.q_th_w_p90 = banded.bands.q_th_p90[i];
+    r.p_el_w_p50 = banded.bands.p_el_p50[i];
+    r.q_th_w_p50 = banded.bands.q_th_p50[i];
     r.p_el_w_ref = forecast.reference[Channel::kPElW][i];
     r.q_th_w_ref = forecast.reference[Channel::kQThW][i];
   }
@@ -721,8 +724,10 @@ void Service::IssueForecast() {
 
 void Service::UpdateForecastStats(const Series& history, const ForecastRequest& request) {
   const std::int64_t day = request.issued_at_s - ((request.issued_at_s % kDayS) + kDayS) % kDayS;
-  if (day == forecast_stats_day_ && params_id_ == forecast_stats_params_id_) return;
-  forecast_stats_day_ = day;
+  if (request.issued_at_s == forecast_stats_issued_at_ && params_id_ == forecast_stats_params_id_) {
+    return;
+  }
+  forecast_stats_issued_at_ = request.issued_at_s;
   forecast_stats_params_id_ = params_id_;
   Series past_weather;
   std::string error;

@@ -281,13 +281,76 @@ std::vector<std::string> SchemaV7() {
   };
 }
 
+// Version 8: the median of each output beside the band (the point forecast
+// is the model's run on the expected inputs; p50 = point + the median of its
+// held-out errors, core/forecast/forecast_bands.h), and the band's coverage
+// per output in forecast_skill. The views are created again with their old
+// columns first.
+std::vector<std::string> SchemaV8() {
+  std::vector<std::string> s;
+  for (const char* column : {"p_el_w_p50", "q_th_w_p50"}) {
+    s.push_back(std::string("ALTER TABLE forecast ADD COLUMN ") + column + " REAL");
+  }
+  s.push_back("DROP VIEW forecast_latest");
+  s.push_back(
+      "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c, p_el_w_p10, "
+      "p_el_w_p90, q_th_w_p10, q_th_w_p90, p_el_w_p50, q_th_w_p50) AS "
+      "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c, f.p_el_w_p10, "
+      "f.p_el_w_p90, f.q_th_w_p10, f.q_th_w_p90, f.p_el_w_p50, f.q_th_w_p50 FROM forecast f "
+      "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)");
+  s.push_back("DROP VIEW forecast_skill");
+  const std::string min_minutes = std::to_string(kMinScoredMinutes);
+  const std::string enough = " CASE WHEN COUNT(*) >= " + min_minutes + " THEN";
+  s.push_back(
+      "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, "
+      "skill_q_th, coverage_p10_p90, minutes, coverage_p_el, coverage_q_th) AS "
+      "WITH pairs AS ("
+      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
+      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
+      "  CASE WHEN f.p_el_w IS NOT NULL THEN f.p_el_w_ref - m.p_el_w END AS ref_p,"
+      "  CASE WHEN f.q_th_w IS NOT NULL THEN f.q_th_w_ref - m.q_th_w END AS ref_q,"
+      "  CASE WHEN f.p_el_w_p90 > f.p_el_w_p10 AND m.p_el_w IS NOT NULL"
+      "   THEN m.p_el_w BETWEEN f.p_el_w_p10 AND f.p_el_w_p90 END AS in_p,"
+      "  CASE WHEN f.q_th_w_p90 > f.q_th_w_p10 AND m.q_th_w IS NOT NULL"
+      "   THEN m.q_th_w BETWEEN f.q_th_w_p10 AND f.q_th_w_p90 END AS in_q"
+      " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
+      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+      "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+      " WHERE m.valid IS NULL OR m.valid != 0)"
+      " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
+      "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
+      "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END)),"
+      "  " +
+      enough +
+      " 1.0 -"
+      "   SUM(CASE WHEN ref_p IS NOT NULL THEN ABS(err_p) END) /"
+      "   NULLIF(SUM(CASE WHEN err_p IS NOT NULL THEN ABS(ref_p) END), 0) END,"
+      "  " +
+      enough +
+      " 1.0 -"
+      "   SUM(CASE WHEN ref_q IS NOT NULL THEN ABS(err_q) END) /"
+      "   NULLIF(SUM(CASE WHEN err_q IS NOT NULL THEN ABS(ref_q) END), 0) END,"
+      "  " +
+      enough +
+      "   (TOTAL(in_p) + TOTAL(in_q)) / NULLIF(COUNT(in_p) + COUNT(in_q), 0) END,"
+      "  COUNT(*),"
+      "  " +
+      enough +
+      " TOTAL(in_p) / NULLIF(COUNT(in_p), 0) END,"
+      "  " +
+      enough +
+      " TOTAL(in_q) / NULLIF(COUNT(in_q), 0) END"
+      " FROM pairs GROUP BY day");
+  return s;
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3},
-                                 {4, &SchemaV4}, {5, &SchemaV5}, {6, &SchemaV6},
-                                 {7, &SchemaV7}};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}, {4, &SchemaV4},
+                                 {5, &SchemaV5}, {6, &SchemaV6}, {7, &SchemaV7}, {8, &SchemaV8}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 
@@ -1410,7 +1473,8 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
         DbStatus s = db.Prepare(
             "INSERT OR REPLACE INTO forecast(issued_at, ts, calibration_id, p_el_w, q_th_w, "
             "t_pv_c, t_out_c, inputs, p_el_w_p10, p_el_w_p90, q_th_w_p10, q_th_w_p90, "
-            "p_el_w_ref, q_th_w_ref) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            "p_el_w_ref, q_th_w_ref, p_el_w_p50, q_th_w_p50) "
+            "VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             &stmt);
         if (!s.ok()) return s;
         for (const ForecastRow& row : rows) {
@@ -1428,7 +1492,7 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
           }
           sqlite3_bind_text(stmt, column++, inputs.c_str(), -1, SQLITE_TRANSIENT);
           for (double v : {row.p_el_w_p10, row.p_el_w_p90, row.q_th_w_p10, row.q_th_w_p90,
-                           row.p_el_w_ref, row.q_th_w_ref}) {
+                           row.p_el_w_ref, row.q_th_w_ref, row.p_el_w_p50, row.q_th_w_p50}) {
             BindReal(stmt, column++, v);
           }
           s = db.StepDone(stmt, "insert forecast row ts " + std::to_string(row.ts));
@@ -1461,13 +1525,15 @@ bool Store::ReadLatestForecast(std::int64_t from_ts, std::int64_t to_ts,
                                std::vector<ForecastRow>* out, std::string* error) {
   return impl_->ReadRows(
       "SELECT ts, p_el_w, q_th_w, t_pv_c, t_out_c, p_el_w_p10, p_el_w_p90, q_th_w_p10, "
-      "q_th_w_p90 FROM forecast_latest WHERE ts >= ? AND ts < ? ORDER BY ts",
+      "q_th_w_p90, p_el_w_p50, q_th_w_p50 FROM forecast_latest WHERE ts >= ? AND ts < ? "
+      "ORDER BY ts",
       "read forecast_latest", from_ts, to_ts,
       [](sqlite3_stmt* stmt) {
         ForecastRow r;
         r.ts = sqlite3_column_int64(stmt, 0);
-        ColumnReals(stmt, {&r.p_el_w, &r.q_th_w, &r.t_pv_c, &r.t_out_c, &r.p_el_w_p10,
-                           &r.p_el_w_p90, &r.q_th_w_p10, &r.q_th_w_p90});
+        ColumnReals(stmt,
+                    {&r.p_el_w, &r.q_th_w, &r.t_pv_c, &r.t_out_c, &r.p_el_w_p10, &r.p_el_w_p90,
+                     &r.q_th_w_p10, &r.q_th_w_p90, &r.p_el_w_p50, &r.q_th_w_p50});
         return r;
       },
       out, error);
@@ -1477,7 +1543,8 @@ bool Store::ReadForecastSkill(std::int64_t from_day, std::int64_t to_day,
                               std::vector<SkillRow>* out, std::string* error) {
   return impl_->ReadRows(
       "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
-      "coverage_p10_p90, minutes FROM forecast_skill WHERE day >= ? AND day < ? ORDER BY day",
+      "coverage_p10_p90, minutes, coverage_p_el, coverage_q_th FROM forecast_skill "
+      "WHERE day >= ? AND day < ? ORDER BY day",
       "read forecast_skill", from_day, to_day,
       [](sqlite3_stmt* stmt) {
         SkillRow r;
@@ -1485,6 +1552,11 @@ bool Store::ReadForecastSkill(std::int64_t from_day, std::int64_t to_day,
         ColumnReals(stmt, {&r.mae_p_el_w, &r.mae_q_th_w, &r.nmae_p_el, &r.nmae_q_th, &r.skill_p_el,
                            &r.skill_q_th, &r.coverage_p10_p90});
         r.minutes = sqlite3_column_int64(stmt, 8);
+        r.coverage_p_el =
+            sqlite3_column_type(stmt, 9) == SQLITE_NULL ? kNoValue : sqlite3_column_double(stmt, 9);
+        r.coverage_q_th = sqlite3_column_type(stmt, 10) == SQLITE_NULL
+                              ? kNoValue
+                              : sqlite3_column_double(stmt, 10);
         return r;
       },
       out, error);

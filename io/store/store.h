@@ -128,6 +128,16 @@
 //       copied to another site must not upload under the original's
 //       plant_id.
 //
+// Version 8 adds (issue 53, core/forecast/forecast_bands.h):
+//   forecast.p_el_w_p50, q_th_w_p50 REAL
+//       the median of each output: the forecast (the model's run on the
+//       expected inputs) plus the median of its held-out errors in the
+//       row's regime, within the band. The band now always holds the
+//       forecast: p10 ≤ p_el_w ≤ p90 (and q_th_w alike).
+//   view forecast_latest gains p_el_w_p50, q_th_w_p50.
+//   view forecast_skill gains coverage_p_el, coverage_q_th: the band's
+//       coverage of each output alone (coverage_p10_p90 pools both).
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -179,7 +189,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 7;
+inline constexpr int kStoreSchemaVersion = 8;
 // NULL in a row struct.
 inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
@@ -226,6 +236,8 @@ class Store {
     double p_el_w_p10 = kNoValue, p_el_w_p90 = kNoValue, q_th_w_p10 = kNoValue,
            q_th_w_p90 = kNoValue;
     double p_el_w_ref = kNoValue, q_th_w_ref = kNoValue;  // written, not read back
+    // The median of each output (version 8), within the band; NaN: NULL.
+    double p_el_w_p50 = kNoValue, q_th_w_p50 = kNoValue;
   };
 
   // One row of the forecast_skill view (NaN: NULL).
@@ -234,6 +246,7 @@ class Store {
     double mae_p_el_w = 0.0, mae_q_th_w = 0.0, nmae_p_el = 0.0, nmae_q_th = 0.0;
     double skill_p_el = kNoValue, skill_q_th = kNoValue, coverage_p10_p90 = kNoValue;
     std::int64_t minutes = 0;
+    double coverage_p_el = kNoValue, coverage_q_th = kNoValue;  // version 8
   };
 
   // Opens (creating if needed) and migrates the database at path. Returns

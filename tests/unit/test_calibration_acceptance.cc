@@ -28,17 +28,23 @@ TEST(CalibrationAcceptance, AFitInsideItsBoundsNeedsOnlyToBeNoWorse) {
             "parameters kept");
 }
 
-TEST(CalibrationAcceptance, AFitAtItsBoundsMustBeTwoPercentBetter) {
-  // 1 % better is not enough for parameters at their bounds …
+// The held-out evidence decides, whatever the bounds: a fit with parameters
+// at their bounds is taken as one inside them is (before, it had to be 2 %
+// better, and fits that sat at the same bounds every night never landed);
+// the bounds are named.
+TEST(CalibrationAcceptance, AFitAtItsBoundsIsJudgedByTheHeldOutDaysAlone) {
   AcceptanceDecision d = DecideCalibration(5.94, 6.0, {"f_th", "u_front_w_m2k"}, 1.0);
-  EXPECT_FALSE(d.accept);
+  EXPECT_TRUE(d.accept) << d.reason;
   EXPECT_EQ(d.reason,
-            "held-out MAE (P_el + Q_u) 5.94 W (5.94 W/m²) exceeds 2 % below the current 6 W "
-            "(6 W/m²); 2 parameters at bounds (f_th, u_front_w_m2k); parameters kept");
-  // … 3 % is.
-  d = DecideCalibration(5.82, 6.0, {"f_th"}, 1.0);
-  EXPECT_TRUE(d.accept);
-  EXPECT_NE(d.reason.find("≤ 2 % below the current"), std::string::npos) << d.reason;
+            "held-out MAE (P_el + Q_u) 5.94 W (5.94 W/m²) ≤ the current 6 W (6 W/m²); "
+            "2 parameters at bounds (f_th, u_front_w_m2k)");
+  d = DecideCalibration(6.1, 6.0, {"u_coll_w_m2k"}, 1.0, 0.2);
+  EXPECT_TRUE(d.accept) << d.reason;
+  d = DecideCalibration(6.3, 6.0, {"u_coll_w_m2k"}, 1.0, 0.2);
+  EXPECT_FALSE(d.accept) << d.reason;
+  EXPECT_NE(d.reason.find("1 parameter at bounds (u_coll_w_m2k); parameters kept"),
+            std::string::npos)
+      << d.reason;
 }
 
 // Numbers in the reason are not rounded to look equal: 12.0043 against 12.0021.
@@ -51,7 +57,7 @@ TEST(CalibrationAcceptance, TheReasonKeepsTheDigitsThatDecide) {
 }
 
 // Within the spread of the held-out comparison a fresh fit is taken (the
-// parameters follow the plant); beyond it, or at bounds, it is not.
+// parameters follow the plant); beyond it, it is not.
 TEST(CalibrationAcceptance, TheToleranceIsTheSpreadOfTheHeldOutComparison) {
   AcceptanceDecision d = DecideCalibration(6.1, 6.0, {}, 1.0, 0.2);
   EXPECT_TRUE(d.accept) << d.reason;
@@ -61,9 +67,6 @@ TEST(CalibrationAcceptance, TheToleranceIsTheSpreadOfTheHeldOutComparison) {
       << d.reason;
   d = DecideCalibration(6.3, 6.0, {}, 1.0, 0.2);
   EXPECT_FALSE(d.accept) << d.reason;
-  d = DecideCalibration(6.1, 6.0, {"f_th"}, 1.0, 0.2);
-  EXPECT_FALSE(d.accept) << d.reason;
-  EXPECT_EQ(d.reason.find("standard error"), std::string::npos) << d.reason;
 }
 
 // Five clear days at 1 min from the synthetic plant.

@@ -51,6 +51,19 @@ TEST(Demo, ALiveRunCutShortByItsTimeLimitStillSucceedsAndCountsItsForecasts) {
                       "p_el_w <= p_el_w_p90 AND q_th_w_p90 > q_th_w_p10"),
             60);
   EXPECT_EQ(db.Number("SELECT count(*) FROM forecast WHERE p_el_w_ref IS NULL"), 0);
+  // Every forecast row the daemon wrote lies inside its band, with its
+  // median (issue 53).
+  EXPECT_EQ(db.Number("SELECT count(*) FROM forecast WHERE p_el_w < p_el_w_p10 OR "
+                      "p_el_w > p_el_w_p90 OR q_th_w < q_th_w_p10 OR q_th_w > q_th_w_p90 OR "
+                      "p_el_w_p50 NOT BETWEEN p_el_w_p10 AND p_el_w_p90 OR "
+                      "q_th_w_p50 NOT BETWEEN q_th_w_p10 AND q_th_w_p90"),
+            0);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM forecast WHERE p_el_w_p10 IS NOT NULL AND "
+                      "(p_el_w_p50 IS NULL OR q_th_w_p50 IS NULL)"),
+            0);
+  EXPECT_NE(run.out.find("(the band: where a minute's measurement falls 8 times in 10"),
+            std::string::npos)
+      << run.out;
   EXPECT_TRUE(std::regex_search(
       run.out, m,
       std::regex(R"(all \d+ days: skill P_el -?[0-9.]+, Q_u -?[0-9.]+; the 10-90 % band covers)")))

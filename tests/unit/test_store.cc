@@ -74,17 +74,21 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
             (std::vector<std::string>{"id", "run_at", "variant", "window_start", "window_end",
                                       "status", "mae_p_el_w", "mae_q_th_w", "runtime_s", "n_evals",
                                       "params_json", "reason", "heldout_mae_w", "accepted"}));
-  // Version 6 appended the bands and the reference (issue 15).
+  // Version 6 appended the bands and the reference (issue 15), version 8
+  // the medians and the coverage per output (issue 53).
   EXPECT_EQ(db.Columns("forecast"),
             (std::vector<std::string>{"issued_at", "ts", "calibration_id", "p_el_w", "q_th_w",
                                       "t_pv_c", "t_out_c", "inputs", "p_el_w_p10", "p_el_w_p90",
-                                      "q_th_w_p10", "q_th_w_p90", "p_el_w_ref", "q_th_w_ref"}));
+                                      "q_th_w_p10", "q_th_w_p90", "p_el_w_ref", "q_th_w_ref",
+                                      "p_el_w_p50", "q_th_w_p50"}));
   EXPECT_EQ(db.Columns("forecast_latest"),
             (std::vector<std::string>{"ts", "issued_at", "p_el_w", "q_th_w", "t_pv_c", "t_out_c",
-                                      "p_el_w_p10", "p_el_w_p90", "q_th_w_p10", "q_th_w_p90"}));
+                                      "p_el_w_p10", "p_el_w_p90", "q_th_w_p10", "q_th_w_p90",
+                                      "p_el_w_p50", "q_th_w_p50"}));
   EXPECT_EQ(db.Columns("forecast_skill"),
             (std::vector<std::string>{"day", "mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th",
-                                      "skill_p_el", "skill_q_th", "coverage_p10_p90", "minutes"}));
+                                      "skill_p_el", "skill_q_th", "coverage_p10_p90", "minutes",
+                                      "coverage_p_el", "coverage_q_th"}));
   EXPECT_EQ(
       db.Columns("weather_forecast"),
       (std::vector<std::string>{"ts", "g_poa_w_m2", "ghi_w_m2", "dhi_w_m2", "g_poa_diffuse_w_m2",
@@ -151,6 +155,8 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
                             "ALTER TABLE forecast DROP COLUMN q_th_w_p90",
                             "ALTER TABLE forecast DROP COLUMN p_el_w_ref",
                             "ALTER TABLE forecast DROP COLUMN q_th_w_ref",
+                            "ALTER TABLE forecast DROP COLUMN p_el_w_p50",
+                            "ALTER TABLE forecast DROP COLUMN q_th_w_p50",
                             "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
                             "CREATE VIEW forecast_skill(day) AS SELECT ts FROM measurement_1min",
                             "DROP TABLE measurement_interval",
@@ -178,6 +184,13 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM parameter_history"), 0.0);
   // Version 7: the migrated store gets an identity of its own.
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM store_identity WHERE length(store_id) = 32"), 1.0);
+  // Version 8: the medians and the coverage per output.
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM pragma_table_info('forecast') WHERE name IN "
+                      "('p_el_w_p50', 'q_th_w_p50')"),
+            2.0);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM pragma_table_info('forecast_skill') WHERE name IN "
+                      "('coverage_p_el', 'coverage_q_th')"),
+            2.0);
 }
 
 TEST_F(StoreTest, EveryNewStoreGetsItsOwnIdentityAndKeepsItWhenReopened) {
@@ -566,6 +579,7 @@ TEST_F(StoreTest, ForecastSkillScoresAgainstTheReferenceAndCountsTheBandsCoverag
     r.q_th_w_p90 = k < 40 ? 500.0 : 520.0;
     r.p_el_w_ref = 110.0;
     r.q_th_w_ref = 480.0;
+    r.p_el_w_p50 = 100.5;
     rows.push_back(r);
   }
   for (int k = 0; k < 100; ++k) {
@@ -589,7 +603,11 @@ TEST_F(StoreTest, ForecastSkillScoresAgainstTheReferenceAndCountsTheBandsCoverag
   EXPECT_NEAR(skill[0].skill_p_el, 1.0 - 1.5 / 8.5, 1e-12);
   EXPECT_NEAR(skill[0].skill_q_th, 1.0 - 10.0 / 30.0, 1e-12);
   EXPECT_NEAR(skill[0].coverage_p10_p90, (200.0 + 360.0) / (400.0 + 360.0), 1e-12);
+  // Per output (version 8): P_el 200 of 400, Q_u 360 of 360.
+  EXPECT_NEAR(skill[0].coverage_p_el, 0.5, 1e-12);
+  EXPECT_NEAR(skill[0].coverage_q_th, 1.0, 1e-12);
   EXPECT_EQ(skill[1].minutes, 100);
+  EXPECT_TRUE(std::isnan(skill[1].coverage_p_el));
   EXPECT_DOUBLE_EQ(skill[1].mae_p_el_w, 10.0);
   EXPECT_TRUE(std::isnan(skill[1].skill_p_el));
   EXPECT_TRUE(std::isnan(skill[1].coverage_p10_p90));
@@ -598,6 +616,8 @@ TEST_F(StoreTest, ForecastSkillScoresAgainstTheReferenceAndCountsTheBandsCoverag
   ASSERT_EQ(latest.size(), 2u);
   EXPECT_EQ(latest[1].p_el_w_p10, 99.0);
   EXPECT_EQ(latest[1].q_th_w_p90, 500.0);
+  EXPECT_EQ(latest[1].p_el_w_p50, 100.5);
+  EXPECT_TRUE(std::isnan(latest[1].q_th_w_p50));
   ASSERT_TRUE(store->ReadLatestForecast(day1, day1 + 60, &latest, &error)) << error;
   EXPECT_TRUE(std::isnan(latest[0].p_el_w_p10));  // written without a band: NULL
 }

@@ -51,6 +51,26 @@ const std::vector<std::pair<std::string, std::string>>& Examples() {
   return examples;
 }
 
+// One line per verb for the top-level help (the verb's --help has the rest).
+const std::vector<std::pair<std::string, std::string>>& Summaries() {
+  static const std::vector<std::pair<std::string, std::string>> summaries = {
+      {"check-config", "Validate a pvtwin config file (TOML) and exit"},
+      {"calibrate", "Identify a model variant's parameters from operation data"},
+      {"simulate", "Run a model variant with given parameters over measured inputs"},
+      {"backtest", "The paper's rolling evaluation of variants, day by day"},
+      {"import", "Load a canonical CSV into the SQLite store"},
+      {"import-weather", "Load a weather forecast (Open-Meteo JSON or CSV) into the store"},
+      {"export", "Write a time range of the SQLite store as canonical CSV"},
+      {"sim", "The plant simulator: a simulated PVT plant behind real Modbus servers"},
+      {"run", "Run the daemon: poll, store, calibrate nightly, forecast"},
+      {"demo", "Run the whole job on the built-in example plant"},
+      {"diagnose", "Sim-to-real gap diagnosis: which effect the model misses"},
+      {"diagnose-selftest", "Proof of the diagnosis on synthetic data with a known answer"},
+      {"upload", "Replicate the store into the central PostgreSQL"},
+  };
+  return summaries;
+}
+
 // The variant grammar, for the verbs that take a variant.
 std::string VariantHelp() {
   std::string paper;
@@ -66,6 +86,13 @@ std::string VariantHelp() {
 }
 
 }  // namespace
+
+std::string VerbSummary(const std::string& verb) {
+  for (const auto& [name, summary] : Summaries()) {
+    if (name == verb) return summary;
+  }
+  return "";
+}
 
 void RegisterCommands(CLI::App& app) {
   // Every option's default is shown in --help.

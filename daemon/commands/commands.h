@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace pvtwin::cli {
 
@@ -12,6 +13,9 @@ inline constexpr int kExitRuntime = 1;
 inline constexpr int kExitBadInput = 2;
 
 void RegisterCommands(CLI::App& app);
+
+// The verb's one-line summary for the top-level help ("" for none).
+std::string VerbSummary(const std::string& verb);
 
 // The exit code chosen by the subcommand that ran.
 int ExitCode();

@@ -47,6 +47,7 @@ const std::vector<std::pair<std::string, std::string>>& Examples() {
        "pvtwin diagnose --config plant.toml --csv data.csv --variant 1N1Cwr --report out/"},
       {"diagnose-selftest", "pvtwin diagnose-selftest --seeds 5 --jobs 2"},
       {"upload", "pvtwin upload --once --config /etc/pvtwin/pvtwin.toml"},
+      {"poll", "pvtwin poll --once --config /etc/pvtwin/pvtwin.toml"},
   };
   return examples;
 }
@@ -67,6 +68,7 @@ const std::vector<std::pair<std::string, std::string>>& Summaries() {
       {"diagnose", "Sim-to-real gap diagnosis: which effect the model misses"},
       {"diagnose-selftest", "Proof of the diagnosis on synthetic data with a known answer"},
       {"upload", "Replicate the store into the central PostgreSQL"},
+      {"poll", "Read every Modbus device once and show values, registers, rejections"},
   };
   return summaries;
 }
@@ -109,6 +111,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterDemo(app);
   RegisterDiagnose(app);
   RegisterUpload(app);
+  RegisterPoll(app);
   for (const auto& [verb, example] : Examples()) {
     CLI::App* cmd = app.get_subcommand(verb);
     std::string footer = "\nExample:\n  " + example;

@@ -33,5 +33,6 @@ void RegisterRun(CLI::App& app);
 void RegisterDemo(CLI::App& app);
 void RegisterDiagnose(CLI::App& app);
 void RegisterUpload(CLI::App& app);
+void RegisterPoll(CLI::App& app);
 
 }  // namespace pvtwin::cli

@@ -176,7 +176,11 @@ bool ReadStoreWindow(const DiagnoseArgs& a, const Config& config, std::unique_pt
     std::cerr << "--db = " << a.db << ": no such database\n";
     return false;
   }
-  if (!OpenStoreOrReport(a.db, StoreOptionsFor(config), store)) return false;
+  // Only --record writes (the daemon's nightly diagnosis); a reader's
+  // diagnosis opens the store read-only and never migrates it.
+  const bool opened = a.record ? OpenStoreOrReport(a.db, StoreOptionsFor(config), store)
+                               : OpenStoreReadOnlyOrReport(a.db, StoreOptionsFor(config), store);
+  if (!opened) return false;
   std::string error;
   if (!(*store)->ReadMinutes(from_ts, to_ts, series, &error)) {
     std::cerr << error << "\n";

@@ -48,6 +48,8 @@ const std::vector<std::pair<std::string, std::string>>& Examples() {
       {"diagnose-selftest", "pvtwin diagnose-selftest --seeds 5 --jobs 2"},
       {"upload", "pvtwin upload --once --config /etc/pvtwin/pvtwin.toml"},
       {"poll", "pvtwin poll --once --config /etc/pvtwin/pvtwin.toml"},
+      {"migrate",
+       "pvtwin migrate --db /var/lib/pvtwin/pvtwin.db   # as the service user: sudo -u pvtwin"},
   };
   return examples;
 }
@@ -69,6 +71,7 @@ const std::vector<std::pair<std::string, std::string>>& Summaries() {
       {"diagnose-selftest", "Proof of the diagnosis on synthetic data with a known answer"},
       {"upload", "Replicate the store into the central PostgreSQL"},
       {"poll", "Read every Modbus device once and show values, registers, rejections"},
+      {"migrate", "Upgrade the SQLite store to this pvtwin's schema"},
   };
   return summaries;
 }
@@ -112,6 +115,7 @@ void RegisterCommands(CLI::App& app) {
   RegisterDiagnose(app);
   RegisterUpload(app);
   RegisterPoll(app);
+  RegisterMigrate(app);
   for (const auto& [verb, example] : Examples()) {
     CLI::App* cmd = app.get_subcommand(verb);
     std::string footer = "\nExample:\n  " + example;

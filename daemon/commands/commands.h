@@ -34,5 +34,6 @@ void RegisterDemo(CLI::App& app);
 void RegisterDiagnose(CLI::App& app);
 void RegisterUpload(CLI::App& app);
 void RegisterPoll(CLI::App& app);
+void RegisterMigrate(CLI::App& app);
 
 }  // namespace pvtwin::cli

@@ -16,7 +16,7 @@ TEST(CliHelp, EveryVerbShowsAnExampleAndItsDefaults) {
   const std::string verbs[] = {"check-config", "calibrate", "simulate", "backtest",
                                "import",       "export",    "sim",      "run",
                                "demo",         "diagnose",  "diagnose-selftest",
-                               "import-weather", "upload", "poll"};
+                               "import-weather", "upload", "poll", "migrate"};
   for (const std::string& verb : verbs) {
     const testing::ProcessResult r = testing::RunPvtwin(".", verb + " --help");
     EXPECT_EQ(r.exit_code, 0) << verb;

@@ -40,6 +40,18 @@ std::string_view WordOrderName(WordOrder order) {
   return kOrderNames[static_cast<std::size_t>(order)];
 }
 
+std::string_view ModbusPoint::ChannelNameInMap() const {
+  switch (wire_unit) {
+    case WireUnit::kLitrePerHour:
+      return "flow_l_h";
+    case WireUnit::kCubicMetrePerHour:
+      return "flow_m3_h";
+    case WireUnit::kChannel:
+      break;
+  }
+  return ChannelName(channel);
+}
+
 int RegisterCount(RegisterType type) {
   switch (type) {
     case RegisterType::kU16:
@@ -83,7 +95,7 @@ std::string CanonicalChannelList() {
   for (const ChannelInfo& info : kChannels) {
     list += (list.empty() ? "" : ", ") + std::string(info.name);
   }
-  return list;
+  return list + "; or flow_l_h, flow_m3_h for a volume flow";
 }
 
 // One [[modbus.*]] array: its tables, or an error when it is something else.
@@ -215,6 +227,9 @@ bool ReadPoint(SectionReader& r, const std::vector<ModbusDevice>& devices, Modbu
   if (r.String("channel", kRequired, &channel)) {
     if (const std::optional<Channel> c = ChannelFromName(channel)) {
       p->channel = *c;
+    } else if (channel == "flow_l_h" || channel == "flow_m3_h") {
+      p->channel = Channel::kMdotKgS;
+      p->wire_unit = channel == "flow_l_h" ? WireUnit::kLitrePerHour : WireUnit::kCubicMetrePerHour;
     } else {
       r.Reject("channel", "not a canonical channel (" + CanonicalChannelList() + ")");
       ok = false;
@@ -331,7 +346,7 @@ void ReadModbusSection(const toml::node& node, const SourceText& source, const s
           other.address < point.address + point.Count()) {
         r.Reject("address",
                  "registers " + RegisterRange(point) + " overlap registers " +
-                     RegisterRange(other) + " of " + std::string(ChannelName(other.channel)) +
+                     RegisterRange(other) + " of " + std::string(other.ChannelNameInMap()) +
                      " (line " + std::to_string(other.line) + ") on " +
                      config.devices[point.device].name + " " + std::string(TableName(point.table)));
         break;

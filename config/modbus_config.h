@@ -17,7 +17,10 @@
 //                      that the device sends for "no reading").
 //
 // Units on the wire are the canonical CSV units: aoi_deg in degrees (the
-// poller converts to radians, as the CSV reader does), flow in kg/s.
+// poller converts to radians, as the CSV reader does), flow in kg/s. A
+// volume-flow meter is mapped as channel flow_l_h or flow_m3_h: the point
+// feeds flow_kg_s, its value (valid range and nan_value in L/h or m³/h) times
+// [plant] fluid_density_kg_m3 (ParseConfig copies it into every point).
 //
 // Validation (modbus_config.cc) reports, all at once with file:line: unknown
 // keys, bad values, a point on an unknown device, a channel outside the
@@ -42,6 +45,9 @@ enum class RegisterType { kU16, kI16, kU32, kI32, kF32, kF64 };
 // Byte order of a value on the wire, written for 32 bits with A the most
 // significant byte (see io/modbus/register_codec.h for 16 and 64 bits).
 enum class WordOrder { kABCD, kCDAB, kBADC, kDCBA };
+// The unit of a point's decoded value: the channel's own, or a volume flow
+// that feeds flow_kg_s through the fluid density.
+enum class WireUnit { kChannel, kLitrePerHour, kCubicMetrePerHour };
 
 std::string_view TableName(RegisterTable table);
 std::string_view TypeName(RegisterType type);
@@ -80,9 +86,14 @@ struct ModbusPoint {
   double valid_min = -std::numeric_limits<double>::infinity();
   double valid_max = std::numeric_limits<double>::infinity();
   std::optional<double> nan_value;  // raw sentinel
-  int line = 0;                     // config line of the [[modbus.point]] table
+  WireUnit wire_unit = WireUnit::kChannel;
+  double fluid_density_kg_m3 = 1040.0;  // volume flow to kg/s: [plant] fluid_density_kg_m3
+  int line = 0;                         // config line of the [[modbus.point]] table
 
   int Count() const { return RegisterCount(type); }
+  // The name the register map gives the channel: flow_l_h, flow_m3_h or the
+  // canonical one.
+  std::string_view ChannelNameInMap() const;
 };
 
 struct ModbusConfig {

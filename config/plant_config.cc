@@ -482,6 +482,10 @@ bool ParseConfig(std::string_view toml_text, const std::string& path_for_message
   Config config;
   config.source_path = path_for_messages;
   ReadDocument(root, SourceText(toml_text), path_for_messages, &config, &found);
+  // Volume-flow points feed flow_kg_s through the plant's fluid density.
+  for (ModbusPoint& point : config.modbus.points) {
+    point.fluid_density_kg_m3 = config.plant.fluid_density_kg_m3;
+  }
   // toml++ keeps keys sorted by name; report in file order instead.
   std::stable_sort(found.begin(), found.end(),
                    [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });

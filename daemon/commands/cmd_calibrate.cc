@@ -423,7 +423,9 @@ void RegisterCalibrate(CLI::App& app) {
   cmd->add_option("--train-end", args->train_end,
                   "end of the training window, exclusive (default: after the last row)");
   cmd->add_option("--step", args->step_s,
-                  "average the data to this step in seconds first (a multiple of the data step)");
+                  "average the data to this step in seconds first (a multiple of the data step; "
+                  "default: the data's own step)")
+      ->default_str("");
   cmd->add_option("--test-csv", args->test_csv,
                   "held-out data: print the errors of the identified model on it");
   cmd->add_option("--start", args->start_params,
@@ -445,23 +447,27 @@ void RegisterCalibrate(CLI::App& app) {
                   "PV correction coefficients)")
       ->delimiter(',');
   cmd->add_option("--fix", args->fix, "parameters to keep at their start values")->delimiter(',');
-  cmd->add_option("--max-evaluations", args->max_evaluations, "simulation budget of the fit");
+  cmd->add_option("--max-evaluations", args->max_evaluations, "simulation budget of the fit")
+      ->default_str(std::to_string(IdentOptions::DefaultOptimizerOptions().max_evaluations));
   cmd->add_option("--ftol", args->ftol_rel,
                   "stop when an iteration lowers the MAE by less than this fraction and, for "
                   "lad_lm, its undamped step promised less than 0.3 times that, or before a "
                   "step predicted to gain less than 0.3 times that (than this fraction itself "
                   "in the polish after the coarse stage) (default 1e-3; on synthetic data 1e-4 "
                   "takes longer for a held-out MAE within 0.05 % of the default's)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->default_str("1e-3");
   cmd->add_option("--threads", args->threads,
                   "threads for the runs with exact derivatives, their columns split, for "
                   "the start's cost beside the coarse stage and for the normal equations of "
                   "fits on 65536 rows or more, e.g. 14 days at 15 s (1 or 2; default 2 on a "
                   "machine with two cores or more); the result is the same on either")
-      ->check(CLI::Range(1, 2));
+      ->check(CLI::Range(1, 2))
+      ->default_str("auto");
   cmd->add_option("--parent-pid", args->parent_pid,
                   "exit when the process with this pid ends (used by pvtwin run for its "
-                  "calibration child)");
+                  "calibration child)")
+      ->group("");
   cmd->add_flag("--timing", args->timing,
                 "print the time split (parse, prepare, fit coarse/fine with their model runs as "
                 "counted against the budget and how many of them an earlier run served, "

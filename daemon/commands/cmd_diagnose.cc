@@ -176,7 +176,11 @@ bool ReadStoreWindow(const DiagnoseArgs& a, const Config& config, std::unique_pt
     std::cerr << "--db = " << a.db << ": no such database\n";
     return false;
   }
-  if (!OpenStoreOrReport(a.db, StoreOptionsFor(config), store)) return false;
+  // Only --record writes (the daemon's nightly diagnosis); a reader's
+  // diagnosis opens the store read-only and never migrates it.
+  const bool opened = a.record ? OpenStoreOrReport(a.db, StoreOptionsFor(config), store)
+                               : OpenStoreReadOnlyOrReport(a.db, StoreOptionsFor(config), store);
+  if (!opened) return false;
   std::string error;
   if (!(*store)->ReadMinutes(from_ts, to_ts, series, &error)) {
     std::cerr << error << "\n";
@@ -432,21 +436,26 @@ void RegisterDiagnose(CLI::App& app) {
                   "with --record: the calibration whose window is diagnosed");
   cmd->add_option("--run-at", args->run_at,
                   "with --record: the row's run_at, unix s (default: now; pvtwin run passes its "
-                  "clock)");
+                  "clock)")
+      ->group("");
   cmd->add_option("--parent-pid", args->parent_pid,
-                  "exit when the process with this pid ends (used by pvtwin run)");
+                  "exit when the process with this pid ends (used by pvtwin run)")
+      ->group("");
   cmd->add_option("--variant", args->variant,
                   "base model variant, e.g. 1N1Cwr (required with --csv; with --db the default is "
                   "[calibration] variant)");
   cmd->add_option("--train-days", args->train_days,
                   "training days from the first day of data (default: two thirds of the days)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::NonNegativeNumber)
+      ->default_str("auto");
   cmd->add_option("--heldout-days", args->heldout_days,
                   "held-out days after the training days (default: all remaining)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::NonNegativeNumber)
+      ->default_str("auto");
   cmd->add_option("--step", args->step_s,
                   "average the data to this step in s before diagnosing (default: the data's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::NonNegativeNumber)
+      ->default_str("auto");
   cmd->add_option("--effects", args->effects,
                   "comma-separated effects to test (default: every one the model can take)")
       ->delimiter(',');

@@ -57,7 +57,7 @@ int RunExport(const ExportArgs& a) {
     return kExitBadInput;
   }
   std::unique_ptr<Store> store;
-  if (!OpenStoreOrReport(path, StoreOptionsFor(config), &store)) return kExitRuntime;
+  if (!OpenStoreReadOnlyOrReport(path, StoreOptionsFor(config), &store)) return kExitRuntime;
 
   Series series;
   std::string error;

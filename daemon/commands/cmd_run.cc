@@ -68,12 +68,15 @@ void RegisterRun(CLI::App& app) {
   cmd->add_option("--config", args->service.config_path, "the daemon's TOML config")->required();
   cmd->add_option("--db", args->service.db_path, "SQLite file (overrides [storage] path)");
   cmd->add_option("--speed", args->service.speed,
-                  "run the clock this many times faster than real time (tests, demos)");
+                  "run the clock this many times faster than real time (tests, demos)")
+      ->group("");
   cmd->add_option("--sim-start", args->sim_start,
-                  "simulated time at --wall-anchor (ISO 8601 or unix s); default: real time");
+                  "simulated time at --wall-anchor (ISO 8601 or unix s); default: real time")
+      ->group("");
   cmd->add_option("--wall-anchor", args->service.wall_anchor_s,
                   "wall-clock unix time at which the simulated clock reads --sim-start "
-                  "(default: now); give the simulator the same value to share its clock");
+                  "(default: now); give the simulator the same value to share its clock")
+      ->group("");
   cmd->add_option("--calibration-timeout", args->service.calibration_timeout_s,
                   "wall seconds after which a calibration is abandoned");
   cmd->add_flag("--adopt-store", args->service.adopt_store,

@@ -265,7 +265,8 @@ void RegisterSim(CLI::App& app) {
                   "--export: 00:00 UTC --days days ago)");
   cmd->add_option("--wall-anchor", args->wall_anchor_s,
                   "wall-clock unix time at which the simulated clock reads --start (default: "
-                  "now); give the daemon the same start, anchor and speed");
+                  "now); give the daemon the same start, anchor and speed")
+      ->group("");
   cmd->add_flag("--stepped", args->stepped,
                 "simulated time stands still at --start and moves only by 'advance S' on stdin");
   cmd->add_option("--seed", args->seed, "seed of weather, operation and sensor noise");

@@ -47,8 +47,33 @@ const std::vector<std::pair<std::string, std::string>>& Examples() {
        "pvtwin diagnose --config plant.toml --csv data.csv --variant 1N1Cwr --report out/"},
       {"diagnose-selftest", "pvtwin diagnose-selftest --seeds 5 --jobs 2"},
       {"upload", "pvtwin upload --once --config /etc/pvtwin/pvtwin.toml"},
+      {"poll", "pvtwin poll --once --config /etc/pvtwin/pvtwin.toml"},
+      {"migrate",
+       "pvtwin migrate --db /var/lib/pvtwin/pvtwin.db   # as the service user: sudo -u pvtwin"},
   };
   return examples;
+}
+
+// One line per verb for the top-level help (the verb's --help has the rest).
+const std::vector<std::pair<std::string, std::string>>& Summaries() {
+  static const std::vector<std::pair<std::string, std::string>> summaries = {
+      {"check-config", "Validate a pvtwin config file (TOML) and exit"},
+      {"calibrate", "Identify a model variant's parameters from operation data"},
+      {"simulate", "Run a model variant with given parameters over measured inputs"},
+      {"backtest", "The paper's rolling evaluation of variants, day by day"},
+      {"import", "Load a canonical CSV into the SQLite store"},
+      {"import-weather", "Load a weather forecast (Open-Meteo JSON or CSV) into the store"},
+      {"export", "Write a time range of the SQLite store as canonical CSV"},
+      {"sim", "The plant simulator: a simulated PVT plant behind real Modbus servers"},
+      {"run", "Run the daemon: poll, store, calibrate nightly, forecast"},
+      {"demo", "Run the whole job on the built-in example plant"},
+      {"diagnose", "Sim-to-real gap diagnosis: which effect the model misses"},
+      {"diagnose-selftest", "Proof of the diagnosis on synthetic data with a known answer"},
+      {"upload", "Replicate the store into the central PostgreSQL"},
+      {"poll", "Read every Modbus device once and show values, registers, rejections"},
+      {"migrate", "Upgrade the SQLite store to this pvtwin's schema"},
+  };
+  return summaries;
 }
 
 // The variant grammar, for the verbs that take a variant.
@@ -67,6 +92,13 @@ std::string VariantHelp() {
 
 }  // namespace
 
+std::string VerbSummary(const std::string& verb) {
+  for (const auto& [name, summary] : Summaries()) {
+    if (name == verb) return summary;
+  }
+  return "";
+}
+
 void RegisterCommands(CLI::App& app) {
   // Every option's default is shown in --help.
   app.option_defaults()->always_capture_default();
@@ -82,6 +114,8 @@ void RegisterCommands(CLI::App& app) {
   RegisterDemo(app);
   RegisterDiagnose(app);
   RegisterUpload(app);
+  RegisterPoll(app);
+  RegisterMigrate(app);
   for (const auto& [verb, example] : Examples()) {
     CLI::App* cmd = app.get_subcommand(verb);
     std::string footer = "\nExample:\n  " + example;

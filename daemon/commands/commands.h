@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace pvtwin::cli {
 
@@ -12,6 +13,9 @@ inline constexpr int kExitRuntime = 1;
 inline constexpr int kExitBadInput = 2;
 
 void RegisterCommands(CLI::App& app);
+
+// The verb's one-line summary for the top-level help ("" for none).
+std::string VerbSummary(const std::string& verb);
 
 // The exit code chosen by the subcommand that ran.
 int ExitCode();
@@ -29,5 +33,7 @@ void RegisterRun(CLI::App& app);
 void RegisterDemo(CLI::App& app);
 void RegisterDiagnose(CLI::App& app);
 void RegisterUpload(CLI::App& app);
+void RegisterPoll(CLI::App& app);
+void RegisterMigrate(CLI::App& app);
 
 }  // namespace pvtwin::cli

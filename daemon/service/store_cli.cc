@@ -21,4 +21,13 @@ bool OpenStoreOrReport(const std::string& path, const StoreOptions& options,
   return false;
 }
 
+bool OpenStoreReadOnlyOrReport(const std::string& path, const StoreOptions& options,
+                               std::unique_ptr<Store>* store) {
+  std::string error;
+  *store = Store::OpenReadOnly(path, options, &error);
+  if (*store != nullptr) return true;
+  std::cerr << error << "\n";
+  return false;
+}
+
 }  // namespace pvtwin::cli

@@ -17,4 +17,10 @@ StoreOptions StoreOptionsFor(const Config& config);
 bool OpenStoreOrReport(const std::string& path, const StoreOptions& options,
                        std::unique_ptr<Store>* store);
 
+// Opens the existing store at path for reading only (Store::OpenReadOnly:
+// never creates, migrates or writes it); reports a failure on stderr and
+// returns false.
+bool OpenStoreReadOnlyOrReport(const std::string& path, const StoreOptions& options,
+                               std::unique_ptr<Store>* store);
+
 }  // namespace pvtwin::cli

@@ -9,7 +9,7 @@
 #include <cmath>
 
 #include "core/data/physical_limits.h"
-#include "io/modbus/modbus_tcp_read.h"
+#include "io/modbus/modbus_link.h"
 #include "io/modbus/register_codec.h"
 
 namespace pvtwin {
@@ -21,47 +21,6 @@ namespace {
 constexpr std::size_t kResultSlots = 4;
 
 enum class LinkState { kStarting, kOk, kDown, kExceptions, kFrozen };
-
-bool IsException(int error) { return error > MODBUS_ENOBASE && error <= EMBXGTAR; }
-
-// libmodbus's errors for a reply that is not the answer to the request.
-bool IsBadReply(int error) {
-  return error == EMBBADCRC || error == EMBBADDATA || error == EMBBADEXC || error == EMBUNKEXC ||
-         error == EMBBADSLAVE;
-}
-
-int FunctionOf(RegisterTable table) {
-  return table == RegisterTable::kInput ? MODBUS_FC_READ_INPUT_REGISTERS
-                                        : MODBUS_FC_READ_HOLDING_REGISTERS;
-}
-
-// RTU reads stay with libmodbus: for RTU it compares the slave id and checks
-// the CRC (modbus-rtu.c), then the function and byte count (modbus.c
-// check_confirmation). One of the poller's two request-sending paths, both
-// read-only.
-ReadOutcome ReadRegistersRtu(modbus_t* ctx, const RegisterRead& read,
-                             std::span<std::uint16_t> words) {
-  const int function = FunctionOf(read.table);
-  const int n = function == MODBUS_FC_READ_INPUT_REGISTERS
-                    ? modbus_read_input_registers(ctx, read.address, read.count, words.data())
-                    : modbus_read_registers(ctx, read.address, read.count, words.data());
-  const int error = errno;
-  ReadOutcome outcome;
-  if (n == read.count) {
-    outcome.status = ReadStatus::kOk;
-    return outcome;
-  }
-  outcome.message = n < 0 ? modbus_strerror(error) : "short answer";
-  if (n >= 0 || IsBadReply(error)) {
-    outcome.status = ReadStatus::kBadReply;
-  } else if (IsException(error)) {
-    outcome.status = ReadStatus::kException;
-    outcome.exception_code = static_cast<std::uint8_t>(error - MODBUS_ENOBASE);
-  } else {
-    outcome.status = error == ETIMEDOUT ? ReadStatus::kTimeout : ReadStatus::kBroken;
-  }
-  return outcome;
-}
 
 }  // namespace
 
@@ -97,26 +56,15 @@ struct ModbusPoller::Device {
            std::to_string(config.unit_id) + ")";
   }
 
-  // One read on the open connection; TCP through our own frame checks (the
-  // other request-sending path: EncodeReadRequest sends only 3 and 4).
+  // One read on the open connection (io/modbus/modbus_link.h: TCP through our
+  // own frame checks, RTU through libmodbus; function codes 3 and 4 only).
   ReadOutcome Read(const RegisterRead& read, std::span<std::uint16_t> words) {
-    if (config.IsRtu()) return ReadRegistersRtu(ctx, read, words);
-    ReadRequest request;
-    request.transaction_id = next_transaction_id++;
-    request.unit_id = static_cast<std::uint8_t>(config.unit_id);
-    request.function = static_cast<std::uint8_t>(FunctionOf(read.table));
-    request.address = static_cast<std::uint16_t>(read.address);
-    request.count = static_cast<std::uint16_t>(read.count);
-    return ReadRegistersTcp(modbus_get_socket(ctx), request, config.timeout_ms, words);
+    return ReadModbus(ctx, config, read, &next_transaction_id, words);
   }
 
   void Close() {
-    if (ctx != nullptr) {
-      modbus_flush(ctx);
-      modbus_close(ctx);
-      modbus_free(ctx);
-      ctx = nullptr;
-    }
+    CloseModbus(ctx);
+    ctx = nullptr;
     connected = false;
   }
 };
@@ -227,20 +175,8 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
 
   if (!device->connected) {
     if (period < device->next_attempt_period) return;
-    device->ctx = c.IsRtu()
-                      ? modbus_new_rtu(c.serial.c_str(), c.baud, c.parity, c.data_bits, c.stop_bits)
-                      : modbus_new_tcp_pi(c.host.c_str(), std::to_string(c.port).c_str());
     std::string error;
-    if (device->ctx == nullptr) {
-      error = std::string("cannot create the libmodbus context: ") + modbus_strerror(errno);
-    } else {
-      modbus_set_response_timeout(device->ctx, static_cast<std::uint32_t>(c.timeout_ms / 1000),
-                                  static_cast<std::uint32_t>(c.timeout_ms % 1000) * 1000u);
-      modbus_set_slave(device->ctx, c.unit_id);
-      if (modbus_connect(device->ctx) != 0) {
-        error = std::string("connect failed: ") + modbus_strerror(errno);
-      }
-    }
+    device->ctx = OpenModbus(c, &error);
     if (!error.empty()) {
       record_error(error, ReadStatus::kBroken);
       lose_connection(error);
@@ -289,7 +225,7 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
           std::span<const std::uint16_t>(buf.data() + offset, static_cast<std::size_t>(p.Count())));
       const auto c_index = static_cast<std::size_t>(p.channel);
       result->read_mask |= 1u << c_index;
-      result->value[c_index] = WireToChannelUnit(p.channel, v.value);
+      result->value[c_index] = PointToChannelUnit(p, v.value);
       if (v.rejected ||
           !PhysicalLimitOf(p.channel, options_.area_m2).Contains(result->value[c_index])) {
         result->rejected_mask |= 1u << c_index;

@@ -109,4 +109,27 @@ double ChannelToWireUnit(Channel channel, double channel_value) {
   return channel == Channel::kAoiRad ? RadToDeg(channel_value) : channel_value;
 }
 
+namespace {
+// kg/s per wire unit of volume flow.
+double KgSPerWireUnit(const ModbusPoint& point) {
+  switch (point.wire_unit) {
+    case WireUnit::kLitrePerHour:
+      return point.fluid_density_kg_m3 / 1000.0 / 3600.0;
+    case WireUnit::kCubicMetrePerHour:
+      return point.fluid_density_kg_m3 / 3600.0;
+    case WireUnit::kChannel:
+      break;
+  }
+  return 1.0;
+}
+}  // namespace
+
+double PointToChannelUnit(const ModbusPoint& point, double wire_value) {
+  return WireToChannelUnit(point.channel, wire_value) * KgSPerWireUnit(point);
+}
+
+double ChannelToPointUnit(const ModbusPoint& point, double channel_value) {
+  return ChannelToWireUnit(point.channel, channel_value) / KgSPerWireUnit(point);
+}
+
 }  // namespace pvtwin

@@ -52,4 +52,9 @@ void EncodePoint(const ModbusPoint& point, double value, std::span<std::uint16_t
 double WireToChannelUnit(Channel channel, double wire_value);
 double ChannelToWireUnit(Channel channel, double channel_value);
 
+// The same for a point of the register map, whose value may also be a volume
+// flow (L/h, m³/h) feeding flow_kg_s through its fluid density.
+double PointToChannelUnit(const ModbusPoint& point, double wire_value);
+double ChannelToPointUnit(const ModbusPoint& point, double channel_value);
+
 }  // namespace pvtwin

@@ -319,7 +319,7 @@ void ModbusSimServer::Serve(Device* device) {
       } else if (has(faults, FaultKind::kRange)) {
         EncodePoint(p, OutOfRangeValue(p), words);
       } else {
-        EncodePoint(p, ChannelToWireUnit(p.channel, sample.Get(p.channel)), words);
+        EncodePoint(p, ChannelToPointUnit(p, sample.Get(p.channel)), words);
       }
     }
     if (has(faults, FaultKind::kStray)) {

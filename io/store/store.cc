@@ -1790,4 +1790,90 @@ bool Store::Checkpoint(std::int64_t* db_bytes, std::string* error) {
   return ok;
 }
 
+// --- Read-only open (the verbs that only read) ---
+
+namespace {
+
+// path as the path of an SQLite URI ("file:PATH?…"): '%', '?' and '#' escaped.
+std::string UriPath(const std::string& path) {
+  std::string out;
+  for (const char c : path) {
+    if (c == '%') {
+      out += "%25";
+    } else if (c == '?') {
+      out += "%3f";
+    } else if (c == '#') {
+      out += "%23";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<Store> Store::OpenReadOnly(const std::string& path, const StoreOptions& options,
+                                           std::string* error) {
+  assert(error != nullptr);
+  if (::access(path.c_str(), F_OK) != 0) {
+    *error = path + ": no such store (" + std::strerror(errno) + ")";
+    return nullptr;
+  }
+  const auto open = [&](const char* query) -> std::unique_ptr<Impl> {
+    auto impl = std::make_unique<Impl>();
+    impl->path = path;
+    impl->options = options;
+    const std::string uri = "file:" + UriPath(path) + "?" + query;
+    const int rc = sqlite3_open_v2(uri.c_str(), &impl->db,
+                                   SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_NOMUTEX,
+                                   nullptr);
+    if (rc != SQLITE_OK) {
+      *error = impl->Describe(impl->Fail(rc, "cannot open the store read-only"));
+      return nullptr;
+    }
+    sqlite3_extended_result_codes(impl->db, 0);
+    sqlite3_busy_timeout(impl->db, options.busy_timeout_ms);
+    return impl;
+  };
+  std::unique_ptr<Impl> impl = open("mode=ro");
+  if (impl == nullptr) return nullptr;
+  // A WAL store is read through its -shm: without it, and without the right
+  // to create it, the first read fails. No -wal and no -shm means no
+  // connection has the store open, so its file alone is the whole store.
+  int rc = sqlite3_exec(impl->db, "SELECT count(*) FROM sqlite_schema", nullptr, nullptr, nullptr);
+  if ((rc == SQLITE_CANTOPEN || rc == SQLITE_READONLY) &&
+      ::access((path + "-wal").c_str(), F_OK) != 0 &&
+      ::access((path + "-shm").c_str(), F_OK) != 0) {
+    impl = open("immutable=1");
+    if (impl == nullptr) return nullptr;
+    rc = sqlite3_exec(impl->db, "SELECT count(*) FROM sqlite_schema", nullptr, nullptr, nullptr);
+  }
+  if (rc != SQLITE_OK && rc != SQLITE_NOTADB) {
+    *error = impl->Describe(impl->Fail(rc, "cannot read the store")) +
+             "; a reader needs read access to the file and to its -wal and -shm files";
+    return nullptr;
+  }
+  if (!impl->CheckIntegrityAndOwner(error)) return nullptr;
+  int version = 0;
+  sqlite3_exec(
+      impl->db, "PRAGMA user_version",
+      [](void* out, int, char** values, char**) {
+        *static_cast<int*>(out) = values[0] ? std::atoi(values[0]) : 0;
+        return 0;
+      },
+      &version, nullptr);
+  if (version == 0) {
+    *error = path + ": an empty database, not a pvtwin store yet; nothing to read";
+    return nullptr;
+  }
+  if (version < kStoreSchemaVersion) {
+    *error = path + ": store schema " + std::to_string(version) + " is older than this pvtwin's " +
+             std::to_string(kStoreSchemaVersion) +
+             "; run the daemon or `pvtwin migrate` to upgrade it (this command only reads)";
+    return nullptr;
+  }
+  return std::unique_ptr<Store>(new Store(std::move(impl)));
+}
+
 }  // namespace pvtwin

@@ -255,6 +255,17 @@ class Store {
   static std::unique_ptr<Store> Open(const std::string& path, std::string* error);
   static std::unique_ptr<Store> Open(const std::string& path, const StoreOptions& options,
                                      std::string* error);
+  // Opens an existing store for reading only (export, diagnose --db): never
+  // creates, migrates or writes it, and needs no write access. SQLite's
+  // `mode=ro`, which reads a live WAL store (the daemon running) with read
+  // access to the file, -wal and -shm; when those cannot be opened and no
+  // -wal or -shm file exists (no connection has the store open),
+  // `immutable=1`. Refuses, with what to do, a store of an older schema
+  // (the daemon or `pvtwin migrate` upgrades it), a newer one, a damaged
+  // file or one that is not a pvtwin store. The write calls of a store
+  // opened so fail.
+  static std::unique_ptr<Store> OpenReadOnly(const std::string& path, const StoreOptions& options,
+                                             std::string* error);
   ~Store();
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;

@@ -2,6 +2,7 @@
 // shipped examples and error handling that golden folders cannot express.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 #include "config/plant_config.h"
@@ -120,6 +121,25 @@ TEST(ConfigLoad, ShippedExamplesAreValid) {
         << name << ": " << (errors.empty() ? "" : errors.front().ToString());
     EXPECT_DOUBLE_EQ(config.plant.area_m2, 1.8);
   }
+}
+
+// The register-map examples for TCP and RTU check, volume flows included.
+TEST(ConfigLoad, ShippedRegisterMapExamplesAreValid) {
+  for (const char* name : {"modbus-tcp.toml", "modbus-rtu.toml"}) {
+    Config config;
+    Diagnostics errors;
+    EXPECT_TRUE(LoadConfig(kExamplesDir + name, &config, &errors))
+        << name << ": " << (errors.empty() ? "" : errors.front().ToString());
+    EXPECT_GE(config.modbus.devices.size(), 2u) << name;
+    const bool volume_flow =
+        std::any_of(config.modbus.points.begin(), config.modbus.points.end(),
+                    [](const ModbusPoint& p) { return p.wire_unit != WireUnit::kChannel; });
+    EXPECT_TRUE(volume_flow) << name;
+  }
+  Config rtu;
+  Diagnostics errors;
+  ASSERT_TRUE(LoadConfig(kExamplesDir + "modbus-rtu.toml", &rtu, &errors));
+  EXPECT_EQ(rtu.modbus.devices[0].Endpoint(), "/dev/ttyUSB0@19200,8E1");
 }
 
 TEST(ConfigLoad, MissingFileIsOneErrorNamingThePath) {
@@ -284,6 +304,49 @@ TEST(ConfigLoad, UploadUrlWithAPasswordIsRejectedInEveryFormWithoutShowingIt) {
     EXPECT_NE(errors[0].rule.find("holds a password"), std::string::npos);
     EXPECT_EQ(errors[0].ToString().find("pw1234"), std::string::npos) << errors[0].ToString();
   }
+}
+
+}  // namespace
+}  // namespace pvtwin
+
+namespace pvtwin {
+namespace {
+
+// A volume-flow meter maps as flow_l_h or flow_m3_h: it feeds flow_kg_s
+// through [plant] fluid_density_kg_m3, in the poller as in the simulator.
+TEST(ConfigModbus, VolumeFlowChannelsFeedTheMassFlowThroughTheDensity) {
+  const auto point = [](const std::string& channel, const std::string& type) {
+    const std::string map =
+        "fluid_density_kg_m3 = 1000\n"
+        "[[modbus.device]]\nname = \"meter\"\nhost = \"127.0.0.1\"\n"
+        "[[modbus.point]]\ndevice = \"meter\"\nchannel = \"" +
+        channel + "\"\ntable = \"input\"\naddress = 0\ntype = \"" + type + "\"\n";
+    Config config;
+    Diagnostics errors;
+    EXPECT_TRUE(ParseConfig(std::string(kMinimalPlant) + map, "config.toml", &config, &errors))
+        << errors.front().ToString();
+    return config.modbus.points.empty() ? ModbusPoint{} : config.modbus.points.front();
+  };
+  const ModbusPoint l_h = point("flow_l_h", "u16");
+  const ModbusPoint m3_h = point("flow_m3_h", "f32");
+  EXPECT_EQ(l_h.channel, Channel::kMdotKgS);
+  EXPECT_EQ(m3_h.channel, Channel::kMdotKgS);
+  EXPECT_EQ(l_h.ChannelNameInMap(), "flow_l_h");
+  EXPECT_EQ(m3_h.ChannelNameInMap(), "flow_m3_h");
+  EXPECT_NEAR(PointToChannelUnit(l_h, 360.0), 0.1, 1e-12);  // 360 L/h of 1000 kg/m³
+  EXPECT_NEAR(PointToChannelUnit(m3_h, 0.36), 0.1, 1e-12);
+  EXPECT_NEAR(ChannelToPointUnit(l_h, 0.1), 360.0, 1e-9);
+  Config config;
+  Diagnostics errors;
+  // Both feed one channel: a second point for it is refused.
+  const std::string twice =
+      "[[modbus.device]]\nname = \"meter\"\nhost = \"127.0.0.1\"\n"
+      "[[modbus.point]]\ndevice = \"meter\"\nchannel = \"flow_l_h\"\ntable = \"input\"\n"
+      "address = 0\ntype = \"u16\"\n"
+      "[[modbus.point]]\ndevice = \"meter\"\nchannel = \"flow_kg_s\"\ntable = \"input\"\n"
+      "address = 1\ntype = \"u16\"\n";
+  errors.clear();
+  EXPECT_FALSE(ParseConfig(std::string(kMinimalPlant) + twice, "config.toml", &config, &errors));
 }
 
 }  // namespace

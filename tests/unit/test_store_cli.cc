@@ -1,6 +1,7 @@
 // pvtwin import and export as real processes on real files: 5 s and 1-min
 // CSV, idempotent re-import of overlapping data, --db, progress, errors.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include "core/common/units.h"
 #include "io/files/csv.h"
 #include "io/platform/time_format.h"
+#include "io/store/store.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
 
@@ -315,6 +317,85 @@ TEST_F(StoreCli, ALocalTimeTheClocksSkipIsAnError) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("spring.csv:3: time"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("does not exist in Europe/Vienna"), std::string::npos) << run.err;
+}
+
+// The verbs that only read (export, diagnose --db) open the store read-only:
+// a store of an older schema is refused with what to do, never migrated,
+// and its file is left byte for byte as it was.
+TEST_F(StoreCli, ReadOnlyVerbsRefuseAnOlderSchemaInsteadOfMigratingIt) {
+  WriteRows("m.csv", Rows(kMinute0, 5, 60.0));
+  ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
+  {
+    RawDb db(dir_ / "t.db");
+    ASSERT_EQ(db.Exec("PRAGMA user_version = 5"), SQLITE_OK);
+  }
+  const std::string before = testing::ReadFile(dir_ / "t.db");
+  const std::string message = "store schema 5 is older than this pvtwin's " +
+                              std::to_string(kStoreSchemaVersion) +
+                              "; run the daemon or `pvtwin migrate` to upgrade it";
+  ProcessResult run = Pvtwin("export --db t.db --from 2024-06-01 --to 2024-06-02");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find(message), std::string::npos) << run.err;
+  run = Pvtwin("diagnose --db t.db --from 2024-06-01 --to 2024-06-02");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find(message), std::string::npos) << run.err;
+  EXPECT_EQ(testing::ReadFile(dir_ / "t.db"), before) << "the store was written";
+  {
+    RawDb db(dir_ / "t.db");
+    EXPECT_EQ(db.Number("PRAGMA user_version"), 5.0);
+  }
+}
+
+// `pvtwin migrate`, named by that message, opens the store as the daemon
+// does (upgrading it) and says its schema; a current store stays as it is.
+TEST_F(StoreCli, MigrateNamesTheSchemaOfTheStore) {
+  WriteRows("m.csv", Rows(kMinute0, 5, 60.0));
+  ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
+  ProcessResult run = Pvtwin("migrate --db t.db");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("t.db: store schema " + std::to_string(kStoreSchemaVersion)),
+            std::string::npos)
+      << run.out;
+  run = RunPvtwin(dir_, "migrate --db none.db");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "none.db"));
+}
+
+// A read-only verb never creates a store either.
+TEST_F(StoreCli, ReadOnlyVerbsNeverCreateAStore) {
+  const ProcessResult run = RunPvtwin(dir_, "export --db none.db --from 2024-06-01");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "none.db"));
+}
+
+// A reader without write access (uid/gid 65534, as a member of the store's
+// group would be) exports from a store in a directory it cannot write: with
+// the daemon's connection open (mode=ro through the existing -wal and -shm,
+// readable to it) and after the daemon closed it (no -wal, no -shm: the file
+// alone, immutable). As root only: setpriv acts as the other user.
+TEST_F(StoreCli, AReaderWithoutWriteAccessExportsWithAndWithoutTheDaemon) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to act as another user (setpriv)";
+  WriteRows("m.csv", Rows(kMinute0, 5, 60.0));
+  ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
+  std::filesystem::permissions(dir_, std::filesystem::perms(0755));
+  const std::string as_reader = "setpriv --reuid=65534 --regid=65534 --clear-groups '" +
+                                std::string(PVTWIN_BINARY) +
+                                "' export --db t.db --from 2024-06-01 --to 2024-06-02";
+  // The daemon's connection stands open: -wal and -shm exist, 0644.
+  {
+    RawDb daemon(dir_ / "t.db");
+    ASSERT_EQ(daemon.Number("SELECT COUNT(*) FROM measurement_1min"), 5.0);
+    ASSERT_TRUE(std::filesystem::exists(dir_ / "t.db-shm"));
+    const ProcessResult run = testing::RunCommand(dir_, as_reader);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_NE(run.out.find("2024-06-01T12:04:00Z"), std::string::npos) << run.out;
+  }
+  // Closed: SQLite removed -wal and -shm, and the reader cannot create them.
+  ASSERT_FALSE(std::filesystem::exists(dir_ / "t.db-shm"));
+  const ProcessResult run = testing::RunCommand(dir_, as_reader);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("2024-06-01T12:04:00Z"), std::string::npos) << run.out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "t.db-shm"));
 }
 
 }  // namespace

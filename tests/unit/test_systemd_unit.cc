@@ -56,11 +56,27 @@ TEST(SystemdUnit, OfflineSecurityExposureIsLow) {
 TEST(SystemdUnit, IsNotifyTypeWithAWatchdogAndADedicatedUser) {
   const std::string text = ReadFile(kUnit);
   for (const char* line :
-       {"Type=notify", "WatchdogSec=", "User=pvtwin", "Group=pvtwin", "DynamicUser=yes",
+       {"Type=notify", "WatchdogSec=", "User=pvtwin\n", "Group=pvtwin\n",
         "ExecReload=/bin/kill -HUP $MAINPID", "StateDirectory=pvtwin", "ProtectSystem=strict",
-        "NoNewPrivileges=yes", "CapabilityBoundingSet=\n", "MemoryDenyWriteExecute=yes"}) {
+        "NoNewPrivileges=yes", "CapabilityBoundingSet=\n", "MemoryDenyWriteExecute=yes",
+        "RemoveIPC=yes"}) {
     EXPECT_NE(text.find(line), std::string::npos) << line;
   }
+}
+
+// The store is readable by the group pvtwin (a reader such as grafana is
+// added to it): a static user and group, not a DynamicUser whose state sits
+// behind /var/lib/private (0700), a state directory the group may enter and
+// files created group-readable, not group-writable.
+TEST(SystemdUnit, TheStoreIsReadableByTheStaticGroup) {
+  const std::string text = ReadFile(kUnit);
+  EXPECT_EQ(text.find("\nDynamicUser="), std::string::npos) << text;
+  EXPECT_NE(text.find("\nStateDirectoryMode=0750\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\nUMask=0027\n"), std::string::npos) << text;
+  const std::string sysusers =
+      ReadFile(fs::path(PVTWIN_SOURCE_DIR) / "systemd" / "pvtwin.sysusers");
+  EXPECT_NE(sysusers.find("\ng pvtwin -\n"), std::string::npos) << sysusers;
+  EXPECT_NE(sysusers.find("\nu pvtwin -:pvtwin "), std::string::npos) << sysusers;
 }
 
 // `cmake --install` into a scratch prefix, as the README installs it: the
@@ -87,6 +103,7 @@ TEST(SystemdInstall, TheUnitNamesTheInstalledBinaryAndTheUserIsShipped) {
   r = RunCommand(dir.path(), "systemd-sysusers --dry-run --root='" + (dir / "root").string() +
                                  "' '" + sysusers.string() + "'");
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE((r.out + r.err).find("Creating group 'pvtwin'"), std::string::npos) << r.out << r.err;
   EXPECT_NE((r.out + r.err).find("Creating user 'pvtwin'"), std::string::npos) << r.out << r.err;
 }
 

@@ -613,38 +613,52 @@ bool Uploader::Impl::BindStore(PgError* error) {
   return pg->Query("UPDATE plant SET store_id = $2 WHERE plant_id = $1", ids, nullptr, error);
 }
 
+// Under the schema's advisory lock, and only when the schema is still
+// incomplete once the lock is held (another uploader may have completed it
+// meanwhile). The uploaded tables are altered before `plant`, in the order
+// in which a batch locks them (its table, then plant), so that a migration
+// and another plant's batch never wait on each other in a cycle.
 bool Uploader::Impl::MigrateCentral(PgError* error) {
-  std::string sql = "BEGIN; SELECT pg_advisory_xact_lock(" + std::string(kSchemaLockKey) +
-                    ");"
-                    "CREATE TABLE IF NOT EXISTS pvtwin_schema(version integer PRIMARY KEY, "
-                    "applied_at timestamptz NOT NULL DEFAULT now());"
-                    "CREATE TABLE IF NOT EXISTS plant(plant_id text PRIMARY KEY, "
-                    "first_upload_at bigint, last_upload_at bigint);"
-                    // Version 2: the store each plant_id belongs to.
-                    "ALTER TABLE plant ADD COLUMN IF NOT EXISTS store_id text;";
+  const auto fail = [&](const char* what) {
+    PgError ignored;
+    if (pg && pg->Ok()) pg->Exec("ROLLBACK", &ignored);
+    error->message = std::string(what) + error->message;
+    return false;
+  };
+  if (!pg->Exec("BEGIN; SELECT pg_advisory_xact_lock(" + std::string(kSchemaLockKey) + ")",
+                error)) {
+    return fail("creating the central schema: ");
+  }
+  bool complete = false;
+  if (!CentralSchemaComplete(&complete, error)) return fail("");
+  if (complete) return pg->Exec("COMMIT", error) || fail("creating the central schema: ");
   // The tables there will be: this plant's, and those other plants brought.
   std::vector<std::vector<std::string>> rows;
   if (!pg->Query("SELECT table_name FROM information_schema.tables WHERE table_schema = "
                  "current_schema()",
                  {}, &rows, error)) {
-    return false;
+    return fail("creating the central schema: ");
   }
   std::set<std::string> present;
   for (const auto& r : rows) present.insert(r[0]);
+  std::string sql =
+      "CREATE TABLE IF NOT EXISTS pvtwin_schema(version integer PRIMARY KEY, "
+      "applied_at timestamptz NOT NULL DEFAULT now());";
   for (const Table& t : tables) {
     sql += CentralTableDdl(t);
     present.insert(std::string(t.spec->name));
   }
+  sql +=
+      "CREATE TABLE IF NOT EXISTS plant(plant_id text PRIMARY KEY, "
+      "first_upload_at bigint, last_upload_at bigint);"
+      // Version 2: the store each plant_id belongs to.
+      "ALTER TABLE plant ADD COLUMN IF NOT EXISTS store_id text;";
   sql += PlantLatestDdl(present.count("qc_event") > 0);
   // Version 3: the event view, as the store's.
   sql += EventDdl(present);
   sql += "INSERT INTO pvtwin_schema(version) VALUES(" + std::to_string(kCentralSchemaVersion) +
          ") ON CONFLICT DO NOTHING; COMMIT;";
-  if (pg->Exec(sql, error)) return true;
-  PgError ignored;
-  pg->Exec("ROLLBACK", &ignored);
-  error->message = "creating the central schema: " + error->message;
-  return false;
+  return pg->Exec(sql, error) || fail("creating the central schema: ");
 }
 
 bool Uploader::Impl::ReadBatch(const Table& t, std::int64_t hwm, std::string* copy,

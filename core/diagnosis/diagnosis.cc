@@ -42,6 +42,12 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
     out << "min_shrink_pct = " << min_shrink_pct << ": must be in [0, 100); ";
   }
   if (min_test_units < 2) out << "min_test_units = " << min_test_units << ": must be ≥ 2; ";
+  if (!(min_confidence > 0.5 && min_confidence < 1.0)) {
+    out << "min_confidence = " << min_confidence << ": must be in (0.5, 1); ";
+  }
+  if (bootstrap_resamples < 100) {
+    out << "bootstrap_resamples = " << bootstrap_resamples << ": must be ≥ 100; ";
+  }
   if (max_ladder_steps < 1) out << "max_ladder_steps = " << max_ladder_steps << ": must be ≥ 1; ";
   if (!(unknown_noise_ratio > 1.0)) {
     out << "unknown_noise_ratio = " << unknown_noise_ratio << ": must be > 1; ";

@@ -62,6 +62,11 @@ struct Score {
   SimOutputs sim;
   ErrorMetrics errors;
   std::vector<double> unit_objective_w_m2;  // per test unit, NaN if the unit has no rows
+  // Per test unit: the sum over its objective rows of |e_P_el| + |e_Q_u|, W
+  // (0 if the unit has no rows). Summed over a resample of units and divided
+  // by its rows, this is the pooled held-out objective of the resample.
+  std::vector<double> unit_loss_w, unit_loss_p_el_w, unit_loss_q_th_w;
+  std::vector<double> unit_rows;
   // Per held-out row: |e_P_el|, |e_Q_u| and their sum, W; NaN off the
   // objective rows.
   std::vector<double> loss_p_el_w, loss_q_th_w, loss_w;

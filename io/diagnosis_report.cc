@@ -194,6 +194,7 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
                            {"share", Number(f.share)},
                            {"size", Number(f.size)},
                            {"detail", f.detail}});
+    if (!f.from.empty()) sensors.back()["from"] = f.from;
   }
   j["sensors"] = sensors;
   j["final_variant"] = r.final_variant;

@@ -48,6 +48,12 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
   if (bootstrap_resamples < 100) {
     out << "bootstrap_resamples = " << bootstrap_resamples << ": must be ≥ 100; ";
   }
+  if (sensor_step_min_rows < 1) {
+    out << "sensor_step_min_rows = " << sensor_step_min_rows << ": must be ≥ 1; ";
+  }
+  if (!(min_temperature_offset_k >= 0.0)) {
+    out << "min_temperature_offset_k = " << min_temperature_offset_k << ": must be ≥ 0; ";
+  }
   if (max_ladder_steps < 1) out << "max_ladder_steps = " << max_ladder_steps << ": must be ≥ 1; ";
   if (!(unknown_noise_ratio > 1.0)) {
     out << "unknown_noise_ratio = " << unknown_noise_ratio << ": must be > 1; ";
@@ -99,6 +105,11 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   const st::BaseResiduals residuals = st::LocaliseBaseGap(split, base_fit, plant, options, &r);
   r.extrapolation = st::FindExtrapolation(base_fit, options);
   r.sensors = st::CheckSensors(data, plant);
+  if (std::optional<SensorFinding> step =
+          st::FindInletOffsetStep(data, split, plant, base, base_fit.params, options, progress)) {
+    r.sensors.insert(r.sensors.begin(), std::move(*step));
+    ++r.identifications;
+  }
   if (!base_fit.train.drivers.sky_note.empty()) r.notes.push_back(base_fit.train.drivers.sky_note);
   if (!split.cleanings.empty()) {
     std::string days;

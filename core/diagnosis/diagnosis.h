@@ -112,6 +112,12 @@ struct DiagnosisOptions {
   // "unknown" when nothing is significant and the held-out objective is
   // more than this multiple of the noise floor.
   double unknown_noise_ratio = 2.0;
+  // The inlet offset step (sensor_steps.cc): days with fewer rows with flow
+  // than this give no daily median (half an hour of pumping at 1 min).
+  int sensor_step_min_rows = 30;
+  // Smallest step that is a sensor fault, K: twice the tolerance of a
+  // class-A Pt100 at 25 °C (IEC 60751: ±(0.15 + 0.002·|T|) K).
+  double min_temperature_offset_k = 0.4;
   // Effects to try (names of the vocabulary); empty = every candidate.
   std::vector<std::string> effects;
   LocaliseOptions where;
@@ -130,7 +136,10 @@ struct SensorFinding {
   std::string kind;            // sky_warmer_than_air, frozen, missing, above_clear_sky, …
   std::size_t rows = 0;        // rows in the flagged intervals
   double share = 0.0;          // of all rows
-  double size = std::nan("");  // sky_warmer_than_air: median sky − air on those rows, K
+  double size = std::nan("");  // sky_warmer_than_air: median sky − air on those rows, K;
+                               // offset_step: the step, K
+  std::string from;            // offset_step: the solar day it starts (YYYY-MM-DD), else ""
+  std::int64_t from_s = 0;     // … its start, unix s
   std::string detail;          // the first interval's sentence, and how many there are
 };
 

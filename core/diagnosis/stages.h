@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -138,6 +139,15 @@ std::vector<std::uint8_t> RowsInsideTrainingRange(const Drivers& d,
 // The sensor checks of the monitor (FindSensorFaults) over the whole data,
 // one finding per channel and kind, most rows first (sensors.cc).
 std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant);
+
+// A constant offset of the inlet (or outlet) temperature from one day on, in
+// the Q_u residual of `base` fitted on all the data from `start`
+// (sensor_steps.cc); nullopt when there is none.
+std::optional<SensorFinding> FindInletOffsetStep(const Series& data, const Split& split,
+                                                 const Plant& plant, const ModelSpec& base,
+                                                 const ParamVector& start,
+                                                 const DiagnosisOptions& options,
+                                                 const Progress& progress);
 
 // --- 4. Candidate trials ---
 // Controls of the evidence regression, per held-out row: in-plane

@@ -124,9 +124,12 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
   }
   for (const SensorFinding& f : r.sensors) {
     r.verdict_sentence +=
-        " Sensor check: " + f.channel + " " + f.kind + " on " + std::to_string(f.rows) + " rows (" +
-        FixedDecimals(100.0 * f.share, 1) + " % of the data" +
-        (std::isfinite(f.size) ? ", median " + FixedDecimals(f.size, 1) + " K" : std::string()) +
+        " Sensor check: " + f.channel + " " + f.kind +
+        (f.from.empty() ? std::string() : " from " + f.from) + " on " + std::to_string(f.rows) +
+        " rows (" + FixedDecimals(100.0 * f.share, 1) + " % of the data" +
+        (std::isfinite(f.size)
+             ? (f.from.empty() ? ", median " : ", size ") + FixedDecimals(f.size, 1) + " K"
+             : std::string()) +
         ").";
   }
 }

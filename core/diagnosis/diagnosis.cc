@@ -105,11 +105,6 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   const st::BaseResiduals residuals = st::LocaliseBaseGap(split, base_fit, plant, options, &r);
   r.extrapolation = st::FindExtrapolation(base_fit, options);
   r.sensors = st::CheckSensors(data, plant);
-  if (std::optional<SensorFinding> step =
-          st::FindInletOffsetStep(data, split, plant, base, base_fit.params, options, progress)) {
-    r.sensors.insert(r.sensors.begin(), std::move(*step));
-    ++r.identifications;
-  }
   if (!base_fit.train.drivers.sky_note.empty()) r.notes.push_back(base_fit.train.drivers.sky_note);
   if (!split.cleanings.empty()) {
     std::string days;
@@ -138,6 +133,15 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   trials.progress = progress;
   trials.extrapolation = &r.extrapolation;
   const st::LadderModel final_model = st::RunLadder(trials, base, &r);
+  // The offset step is looked for in the residuals of the final model: a
+  // base model that lacks a large effect leaves day-to-day structure that a
+  // step can fit (final-check seed 31, other-form wind in October: a false
+  // t_out_c step with the base 1N1Cr fitted on all days).
+  if (std::optional<SensorFinding> step = st::FindInletOffsetStep(
+          data, split, plant, final_model.spec, final_model.params, options, progress)) {
+    r.sensors.insert(r.sensors.begin(), std::move(*step));
+  }
+  ++r.identifications;
 
   if (!st::EstimateNoiseFloor(split, plant, final_model, &r, error)) return false;
   st::BuildReportModel(split, base_fit, residuals, final_model, plant.area_m2, &r);

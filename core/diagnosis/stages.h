@@ -141,7 +141,8 @@ std::vector<std::uint8_t> RowsInsideTrainingRange(const Drivers& d,
 std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant);
 
 // A constant offset of the inlet (or outlet) temperature from one day on, in
-// the Q_u residual of `base` fitted on all the data from `start`
+// the Q_u residual of `base` (the ladder's final model) fitted on all the
+// data from `start`
 // (sensor_steps.cc); nullopt when there is none.
 std::optional<SensorFinding> FindInletOffsetStep(const Series& data, const Split& split,
                                                  const Plant& plant, const ModelSpec& base,

@@ -108,12 +108,13 @@ int DaysImproved(const Score& before, const Score& after, const Part& heldout,
   return better;
 }
 
-// The decision on a trial whose fit succeeded: a held-out improvement that
-// is significant (loss test, p ≤ alpha) and large enough (min_shrink_pct),
-// and that the effect's physics backs: neither output worse beyond what the
-// test can tell from noise, not every parameter at a bound, better on more
-// than one day (where there are several), and the module's own signature in
-// the data. Fills t's tests and, for an improvement turned down, `rejected`.
+// The evidence on a trial whose fit succeeded, next to its held-out score:
+// the loss test, the split by output, the days it helps, parameters at a
+// bound, a gain that is only a shift of the bias on extrapolated days, and
+// the module's own signature. None of it decides: the ladder's model
+// selection (ladder.cc) judges every candidate on the held-out objective
+// (the sum of both outputs) resampled over the test units; what speaks
+// against a candidate is listed in t.cautions beside its confidence.
 void Judge(const TrialInputs& in, const EffectCandidate& c, const Part& ho, const Score& before,
            const Score& after, EffectTrial* trial) {
   EffectTrial& t = *trial;
@@ -128,8 +129,6 @@ void Judge(const TrialInputs& in, const EffectCandidate& c, const Part& ho, cons
   t.days_improved = DaysImproved(before, after, ho, in.split->offset_s, &days);
   bool all_at_bounds = false;
   t.at_bounds = AtBounds(*c.module, c.spec, t, *in.plant, &all_at_bounds);
-  t.significant = t.heldout_test.p <= o.alpha && t.shrink_pct >= o.min_shrink_pct;
-  if (!t.significant) return;
   std::vector<std::string> why;
   const struct {
     const char* name;
@@ -139,10 +138,10 @@ void Judge(const TrialInputs& in, const EffectCandidate& c, const Part& ho, cons
                  {"Q_u", Loss::kQTh, t.mae_q_th_before_w, t.mae_q_th_after_w}};
   for (const auto& out : outputs) {
     const LossDifferenceTest worse = CompareLosses(after, before, ho, bw, out.loss);
-    if (worse.p <= o.alpha && out.after_w > out.before_w * (1.0 + o.min_shrink_pct / 100.0)) {
+    if (worse.p <= o.alpha && out.after_w > out.before_w) {
       why.push_back("it makes " + std::string(out.name) + " worse (" +
                     FixedDecimals(out.before_w, 2) + " → " + FixedDecimals(out.after_w, 2) +
-                    " W, p = " + PValue(worse.p) + ")");
+                    " W, p = " + PValue(worse.p) + "; judged on the sum)");
     }
   }
   // On held-out days outside the training range the base model's error is
@@ -201,8 +200,7 @@ void Judge(const TrialInputs& in, const EffectCandidate& c, const Part& ho, cons
     t.signature_check = check.sentence;
     if (!check.shown) why.push_back("its signature is missing: " + check.sentence);
   }
-  for (const std::string& w : why) t.rejected += (t.rejected.empty() ? "" : "; ") + w;
-  t.significant = why.empty();
+  t.cautions = std::move(why);
 }
 
 // The candidates of this step: every effect the current model can take with
@@ -342,7 +340,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   Judge(in, c, ho, current_score, *score, &t);
   if (c.module->sensor_estimate != nullptr) {
     SensorTest(*in.data, in.split->day_starts, plant, c.spec, *c.module, &t);
-    t.significant =
+    t.sensor_fault =
         t.sensor_p <= options.alpha && std::fabs(t.sensor_estimate) >= options.min_sensor_error;
   }
 }
@@ -351,13 +349,14 @@ std::string ProgressLine(int step, int finished, std::size_t candidates, const E
                          const std::string& test_unit) {
   return "[step " + std::to_string(step) + ", " + std::to_string(finished) + "/" +
          std::to_string(candidates) + "] +" + t.name + ": " +
-         (t.fit_ok ? "shrink " + FixedDecimals(t.shrink_pct, 1) + " %, better on " +
-                         std::to_string(t.test.positives) + " of " + std::to_string(t.test.pairs) +
-                         " " + test_unit + "s, loss test p = " + PValue(t.heldout_test.p) +
-                         (t.significant        ? " (significant)"
-                          : t.rejected.empty() ? ""
-                                               : " (not accepted)")
-                   : "FAILED: " + t.failure) +
+         (t.fit_ok
+              ? "shrink " + FixedDecimals(t.shrink_pct, 1) + " %, better on " +
+                    std::to_string(t.test.positives) + " of " + std::to_string(t.test.pairs) + " " +
+                    test_unit + "s, loss test p = " + PValue(t.heldout_test.p) +
+                    (t.sensor_fault ? " (sensor fault)" : "") +
+                    (t.cautions.empty() ? ""
+                                        : " (" + std::to_string(t.cautions.size()) + " caution(s))")
+              : "FAILED: " + t.failure) +
          " (" + FixedDecimals(t.fit_runtime_s, 2) + " s)";
 }
 
@@ -384,7 +383,7 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
        << "per " << test_unit << ": lower on " << t.test.positives << " of " << t.test.pairs
        << " (Wilcoxon p = " << PValue(t.test.wilcoxon_p) << ")";
     if (!t.signature_check.empty()) ev << "; " << t.signature_check;
-    if (!t.rejected.empty()) ev << "; not accepted: " << t.rejected;
+    for (const std::string& c : t.cautions) ev << "; against it: " << c;
   } else {
     ev << "not tested: " << t.failure;
   }

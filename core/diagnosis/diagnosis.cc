@@ -42,6 +42,18 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
     out << "min_shrink_pct = " << min_shrink_pct << ": must be in [0, 100); ";
   }
   if (min_test_units < 2) out << "min_test_units = " << min_test_units << ": must be ≥ 2; ";
+  if (!(min_confidence > 0.5 && min_confidence < 1.0)) {
+    out << "min_confidence = " << min_confidence << ": must be in (0.5, 1); ";
+  }
+  if (bootstrap_resamples < 100) {
+    out << "bootstrap_resamples = " << bootstrap_resamples << ": must be ≥ 100; ";
+  }
+  if (sensor_step_min_rows < 1) {
+    out << "sensor_step_min_rows = " << sensor_step_min_rows << ": must be ≥ 1; ";
+  }
+  if (!(min_temperature_offset_k >= 0.0)) {
+    out << "min_temperature_offset_k = " << min_temperature_offset_k << ": must be ≥ 0; ";
+  }
   if (max_ladder_steps < 1) out << "max_ladder_steps = " << max_ladder_steps << ": must be ≥ 1; ";
   if (!(unknown_noise_ratio > 1.0)) {
     out << "unknown_noise_ratio = " << unknown_noise_ratio << ": must be > 1; ";
@@ -121,6 +133,15 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   trials.progress = progress;
   trials.extrapolation = &r.extrapolation;
   const st::LadderModel final_model = st::RunLadder(trials, base, &r);
+  // The offset step is looked for in the residuals of the final model: a
+  // base model that lacks a large effect leaves day-to-day structure that a
+  // step can fit (final-check seed 31, other-form wind in October: a false
+  // t_out_c step with the base 1N1Cr fitted on all days).
+  if (std::optional<SensorFinding> step = st::FindInletOffsetStep(
+          data, split, plant, final_model.spec, final_model.params, options, progress)) {
+    r.sensors.insert(r.sensors.begin(), std::move(*step));
+  }
+  ++r.identifications;
 
   if (!st::EstimateNoiseFloor(split, plant, final_model, &r, error)) return false;
   st::BuildReportModel(split, base_fit, residuals, final_model, plant.area_m2, &r);

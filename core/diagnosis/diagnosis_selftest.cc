@@ -95,6 +95,15 @@ std::vector<SelftestCase> OtherFormSelftestCases(const Plant& plant) {
     if (effect != nullptr && effect->other_truth == nullptr) continue;
     cases.push_back(c);
   }
+  // The same effects and the null case in autumn: 2024-10-01 00:00 UTC.
+  const std::size_t summer = cases.size();
+  for (std::size_t k = 0; k < summer; ++k) {
+    if (cases[k].disturbance) continue;
+    SelftestCase c = cases[k];
+    c.name += "_october";
+    c.start_time_s = 1727740800;
+    cases.push_back(c);
+  }
   return cases;
 }
 
@@ -137,6 +146,7 @@ Series SelftestData(const Plant& plant, const SelftestCase& c, std::uint64_t see
   synth.truth = c.truth_params;
   SetTruthForm(c, &synth);
   synth.weather.step_s = options.step_s;
+  if (c.start_time_s != 0) synth.weather.start_time_s = c.start_time_s;
   // Start at local solar midnight so that the data are whole solar days.
   const std::int64_t offset_s = SolarDayOffsetS(plant);
   const std::int64_t first = SolarDayStartS(synth.weather.start_time_s, offset_s) + kSecondsPerDay;

@@ -54,6 +54,9 @@ struct SelftestCase {
   double severity = 0.0;  // Disturbance::severity
   // Same-form or other-form truth (SyntheticOptions::truth_form).
   TruthForm form = TruthForm::kSameForm;
+  // First day of the data (unix s UTC; moved to the next local solar
+  // midnight); 0 = the generator's default, 1 June.
+  std::int64_t start_time_s = 0;
 };
 
 struct SelftestOptions {
@@ -95,7 +98,10 @@ std::vector<SelftestCase> SelftestCases(const Plant& plant);
 // (with the same base as its same-form case; only the withheld effect takes
 // its other form), the null case and the
 // disturbances (their truth has no effect: the same data as the same-form
-// battery's).
+// battery's); then each of these effect cases and the null case again in
+// another season ("<case>_october": data from 1 October, lower sun, longer
+// paths through the glass, colder air and sky), a season no candidate was
+// developed on.
 std::vector<SelftestCase> OtherFormSelftestCases(const Plant& plant);
 
 // Whether the case's data differ from its same-form twin's (its withheld

@@ -31,14 +31,22 @@ Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& 
   Score score;
   Simulate(heldout.drivers, params, &score.sim);
   score.errors = ComputeErrors(heldout.meas, score.sim, area_m2);
-  std::vector<double> sum(static_cast<std::size_t>(units.count), 0.0);
-  std::vector<double> rows(static_cast<std::size_t>(units.count), 0.0);
+  const auto n_units = static_cast<std::size_t>(units.count);
+  std::vector<double>& sum = score.unit_loss_w;
+  std::vector<double>& rows = score.unit_rows;
+  sum.assign(n_units, 0.0);
+  rows.assign(n_units, 0.0);
+  score.unit_loss_p_el_w.assign(n_units, 0.0);
+  score.unit_loss_q_th_w.assign(n_units, 0.0);
   for (std::uint32_t i : heldout.meas.rows) {
     const int u = units.unit_of_row[i];
     if (u < 0) continue;
     const auto k = static_cast<std::size_t>(u);
-    sum[k] += std::fabs(score.sim.p_el_w[i] - heldout.meas.p_el_w[i]) +
-              std::fabs(score.sim.q_th_w[i] - heldout.meas.q_th_w[i]);
+    const double lp = std::fabs(score.sim.p_el_w[i] - heldout.meas.p_el_w[i]);
+    const double lq = std::fabs(score.sim.q_th_w[i] - heldout.meas.q_th_w[i]);
+    score.unit_loss_p_el_w[k] += lp;
+    score.unit_loss_q_th_w[k] += lq;
+    sum[k] += lp + lq;
     rows[k] += 1.0;
   }
   score.loss_p_el_w.assign(heldout.meas.size(), kNaN);

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,11 @@ struct Score {
   SimOutputs sim;
   ErrorMetrics errors;
   std::vector<double> unit_objective_w_m2;  // per test unit, NaN if the unit has no rows
+  // Per test unit: the sum over its objective rows of |e_P_el| + |e_Q_u|, W
+  // (0 if the unit has no rows). Summed over a resample of units and divided
+  // by its rows, this is the pooled held-out objective of the resample.
+  std::vector<double> unit_loss_w, unit_loss_p_el_w, unit_loss_q_th_w;
+  std::vector<double> unit_rows;
   // Per held-out row: |e_P_el|, |e_Q_u| and their sum, W; NaN off the
   // objective rows.
   std::vector<double> loss_p_el_w, loss_q_th_w, loss_w;
@@ -133,6 +139,16 @@ std::vector<std::uint8_t> RowsInsideTrainingRange(const Drivers& d,
 // The sensor checks of the monitor (FindSensorFaults) over the whole data,
 // one finding per channel and kind, most rows first (sensors.cc).
 std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant);
+
+// A constant offset of the inlet (or outlet) temperature from one day on, in
+// the Q_u residual of `base` (the ladder's final model) fitted on all the
+// data from `start`
+// (sensor_steps.cc); nullopt when there is none.
+std::optional<SensorFinding> FindInletOffsetStep(const Series& data, const Split& split,
+                                                 const Plant& plant, const ModelSpec& base,
+                                                 const ParamVector& start,
+                                                 const DiagnosisOptions& options,
+                                                 const Progress& progress);
 
 // --- 4. Candidate trials ---
 // Controls of the evidence regression, per held-out row: in-plane

@@ -57,9 +57,17 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
       << " %, from " << FixedDecimals(first.heldout_mae_w, 1) << " W to "
       << FixedDecimals(r.ladder[1].heldout_mae_w, 1) << " W";
     if (top != nullptr) {
-      s << " (held-out loss test p = " << PValue(top->heldout_test.p) << ", better on "
-        << top->days_improved << " held-out day(s))";
+      if (top->sensor_fault && top->confidence < options.min_confidence) {
+        s << " (a sensor fault, named by its sensor test: "
+          << "p = " << PValue(top->sensor_p) << " over " << top->sensor_days << " days)";
+      } else {
+        s << " (confidence " << FixedDecimals(100.0 * top->confidence, 1)
+          << " %: the best candidate in that share of the resampled held-out " << r.test_unit
+          << "s; held-out loss test p = " << PValue(top->heldout_test.p) << ", better on "
+          << top->days_improved << " held-out day(s))";
+      }
       if (!top->signature_check.empty()) s << "; " << top->signature_check;
+      for (const std::string& c : top->cautions) s << "; against it: " << c;
     }
     s << ".";
     if (r.ladder.size() > 2) {
@@ -78,10 +86,12 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
     r.verdict_sentence = s.str();
   } else if (!r.candidates.empty()) {
     r.verdict = "undecided";
-    r.verdict_sentence = "Adding any of " + JoinNames(r.candidates) + " to " + r.base_variant +
+    r.verdict_sentence = "Adding " + JoinNames(r.candidates) + " to " + r.base_variant +
                          " lowers its held-out error (" + FixedDecimals(first.heldout_mae_w, 1) +
-                         " W, MAE P_el + Q_u), and the held-out loss test cannot tell them apart: "
-                         "the data do not say which effect is missing." +
+                         " W, MAE P_el + Q_u), but neither is the best with " +
+                         FixedDecimals(100.0 * options.min_confidence, 0) +
+                         " % confidence over the resampled held-out " + r.test_unit +
+                         "s: the data do not say which effect is missing. " + r.separation + "." +
                          ExtrapolationSentence(r);
   } else if (r.noise.ratio > options.unknown_noise_ratio) {
     r.verdict = "unknown";
@@ -114,9 +124,12 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
   }
   for (const SensorFinding& f : r.sensors) {
     r.verdict_sentence +=
-        " Sensor check: " + f.channel + " " + f.kind + " on " + std::to_string(f.rows) + " rows (" +
-        FixedDecimals(100.0 * f.share, 1) + " % of the data" +
-        (std::isfinite(f.size) ? ", median " + FixedDecimals(f.size, 1) + " K" : std::string()) +
+        " Sensor check: " + f.channel + " " + f.kind +
+        (f.from.empty() ? std::string() : " from " + f.from) + " on " + std::to_string(f.rows) +
+        " rows (" + FixedDecimals(100.0 * f.share, 1) + " % of the data" +
+        (std::isfinite(f.size)
+             ? (f.from.empty() ? ", median " : ", size ") + FixedDecimals(f.size, 1) + " K"
+             : std::string()) +
         ").";
   }
 }

@@ -96,6 +96,8 @@ std::string_view DisturbanceName(DisturbanceKind kind) {
       return "stuck_flow_reading";
     case DisturbanceKind::kSnowCover:
       return "snow_cover";
+    case DisturbanceKind::kInletSensorOffset:
+      return "inlet_sensor_offset";
   }
   return "?";
 }
@@ -194,10 +196,29 @@ Series DisturbedPhysics(const Series& s, const SyntheticOptions& options) {
             if (physics.Has(c)) physics[c][i] *= d.severity;
           }
           break;
+        case DisturbanceKind::kInletSensorOffset:
+          break;  // a sensor fault: the physics is untouched (InletSensorOffsets)
       }
     }
   }
   return physics;
+}
+
+// The logged inlet temperature of an inlet sensor offset, and the heat
+// meter's reading computed from it (flow × c_p × (T_out − T_in) as logged).
+void InletSensorOffsets(const Plant& plant, const std::vector<Disturbance>& disturbances,
+                        Series* s) {
+  for (const Disturbance& d : disturbances) {
+    if (d.kind != DisturbanceKind::kInletSensorOffset) continue;
+    auto& t_in = (*s)[Channel::kTInC];
+    auto& q_th = (*s)[Channel::kQThW];
+    const auto& flow = (*s)[Channel::kMdotKgS];
+    for (std::size_t i = 0; i < s->size(); ++i) {
+      if (!InWindow(d, s->time_s[i])) continue;
+      t_in[i] += d.severity;
+      if (flow[i] > 0.0) q_th[i] -= flow[i] * plant.fluid_cp_j_kgk * d.severity;
+    }
+  }
 }
 
 // The modules whose other form the truth runs (UsesOtherForm).
@@ -323,6 +344,7 @@ Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& option
   SimOutputs out;
   RunTruth(other, ctx, options.truth, &drivers, &out);
   WriteMeasuredOutputs(plant, options.noise, drivers, out, &s);
+  InletSensorOffsets(plant, options.disturbances, &s);
   for (const EffectModule* m : EffectRegistry()) {
     const bool other_form = std::find(other.begin(), other.end(), m) != other.end();
     if (other_form && m->other_truth->measured != nullptr) {

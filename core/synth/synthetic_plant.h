@@ -76,6 +76,12 @@ enum class DisturbanceKind {
   // still see the sun, the collector absorbs `severity` × the irradiance
   // (0 = total cover), so P_el and Q_u are near zero.
   kSnowCover,
+  // The inlet temperature sensor reads `severity` K high (a drifted or
+  // re-mounted Pt100) on the rows of the window, typically from one day to
+  // the end of the data. The physics is untouched; the logged t_in_c is
+  // high and the heat meter, which multiplies flow by the logged
+  // T_out − T_in, reads ṁ·c_p·severity less while the pump runs.
+  kInletSensorOffset,
 };
 
 std::string_view DisturbanceName(DisturbanceKind kind);

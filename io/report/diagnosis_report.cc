@@ -123,6 +123,9 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
     Json e;
     e["name"] = t.name;
     e["significant"] = t.significant;
+    e["confidence"] = Number(t.fit_ok ? t.confidence : std::nan(""));
+    e["confidence_beats"] = Number(t.fit_ok ? t.confidence_beats : std::nan(""));
+    if (t.sensor_fault) e["sensor_fault"] = true;
     e["shrink_pct"] = Number(t.fit_ok ? t.shrink_pct : std::nan(""));
     e["heldout_mae_before_w"] = Number(t.heldout_mae_before_w);
     e["heldout_mae_after_w"] = Number(t.fit_ok ? t.heldout_mae_after_w : std::nan(""));
@@ -162,6 +165,7 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
       if (!t.at_bounds.empty()) e["at_bounds"] = t.at_bounds;
       if (!t.signature_check.empty()) e["signature_check"] = t.signature_check;
       if (!t.rejected.empty()) e["rejected"] = t.rejected;
+      if (!t.cautions.empty()) e["cautions"] = t.cautions;
     }
     e["explanation"] = t.explanation;
     if (!t.advice.empty()) e["advice"] = t.advice;
@@ -172,6 +176,7 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
   j["effects"] = effects;
   j["verdict"] = r.verdict;
   if (!r.candidates.empty()) j["candidates"] = r.candidates;
+  if (!r.separation.empty()) j["separation"] = r.separation;
   j["verdict_sentence"] = r.verdict_sentence;
   Json extrapolation = Json::array();
   for (const Extrapolation& x : r.extrapolation) {
@@ -189,6 +194,7 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
                            {"share", Number(f.share)},
                            {"size", Number(f.size)},
                            {"detail", f.detail}});
+    if (!f.from.empty()) sensors.back()["from"] = f.from;
   }
   j["sensors"] = sensors;
   j["final_variant"] = r.final_variant;

@@ -144,8 +144,41 @@ TEST(SyntheticTruth, DisturbancesActOnTheirDaysOnly) {
         EXPECT_LT(p_ratio, 0.01) << name;
         EXPECT_LT(q_ratio, 0.05) << name;
         break;
+      case DisturbanceKind::kInletSensorOffset:
+        break;  // a sensor fault: its own test below
     }
   }
+}
+
+// An inlet sensor offset is a reading: the logged t_in_c is high by the
+// offset from its first day on, the heat meter reads ṁ·c_p·ΔT less while
+// the pump runs, and P_el, the flow and the outlet are untouched.
+TEST(SyntheticTruth, InletSensorOffsetIsAReadingFromItsDayOn) {
+  const Plant plant = DesignExamplePlant();
+  SyntheticOptions clean = Options("1N1Cwr", 4, 24);
+  clean.defects = DataDefects{};
+  const Series base = MakeSyntheticPlantData(plant, clean);
+  const std::int64_t day2 = base.time_s[0] + 2 * 86400;
+  SyntheticOptions o = clean;
+  o.disturbances = {{DisturbanceKind::kInletSensorOffset, day2, base.time_s.back() + 1, 1.5}};
+  const Series s = MakeSyntheticPlantData(plant, o);
+  int flowing = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    ASSERT_EQ(s[Channel::kPElW][i], base[Channel::kPElW][i]);
+    ASSERT_EQ(s[Channel::kTOutC][i], base[Channel::kTOutC][i]);
+    const double dt = s[Channel::kTInC][i] - base[Channel::kTInC][i];
+    const double dq = s[Channel::kQThW][i] - base[Channel::kQThW][i];
+    if (s.time_s[i] < day2) {
+      ASSERT_EQ(dt, 0.0);
+      ASSERT_EQ(dq, 0.0);
+      continue;
+    }
+    ASSERT_NEAR(dt, 1.5, 1e-9);
+    const double flow = s[Channel::kMdotKgS][i];
+    if (flow > 0.0) ++flowing;
+    ASSERT_NEAR(dq, flow > 0.0 ? -flow * plant.fluid_cp_j_kgk * 1.5 : 0.0, 1e-6);
+  }
+  EXPECT_GT(flowing, 100);
 }
 
 // irradiance_bias is a sensor error: the plane-of-array reading is scaled,

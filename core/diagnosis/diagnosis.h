@@ -20,14 +20,18 @@
 //     days with the paper's objective MAE(P_el)/A + MAE(Q_u)/A per unit.
 //     Units are held-out days; with fewer than min_test_units days they are
 //     one-hour blocks (reported as low confidence: hours of one day are not
-//     independent weather). The effect is significant when the one-sided
-//     Wilcoxon signed-rank test over units (core/diagnosis/diagnosis_stats.h) gives
-//     p ≤ alpha AND the pooled held-out objective shrinks by at least
-//     min_shrink_pct: consistency across days and a size that matters.
-//     A sensor fault is judged by its sensor test instead (EffectTrial).
-//  5. Ladder (forward selection): the significant effect with the largest
-//     shrink is accepted, and step 4 is repeated from the extended model,
-//     until nothing is significant or max_ladder_steps are accepted.
+//     independent weather). The candidates are compared by model selection:
+//     the units are resampled with replacement (DiagnosisOptions::
+//     bootstrap_resamples), and a candidate's confidence is the share of
+//     resamples in which it has the lowest pooled held-out objective and
+//     beats the current model by min_shrink_pct. Signatures, the output
+//     split, bounds and extrapolated days are reported as cautions next to
+//     the candidate, none discards it. A sensor fault is judged by its
+//     sensor test instead (EffectTrial; alpha and min_sensor_error).
+//  5. Ladder (forward selection): the candidate whose confidence reaches
+//     min_confidence is accepted, and step 4 is repeated from the extended
+//     model, until none does (then `undecided` between the top two when
+//     together they beat the model) or max_ladder_steps are accepted.
 //  6. Noise floor: the MAE that sensor noise alone gives, from the second
 //     differences of the final model's held-out residuals
 //     (NoiseMaeFromSecondDifferences), per output.

@@ -413,10 +413,11 @@ void RegisterDiagnose(CLI::App& app) {
       "hour, day, angle of incidence, irradiance and its rate of change, beam fraction, wind,\n"
       "sky temperature deficit, T_in - T_amb, flow, pump switching, sun position); which\n"
       "catalogued effect (capacitance, second_node, wind, sky_radiation, iam, ...) removes it,\n"
-      "tested by adding the effect, re-identifying and checking that the held-out error falls\n"
-      "on the held-out days consistently (one-sided Wilcoxon test over days; over hours when\n"
-      "there are fewer than 5 held-out days, reported as low confidence); the ladder of\n"
-      "accepted effects; and a verdict: an effect, 'none' (nothing significant, error near the\n"
+      "tested by adding the effect, re-identifying and scoring the held-out days: the held-out\n"
+      "days are resampled, and an effect's confidence is the share of resamples in which it is\n"
+      "the best candidate and beats the model (over hours when there are fewer than 5 held-out\n"
+      "days, reported as low confidence); the ladder of accepted effects; and a verdict: an\n"
+      "effect (confidence >= 0.8), 'undecided' (the top two named), 'none' (error near the\n"
       "sensor-noise floor) or 'unknown' (error far above noise that no effect removes).\n"
       "Progress on stderr, a summary on stdout, DIR/report.json (doc/contracts.md) and "
       "DIR/report.html\n"
@@ -460,7 +461,8 @@ void RegisterDiagnose(CLI::App& app) {
                   "comma-separated effects to test (default: every one the model can take)")
       ->delimiter(',');
   cmd->add_option("--alpha", args->alpha,
-                  "one-sided Wilcoxon p at or below which an improvement is consistent (0.05)");
+                  "p at or below which a sensor test (a pyranometer's scale error) names a fault; "
+                  "the effects are chosen by their bootstrap confidence (0.05)");
   cmd->add_option("--min-shrink", args->min_shrink_pct,
                   "smallest held-out error reduction in % that counts (1)");
   cmd->add_option("--threads", args->threads, "worker threads, 0 = all cores (default 0)")

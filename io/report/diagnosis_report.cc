@@ -284,8 +284,11 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
 
   h << "<h2>Effects tested</h2>\n<p>Each effect was added to the model, the model re-identified "
     << "on the training days and scored on the held-out " << XmlEscape(r.test_unit)
-    << "s. Significant = lower error consistently (one-sided Wilcoxon signed-rank test over "
-    << XmlEscape(r.test_unit) << "s) and by a margin that matters.</p>\n"
+    << "s. Significant = named by the model selection: its confidence, the share of resamples "
+    << "of the held-out " << XmlEscape(r.test_unit)
+    << "s in which it is the best candidate and beats the model, reaches the threshold; p is the "
+    << "one-sided Wilcoxon signed-rank test over " << XmlEscape(r.test_unit)
+    << "s, for reference.</p>\n"
     << "<table><tr><th class='l'>effect</th><th class='l'>model</th><th>before W</th>"
     << "<th>after W</th><th>shrink %</th><th>better</th><th>p</th><th>evidence r</th>"
     << "<th class='l'>significant</th></tr>\n";

@@ -39,13 +39,7 @@ struct UploadArgs {
 };
 
 UploadSettings SettingsFor(const Config& config) {
-  UploadSettings s;
-  s.store_path = config.storage.path;
-  s.url = config.upload.url;
-  s.password_file = config.upload.password_file;
-  s.plant_id = config.upload.plant_id;
-  s.batch_rows = config.upload.batch_rows;
-  s.forecast_days = config.upload.forecast_days;
+  UploadSettings s = UploadSettingsFor(config);
   s.stop = &g_upload_stop;
   return s;
 }

@@ -748,15 +748,8 @@ void Service::UpdateForecastStats(const Series& history, const ForecastRequest& 
 }
 
 void Service::StartUpload() {
-  UploadSettings settings;
-  settings.store_path = config_.storage.path;
-  settings.url = config_.upload.url;
-  settings.password_file = config_.upload.password_file;
-  settings.plant_id = config_.upload.plant_id;
-  settings.batch_rows = config_.upload.batch_rows;
-  settings.forecast_days = config_.upload.forecast_days;
   upload_ = std::make_unique<UploadWorker>(
-      settings, config_.upload.interval_s,
+      UploadSettingsFor(config_), config_.upload.interval_s,
       [](int priority, const std::string& line) { LogToStderr(priority, line); });
   upload_->Start();
 }

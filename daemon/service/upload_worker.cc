@@ -17,6 +17,17 @@ std::string Seconds(double s) {
 
 }  // namespace
 
+UploadSettings UploadSettingsFor(const Config& config) {
+  UploadSettings s;
+  s.store_path = config.storage.path;
+  s.url = config.upload.url;
+  s.password_file = config.upload.password_file;
+  s.plant_id = config.upload.plant_id;
+  s.batch_rows = config.upload.batch_rows;
+  s.forecast_days = config.upload.forecast_days;
+  return s;
+}
+
 UploadWorker::UploadWorker(const UploadSettings& settings, double interval_s, LogFn log)
     : settings_(settings), interval_s_(interval_s), log_(std::move(log)) {
   // A stop ends any wait on the server at once (io/fleet/pg_client.h PgWait).

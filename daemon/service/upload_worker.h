@@ -14,11 +14,15 @@
 #include <string>
 #include <thread>
 
+#include "config/plant_config.h"
 #include "daemon/service/worker_thread.h"
 #include "io/platform/log.h"
 #include "io/fleet/upload.h"
 
 namespace pvtwin {
+
+// The upload's settings from the config's [upload] and [storage] path.
+UploadSettings UploadSettingsFor(const Config& config);
 
 class UploadWorker {
  public:

@@ -53,6 +53,7 @@
 #include "io/platform/time_format.h"
 #include "tests/support/child_process.h"
 #include "tests/support/files.h"
+#include "tests/support/ports.h"
 
 namespace pvtwin {
 namespace {
@@ -118,18 +119,7 @@ Scenario LoadScenario(const std::string& name) {
 
 std::vector<std::string> ScenarioNames() { return pvtwin::testing::SubfolderNames(kScenarioDir); }
 
-// A TCP port on loopback with nothing listening (bound, then released).
-int ClosedPort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
+using testing::ClosedPort;
 
 // socat's pseudo-terminal pair; both paths, or a failure message.
 struct PtyPair {

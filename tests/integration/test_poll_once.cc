@@ -4,8 +4,6 @@
 // that fails is named with its endpoint, unit id, the read and libmodbus's
 // error, and the exit code says so.
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -18,6 +16,7 @@
 
 #include "tests/support/child_process.h"
 #include "tests/support/files.h"
+#include "tests/support/ports.h"
 #include "tests/support/run_pvtwin.h"
 
 namespace pvtwin {
@@ -31,18 +30,7 @@ const fs::path kSimPlant =
     fs::path(PVTWIN_SCENARIO_DIR) / "../../../config/examples/sim-plant.toml";
 constexpr std::int64_t kNoonS = 1718971200;  // 2024-06-21T12:00:00Z
 
-// A TCP port on loopback with nothing listening (bound, then released).
-int ClosedPort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
+using testing::ClosedPort;
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
   const std::size_t at = text.find(from);

@@ -1,0 +1,335 @@
+// The store's schema, version by version, and the migrations that bring an
+// older store up to kStoreSchemaVersion (the schema is described at the head
+// of io/store/store.h and in doc/sql.md).
+#include <sqlite3.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/data/physical_limits.h"
+#include "core/forecast/forecast.h"
+#include "io/store/store_impl.h"
+
+namespace pvtwin {
+
+using namespace store_detail;
+
+namespace {
+
+// Schema version 1 (io/store/store.h). Each later version appends one Migration
+// whose statements turn version N-1 into N; Open runs the missing ones in
+// order, each in its own transaction together with the user_version update.
+std::vector<std::string> SchemaV1() {
+  return {
+      "CREATE TABLE sample_5s(ts INTEGER PRIMARY KEY" + ChannelColumnDefs() +
+          ", rejected_mask INTEGER NOT NULL DEFAULT 0)",
+      "CREATE TABLE measurement_1min(ts INTEGER PRIMARY KEY" + ChannelColumnDefs() +
+          ", n_samples INTEGER, qc_flags INTEGER NOT NULL DEFAULT 0)",
+      "CREATE TABLE calibration(id INTEGER PRIMARY KEY, run_at INTEGER NOT NULL, variant TEXT, "
+      "window_start INTEGER, window_end INTEGER, status TEXT NOT NULL, mae_p_el_w REAL, "
+      "mae_q_th_w REAL, runtime_s REAL, n_evals INTEGER, params_json TEXT, reason TEXT, "
+      "heldout_mae_w REAL, accepted INTEGER NOT NULL DEFAULT 0)",
+      "CREATE INDEX calibration_accepted ON calibration(accepted, run_at)",
+      "CREATE TABLE forecast(issued_at INTEGER NOT NULL, ts INTEGER NOT NULL, "
+      "calibration_id INTEGER REFERENCES calibration(id), p_el_w REAL, q_th_w REAL, "
+      "t_pv_c REAL, t_out_c REAL, inputs TEXT, PRIMARY KEY(issued_at, ts)) WITHOUT ROWID",
+      "CREATE INDEX forecast_by_ts ON forecast(ts, issued_at)",
+      "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c) AS "
+      "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c FROM forecast f "
+      "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)",
+      // Day-ahead pairs: for each valid measurement, the forecast row at its
+      // ts from the newest issue at or before 00:00 UTC of its day. The
+      // measurements drive the join (CROSS JOIN fixes SQLite's loop order),
+      // each looking up its forecast through forecast_by_ts.
+      "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th) AS "
+      "WITH pairs AS ("
+      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
+      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q"
+      " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
+      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+      "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+      " WHERE m.valid IS NULL OR m.valid != 0)"
+      " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
+      "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
+      "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END))"
+      " FROM pairs GROUP BY day",
+      "CREATE TABLE weather_forecast(ts INTEGER PRIMARY KEY" + ColumnDefs(kWeatherChannels) + ")",
+      "CREATE TABLE operation_plan(ts INTEGER PRIMARY KEY" + ColumnDefs(kOperationChannels) + ")",
+  };
+}
+
+// Version 2: data of a logger step above 1 min, kept at that step.
+std::vector<std::string> SchemaV2() {
+  return {"CREATE TABLE measurement_interval(ts INTEGER PRIMARY KEY, step_s INTEGER NOT NULL" +
+          ChannelColumnDefs() + ", qc_flags INTEGER NOT NULL DEFAULT 0)"};
+}
+
+// Version 3: the identified parameters of every calibration, one row each,
+// and their history with the calibration's time and acceptance.
+std::vector<std::string> SchemaV3() {
+  return {
+      "CREATE TABLE calibration_param(calibration_id INTEGER NOT NULL REFERENCES "
+      "calibration(id), name TEXT NOT NULL, value REAL, std_error REAL, unit TEXT, status TEXT, "
+      "PRIMARY KEY(calibration_id, name)) WITHOUT ROWID",
+      "CREATE VIEW parameter_history(run_at, calibration_id, accepted, name, value, std_error, "
+      "unit, status) AS SELECT c.run_at, p.calibration_id, c.accepted, p.name, p.value, "
+      "p.std_error, p.unit, p.status FROM calibration_param p JOIN calibration c ON c.id = "
+      "p.calibration_id",
+  };
+}
+
+// The QC flags of measurement_1min, one named 0/1 column each, for the
+// measurement_qc view (core/aggregate.h).
+std::string QcFlagColumns() {
+  const std::pair<const char*, unsigned> kFlags[] = {
+      {"few_samples", 0},          {"required_missing", 1}, {"rejected_values", 2},
+      {"irradiance_corrected", 3}, {"flow_corrected", 4},   {"thermal_power_computed", 5},
+      {"invalid_samples", 6},      {"imported", 7}};
+  std::string names = "ts", exprs = "ts";
+  for (const auto& [name, bit] : kFlags) {
+    names += std::string(", ") + name;
+    exprs += ", (qc_flags >> " + std::to_string(bit) + ") & 1";
+  }
+  for (const ChannelInfo& info : kChannels) {
+    if (info.channel == Channel::kValid) continue;
+    names += ", missing_" + std::string(info.name);
+    exprs += ", (qc_flags >> " +
+             std::to_string(kQcChannelMissingShift + static_cast<unsigned>(info.channel)) + ") & 1";
+  }
+  return "CREATE VIEW measurement_qc(" + names + ") AS SELECT " + exprs + " FROM measurement_1min";
+}
+
+// Version 4: what the twin watches day by day (core/monitoring.h) and the
+// one list of events an operator reads first.
+std::vector<std::string> SchemaV4() {
+  return {
+      QcFlagColumns(),
+      "CREATE TABLE performance_daily(day INTEGER PRIMARY KEY, e_el_meas_wh REAL, "
+      "e_el_model_wh REAL, e_th_meas_wh REAL, e_th_model_wh REAL, pi_el REAL, pi_th REAL, "
+      "pi_el_low REAL, pi_el_high REAL, pi_th_low REAL, pi_th_high REAL, valid_minutes INTEGER, "
+      "calibration_id INTEGER REFERENCES calibration(id))",
+      "CREATE TABLE qc_event(id INTEGER PRIMARY KEY, channel TEXT NOT NULL, start_ts INTEGER NOT "
+      "NULL, end_ts INTEGER NOT NULL, kind TEXT NOT NULL, detail TEXT)",
+      "CREATE UNIQUE INDEX qc_event_key ON qc_event(channel, kind, start_ts)",
+      "CREATE TABLE monitor_event(id INTEGER PRIMARY KEY, ts INTEGER NOT NULL, kind TEXT NOT "
+      "NULL, severity TEXT NOT NULL, message TEXT)",
+      "CREATE TABLE diagnosis(id INTEGER PRIMARY KEY, run_at INTEGER NOT NULL, calibration_id "
+      "INTEGER, window_start INTEGER, window_end INTEGER, base_variant TEXT, verdict TEXT, "
+      "low_confidence INTEGER, shrink_pct REAL, bias_p_el_w REAL, bias_q_th_w REAL, "
+      "report_json TEXT)",
+      "CREATE VIEW event(ts, kind, severity, message) AS"
+      " SELECT ts, kind, severity, message FROM monitor_event"
+      " UNION ALL SELECT start_ts, 'qc_' || kind, 'warning', channel || ': ' || detail"
+      "  FROM qc_event"
+      " UNION ALL SELECT run_at, 'calibration_' || status,"
+      "  CASE WHEN accepted = 1 THEN 'info' ELSE 'warning' END,"
+      "  'calibration ' || id || ' (' || variant || '): ' || status ||"
+      "  COALESCE(': ' || reason, '') FROM calibration"
+      " UNION ALL SELECT run_at, 'diagnosis',"
+      "  CASE WHEN verdict = 'none' THEN 'info' ELSE 'warning' END,"
+      "  'diagnosis of ' || base_variant || ': ' || verdict ||"
+      "  CASE WHEN low_confidence = 1 THEN ' (low confidence)' ELSE '' END FROM diagnosis"
+      " ORDER BY 1 DESC",
+  };
+}
+
+// Version 5: where each weather_forecast row came from (import-weather, the
+// daemon's fetch; NULL for rows other programs wrote), and the plant the
+// store belongs to, so that commands given only the store know the site.
+std::vector<std::string> SchemaV5() {
+  return {
+      "ALTER TABLE weather_forecast ADD COLUMN source TEXT",
+      "CREATE TABLE plant_config(key TEXT PRIMARY KEY, value REAL NOT NULL) WITHOUT ROWID",
+  };
+}
+
+// Version 6: forecasts with uncertainty bands and the reference forecast
+// they are scored against (issue 15, core/forecast/forecast_bands.h); the
+// views gain the bands, the skill against the reference, the band's
+// coverage and the scored minutes. Views are dropped and created again with
+// their old columns first.
+std::vector<std::string> SchemaV6() {
+  std::vector<std::string> s;
+  for (const char* column :
+       {"p_el_w_p10", "p_el_w_p90", "q_th_w_p10", "q_th_w_p90", "p_el_w_ref", "q_th_w_ref"}) {
+    s.push_back(std::string("ALTER TABLE forecast ADD COLUMN ") + column + " REAL");
+  }
+  s.push_back("DROP VIEW forecast_latest");
+  s.push_back(
+      "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c, p_el_w_p10, "
+      "p_el_w_p90, q_th_w_p10, q_th_w_p90) AS "
+      "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c, f.p_el_w_p10, "
+      "f.p_el_w_p90, f.q_th_w_p10, f.q_th_w_p90 FROM forecast f "
+      "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)");
+  s.push_back("DROP VIEW forecast_skill");
+  // The pairs of version 1, plus per minute: the reference's error where the
+  // forecast has a value, and whether the measurement lies in a band of
+  // width (NULL without one). Skill compares MAEs over the minutes where
+  // both are known; skill and coverage need kMinScoredMinutes scored minutes.
+  const std::string min_minutes = std::to_string(kMinScoredMinutes);
+  s.push_back(
+      "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, "
+      "skill_q_th, coverage_p10_p90, minutes) AS "
+      "WITH pairs AS ("
+      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
+      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
+      "  CASE WHEN f.p_el_w IS NOT NULL THEN f.p_el_w_ref - m.p_el_w END AS ref_p,"
+      "  CASE WHEN f.q_th_w IS NOT NULL THEN f.q_th_w_ref - m.q_th_w END AS ref_q,"
+      "  CASE WHEN f.p_el_w_p90 > f.p_el_w_p10 AND m.p_el_w IS NOT NULL"
+      "   THEN m.p_el_w BETWEEN f.p_el_w_p10 AND f.p_el_w_p90 END AS in_p,"
+      "  CASE WHEN f.q_th_w_p90 > f.q_th_w_p10 AND m.q_th_w IS NOT NULL"
+      "   THEN m.q_th_w BETWEEN f.q_th_w_p10 AND f.q_th_w_p90 END AS in_q"
+      " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
+      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+      "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+      " WHERE m.valid IS NULL OR m.valid != 0)"
+      " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
+      "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
+      "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END)),"
+      "  CASE WHEN COUNT(*) >= " +
+      min_minutes +
+      " THEN 1.0 -"
+      "   SUM(CASE WHEN ref_p IS NOT NULL THEN ABS(err_p) END) /"
+      "   NULLIF(SUM(CASE WHEN err_p IS NOT NULL THEN ABS(ref_p) END), 0) END,"
+      "  CASE WHEN COUNT(*) >= " +
+      min_minutes +
+      " THEN 1.0 -"
+      "   SUM(CASE WHEN ref_q IS NOT NULL THEN ABS(err_q) END) /"
+      "   NULLIF(SUM(CASE WHEN err_q IS NOT NULL THEN ABS(ref_q) END), 0) END,"
+      "  CASE WHEN COUNT(*) >= " +
+      min_minutes +
+      " THEN"
+      "   (TOTAL(in_p) + TOTAL(in_q)) / NULLIF(COUNT(in_p) + COUNT(in_q), 0) END,"
+      "  COUNT(*)"
+      " FROM pairs GROUP BY day");
+  return s;
+}
+
+// Version 7: the store's identity, a random id made once when the schema
+// reaches version 7 (at creation, or at the migration of an older store).
+// The fleet upload sends it, so that two stores under one plant_id are told
+// apart centrally (io/fleet/upload.h).
+std::vector<std::string> SchemaV7() {
+  return {
+      "CREATE TABLE store_identity(id INTEGER PRIMARY KEY CHECK(id = 1), store_id TEXT NOT NULL, "
+      "created_at INTEGER NOT NULL)",
+      "INSERT INTO store_identity(id, store_id, created_at) VALUES(1, lower(hex(randomblob(16))), "
+      "CAST(strftime('%s', 'now') AS INTEGER))",
+  };
+}
+
+// Version 8: the median of each output beside the band (the point forecast
+// is the model's run on the expected inputs; p50 = point + the median of its
+// held-out errors, core/forecast/forecast_bands.h), and the band's coverage
+// per output in forecast_skill. The views are created again with their old
+// columns first.
+std::vector<std::string> SchemaV8() {
+  std::vector<std::string> s;
+  for (const char* column : {"p_el_w_p50", "q_th_w_p50"}) {
+    s.push_back(std::string("ALTER TABLE forecast ADD COLUMN ") + column + " REAL");
+  }
+  s.push_back("DROP VIEW forecast_latest");
+  s.push_back(
+      "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c, p_el_w_p10, "
+      "p_el_w_p90, q_th_w_p10, q_th_w_p90, p_el_w_p50, q_th_w_p50) AS "
+      "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c, f.p_el_w_p10, "
+      "f.p_el_w_p90, f.q_th_w_p10, f.q_th_w_p90, f.p_el_w_p50, f.q_th_w_p50 FROM forecast f "
+      "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)");
+  s.push_back("DROP VIEW forecast_skill");
+  const std::string min_minutes = std::to_string(kMinScoredMinutes);
+  const std::string enough = " CASE WHEN COUNT(*) >= " + min_minutes + " THEN";
+  s.push_back(
+      "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, "
+      "skill_q_th, coverage_p10_p90, minutes, coverage_p_el, coverage_q_th) AS "
+      "WITH pairs AS ("
+      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
+      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
+      "  CASE WHEN f.p_el_w IS NOT NULL THEN f.p_el_w_ref - m.p_el_w END AS ref_p,"
+      "  CASE WHEN f.q_th_w IS NOT NULL THEN f.q_th_w_ref - m.q_th_w END AS ref_q,"
+      "  CASE WHEN f.p_el_w_p90 > f.p_el_w_p10 AND m.p_el_w IS NOT NULL"
+      "   THEN m.p_el_w BETWEEN f.p_el_w_p10 AND f.p_el_w_p90 END AS in_p,"
+      "  CASE WHEN f.q_th_w_p90 > f.q_th_w_p10 AND m.q_th_w IS NOT NULL"
+      "   THEN m.q_th_w BETWEEN f.q_th_w_p10 AND f.q_th_w_p90 END AS in_q"
+      " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
+      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+      "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+      " WHERE m.valid IS NULL OR m.valid != 0)"
+      " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
+      "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
+      "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END)),"
+      "  " +
+      enough +
+      " 1.0 -"
+      "   SUM(CASE WHEN ref_p IS NOT NULL THEN ABS(err_p) END) /"
+      "   NULLIF(SUM(CASE WHEN err_p IS NOT NULL THEN ABS(ref_p) END), 0) END,"
+      "  " +
+      enough +
+      " 1.0 -"
+      "   SUM(CASE WHEN ref_q IS NOT NULL THEN ABS(err_q) END) /"
+      "   NULLIF(SUM(CASE WHEN err_q IS NOT NULL THEN ABS(ref_q) END), 0) END,"
+      "  " +
+      enough +
+      "   (TOTAL(in_p) + TOTAL(in_q)) / NULLIF(COUNT(in_p) + COUNT(in_q), 0) END,"
+      "  COUNT(*),"
+      "  " +
+      enough +
+      " TOTAL(in_p) / NULLIF(COUNT(in_p), 0) END,"
+      "  " +
+      enough +
+      " TOTAL(in_q) / NULLIF(COUNT(in_q), 0) END"
+      " FROM pairs GROUP BY day");
+  return s;
+}
+
+struct Migration {
+  int to_version;
+  std::vector<std::string> (*statements)();
+};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}, {4, &SchemaV4},
+                                 {5, &SchemaV5}, {6, &SchemaV6}, {7, &SchemaV7}, {8, &SchemaV8}};
+static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
+              "one migration per schema version");
+
+}  // namespace
+
+bool Store::Impl::Migrate(std::string* error) {
+  for (const Migration& migration : kMigrations) {
+    Impl& db = *this;
+    const bool migrated = db.Run(
+        true, "migrate to schema version " + std::to_string(migration.to_version),
+        [&db, &migration]() -> DbStatus {
+          sqlite3_stmt* stmt = nullptr;
+          DbStatus s = db.Prepare("PRAGMA user_version", &stmt);
+          if (!s.ok()) return s;
+          const int src = sqlite3_step(stmt);
+          if (src != SQLITE_ROW) return db.Fail(src, "PRAGMA user_version");
+          const int version = sqlite3_column_int(stmt, 0);
+          sqlite3_reset(stmt);
+          if (version > kStoreSchemaVersion) {
+            return {SQLITE_ERROR,
+                    "schema version " + std::to_string(version) +
+                        " is newer than this pvtwin knows (" + std::to_string(kStoreSchemaVersion) +
+                        "); use a newer pvtwin",
+                    ""};
+          }
+          if (version >= migration.to_version) return {};
+          if (version != migration.to_version - 1) {
+            return {SQLITE_ERROR, "schema version " + std::to_string(version) + " is unknown", ""};
+          }
+          for (const std::string& sql : migration.statements()) {
+            s = db.Exec(sql);
+            if (!s.ok()) return s;
+          }
+          return db.Exec("PRAGMA user_version = " + std::to_string(migration.to_version));
+        },
+        error);
+    if (!migrated) return false;
+  }
+  return true;
+}
+
+}  // namespace pvtwin

@@ -3,7 +3,8 @@
 //   1. a scratch directory with the example plant and register map
 //      (config/examples/sim-plant.toml, compiled in) and a SQLite file;
 //   2. 14 days of history from the simulator's truth model (`pvtwin sim
-//      --export`), imported as 1-min rows;
+//      --export`), imported as 1-min rows, up to 08:00 UTC on the latest day
+//      on which the live part ends before the wall clock;
 //   3. `pvtwin sim` serving the plant over Modbus TCP on loopback, and the
 //      daemon loop (daemon/service/service.h) polling it, both on one accelerated
 //      clock;
@@ -58,8 +59,21 @@ struct DemoArgs {
   double speed = 60.0;
   int live_minutes = 30;
   double max_wall_s = 110.0;
-  std::string date;  // UTC day of the live part, YYYY-MM-DD; empty: today
+  std::string date;  // UTC day of the live part, YYYY-MM-DD; empty: the latest that fits
 };
+
+// The live part starts at 08:00 UTC: morning in Europe, sun up at the example
+// plant.
+constexpr std::int64_t kLiveStartOfDayS = 8 * 3600;
+
+// The simulated seconds the live part can span at most: the daemon's clock
+// runs `speed` times the wall clock for at most --max-wall seconds from the
+// demo's start, then one last loop pass and the shutdown store what the
+// poller still holds (allowed kLiveSlackWallS of wall time).
+std::int64_t LiveSpanS(const DemoArgs& a) {
+  constexpr double kLiveSlackWallS = 10.0;
+  return static_cast<std::int64_t>(std::ceil((a.max_wall_s + kLiveSlackWallS) * a.speed));
+}
 
 std::string Q(const std::string& s) { return "'" + s + "'"; }
 
@@ -258,14 +272,35 @@ bool PrepareDemo(const DemoArgs& a, DemoRun* run, int* code) {
   run->history_csv = dir / "history.csv";
   std::ofstream(run->sim_config) << kDemoPlantConfig;
 
-  // Live part of the demo starts at 08:00 UTC today or on --date (morning in
-  // Europe, sun up at the example plant); history covers the 14 days before.
-  std::int64_t day_s = static_cast<std::int64_t>(WallNowS()) / 86400 * 86400;
-  if (!a.date.empty() && !ParseTimeOrReport("--date", a.date + "T00:00:00Z", &day_s)) {
-    *code = kExitBadInput;
-    return false;
+  // The live part starts at 08:00 UTC on --date, else on the latest day on
+  // which it ends before the wall clock: the daemon stamps its 5 s samples
+  // and 1-min rows with a simulated clock `speed` times faster than the wall
+  // clock, and none may lie after the wall clock when it is written (issue
+  // 54). The history covers the 14 days before.
+  const std::int64_t now_s = static_cast<std::int64_t>(WallNowS());
+  const std::int64_t latest_t0 = now_s - LiveSpanS(a);
+  const std::int64_t latest_day_t0 =
+      (latest_t0 - kLiveStartOfDayS) / 86400 * 86400 + kLiveStartOfDayS;
+  run->t0 = latest_day_t0;
+  if (!a.date.empty()) {
+    std::int64_t day_s = 0;
+    if (!ParseTimeOrReport("--date", a.date + "T00:00:00Z", &day_s)) {
+      *code = kExitBadInput;
+      return false;
+    }
+    run->t0 = day_s / 86400 * 86400 + kLiveStartOfDayS;
+    if (run->t0 > latest_t0) {
+      std::fprintf(stderr,
+                   "--date = %s: the live part, from %s for up to %.1f h of simulated time "
+                   "(--max-wall %.0f s at --speed %.0f), would end after the wall clock (%s); "
+                   "the latest day it fits is %s\n",
+                   a.date.c_str(), FormatIsoUtc(run->t0).c_str(), LiveSpanS(a) / 3600.0,
+                   a.max_wall_s, a.speed, FormatIsoUtc(now_s).c_str(),
+                   FormatIsoUtc(latest_day_t0).substr(0, 10).c_str());
+      *code = kExitBadInput;
+      return false;
+    }
   }
-  run->t0 = day_s / 86400 * 86400 + 8 * 3600;
   if (!LoadConfigOrReport(run->sim_config.string(), &run->plant)) {
     *code = kExitRuntime;
     return false;
@@ -506,8 +541,9 @@ void RegisterDemo(CLI::App& app) {
                   "stop the live part after this many wall seconds (default 110)")
       ->check(CLI::Range(10.0, 86400.0));
   cmd->add_option("--date", args->date,
-                  "UTC day of the live part, YYYY-MM-DD (default: today), e.g. a June day to "
-                  "see the plant in summer");
+                  "UTC day of the live part, YYYY-MM-DD, from 08:00 UTC (default: the latest "
+                  "day on which it ends before now), e.g. a past June day to see the plant in "
+                  "summer");
   cmd->callback([args] { SetExitCode(RunDemo(*args)); });
 }
 

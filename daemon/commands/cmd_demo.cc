@@ -3,7 +3,8 @@
 //   1. a scratch directory with the example plant and register map
 //      (config/examples/sim-plant.toml, compiled in) and a SQLite file;
 //   2. 14 days of history from the simulator's truth model (`pvtwin sim
-//      --export`), imported as 1-min rows;
+//      --export`), imported as 1-min rows, up to 08:00 UTC on the latest day
+//      on which the live part ends before the wall clock;
 //   3. `pvtwin sim` serving the plant over Modbus TCP on loopback, and the
 //      daemon loop (daemon/service/service.h) polling it, both on one accelerated
 //      clock;
@@ -58,8 +59,21 @@ struct DemoArgs {
   double speed = 60.0;
   int live_minutes = 30;
   double max_wall_s = 110.0;
-  std::string date;  // UTC day of the live part, YYYY-MM-DD; empty: today
+  std::string date;  // UTC day of the live part, YYYY-MM-DD; empty: the latest that fits
 };
+
+// The live part starts at 08:00 UTC: morning in Europe, sun up at the example
+// plant.
+constexpr std::int64_t kLiveStartOfDayS = 8 * 3600;
+
+// The simulated seconds the live part can span at most: the daemon's clock
+// runs `speed` times the wall clock for at most --max-wall seconds from the
+// demo's start, then one last loop pass and the shutdown store what the
+// poller still holds (allowed kLiveSlackWallS of wall time).
+std::int64_t LiveSpanS(const DemoArgs& a) {
+  constexpr double kLiveSlackWallS = 10.0;
+  return static_cast<std::int64_t>(std::ceil((a.max_wall_s + kLiveSlackWallS) * a.speed));
+}
 
 std::string Q(const std::string& s) { return "'" + s + "'"; }
 
@@ -218,120 +232,184 @@ void PrintMonitoring(Store* store, const fs::path& state_dir) {
   }
 }
 
-int RunDemo(const DemoArgs& a) {
-  const double wall_start = WallNowS();
+// What the stages of the demo share: where it works and on which timeline.
+struct DemoRun {
+  double wall_start = 0.0;  // wall clock when the demo began
+  fs::path dir;             // scratch directory
+  std::string db;           // SQLite file
+  std::string exe;          // this executable, for `pvtwin sim`
+  fs::path sim_config;      // the example plant (kDemoPlantConfig)
+  fs::path history_csv;     // the exported history
+  Config plant;             // sim_config loaded
+  std::int64_t t0 = 0;      // start of the live part; history covers the 14 days before
+};
+
+// The scratch directory, the database path and the example plant; false
+// (with the exit code in *code) when the demo cannot start.
+bool PrepareDemo(const DemoArgs& a, DemoRun* run, int* code) {
+  run->wall_start = WallNowS();
   fs::path dir = a.dir;
   if (dir.empty()) {
     std::string tmpl = (fs::temp_directory_path() / "pvtwin-demo-XXXXXX").string();
     if (::mkdtemp(tmpl.data()) == nullptr) {
       std::perror("mkdtemp");
-      return kExitRuntime;
+      *code = kExitRuntime;
+      return false;
     }
     dir = tmpl;
   }
   std::error_code ec;
   fs::create_directories(dir, ec);
-  const std::string db = a.db.empty() ? (dir / "pvtwin.db").string() : fs::absolute(a.db).string();
-  if (fs::exists(db)) {
-    std::cerr << "--db = " << db << ": exists; the demo starts from an empty database\n";
-    return kExitBadInput;
+  run->dir = dir;
+  run->db = a.db.empty() ? (dir / "pvtwin.db").string() : fs::absolute(a.db).string();
+  if (fs::exists(run->db)) {
+    std::cerr << "--db = " << run->db << ": exists; the demo starts from an empty database\n";
+    *code = kExitBadInput;
+    return false;
   }
-  const std::string exe = SelfExecutable();
-  const fs::path sim_config = dir / "sim.toml";
-  std::ofstream(sim_config) << kDemoPlantConfig;
+  run->exe = SelfExecutable();
+  run->sim_config = dir / "sim.toml";
+  run->history_csv = dir / "history.csv";
+  std::ofstream(run->sim_config) << kDemoPlantConfig;
 
-  // Live part of the demo starts at 08:00 UTC today or on --date (morning in
-  // Europe, sun up at the example plant); history covers the 14 days before.
-  std::int64_t day_s = static_cast<std::int64_t>(WallNowS()) / 86400 * 86400;
-  if (!a.date.empty() && !ParseTimeOrReport("--date", a.date + "T00:00:00Z", &day_s)) {
-    return kExitBadInput;
+  // The live part starts at 08:00 UTC on --date, else on the latest day on
+  // which it ends before the wall clock: the daemon stamps its 5 s samples
+  // and 1-min rows with a simulated clock `speed` times faster than the wall
+  // clock, and none may lie after the wall clock when it is written (issue
+  // 54). The history covers the 14 days before.
+  const std::int64_t now_s = static_cast<std::int64_t>(WallNowS());
+  const std::int64_t latest_t0 = now_s - LiveSpanS(a);
+  const std::int64_t latest_day_t0 =
+      (latest_t0 - kLiveStartOfDayS) / 86400 * 86400 + kLiveStartOfDayS;
+  run->t0 = latest_day_t0;
+  if (!a.date.empty()) {
+    std::int64_t day_s = 0;
+    if (!ParseTimeOrReport("--date", a.date + "T00:00:00Z", &day_s)) {
+      *code = kExitBadInput;
+      return false;
+    }
+    run->t0 = day_s / 86400 * 86400 + kLiveStartOfDayS;
+    if (run->t0 > latest_t0) {
+      std::fprintf(stderr,
+                   "--date = %s: the live part, from %s for up to %.1f h of simulated time "
+                   "(--max-wall %.0f s at --speed %.0f), would end after the wall clock (%s); "
+                   "the latest day it fits is %s\n",
+                   a.date.c_str(), FormatIsoUtc(run->t0).c_str(), LiveSpanS(a) / 3600.0,
+                   a.max_wall_s, a.speed, FormatIsoUtc(now_s).c_str(),
+                   FormatIsoUtc(latest_day_t0).substr(0, 10).c_str());
+      *code = kExitBadInput;
+      return false;
+    }
   }
-  const std::int64_t t0 = day_s / 86400 * 86400 + 8 * 3600;
-  Config demo_plant;
-  if (!LoadConfigOrReport(sim_config.string(), &demo_plant)) return kExitRuntime;
-  std::printf("pvtwin demo: working in %s\n", dir.string().c_str());
-  std::printf("      plant: %s\n", OperationSummary(demo_plant.sim).c_str());
+  if (!LoadConfigOrReport(run->sim_config.string(), &run->plant)) {
+    *code = kExitRuntime;
+    return false;
+  }
+  return true;
+}
+
+// [1/4] 14 days of history from the simulator's truth model (`pvtwin sim
+// --export`), imported into the database as 1-min rows.
+bool SeedHistory(const DemoRun& run) {
   std::printf("[1/4] 14 days of plant history from the simulator's truth model ...\n");
   std::fflush(stdout);
-  const fs::path history_csv = dir / "history.csv";
   ChildProcess exporter;
   std::string error;
-  const std::vector<std::string> export_argv = {exe,        "sim",
-                                                "--config", sim_config.string(),
-                                                "--export", history_csv.string(),
+  const std::vector<std::string> export_argv = {run.exe,    "sim",
+                                                "--config", run.sim_config.string(),
+                                                "--export", run.history_csv.string(),
                                                 "--days",   "14",
                                                 "--step",   "60",
-                                                "--start",  std::to_string(t0 - 14 * 86400)};
+                                                "--start",  std::to_string(run.t0 - 14 * 86400)};
   int code = -1;
-  if (!exporter.Start(export_argv, (dir / "sim-export.log").string(), &error)) {
+  if (!exporter.Start(export_argv, (run.dir / "sim-export.log").string(), &error)) {
     std::cerr << error << "\n";
-    return kExitRuntime;
+    return false;
   }
   while (!exporter.Finished(&code)) ::usleep(50000);
   if (code != 0) {
-    std::cerr << "pvtwin sim --export failed; see " << (dir / "sim-export.log").string() << "\n";
-    return kExitRuntime;
+    std::cerr << "pvtwin sim --export failed; see " << (run.dir / "sim-export.log").string()
+              << "\n";
+    return false;
   }
-  {
-    Series history;
-    if (!LoadCsvOrReport(history_csv.string(), demo_plant, &history)) return kExitRuntime;
-    std::unique_ptr<Store> store = Store::Open(db, &error);
-    if (!store || !store->WriteMinutes(history, &error)) {
-      std::cerr << db << ": " << error << "\n";
-      return kExitRuntime;
-    }
-    std::printf("      %zu 1-min rows imported into %s\n", history.size(), db.c_str());
+  Series history;
+  if (!LoadCsvOrReport(run.history_csv.string(), run.plant, &history)) return false;
+  std::unique_ptr<Store> store = Store::Open(run.db, &error);
+  if (!store || !store->WriteMinutes(history, &error)) {
+    std::cerr << run.db << ": " << error << "\n";
+    return false;
   }
+  std::printf("      %zu 1-min rows imported into %s\n", history.size(), run.db.c_str());
+  return true;
+}
 
+// [2/4] `pvtwin sim` serving the plant over Modbus TCP on loopback from t0,
+// on the clock anchored at wall_anchor_s, and the daemon's config pointing at
+// its ports (written to *daemon_config).
+bool StartSimulator(const DemoRun& run, const DemoArgs& a, double wall_anchor_s, ChildProcess* sim,
+                    fs::path* daemon_config) {
   std::printf("[2/4] starting the plant simulator (Modbus TCP on loopback, clock x%.0f) ...\n",
               a.speed);
   std::fflush(stdout);
-  const double anchor = WallNowS();
-  ChildProcess sim;
+  std::string error;
   std::vector<std::string> lines;
-  const fs::path sim_log = dir / "sim.log";
-  if (!sim.StartPiped({exe, "sim", "--config", sim_config.string(), "--ephemeral-ports", "--speed",
-                       std::to_string(a.speed), "--start", std::to_string(t0), "--run-start",
-                       std::to_string(t0 - 14 * 86400), "--wall-anchor", std::to_string(anchor)},
-                      sim_log.string(), &error)) {
+  const fs::path sim_log = run.dir / "sim.log";
+  if (!sim->StartPiped(
+          {run.exe, "sim", "--config", run.sim_config.string(), "--ephemeral-ports", "--speed",
+           std::to_string(a.speed), "--start", std::to_string(run.t0), "--run-start",
+           std::to_string(run.t0 - 14 * 86400), "--wall-anchor", std::to_string(wall_anchor_s)},
+          sim_log.string(), &error)) {
     std::cerr << error << "\n";
-    return kExitRuntime;
+    return false;
   }
-  if (!sim.ReadUntil("ready", 20.0, &lines)) {
+  if (!sim->ReadUntil("ready", 20.0, &lines)) {
     std::cerr << "the simulator did not get ready within 20 s; see " << sim_log.string() << "\n";
-    return kExitRuntime;
+    return false;
   }
   for (const std::string& l : lines) {
     if (l.rfind("listening", 0) == 0) std::printf("      %s\n", l.c_str());
   }
-  const fs::path daemon_config = dir / "pvtwin.toml";
+  *daemon_config = run.dir / "pvtwin.toml";
   DaemonSettings settings;
-  settings.db_path = db;
+  settings.db_path = run.db;
   std::string config_text;
   if (!EditConfig(kDemoPlantConfig, ParseListeningLines(lines), settings, &config_text, &error)) {
     std::cerr << "demo config: " << error << "\n";
-    return kExitRuntime;
+    return false;
   }
-  std::ofstream(daemon_config) << "# Written by `pvtwin demo`: the example plant and register "
-                                  "map at the simulator's\n# loopback ports, and the daemon "
-                                  "sections.\n"
-                               << config_text;
+  std::ofstream(*daemon_config) << "# Written by `pvtwin demo`: the example plant and register "
+                                   "map at the simulator's\n# loopback ports, and the daemon "
+                                   "sections.\n"
+                                << config_text;
+  return true;
+}
 
+// How the live part ended.
+struct LiveResult {
+  int rc = 0;              // RunService's exit code
+  ServiceStatus last;      // the last status the loop reported
+  bool timed_out = false;  // cut short by --max-wall
+};
+
+// [3/4] The daemon loop polling the simulator on the same accelerated clock,
+// with a status line every 2 s of wall time, until forecasts are written and
+// live_minutes aggregated, or --max-wall.
+LiveResult RunLive(const DemoRun& run, const DemoArgs& a, double wall_anchor_s,
+                   const fs::path& daemon_config) {
   std::printf(
       "[3/4] daemon: polling every 5 s (simulated), 1-min aggregation, calibration, "
       "forecast ...\n");
   std::fflush(stdout);
   ServiceOptions options;
   options.config_path = daemon_config.string();
-  options.sim_start_s = static_cast<double>(t0);
-  options.wall_anchor_s = anchor;
+  options.sim_start_s = static_cast<double>(run.t0);
+  options.wall_anchor_s = wall_anchor_s;
   options.speed = a.speed;
-  options.exe_path = exe;
+  options.exe_path = run.exe;
   double next_print = 0.0;
-  ServiceStatus last;
-  bool timed_out = false;
+  LiveResult live;
   options.on_tick = [&](const ServiceStatus& s) {
-    last = s;
+    live.last = s;
     const bool done =
         s.forecasts > 0 && s.minutes_aggregated >= static_cast<std::uint64_t>(a.live_minutes);
     if (WallNowS() >= next_print || done) {
@@ -346,24 +424,27 @@ int RunDemo(const DemoArgs& a) {
                                        : "waiting for calibration");
       std::fflush(stdout);
     }
-    if (WallNowS() - wall_start > a.max_wall_s) {
-      timed_out = true;
+    if (WallNowS() - run.wall_start > a.max_wall_s) {
+      live.timed_out = true;
       return false;
     }
     return !done;
   };
-  const int rc = RunService(options);
-  sim.SendLine("quit");
-  sim.Stop(0, 5.0);
-  if (rc != 0) return rc;
+  live.rc = RunService(options);
+  return live;
+}
 
+// [4/4] The accepted calibration, the forecast, the monitoring, the forecast
+// skill, and the SQL to look at them.
+void PrintSummary(const DemoRun& run, const ServiceStatus& last) {
   std::printf("[4/4] summary\n");
-  std::unique_ptr<Store> store = Store::Open(db, &error);
+  std::string error;
+  std::unique_ptr<Store> store = Store::Open(run.db, &error);
   Store::CalibrationRow cal;
   bool found = false;
   if (store) store->LatestAcceptedCalibration(&cal, &found, &error);
   if (found) {
-    const double area_m2 = demo_plant.plant.area_m2;
+    const double area_m2 = run.plant.plant.area_m2;
     std::printf(
         "      calibration %lld: %s, held-out day MAE P_el %s, MAE Q_u %s, "
         "fit %.1f s, %ld simulations\n",
@@ -374,18 +455,20 @@ int RunDemo(const DemoArgs& a) {
     std::printf("      no accepted calibration (%s)\n", last.last_calibration.c_str());
   }
   std::printf("      forecast rows written: %zu (24 h at 1 min)\n", last.last_forecast_rows);
-  if (store) PrintNoonForecast(store.get(), demo_plant.plant, t0);
-  if (store) PrintMonitoring(store.get(), fs::path(db).parent_path());
+  if (store) PrintNoonForecast(store.get(), run.plant.plant, run.t0);
+  if (store) PrintMonitoring(store.get(), fs::path(run.db).parent_path());
   if (store && found) {
     Series history;
-    if (LoadCsvOrReport(history_csv.string(), demo_plant, &history)) {
-      PrintForecastSkill(store.get(), demo_plant, cal, history);
+    if (LoadCsvOrReport(run.history_csv.string(), run.plant, &history)) {
+      PrintForecastSkill(store.get(), run.plant, cal, history);
     }
   }
-  std::printf("      plant: %s\n", OperationSummary(demo_plant.sim).c_str());
+  std::printf("      plant: %s\n", OperationSummary(run.plant.sim).c_str());
   std::printf("      live polling: %llu samples, %llu 1-min rows; runtime %.0f s\n",
               static_cast<unsigned long long>(last.samples_stored),
-              static_cast<unsigned long long>(last.minutes_aggregated), WallNowS() - wall_start);
+              static_cast<unsigned long long>(last.minutes_aggregated),
+              WallNowS() - run.wall_start);
+  const std::string db = Q(run.db);
   std::printf(
       "\nThe database stays for you to explore:\n"
       "  sqlite3 %s \"SELECT datetime(ts, 'unixepoch') AS time_utc, round(p_el_w, 1) AS p_el_w,\n"
@@ -397,20 +480,41 @@ int RunDemo(const DemoArgs& a) {
       "  sqlite3 %s \"SELECT date(day, 'unixepoch') AS day, round(pi_el, 3) AS pi_el,\n"
       "    round(pi_th, 3) AS pi_th, valid_minutes FROM performance_daily;\"\n"
       "  sqlite3 %s \"SELECT name, value, std_error, unit, status FROM parameter_history;\"\n",
-      Q(db).c_str(), Q(db).c_str(), Q(db).c_str(), Q(db).c_str(), Q(db).c_str(), Q(db).c_str());
-  if (last.forecasts == 0) {
-    std::cerr << "demo: stopped after " << static_cast<long>(WallNowS() - wall_start)
+      db.c_str(), db.c_str(), db.c_str(), db.c_str(), db.c_str(), db.c_str());
+}
+
+int RunDemo(const DemoArgs& a) {
+  DemoRun run;
+  int code = kExitOk;
+  if (!PrepareDemo(a, &run, &code)) return code;
+  std::printf("pvtwin demo: working in %s\n", run.dir.string().c_str());
+  std::printf("      plant: %s\n", OperationSummary(run.plant.sim).c_str());
+  if (!SeedHistory(run)) return kExitRuntime;
+
+  // The simulator and the daemon share one clock: t0 at this wall time.
+  const double anchor = WallNowS();
+  ChildProcess sim;
+  fs::path daemon_config;
+  if (!StartSimulator(run, a, anchor, &sim, &daemon_config)) return kExitRuntime;
+  const LiveResult live = RunLive(run, a, anchor, daemon_config);
+  sim.SendLine("quit");
+  sim.Stop(0, 5.0);
+  if (live.rc != 0) return live.rc;
+
+  PrintSummary(run, live.last);
+  if (live.last.forecasts == 0) {
+    std::cerr << "demo: stopped after " << static_cast<long>(WallNowS() - run.wall_start)
               << " s without a forecast; see the log above\n";
     return kExitRuntime;
   }
-  if (timed_out) {
+  if (live.timed_out) {
     // Forecasts were written: the demo did its job, only the live part was
     // cut short by --max-wall.
     std::printf(
         "\nStopped at the wall-time limit (--max-wall %.0f s) after %llu of %d live minutes, "
         "with %s.\n",
-        a.max_wall_s, static_cast<unsigned long long>(last.minutes_aggregated), a.live_minutes,
-        ForecastsWritten(last.forecasts).c_str());
+        a.max_wall_s, static_cast<unsigned long long>(live.last.minutes_aggregated), a.live_minutes,
+        ForecastsWritten(live.last.forecasts).c_str());
   }
   return kExitOk;
 }
@@ -437,8 +541,9 @@ void RegisterDemo(CLI::App& app) {
                   "stop the live part after this many wall seconds (default 110)")
       ->check(CLI::Range(10.0, 86400.0));
   cmd->add_option("--date", args->date,
-                  "UTC day of the live part, YYYY-MM-DD (default: today), e.g. a June day to "
-                  "see the plant in summer");
+                  "UTC day of the live part, YYYY-MM-DD, from 08:00 UTC (default: the latest "
+                  "day on which it ends before now), e.g. a past June day to see the plant in "
+                  "summer");
   cmd->callback([args] { SetExitCode(RunDemo(*args)); });
 }
 

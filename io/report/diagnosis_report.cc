@@ -239,8 +239,12 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
   return j.dump(2) + "\n";
 }
 
-std::string DiagnosisReportHtml(const DiagnosisResult& r) {
-  std::ostringstream h;
+namespace {
+
+// The HTML report's sections, in the order DiagnosisReportHtml writes them.
+
+// The document head and its style sheet.
+void HtmlHead(std::ostream& h, const DiagnosisResult& r) {
   h << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
     << "<title>pvtwin gap diagnosis: " << XmlEscape(r.base_variant) << "</title>\n<style>"
     << "body{font-family:sans-serif;max-width:1000px;margin:1em auto;color:#222}"
@@ -248,6 +252,10 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
     << "font-size:13px;text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}"
     << ".verdict{font-size:1.15em;background:#fff6e0;border-left:5px solid #e0a000;padding:0.6em}"
     << ".sig{font-weight:bold;color:#0a6b0a}.note{color:#a04000}</style></head><body>\n";
+}
+
+// The title, the verdict with its advice for the site, and the notes.
+void HtmlVerdict(std::ostream& h, const DiagnosisResult& r) {
   h << "<h1>Gap diagnosis of " << XmlEscape(r.base_variant) << "</h1>\n";
   h << "<p class='verdict'><b>Verdict: " << XmlEscape(r.verdict) << ".</b> "
     << XmlEscape(r.verdict_sentence) << "</p>\n";
@@ -257,6 +265,10 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
     }
   }
   for (const std::string& n : r.notes) h << "<p class='note'>" << XmlEscape(n) << "</p>\n";
+}
+
+// Training and held-out days, the base model's held-out error and the noise floor.
+void HtmlErrorSummary(std::ostream& h, const DiagnosisResult& r) {
   std::size_t train = 0, heldout = 0;
   for (const DiagnosisDay& d : r.days) (d.heldout ? heldout : train)++;
   h << "<p>Identified on " << train << " training days, scored on " << heldout
@@ -267,7 +279,10 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
     << Fixed(r.noise.mae_p_el_w, 2) << " W and " << Fixed(r.noise.mae_q_th_w, 2)
     << " W; the final model's held-out error is " << Fixed(r.noise.ratio, 1)
     << "× that floor.</p>\n";
+}
 
+// The ladder: the base model and each effect accepted on top of it.
+void HtmlLadder(std::ostream& h, const DiagnosisResult& r) {
   h << "<h2>Ladder</h2>\n<table><tr><th class='l'>step</th><th class='l'>model</th>"
     << "<th>MAE P<sub>el</sub> W</th><th>MAE Q<sub>u</sub> W</th><th>sum W</th>"
     << "<th>objective W/m²</th><th>shrink %</th><th>loss test p</th></tr>\n";
@@ -281,7 +296,10 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
       << (k ? Fixed(s.loss_test_p, 4) : "") << "</td></tr>\n";
   }
   h << "</table>\n";
+}
 
+// Every effect tried, the ones not tried, and what each means.
+void HtmlEffectsTested(std::ostream& h, const DiagnosisResult& r) {
   h << "<h2>Effects tested</h2>\n<p>Each effect was added to the model, the model re-identified "
     << "on the training days and scored on the held-out " << XmlEscape(r.test_unit)
     << "s. Significant = named by the model selection: its confidence, the share of resamples "
@@ -319,7 +337,10 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
       << "<br><i>Evidence:</i> " << XmlEscape(t.evidence) << "</dd>";
   }
   h << "</dl></details>\n";
+}
 
+// The regimes holding more of the error than of the data.
+void HtmlWhereTheErrorLies(std::ostream& h, const DiagnosisResult& r) {
   h << "<h2>Where the error lies</h2>\n";
   if (r.where.empty()) {
     h << "<p>No regime holds a share of the error clearly beyond its share of the data.</p>\n";
@@ -337,47 +358,65 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
       << "region's share of the absolute error exceeds its share of the rows. Bias = predicted − "
       << "measured.</p>\n";
   }
+}
 
-  // Plots.
-  const DiagnosisTrace& tr = r.trace;
-  std::vector<double> t(tr.time_s.begin(), tr.time_s.end());
-  std::vector<double> rp_base, rq_base, rp_final, rq_final, abs_q, abs_p;
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    rp_base.push_back(tr.p_el_base_w[i] - tr.p_el_meas_w[i]);
-    rq_base.push_back(tr.q_th_base_w[i] - tr.q_th_meas_w[i]);
-    rp_final.push_back(tr.p_el_final_w[i] - tr.p_el_meas_w[i]);
-    rq_final.push_back(tr.q_th_final_w[i] - tr.q_th_meas_w[i]);
-    abs_q.push_back(std::fabs(rq_base.back()));
-    abs_p.push_back(std::fabs(rp_base.back()));
+// Held-out residuals (predicted − measured) of the base and final models,
+// and the base model's absolute residuals.
+struct HeldOutResiduals {
+  std::vector<double> t, rp_base, rq_base, rp_final, rq_final, abs_q, abs_p;
+};
+
+HeldOutResiduals Residuals(const DiagnosisTrace& tr) {
+  HeldOutResiduals res;
+  res.t.assign(tr.time_s.begin(), tr.time_s.end());
+  for (std::size_t i = 0; i < res.t.size(); ++i) {
+    res.rp_base.push_back(tr.p_el_base_w[i] - tr.p_el_meas_w[i]);
+    res.rq_base.push_back(tr.q_th_base_w[i] - tr.q_th_meas_w[i]);
+    res.rp_final.push_back(tr.p_el_final_w[i] - tr.p_el_meas_w[i]);
+    res.rq_final.push_back(tr.q_th_final_w[i] - tr.q_th_meas_w[i]);
+    res.abs_q.push_back(std::fabs(res.rq_base.back()));
+    res.abs_p.push_back(std::fabs(res.rp_base.back()));
   }
-  h << "<h2>Plots</h2>\n";
+  return res;
+}
+
+// Held-out residuals of Q_u and P_el over time.
+void HtmlResidualsOverTime(std::ostream& h, const DiagnosisResult& r, const HeldOutResiduals& res) {
   const bool has_final = r.final_variant != r.base_variant;
-  for (const auto& [name, base_r, final_r] :
-       {std::tuple{"Q_u", &rq_base, &rq_final}, std::tuple{"P_el", &rp_base, &rp_final}}) {
+  for (const auto& [name, base_r, final_r] : {std::tuple{"Q_u", &res.rq_base, &res.rq_final},
+                                              std::tuple{"P_el", &res.rp_base, &res.rp_final}}) {
     SvgXYOptions o;
     o.title = std::string("Held-out residual of ") + name + " (predicted − measured)";
     o.x_label = "time (UTC)";
     o.y_label = "W";
     o.x_is_unix_time = true;
-    std::vector<SvgSeries> ser = {{r.base_variant, "#d62728", t, *base_r, false}};
-    if (has_final) ser.push_back({r.final_variant, "#1f77b4", t, *final_r, false});
+    std::vector<SvgSeries> ser = {{r.base_variant, "#d62728", res.t, *base_r, false}};
+    if (has_final) ser.push_back({r.final_variant, "#1f77b4", res.t, *final_r, false});
     h << SvgXYPlot(ser, o);
   }
-  {
-    SvgHeatmap m = Heat(tr.hour_of_day, tr.aoi_deg, abs_q, Edges(0, 24, 1), Edges(0, 90, 10));
-    m.title = "Mean |Q_u residual|, hour × AOI";
-    m.x_label = "hour of local solar time";
-    m.y_label = "angle of incidence (°)";
-    m.value_label = "W";
-    h << SvgHeatmapPlot(m);
-    SvgHeatmap s =
-        Heat(tr.sun_azimuth_deg, tr.sun_elevation_deg, abs_p, Edges(30, 330, 15), Edges(0, 70, 5));
-    s.title = "Mean |P_el residual|, sun azimuth × elevation";
-    s.x_label = "sun azimuth (°, 180 = south)";
-    s.y_label = "sun elevation (°)";
-    s.value_label = "W";
-    h << SvgHeatmapPlot(s) << "<br>\n";
-  }
+}
+
+// Mean absolute residuals over hour × AOI (Q_u) and the sun's position (P_el).
+void HtmlResidualMaps(std::ostream& h, const DiagnosisTrace& tr, const HeldOutResiduals& res) {
+  SvgHeatmap m = Heat(tr.hour_of_day, tr.aoi_deg, res.abs_q, Edges(0, 24, 1), Edges(0, 90, 10));
+  m.title = "Mean |Q_u residual|, hour × AOI";
+  m.x_label = "hour of local solar time";
+  m.y_label = "angle of incidence (°)";
+  m.value_label = "W";
+  h << SvgHeatmapPlot(m);
+  SvgHeatmap s = Heat(tr.sun_azimuth_deg, tr.sun_elevation_deg, res.abs_p, Edges(30, 330, 15),
+                      Edges(0, 70, 5));
+  s.title = "Mean |P_el residual|, sun azimuth × elevation";
+  s.x_label = "sun azimuth (°, 180 = south)";
+  s.y_label = "sun elevation (°)";
+  s.value_label = "W";
+  h << SvgHeatmapPlot(s) << "<br>\n";
+}
+
+// Measured against predicted Q_u and P_el.
+void HtmlMeasuredVsPredicted(std::ostream& h, const DiagnosisResult& r) {
+  const DiagnosisTrace& tr = r.trace;
+  const bool has_final = r.final_variant != r.base_variant;
   for (const auto& [name, meas, base_pred, final_pred] :
        {std::tuple{"Q_u", &tr.q_th_meas_w, &tr.q_th_base_w, &tr.q_th_final_w},
         std::tuple{"P_el", &tr.p_el_meas_w, &tr.p_el_base_w, &tr.p_el_final_w}}) {
@@ -392,32 +431,48 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
     if (has_final) ser.push_back({r.final_variant, "#1f77b4", *meas, *final_pred, true});
     h << SvgXYPlot(ser, o);
   }
-  {
-    // Error share by regime: the bins of the drivers holding the flagged
-    // regions (or of a few standard ones).
-    std::vector<std::string> drivers;
-    for (const GapRegion& g : r.where) {
-      if (g.driver2.empty() && std::find(drivers.begin(), drivers.end(), g.driver) == drivers.end())
-        drivers.push_back(g.driver);
-    }
-    for (const char* d : {"hour_of_day", "aoi_deg", "g_poa_w_m2"}) {
-      if (drivers.size() < 3 && std::find(drivers.begin(), drivers.end(), d) == drivers.end())
-        drivers.push_back(d);
-    }
-    for (const std::string& output : {std::string("q_th"), std::string("p_el")}) {
-      std::vector<SvgBarGroup> groups;
-      for (const std::string& d : drivers) {
-        for (const GapRegion& b : r.where_bins) {
-          if (b.output != output || b.driver != d || !b.driver2.empty()) continue;
-          groups.push_back({RegionText(b), {b.share_of_rows, b.share_of_abs_error}});
-        }
-      }
-      if (groups.empty()) continue;
-      h << SvgBarPlot(std::string("Share of rows and of |error| by regime, ") +
-                          (output == "q_th" ? "Q_u" : "P_el"),
-                      {"share of rows", "share of |error|"}, {"#9aa9b8", "#d62728"}, groups);
-    }
+}
+
+// Error share by regime: the bins of the drivers holding the flagged
+// regions (or of a few standard ones).
+void HtmlErrorShareByRegime(std::ostream& h, const DiagnosisResult& r) {
+  std::vector<std::string> drivers;
+  for (const GapRegion& g : r.where) {
+    if (g.driver2.empty() && std::find(drivers.begin(), drivers.end(), g.driver) == drivers.end())
+      drivers.push_back(g.driver);
   }
+  for (const char* d : {"hour_of_day", "aoi_deg", "g_poa_w_m2"}) {
+    if (drivers.size() < 3 && std::find(drivers.begin(), drivers.end(), d) == drivers.end())
+      drivers.push_back(d);
+  }
+  for (const std::string& output : {std::string("q_th"), std::string("p_el")}) {
+    std::vector<SvgBarGroup> groups;
+    for (const std::string& d : drivers) {
+      for (const GapRegion& b : r.where_bins) {
+        if (b.output != output || b.driver != d || !b.driver2.empty()) continue;
+        groups.push_back({RegionText(b), {b.share_of_rows, b.share_of_abs_error}});
+      }
+    }
+    if (groups.empty()) continue;
+    h << SvgBarPlot(std::string("Share of rows and of |error| by regime, ") +
+                        (output == "q_th" ? "Q_u" : "P_el"),
+                    {"share of rows", "share of |error|"}, {"#9aa9b8", "#d62728"}, groups);
+  }
+}
+
+// The plots: residuals over time and over the sun's path, measured against
+// predicted, and the error's share by regime.
+void HtmlPlots(std::ostream& h, const DiagnosisResult& r) {
+  const HeldOutResiduals res = Residuals(r.trace);
+  h << "<h2>Plots</h2>\n";
+  HtmlResidualsOverTime(h, r, res);
+  HtmlResidualMaps(h, r.trace, res);
+  HtmlMeasuredVsPredicted(h, r);
+  HtmlErrorShareByRegime(h, r);
+}
+
+// Each day's role, rows and objectives, and the run's cost.
+void HtmlDays(std::ostream& h, const DiagnosisResult& r) {
   h << "<h2>Days</h2>\n<table><tr><th class='l'>day</th><th class='l'>role</th><th>rows</th>"
     << "<th>base objective W/m²</th><th>final objective W/m²</th></tr>\n";
   for (const DiagnosisDay& d : r.days) {
@@ -428,6 +483,20 @@ std::string DiagnosisReportHtml(const DiagnosisResult& r) {
   }
   h << "</table>\n<p>" << r.identifications << " identifications, " << Fixed(r.wall_time_s, 1)
     << " s.</p>\n</body></html>\n";
+}
+
+}  // namespace
+
+std::string DiagnosisReportHtml(const DiagnosisResult& r) {
+  std::ostringstream h;
+  HtmlHead(h, r);
+  HtmlVerdict(h, r);
+  HtmlErrorSummary(h, r);
+  HtmlLadder(h, r);
+  HtmlEffectsTested(h, r);
+  HtmlWhereTheErrorLies(h, r);
+  HtmlPlots(h, r);
+  HtmlDays(h, r);
   return h.str();
 }
 

@@ -1,10 +1,13 @@
 // `pvtwin demo` as a newcomer runs it, a real process: it ends with exit 0
 // once forecasts are written, says how many, and says so too when its wall
 // time limit cuts the live part short (it once wrote 19 forecasts, then
-// said "stopped ... without a forecast" and exited 1).
+// said "stopped ... without a forecast" and exited 1), and stores no minute
+// after the wall clock (issue 54).
 #include <gtest/gtest.h>
 
+#include <ctime>
 #include <regex>
+#include <string>
 
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
@@ -23,6 +26,7 @@ TEST(Demo, ALiveRunCutShortByItsTimeLimitStillSucceedsAndCountsItsForecasts) {
   const testing::ProcessResult run =
       testing::RunPvtwin(dir.path(), "demo --speed 600 --live-minutes 1100 --max-wall 30 --dir '" +
                                          (dir / "d").string() + "'");
+  const double finished_s = static_cast<double>(std::time(nullptr));
   EXPECT_EQ(run.exit_code, 0) << run.out << run.err;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(run.out, m, std::regex(R"(with (\d+) forecasts? written)")))
@@ -38,6 +42,15 @@ TEST(Demo, ALiveRunCutShortByItsTimeLimitStillSucceedsAndCountsItsForecasts) {
   // close to 1), the parameters have their history, the events their view,
   // and the summary says so with the SQL to read them.
   testing::RawDb db(dir / "d" / "pvtwin.db");
+  // The live part ran on a simulated clock 600 times the wall clock for up
+  // to 30 s (5 h simulated), yet no sample, minute or calibration it stored
+  // lies after the wall clock (issue 54: they lay hours in the future); and
+  // it ran on the latest day that allows, not years back.
+  for (const char* sql : {"SELECT max(ts) FROM sample_5s", "SELECT max(ts) FROM measurement_1min",
+                          "SELECT max(run_at) FROM calibration"}) {
+    EXPECT_LE(db.Number(sql), finished_s) << sql;
+  }
+  EXPECT_GT(db.Number("SELECT min(ts) FROM sample_5s"), finished_s - 2 * 86400);
   EXPECT_GE(db.Number("SELECT count(*) FROM performance_daily WHERE pi_el BETWEEN 0.95 AND 1.05"),
             10);
   EXPECT_GE(db.Number("SELECT count(*) FROM parameter_history WHERE accepted = 1"), 10);
@@ -68,6 +81,26 @@ TEST(Demo, ALiveRunCutShortByItsTimeLimitStillSucceedsAndCountsItsForecasts) {
       run.out, m,
       std::regex(R"(all \d+ days: skill P_el -?[0-9.]+, Q_u -?[0-9.]+; the 10-90 % band covers)")))
       << run.out;
+}
+
+// A --date whose live part would end after the wall clock is refused before
+// anything is simulated, naming the latest day that fits (issue 54): from
+// 08:00 UTC tomorrow it never fits.
+TEST(Demo, RefusesADateWhoseLivePartWouldEndAfterTheWallClock) {
+  testing::ScratchDir dir("demo_date");
+  const std::time_t tomorrow_s = std::time(nullptr) + 86400;
+  std::tm tomorrow{};
+  gmtime_r(&tomorrow_s, &tomorrow);
+  char date[16];
+  std::strftime(date, sizeof date, "%Y-%m-%d", &tomorrow);
+  const testing::ProcessResult run =
+      testing::RunPvtwin(dir.path(), std::string("demo --speed 600 --max-wall 10 --date ") + date +
+                                         " --dir '" + (dir / "d").string() + "'");
+  EXPECT_EQ(run.exit_code, 2) << run.out << run.err;
+  EXPECT_NE(run.err.find(std::string("--date = ") + date + ": the live part"), std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("the latest day it fits is "), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "d" / "pvtwin.db"));
 }
 
 }  // namespace

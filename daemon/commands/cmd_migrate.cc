@@ -31,7 +31,14 @@ int Migrate(const MigrateArgs& a) {
     return kExitBadInput;
   }
   std::unique_ptr<Store> store;
-  if (!OpenStoreOrReport(path, StoreOptionsFor(config), &store)) return kExitRuntime;
+  StoreOptions options = StoreOptionsFor(config);
+  options.log = nullptr;  // said below, on stdout
+  if (!OpenStoreOrReport(path, options, &store)) return kExitRuntime;
+  const Store::SchemaUpgrade& upgrade = store->upgrade();
+  if (upgrade.from_version != 0) {
+    std::cout << path << ": migrated store schema " << upgrade.from_version << " → "
+              << upgrade.to_version << " (backup: " << upgrade.backup_path << ")\n";
+  }
   std::cout << path << ": store schema " << kStoreSchemaVersion << "\n";
   return kExitOk;
 }
@@ -43,8 +50,9 @@ void RegisterMigrate(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "migrate",
       "Upgrade the SQLite store to this pvtwin's schema (the daemon does it when it starts;\n"
-      "export and diagnose --db only read and refuse an older store). Needs write access:\n"
-      "run it as the service user (sudo -u pvtwin). Exit 0 upgraded or already current,\n"
+      "export and diagnose --db only read and refuse an older store), after copying it to\n"
+      "<db>.schema-v<old>.bak. Needs write access: run it as the service user\n"
+      "(sudo -u pvtwin). Exit 0 upgraded or already current,\n"
       "1 the store cannot be opened or upgraded, 2 bad input.");
   cmd->add_option("--config", args->config, "TOML config whose [storage] path is the store");
   cmd->add_option("--db", args->db, "SQLite file to use instead of [storage] path");

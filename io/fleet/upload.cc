@@ -18,6 +18,8 @@
 #include <map>
 #include <set>
 
+#include "core/forecast/forecast.h"
+
 namespace pvtwin {
 
 const std::vector<UploadTable>& UploadTables() {
@@ -277,6 +279,8 @@ struct Uploader::Impl {
   std::string CentralTableDdl(const Table& t) const;
   std::string PlantLatestDdl(bool has_qc_event) const;
   static std::string EventDdl(const std::set<std::string>& present);
+  static std::string ForecastSkillDdl(const std::set<std::string>& present,
+                                      const std::set<std::string>& forecast_columns);
   bool UploadBatch(const Table& t, std::int64_t* settled, bool* full, PgError* error);
   bool ReadBatch(const Table& t, std::int64_t hwm, std::string* copy, std::int64_t* rows_sent,
                  std::int64_t* max_seq, std::int64_t* settled, std::int64_t* keep_from,
@@ -490,6 +494,72 @@ std::string Uploader::Impl::EventDdl(const std::set<std::string>& present) {
   return "CREATE OR REPLACE VIEW event(plant_id, ts, kind, severity, message) AS " + body + ";";
 }
 
+// view forecast_skill(plant_id, day, ...): the store's forecast_skill
+// (io/store/store.h) over every plant, from what is kept centrally: the
+// newest issue of each ts, scored where it was issued at or before the
+// start of the ts's UTC day (a day-ahead forecast, as the store scores).
+// Columns a plant's store does not have yet are NULL.
+std::string Uploader::Impl::ForecastSkillDdl(const std::set<std::string>& present,
+                                             const std::set<std::string>& forecast_columns) {
+  const std::string head =
+      "CREATE OR REPLACE VIEW forecast_skill(plant_id, day, mae_p_el_w, mae_q_th_w, nmae_p_el, "
+      "nmae_q_th, skill_p_el, skill_q_th, coverage_p10_p90, minutes, coverage_p_el, "
+      "coverage_q_th) AS ";
+  if (!present.count("forecast") || !present.count("measurement_1min")) {
+    return head +
+           "SELECT NULL::text, NULL::bigint, NULL::double precision, NULL::double precision, "
+           "NULL::double precision, NULL::double precision, NULL::double precision, NULL::double "
+           "precision, NULL::double precision, NULL::bigint, NULL::double precision, NULL::double "
+           "precision WHERE false;";
+  }
+  const auto f = [&forecast_columns](const std::string& column) {
+    return forecast_columns.count(column) ? "f." + column : std::string("NULL::double precision");
+  };
+  const std::string enough =
+      " CASE WHEN count(*) >= " + std::to_string(kMinScoredMinutes) + " THEN";
+  return head +
+         "WITH pairs AS (SELECT m.plant_id, m.ts - mod(mod(m.ts, 86400) + 86400, 86400) AS day,"
+         " f.p_el_w - m.p_el_w AS err_p,"
+         " CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+         " f.q_th_w - m.q_th_w AS err_q,"
+         " CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
+         " CASE WHEN f.p_el_w IS NOT NULL THEN " +
+         f("p_el_w_ref") +
+         " - m.p_el_w END AS ref_p,"
+         " CASE WHEN f.q_th_w IS NOT NULL THEN " +
+         f("q_th_w_ref") +
+         " - m.q_th_w END AS ref_q,"
+         " CASE WHEN " +
+         f("p_el_w_p90") + " > " + f("p_el_w_p10") +
+         " AND m.p_el_w IS NOT NULL THEN (m.p_el_w BETWEEN " + f("p_el_w_p10") + " AND " +
+         f("p_el_w_p90") +
+         ")::int END AS in_p,"
+         " CASE WHEN " +
+         f("q_th_w_p90") + " > " + f("q_th_w_p10") +
+         " AND m.q_th_w IS NOT NULL THEN (m.q_th_w BETWEEN " + f("q_th_w_p10") + " AND " +
+         f("q_th_w_p90") +
+         ")::int END AS in_q"
+         " FROM measurement_1min m JOIN forecast f ON f.plant_id = m.plant_id AND f.ts = m.ts"
+         " AND f.issued_at <= m.ts - mod(mod(m.ts, 86400) + 86400, 86400)"
+         " WHERE m.valid IS NULL OR m.valid <> 0)"
+         " SELECT plant_id, day, avg(abs(err_p)), avg(abs(err_q)),"
+         " avg(abs(err_p)) / nullif(avg(abs(CASE WHEN err_p IS NOT NULL THEN meas_p END)), 0),"
+         " avg(abs(err_q)) / nullif(avg(abs(CASE WHEN err_q IS NOT NULL THEN meas_q END)), 0)," +
+         enough +
+         " 1.0 - sum(CASE WHEN ref_p IS NOT NULL THEN abs(err_p) END) /"
+         " nullif(sum(CASE WHEN err_p IS NOT NULL THEN abs(ref_p) END), 0) END," +
+         enough +
+         " 1.0 - sum(CASE WHEN ref_q IS NOT NULL THEN abs(err_q) END) /"
+         " nullif(sum(CASE WHEN err_q IS NOT NULL THEN abs(ref_q) END), 0) END," +
+         enough +
+         " (coalesce(sum(in_p), 0) + coalesce(sum(in_q), 0))::double precision /"
+         " nullif(count(in_p) + count(in_q), 0) END,"
+         " count(*)," +
+         enough + " sum(in_p)::double precision / nullif(count(in_p), 0) END," + enough +
+         " sum(in_q)::double precision / nullif(count(in_q), 0) END"
+         " FROM pairs GROUP BY plant_id, day;";
+}
+
 // True when the schema version, every table and column and the view exist
 // (then a role without CREATE can upload).
 bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
@@ -503,10 +573,10 @@ bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
   for (const auto& r : rows) central[r[0]].push_back(r[1]);
   if (!CheckLostTables(central, error)) return false;
   const auto plant = central.find("plant");
-  *complete = central.count("pvtwin_schema") && plant != central.end() &&
-              std::find(plant->second.begin(), plant->second.end(), "store_id") !=
-                  plant->second.end() &&
-              central.count("plant_latest") && central.count("event");
+  *complete =
+      central.count("pvtwin_schema") && plant != central.end() &&
+      std::find(plant->second.begin(), plant->second.end(), "store_id") != plant->second.end() &&
+      central.count("plant_latest") && central.count("event") && central.count("forecast_skill");
   for (const Table& t : tables) {
     const auto it = central.find(std::string(t.spec->name));
     if (it == central.end()) {
@@ -556,9 +626,9 @@ bool Uploader::Impl::CheckLostTables(const std::map<std::string, std::vector<std
       return false;
     }
     const auto it = central.find(name);
-    const std::string counts = std::to_string(uploaded) + " rows of plant_id " +
-                               settings.plant_id + " were uploaded into it and " +
-                               std::to_string(pending) + " are queued";
+    const std::string counts = std::to_string(uploaded) + " rows of plant_id " + settings.plant_id +
+                               " were uploaded into it and " + std::to_string(pending) +
+                               " are queued";
     if (it == central.end()) {
       if (uploaded == 0) continue;  // new to this plant: MigrateCentral creates it
       *error = {PgFault::kRefused,
@@ -641,6 +711,19 @@ bool Uploader::Impl::MigrateCentral(PgError* error) {
   }
   std::set<std::string> present;
   for (const auto& r : rows) present.insert(r[0]);
+  // The forecast columns there will be: those other plants brought, and this
+  // plant's.
+  if (!pg->Query("SELECT column_name FROM information_schema.columns WHERE table_schema = "
+                 "current_schema() AND table_name = 'forecast'",
+                 {}, &rows, error)) {
+    return fail("creating the central schema: ");
+  }
+  std::set<std::string> forecast_columns;
+  for (const auto& r : rows) forecast_columns.insert(r[0]);
+  for (const Table& t : tables) {
+    if (t.spec->name != "forecast") continue;
+    for (const Column& c : t.columns) forecast_columns.insert(c.name);
+  }
   std::string sql =
       "CREATE TABLE IF NOT EXISTS pvtwin_schema(version integer PRIMARY KEY, "
       "applied_at timestamptz NOT NULL DEFAULT now());";
@@ -656,6 +739,8 @@ bool Uploader::Impl::MigrateCentral(PgError* error) {
   sql += PlantLatestDdl(present.count("qc_event") > 0);
   // Version 3: the event view, as the store's.
   sql += EventDdl(present);
+  // Version 4: the forecast_skill view, as the store's.
+  sql += ForecastSkillDdl(present, forecast_columns);
   sql += "INSERT INTO pvtwin_schema(version) VALUES(" + std::to_string(kCentralSchemaVersion) +
          ") ON CONFLICT DO NOTHING; COMMIT;";
   return pg->Exec(sql, error) || fail("creating the central schema: ");
@@ -897,7 +982,8 @@ void Uploader::RecordState(UploadState state, const std::string& last_error, boo
   // ?1 state, ?2 server, ?3 last error ('' keeps the previous one).
   std::string sql =
       "INSERT INTO upload_connection(id, state, since, server, last_error, last_error_at) "
-      "VALUES(1, ?1, " + now + ", ?2, NULLIF(?3, ''), CASE WHEN ?3 = '' THEN NULL ELSE " + now +
+      "VALUES(1, ?1, " +
+      now + ", ?2, NULLIF(?3, ''), CASE WHEN ?3 = '' THEN NULL ELSE " + now +
       " END) ON CONFLICT(id) DO UPDATE SET since = CASE WHEN state = ?1 THEN since ELSE " + now +
       " END, state = ?1, server = ?2, last_error = CASE WHEN ?3 = '' THEN last_error ELSE ?3 END, "
       "last_error_at = CASE WHEN ?3 = '' THEN last_error_at ELSE " +

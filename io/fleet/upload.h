@@ -51,6 +51,15 @@
 //   view event(plant_id, ts, kind, severity, message) (version 3): the
 //       store's event view over every plant (monitor_event, qc_event,
 //       calibration, diagnosis, as far as they exist centrally).
+//   view forecast_skill(plant_id, day, mae_p_el_w, mae_q_th_w, nmae_p_el,
+//       nmae_q_th, skill_p_el, skill_q_th, coverage_p10_p90, minutes,
+//       coverage_p_el, coverage_q_th) (version 4): the store's forecast_skill
+//       per plant and UTC day, with the same columns and rules, over the
+//       rows kept centrally: since forecast keeps only the newest issue of
+//       each ts, a minute is scored only where that issue was made at or
+//       before 00:00 UTC of its day (a plant that re-issues during the day
+//       has fewer scored minutes centrally than in its store; the store's
+//       view is the reference).
 // A session advisory lock per plant_id lets one uploader at a time send a
 // plant's rows (a second one, or two plants configured with one plant_id,
 // is refused with a message).
@@ -75,7 +84,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kCentralSchemaVersion = 3;
+inline constexpr int kCentralSchemaVersion = 4;
 
 // One uploaded table. Adding a table of the store to the fleet is one entry
 // of UploadTables().

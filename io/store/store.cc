@@ -18,14 +18,19 @@ Store::~Store() = default;
 
 const std::string& Store::path() const { return impl_->path; }
 
+const Store::SchemaUpgrade& Store::upgrade() const { return impl_->upgrade; }
+
 bool Store::BackupTo(const std::string& target_path, std::string* error) {
-  Impl& db = *impl_;
-  std::lock_guard lock(db.mutex);
+  std::lock_guard lock(impl_->mutex);
+  return impl_->BackupTo(target_path, error);
+}
+
+bool Store::Impl::BackupTo(const std::string& target_path, std::string* error) {
   sqlite3* target = nullptr;
   int rc = sqlite3_open_v2(target_path.c_str(), &target, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
                            nullptr);
   if (rc == SQLITE_OK) {
-    sqlite3_backup* backup = sqlite3_backup_init(target, "main", db.db, "main");
+    sqlite3_backup* backup = sqlite3_backup_init(target, "main", db, "main");
     if (backup == nullptr) {
       rc = sqlite3_errcode(target);
     } else {

@@ -186,6 +186,7 @@
 #include "core/common/series.h"
 #include "core/data/aggregate.h"
 #include "core/monitor/monitoring.h"
+#include "io/platform/log.h"
 
 namespace pvtwin {
 
@@ -202,6 +203,11 @@ struct StoreOptions {
   int busy_retries = 2;
   // How AggregateMinutes averages: poll period and fluid c_p (plant config).
   AggregateOptions aggregate;
+  // Where Open says that it migrates an existing store (one kNotice line,
+  // "<db>: migrating store schema <old> → <new> (backup: <db>.schema-v<old>.bak)"):
+  // the daemon's log on stderr unless the caller says otherwise; empty:
+  // silent (Store::upgrade() tells the same).
+  LogFn log = LogToStderr;
 };
 
 class Store {
@@ -249,9 +255,21 @@ class Store {
     double coverage_p_el = kNoValue, coverage_q_th = kNoValue;  // version 8
   };
 
-  // Opens (creating if needed) and migrates the database at path. Returns
-  // null and sets *error when it cannot be opened, is not a pvtwin database
-  // of a known version, or the migration fails.
+  // What Open did to the schema of an existing store.
+  struct SchemaUpgrade {
+    int from_version = 0;  // 0: nothing migrated (a new or a current store)
+    int to_version = 0;
+    std::string backup_path;  // the copy made before migrating
+  };
+
+  // Opens (creating if needed) and migrates the database at path. Before it
+  // migrates an existing store (user_version 1 … kStoreSchemaVersion − 1,
+  // not at creation) it copies it with SQLite's online backup to
+  // "<path>.schema-v<old>.bak" (".schema-v<old>.<n>.bak" when that file
+  // exists already, never overwriting one) and logs one line through
+  // options.log; no backup, no migration. Returns null and sets *error when
+  // it cannot be opened, is not a pvtwin database of a known version, the
+  // backup or the migration fails.
   static std::unique_ptr<Store> Open(const std::string& path, std::string* error);
   static std::unique_ptr<Store> Open(const std::string& path, const StoreOptions& options,
                                      std::string* error);
@@ -271,6 +289,8 @@ class Store {
   Store& operator=(const Store&) = delete;
 
   const std::string& path() const;
+  // What Open's migration did (from_version 0 when it migrated nothing).
+  const SchemaUpgrade& upgrade() const;
 
   // Copies the database, as this connection sees it, into a new file at
   // target_path with SQLite's online backup (the rescue of a store whose

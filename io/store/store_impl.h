@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "core/common/units.h"
+#include "io/platform/log.h"
 #include "io/store/store.h"
 
 namespace pvtwin {
@@ -130,6 +131,8 @@ struct Store::Impl {
   // of the first minute not yet known to be done in this process (the whole
   // table after Open).
   std::int64_t aggregate_scan_from = store_detail::kNoLowerBound;
+  // What Open's migration did (Store::upgrade).
+  SchemaUpgrade upgrade;
 
   ~Impl() {
     for (auto& [sql, stmt] : statements) sqlite3_finalize(stmt);
@@ -307,8 +310,11 @@ struct Store::Impl {
   }
 
   // Runs the migrations the store's user_version lacks, each in its own
-  // transaction (store_schema.cc).
+  // transaction, after a backup of an existing store (store_schema.cc).
   bool Migrate(std::string* error);
+  // Copies the database as this connection sees it into target_path
+  // (SQLite's online backup; Store::BackupTo without the lock).
+  bool BackupTo(const std::string& target_path, std::string* error);
   // Writes the rows of `minutes` into measurement_1min (inside a transaction).
   DbStatus WriteMinuteRows(const MinuteRows& minutes, bool replace, bool imported);
   DbStatus InsertCalibrationParams(std::int64_t calibration_id,

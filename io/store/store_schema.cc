@@ -3,7 +3,10 @@
 // of io/store/store.h and in doc/sql.md).
 #include <sqlite3.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -294,9 +297,51 @@ const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3},
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 
+// The schema version of the open store (PRAGMA user_version), -1 when it
+// cannot be read.
+int UserVersion(sqlite3* db) {
+  int version = -1;
+  sqlite3_exec(
+      db, "PRAGMA user_version",
+      [](void* out, int, char** values, char**) {
+        *static_cast<int*>(out) = values[0] ? std::atoi(values[0]) : 0;
+        return 0;
+      },
+      &version, nullptr);
+  return version;
+}
+
+// "<db>.schema-v<version>.bak", or the first "<db>.schema-v<version>.<n>.bak"
+// that does not exist: an earlier backup is never overwritten.
+std::string BackupPathFor(const std::string& db_path, int version) {
+  const std::string stem = db_path + ".schema-v" + std::to_string(version);
+  std::string candidate = stem + ".bak";
+  for (int n = 1; std::filesystem::exists(candidate); ++n) {
+    candidate = stem + "." + std::to_string(n) + ".bak";
+  }
+  return candidate;
+}
+
 }  // namespace
 
 bool Store::Impl::Migrate(std::string* error) {
+  const int version = UserVersion(db);
+  if (version > 0 && version < kStoreSchemaVersion) {
+    const std::string backup = BackupPathFor(path, version);
+    std::string why;
+    if (!BackupTo(backup, &why)) {
+      std::error_code ignored;
+      std::filesystem::remove(backup, ignored);
+      *error = path + ": not migrating store schema " + std::to_string(version) + " → " +
+               std::to_string(kStoreSchemaVersion) + " without a backup: " + why;
+      return false;
+    }
+    upgrade = {version, kStoreSchemaVersion, backup};
+    if (options.log) {
+      options.log(kNotice, path + ": migrating store schema " + std::to_string(version) + " → " +
+                               std::to_string(kStoreSchemaVersion) + " (backup: " + backup + ")");
+    }
+  }
   for (const Migration& migration : kMigrations) {
     Impl& db = *this;
     const bool migrated = db.Run(

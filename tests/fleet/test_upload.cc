@@ -847,5 +847,68 @@ TEST_F(Upload, TheGrafanaDashboardsQueriesRunOnTheStoreAndTheFleetDatabase) {
             1);
 }
 
+// The central forecast_skill view scores as the store's view does: with one
+// issue made before the day began, its row of the day equals the store's,
+// column for column. A later issue of some minutes replaces the earlier one
+// centrally (forecast keeps the newest issue of each ts) and, made during
+// the day, is no day-ahead forecast: centrally those minutes are not scored,
+// while the store still scores them with the earlier issue.
+TEST_F(Upload, TheCentralForecastSkillViewScoresAsTheStoresView) {
+  WritePlant("skill", "");
+  const std::int64_t day = kMorning - 8 * 3600;  // 00:00 UTC
+  Import("skill", day, 1, 60, 3);
+  const std::string d = std::to_string(day);
+  {
+    RawDb db(Db("skill"));
+    // A day-ahead issue at 00:00 UTC: forecast, band and reference made
+    // from the measurement, so that every column has a value.
+    ASSERT_EQ(db.Exec("INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w, p_el_w_p10, p_el_w_p90, "
+                      "q_th_w_p10, q_th_w_p90, p_el_w_ref, q_th_w_ref) SELECT " +
+                      d +
+                      ", ts, p_el_w * 1.1 + 5, q_th_w * 0.9 - 3, p_el_w * 1.1 - 15, "
+                      "p_el_w * 1.1 + 8, q_th_w * 0.9 - 40, q_th_w * 0.9 + 2, p_el_w * 0.7, "
+                      "q_th_w * 0.6 + 10 FROM measurement_1min WHERE ts >= " +
+                      d + " AND ts < " + d + " + 86400"),
+              SQLITE_OK);
+  }
+  auto run = UploadOnce("skill");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const char* kColumns =
+      "day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
+      "coverage_p10_p90, minutes, coverage_p_el, coverage_q_th";
+  const auto expect_equal_rows = [&](const std::string& what) {
+    const auto local = LocalRows(
+        Db("skill"), std::string("SELECT ") + kColumns + " FROM forecast_skill ORDER BY day");
+    const auto central = pg_.Query(std::string("SELECT ") + kColumns +
+                                       " FROM forecast_skill WHERE plant_id = 'skill' ORDER BY day",
+                                   "fleet");
+    ASSERT_EQ(local.size(), 1u) << what;
+    ASSERT_EQ(central.size(), 1u) << what << ": " << (central.empty() ? "" : central[0][0]);
+    for (std::size_t c = 0; c < local[0].size(); ++c) {
+      ASSERT_NE(local[0][c].type, SQLITE_NULL) << what << ": local column " << c << " is NULL";
+      const double x =
+          local[0][c].type == SQLITE_INTEGER ? static_cast<double>(local[0][c].i) : local[0][c].x;
+      EXPECT_NEAR(std::strtod(central[0][c].c_str(), nullptr), x, 1e-9 * (1.0 + std::fabs(x)))
+          << what << ": column " << c << " central " << central[0][c];
+    }
+  };
+  expect_equal_rows("one day-ahead issue");
+  EXPECT_EQ(Central("SELECT minutes FROM forecast_skill WHERE plant_id = 'skill'"), 1440);
+
+  // An issue at 12:00 for the afternoon's 600 minutes.
+  const std::string noon = std::to_string(day + 12 * 3600);
+  {
+    RawDb db(Db("skill"));
+    ASSERT_EQ(db.Exec("INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w) SELECT " + noon +
+                      ", ts, p_el_w, q_th_w FROM measurement_1min WHERE ts >= " + noon +
+                      " AND ts < " + noon + " + 600 * 60"),
+              SQLITE_OK);
+    EXPECT_EQ(db.Number("SELECT minutes FROM forecast_skill"), 1440.0);
+  }
+  run = UploadOnce("skill");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(Central("SELECT minutes FROM forecast_skill WHERE plant_id = 'skill'"), 1440 - 600);
+}
+
 }  // namespace
 }  // namespace pvtwin

@@ -1,0 +1,109 @@
+// The forecast job of the Service (service_internal.h): a banded forecast
+// issued every [forecast] refresh_min and after each accepted calibration,
+// with what the window teaches replayed once per day and calibration.
+#include <cmath>
+
+#include "core/forecast/forecast.h"
+#include "core/forecast/forecast_bands.h"
+#include "daemon/service/service_internal.h"
+#include "io/platform/log.h"
+#include "io/platform/time_format.h"
+
+namespace pvtwin::service_detail {
+
+void Service::IssueForecast() {
+  if (!have_params_) return;
+  const double now = Now();
+  next_forecast_s_ = now + config_.forecast.refresh_min * 60.0;
+  ForecastRequest request;
+  request.issued_at_s = static_cast<std::int64_t>(std::floor(now / 60.0)) * 60;
+  request.horizon_s = config_.forecast.horizon_h * 3600.0;
+  const std::int64_t horizon_end =
+      request.issued_at_s + static_cast<std::int64_t>(request.horizon_s);
+  Series history, weather, plan;
+  std::string error;
+  const std::int64_t history_from = request.issued_at_s - config_.calibration.window_days * kDayS;
+  Store::TextCells weather_text, plan_text;
+  if (!store_->ReadMinutes(history_from, request.issued_at_s, &history, &error) ||
+      !store_->ReadWeatherForecast(request.issued_at_s, horizon_end, &weather, &error,
+                                   &weather_text) ||
+      !store_->ReadOperationPlan(request.issued_at_s, horizon_end, &plan, &error, &plan_text)) {
+    LogToStderr(kErr, "forecast inputs could not be read: " + error);
+    return;
+  }
+  // Text where a number belongs (an `sqlite3 .import` of empty cells): read
+  // as missing, said once for as long as it stays the same.
+  const std::string text_warning = weather_text.Warning("weather_forecast") +
+                                   (weather_text.Total() && plan_text.Total() ? "; " : "") +
+                                   plan_text.Warning("operation_plan");
+  if (text_warning != text_cells_warned_ && !text_warning.empty()) {
+    LogToStderr(kWarning, "forecast inputs: " + text_warning);
+  }
+  text_cells_warned_ = text_warning;
+  UpdateForecastStats(history, request);
+  BandedForecast banded;
+  if (!MakeBandedForecast(config_.plant, spec_, params_, history, weather, plan, request,
+                          forecast_stats_, &banded, &error)) {
+    LogToStderr(kWarning, "no forecast issued: " + error);
+    return;
+  }
+  Forecast& forecast = banded.forecast;
+  if (weather.size() > 0 && !store_->ReadWeatherSources(request.issued_at_s, horizon_end,
+                                                        &forecast.inputs.weather_sources, &error)) {
+    LogToStderr(kWarning, "the weather_forecast sources could not be read: " + error);
+  }
+  std::vector<Store::ForecastRow> rows(forecast.rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    Store::ForecastRow& r = rows[i];
+    r.ts = forecast.rows.time_s[i];
+    r.p_el_w = forecast.rows[Channel::kPElW][i];
+    r.q_th_w = forecast.rows[Channel::kQThW][i];
+    r.t_pv_c = forecast.rows[Channel::kTPvC][i];
+    r.t_out_c = forecast.rows[Channel::kTOutC][i];
+    r.p_el_w_p10 = banded.bands.p_el_p10[i];
+    r.p_el_w_p90 = banded.bands.p_el_p90[i];
+    r.q_th_w_p10 = banded.bands.q_th_p10[i];
+    r.q_th_w_p90 = banded.bands.q_th_p90[i];
+    r.p_el_w_p50 = banded.bands.p_el_p50[i];
+    r.q_th_w_p50 = banded.bands.q_th_p50[i];
+    r.p_el_w_ref = forecast.reference[Channel::kPElW][i];
+    r.q_th_w_ref = forecast.reference[Channel::kQThW][i];
+  }
+  const std::string inputs = banded.Inputs();
+  if (!store_->InsertForecast(request.issued_at_s, params_id_, inputs, rows, &error)) {
+    LogToStderr(kErr, "writing the forecast failed: " + error);
+    return;
+  }
+  ++status_.forecasts;
+  status_.last_forecast_rows = rows.size();
+  LogToStderr(kInfo, "forecast issued at " + FormatIsoUtc(request.issued_at_s) + ": " +
+                         std::to_string(rows.size()) + " rows, calibration " +
+                         std::to_string(params_id_) + "; " + inputs);
+}
+
+void Service::UpdateForecastStats(const Series& history, const ForecastRequest& request) {
+  const std::int64_t day = request.issued_at_s - ((request.issued_at_s % kDayS) + kDayS) % kDayS;
+  if (request.issued_at_s == forecast_stats_issued_at_ && params_id_ == forecast_stats_params_id_) {
+    return;
+  }
+  forecast_stats_issued_at_ = request.issued_at_s;
+  forecast_stats_params_id_ = params_id_;
+  Series past_weather;
+  std::string error;
+  if (!store_->ReadWeatherForecast(history.size() ? history.time_s.front() : day, day + kDayS,
+                                   &past_weather, &error) ||
+      !ReplayWindow(config_.plant, spec_, params_, history, past_weather, request, &forecast_stats_,
+                    &error)) {
+    // Forecasts go on without bands and with the typical day until the
+    // next day or calibration tries again.
+    forecast_stats_ = ForecastWindowStats{};
+    LogToStderr(kWarning,
+                "the forecast's window could not be replayed (forecasts without bands until the "
+                "next day or calibration): " +
+                    error);
+    return;
+  }
+  LogToStderr(kInfo, forecast_stats_.operation.Describe());
+}
+
+}  // namespace pvtwin::service_detail

@@ -1,6 +1,8 @@
 // The model parameters: one table with name, unit, start value and the range
 // searched by identification (paper Table 3). Everything that needs to know a
-// parameter (the model, identification, params.json, the CLI) reads it here.
+// parameter (the model, identification, params.json, the CLI, the effect
+// modules) reads it here; the table, the slots and the effect each slot
+// belongs to derive from one list, core/common/param_list.inc.
 //
 // Normalisation (per m² of collector, as in Table 3):
 //  * Conductances U are W/(m²·K) and capacitances C are J/(m²·K); the model
@@ -26,48 +28,17 @@
 #include <cstddef>
 #include <optional>
 #include <string_view>
+#include <vector>
 
+#include "core/common/effect_list.h"
 #include "core/common/plant.h"
 
 namespace pvtwin {
 
+// One slot per row of core/common/param_list.inc, in its order.
 enum class Param : std::size_t {
-  kAreaM2,           // A_PVT
-  kEpsPvt,           // ε_PVT, long-wave emittance
-  kEtaPvRef,         // η_PVref
-  kFTh,              // F_th, thermal efficiency factor
-  kUFrontWM2K,       // U_front
-  kUBackWM2K,        // U_back
-  kUCollWM2K,        // U_coll (2-node only)
-  kR0FluidM2KW,      // r0_fluid
-  kR1Fluid,          // r1_fluid (dimensionless, see above)
-  kCPvJM2K,          // C_PV
-  kCCollJM2K,        // C_coll
-  kRRefWind,         // r_refwind, (m²K/W)/(m/s)^n
-  kNWind,            // n_wind
-  kUWindWM2K,        // physical wind form: W/(m²K)/(m/s)^n
-  kPvTempCoeffPerK,  // f_corr_T (fixed by default, from the plant config)
-  kPvIrrCoeffM2W,    // f_corr_I (fixed by default, from the plant config)
-  kTransportDelayS,  // effect transport_delay: inlet-to-outlet dead time
-  // Parameters of the effect modules (core/effects/<effect>.h, which list
-  // them in EffectModule::params); appended so that the indices above keep
-  // their meaning. Each is a slot of the fixed-size ParamVector, so that the
-  // simulation loop never allocates: a new effect's parameter adds a slot
-  // here and a row in params.cc.
-  kUPipeWM2K,          // transport_delay: pipe loss to ambient, W/(m²K) of collector
-  kNFlow,              // flow_dependent_u: exponent of the fluid-side resistance on flow
-  kPLimitWM2,          // pv_clipping: inverter AC limit per m² of collector, W/m²
-  kShadeAzimuthRad,    // shading: centre of the obstacle's azimuth window
-  kShadeWidthRad,      // shading: full width of the azimuth window
-  kShadeElevationRad,  // shading: elevation of the obstacle's upper edge
-  kShadeMismatch,      // shading: extra P_el loss per shaded fraction (bypass diodes)
-  kSoilingPerDay,      // soiling: transmittance loss per day since cleaning
-  kClockOffsetS,       // clock_offset: weather clock behind the collector clock
-  kIrradianceBias,     // irradiance_bias: pyranometer scale error k
-  kSkyCloudOffset,     // sky_radiation (broader form): cloud fraction beyond the logged sky's
-  kPipePlugKgM2,       // transport_delay (pipe_volume form): plug-flow fluid mass per m²
-  kPipeMixKgM2,        // transport_delay (pipe_volume form): mixed fluid mass per m²
-  kIamB0Fit,           // iam (fitted form "+iam"): ASHRAE coefficient b0
+#define PVTWIN_PARAM(id, ...) id,
+#include "core/common/param_list.inc"
   kCount
 };
 
@@ -107,5 +78,29 @@ ParamInfo ResolvedInfo(Param p, const Plant& plant);
 ParamVector StartParams(const Plant& plant);
 
 std::optional<Param> ParamFromName(std::string_view name);
+
+namespace param_owner {
+// The owner column of param_list.inc: Base, or an effect's CamelCase name.
+inline constexpr std::optional<Effect> Base = std::nullopt;
+#define PVTWIN_PARAM_OWNER(name, Name) \
+  inline constexpr std::optional<Effect> Name = Effect::k##Name;
+PVTWIN_EFFECTS(PVTWIN_PARAM_OWNER)
+#undef PVTWIN_PARAM_OWNER
+}  // namespace param_owner
+
+// The effect whose module adds each parameter (param_list.inc's owner
+// column); nullopt: the base model's own.
+inline constexpr std::array<std::optional<Effect>, kNumParams> kParamEffect = {
+#define PVTWIN_PARAM(id, owner, ...) param_owner::owner,
+#include "core/common/param_list.inc"
+};
+
+inline constexpr std::optional<Effect> EffectOfParam(Param p) {
+  return kParamEffect[static_cast<std::size_t>(p)];
+}
+
+// The parameters effect e adds, in slot order: its module's
+// EffectModule::params.
+std::vector<Param> EffectParams(Effect e);
 
 }  // namespace pvtwin

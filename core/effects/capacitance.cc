@@ -31,7 +31,7 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) {
 const EffectModule& CapacitanceEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "capacitance";
+    m.name = EffectName(Effect::kCapacitance);
     m.physics =
         "Thermal mass of the PV laminate, absorber and fluid content: the collector "
         "temperature lags behind changes of irradiance, inlet temperature and flow, "
@@ -39,7 +39,7 @@ const EffectModule& CapacitanceEffect() {
         "C·dT/dt in the node balance). Without it the model answers cloud edges and pump "
         "starts instantly.";
     m.source = "paper 2.2 (node balance C·dT/dt) and 2.10 (capacitance placement)";
-    m.params = {Param::kCPvJM2K, Param::kCCollJM2K};
+    m.params = EffectParams(Effect::kCapacitance);
     m.typical_truth = {{Param::kCPvJM2K, 1.2e4}, {Param::kCCollJM2K, 3.5e4}};
     m.signature = "rate of change of the absorbed irradiance, W/m² per minute";
     m.advice =

@@ -171,7 +171,7 @@ std::string OffsetAdvice(const ModelSpec&, const ParamVector& p, const Plant&) {
 const EffectModule& ClockOffsetEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "clock_offset";
+    m.name = EffectName(Effect::kClockOffset);
     m.physics =
         "The weather station's logger clock differs from the collector logger's: the "
         "weather the collector saw at time t is the weather row stamped t + Δt. The "
@@ -180,7 +180,7 @@ const EffectModule& ClockOffsetEffect() {
         "collector clock. Residuals follow the rate of change of irradiance with a sign "
         "that flips between morning and afternoon.";
     m.source = "IEC 61724-1 (PV performance monitoring: synchronised time stamps of all channels)";
-    m.params = {Param::kClockOffsetS};
+    m.params = EffectParams(Effect::kClockOffset);
     m.typical_truth = {{Param::kClockOffsetS, 300.0}};
     m.signature = "rate of change of the absorbed irradiance, W/m² per minute";
     m.advice =

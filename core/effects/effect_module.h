@@ -1,5 +1,6 @@
 // core/effects/: one module per effect of doc/contracts.md's effect vocabulary
-// (capacitance, second_node, …, irradiance_bias), the registration list
+// (capacitance, second_node, …, irradiance_bias; the one list of them is
+// core/common/effect_list.h), the registry expanded from that list
 // (registry.cc) and the generic library functions that ask the modules
 // (effects.h).
 //
@@ -7,12 +8,14 @@
 // (core/model/), the fit, the synthetic plant and the diagnosis depend on
 // it and ask a module what differs between effects; none of them names an
 // effect. Adding an effect = one new module (a .h/.cc pair here, its tests
-// in tests/unit/) plus one line in registry.cc.
+// in tests/unit/) plus its line in the list of effects
+// (core/common/effect_list.h) and its parameters' rows
+// (core/common/param_list.inc); the registry expands the list.
 //
 // An effect module holds everything about its effect: the name and a
 // paragraph of physics with its source; its parameters (rows of the
 // parameter table, core/common/params.h: name, unit, symbol, start, bounds,
-// scale); the channels it needs; its equations as pure functions in its
+// scale; the slots param_list.inc assigns to the effect, EffectParams()); the channels it needs; its equations as pure functions in its
 // header; how it enters the model (ModelExtension's hooks, or the paper's
 // letters of a variant); its residual signature for evidence; its truth form
 // for synthetic data (and a second truth form, different from the
@@ -117,7 +120,8 @@ struct EffectModule {
   std::string_view name;     // doc/contracts.md vocabulary, e.g. "pv_clipping"
   std::string_view physics;  // one paragraph of physics, for the report
   std::string_view source;   // where the equations come from (paper section, reference)
-  // Parameters the effect adds (their rows: Info(Param)).
+  // Parameters the effect adds (their rows: Info(Param)): the slots
+  // core/common/param_list.inc assigns to it, EffectParams(its Effect).
   std::vector<Param> params;
   // Extra input channels the effect needs beyond the base variant's.
   std::vector<Channel> needs;

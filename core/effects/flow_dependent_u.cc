@@ -59,7 +59,7 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) {
 const EffectModule& FlowDependentUEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "flow_dependent_u";
+    m.name = EffectName(Effect::kFlowDependentU);
     m.physics =
         "The absorber-to-fluid heat transfer coefficient depends on the flow regime: "
         "constant Nusselt number in laminar flow, h ∝ Re^0.8 in turbulent flow "
@@ -70,7 +70,7 @@ const EffectModule& FlowDependentUEffect() {
         "form. Visible when the flow varies: Q_u falls faster than the base model "
         "predicts at low flow.";
     m.source = "paper eq. 2.7 (fluid coupling); Dittus–Boelter (h ∝ Re^0.8, turbulent flow)";
-    m.params = {Param::kNFlow};
+    m.params = EffectParams(Effect::kFlowDependentU);
     // Turbulent flow in a sheet-and-tube absorber with a poor bond, where the
     // convective resistance matters.
     m.typical_truth = {{Param::kNFlow, 0.8}, {Param::kR0FluidM2KW, 0.08}};

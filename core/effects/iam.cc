@@ -168,7 +168,7 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) { return d.ao
 const EffectModule& IamEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "iam";
+    m.name = EffectName(Effect::kIam);
     m.physics =
         "Incidence-angle modifier: reflection at the glass rises at grazing angles, so "
         "the absorbed irradiance is the beam weighted by K(θ) = 1 − b0·(1/cos θ − 1) "
@@ -181,7 +181,7 @@ const EffectModule& IamEffect() {
     m.advice =
         "Use a variant with the incidence-angle modifier ('I') and log diffuse irradiance "
         "(g_poa_diffuse_w_m2, or GHI and DHI) so that beam and diffuse can be weighted.";
-    m.params = {Param::kIamB0Fit};
+    m.params = EffectParams(Effect::kIam);
     m.in_spec = InSpec;
     m.add_to_spec = AddToSpec;
     m.diagnosis_forms = {AddFittedForm};

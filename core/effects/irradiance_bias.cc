@@ -152,7 +152,7 @@ std::string PyranometerAdvice(const ModelSpec&, const ParamVector& p, const Plan
 const EffectModule& IrradianceBiasEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "irradiance_bias";
+    m.name = EffectName(Effect::kIrradianceBias);
     m.physics =
         "The plane-of-array pyranometer reads with a scale error, G_true = G_meas·(1 + k) "
         "(calibration drift, soiled dome, misalignment). From P_el and Q_u alone k is "
@@ -162,7 +162,7 @@ const EffectModule& IrradianceBiasEffect() {
         "uses (1 + k)·G_meas, keeping the plane sensor's time resolution. The fit then "
         "returns unbiased η_PV and F_th.";
     m.source = "paper 2.5 (isotropic-sky transposition of GHI/DHI as the second source)";
-    m.params = {Param::kIrradianceBias};
+    m.params = EffectParams(Effect::kIrradianceBias);
     m.needs = {Channel::kGhiWM2, Channel::kDhiWM2};
     m.typical_truth = {{Param::kIrradianceBias, 0.06}};
     m.signature = "transposed GHI/DHI minus measured plane-of-array irradiance, W/m²";

@@ -127,7 +127,7 @@ std::string LimitAdvice(const ModelSpec&, const ParamVector& p, const Plant& pla
 const EffectModule& PvClippingEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "pv_clipping";
+    m.name = EffectName(Effect::kPvClipping);
     m.physics =
         "The inverter or MPPT limits the AC power: P_el = min(P_dc, P_limit). A PVT "
         "module whose electricity is clipped moves its operating point away from the "
@@ -136,7 +136,7 @@ const EffectModule& PvClippingEffect() {
         "while clipping.";
     m.source =
         "Dobos 2014, PVWatts Version 5 Manual (NREL/TP-6A20-62641): P_ac = min(P_dc·η, P_ac0)";
-    m.params = {Param::kPLimitWM2};
+    m.params = EffectParams(Effect::kPvClipping);
     m.typical_truth = {{Param::kPLimitWM2, 120.0}};
     m.signature = "base model P_el per m² (evidence above the limit)";
     m.advice =

@@ -1,28 +1,22 @@
-// The one list that names the effect modules. Adding an effect: write its
-// module (core/effects/<name>.{h,cc}) and add one line here.
+// The registry of the effect modules, expanded from the one list of effects
+// (core/common/effect_list.h): module <Name> is <Name>Effect(), defined in
+// core/effects/<name>.cc. Adding an effect: write its module and add its
+// line to the list.
 #include "core/effects/registry.h"
-
-#include "core/effects/capacitance.h"
-#include "core/effects/clock_offset.h"
-#include "core/effects/flow_dependent_u.h"
-#include "core/effects/iam.h"
-#include "core/effects/irradiance_bias.h"
-#include "core/effects/pv_clipping.h"
-#include "core/effects/second_node.h"
-#include "core/effects/shading.h"
-#include "core/effects/sky_radiation.h"
-#include "core/effects/soiling.h"
-#include "core/effects/transport_delay.h"
-#include "core/effects/wind.h"
 
 namespace pvtwin {
 
+// Every module's accessor, declared from the list (each module's header
+// declares its own as well).
+#define PVTWIN_EFFECT_ACCESSOR(name, Name) const EffectModule& Name##Effect();
+PVTWIN_EFFECTS(PVTWIN_EFFECT_ACCESSOR)
+#undef PVTWIN_EFFECT_ACCESSOR
+
 const std::vector<const EffectModule*>& EffectRegistry() {
   static const std::vector<const EffectModule*> kModules = {
-      &CapacitanceEffect(),    &SecondNodeEffect(),  &WindEffect(),
-      &SkyRadiationEffect(),   &IamEffect(),         &FlowDependentUEffect(),
-      &TransportDelayEffect(), &PvClippingEffect(),  &ShadingEffect(),
-      &SoilingEffect(),        &ClockOffsetEffect(), &IrradianceBiasEffect(),
+#define PVTWIN_EFFECT_MODULE(name, Name) &Name##Effect(),
+      PVTWIN_EFFECTS(PVTWIN_EFFECT_MODULE)
+#undef PVTWIN_EFFECT_MODULE
   };
   return kModules;
 }

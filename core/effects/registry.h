@@ -1,6 +1,6 @@
-// The registration list of the effect modules: every effect of doc/contracts.md's
-// vocabulary, in the vocabulary's order (the order the diagnosis tries them
-// and reports ties in).
+// The registry of the effect modules: one per entry of the list of effects
+// (core/common/effect_list.h, doc/contracts.md's vocabulary), in the list's
+// order (the order the diagnosis tries them and reports ties in).
 #pragma once
 
 #include <string_view>

@@ -21,13 +21,13 @@ std::vector<double> Signature(const Drivers& d, const SimOutputs&) {
 const EffectModule& SecondNodeEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "second_node";
+    m.name = EffectName(Effect::kSecondNode);
     m.physics =
         "A finite conductance U_coll between the PV laminate and the absorber/fluid "
         "channel: the cells run warmer than the fluid-side node by Q/U_coll, which lowers "
         "P_el at high heat flux (paper 2.10, two-node network).";
     m.source = "paper 2.10 (two-node network, U_coll)";
-    m.params = {Param::kUCollWM2K};
+    m.params = EffectParams(Effect::kSecondNode);
     // A PVT module without lamination of the cells onto the absorber.
     m.typical_truth = {{Param::kUCollWM2K, 12.0}};
     m.signature = "inlet minus ambient temperature, K";

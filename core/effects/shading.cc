@@ -353,7 +353,7 @@ std::string ObstacleAdvice(const ModelSpec&, const ParamVector& p, const Plant&)
 const EffectModule& ShadingEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "shading";
+    m.name = EffectName(Effect::kShading);
     m.physics =
         "An obstacle (building, tree, row in front) blocks the beam while the sun is "
         "inside an azimuth window γ_shade ± Δγ/2 below the obstacle's edge α_shade: "
@@ -368,8 +368,7 @@ const EffectModule& ShadingEffect() {
     m.source =
         "Deline et al. 2013, A simplified model of uniform shading in large photovoltaic arrays, "
         "Solar Energy 96";
-    m.params = {Param::kShadeAzimuthRad, Param::kShadeWidthRad, Param::kShadeElevationRad,
-                Param::kShadeMismatch};
+    m.params = EffectParams(Effect::kShading);
     m.needs = {Channel::kGhiWM2, Channel::kDhiWM2};
     m.typical_truth = {{Param::kShadeAzimuthRad, DegToRad(250.0)},
                        {Param::kShadeWidthRad, DegToRad(40.0)},

@@ -113,7 +113,7 @@ const OtherFormTruth& OtherTruth() {
 const EffectModule& SkyRadiationEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "sky_radiation";
+    m.name = EffectName(Effect::kSkyRadiation);
     m.physics =
         "Long-wave exchange of the front with the sky: ε·σ·(T_PV⁴ − T_sky⁴) (paper "
         "2.9, 'r'). Clear nights and clear days with a cold sky cool the collector below "
@@ -124,7 +124,7 @@ const EffectModule& SkyRadiationEffect() {
     m.source =
         "paper 2.9 (long-wave exchange with the sky); cloudy sky: Crawford & Duchon 1999; "
         "sky models' spread: Flerchinger et al. 2009, Water Resour. Res. 45";
-    m.params = {Param::kEpsPvt, Param::kSkyCloudOffset};
+    m.params = EffectParams(Effect::kSkyRadiation);
     m.needs = {Channel::kTSkyC};
     m.typical_truth = {{Param::kEpsPvt, 0.12}};
     m.signature = "ambient minus sky temperature, K";

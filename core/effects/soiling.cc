@@ -97,7 +97,7 @@ std::string SoilingAdvice(const ModelSpec&, const ParamVector& p, const Plant&) 
 const EffectModule& SoilingEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "soiling";
+    m.name = EffectName(Effect::kSoiling);
     m.physics =
         "Dust and pollen on the front cover reduce its transmittance roughly linearly "
         "with the days since the last rain or cleaning: τ_soil = max(0, 1 − r_soil·d) "
@@ -112,7 +112,7 @@ const EffectModule& SoilingEffect() {
         "Kimber et al. 2006, the effects of soiling on large grid-connected PV systems (linear "
         "soiling rate); Deceglie et al. 2018, IEEE J. Photovolt. 8 (stochastic rate and "
         "recovery: cleanings from the performance index)";
-    m.params = {Param::kSoilingPerDay};
+    m.params = EffectParams(Effect::kSoiling);
     m.typical_truth = {{Param::kSoilingPerDay, 0.004}};
     m.signature = "days since the last cleaning";
     m.advice =

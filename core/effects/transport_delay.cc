@@ -303,7 +303,7 @@ std::string DelayAdvice(const ModelSpec& spec, const ParamVector& p, const Plant
 const EffectModule& TransportDelayEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "transport_delay";
+    m.name = EffectName(Effect::kTransportDelay);
     m.physics =
         "The outlet sensor sits behind a pipe: it sees the fluid that left the collector "
         "τ earlier (plug flow dead time), cooled towards ambient on the way, "
@@ -315,8 +315,7 @@ const EffectModule& TransportDelayEffect() {
         "of M_mix losing U_pipe·A, so that the dead time M_plug/ṁ and the lag M_mix/ṁ "
         "scale with 1/flow as a pipe's do.";
     m.source = "Duffie & Beckman, Solar Engineering of Thermal Processes, 10.3 (pipe losses)";
-    m.params = {Param::kTransportDelayS, Param::kUPipeWM2K, Param::kPipePlugKgM2,
-                Param::kPipeMixKgM2};
+    m.params = EffectParams(Effect::kTransportDelay);
     m.typical_truth = {{Param::kTransportDelayS, 120.0}, {Param::kUPipeWM2K, 1.0}};
     m.signature = "rate of change of the base model's outlet temperature, K per minute";
     m.advice =

@@ -98,7 +98,7 @@ const OtherFormTruth& OtherTruth() {
 const EffectModule& WindEffect() {
   static const EffectModule kModule = [] {
     EffectModule m;
-    m.name = "wind";
+    m.name = EffectName(Effect::kWind);
     m.physics =
         "Forced convection on the uncovered front: the front loss conductance depends on "
         "the wind speed, in the paper's printed form 1/U = 1/U_front + r_refwind·v^n "
@@ -108,7 +108,7 @@ const EffectModule& WindEffect() {
     m.source =
         "paper 2.8 ('w'); ISO 9806:2017 quasi-dynamic model, wind term (c6, c3·u) for '+wind'";
     // The paper's form ('w') first, then the physical form's coefficient.
-    m.params = {Param::kRRefWind, Param::kNWind, Param::kUWindWM2K};
+    m.params = EffectParams(Effect::kWind);
     m.needs = {Channel::kWindMS};
     m.typical_truth = {{Param::kRRefWind, 0.02}, {Param::kNWind, 0.8}};
     m.signature = "wind speed, m/s";

@@ -1,34 +1,86 @@
-// The effect registry (core/effects/registry.h): every module is complete —
-// a name of doc/contracts.md's vocabulary, a paragraph of physics with a source,
+// The effect registry (core/effects/registry.h): it is the one list of
+// effects (core/common/effect_list.h) with the parameter slots the list of
+// parameters assigns to each, doc/contracts.md's vocabulary is that list,
+// and every module is complete —
+// a name of the vocabulary, a paragraph of physics with a source,
 // parameters whose bounds contain their start and truth values, a signature
 // and an advice sentence — and the registry holds the whole vocabulary once.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/effects/effects.h"
 #include "core/model/variant.h"
+#include "tests/support/files.h"
 
 namespace pvtwin {
 namespace {
 
-// doc/contracts.md's effect vocabulary, spelled and ordered as there.
-constexpr std::string_view kVocabulary[] = {"capacitance",     "second_node",  "wind",
-                                            "sky_radiation",   "iam",          "flow_dependent_u",
-                                            "transport_delay", "pv_clipping",  "shading",
-                                            "soiling",         "clock_offset", "irradiance_bias"};
+// doc/contracts.md's vocabulary paragraph: the effect names in backquotes,
+// in order, from the paragraph that opens with the first effect.
+std::vector<std::string> ContractsVocabulary() {
+  const std::string text =
+      testing::ReadFile(std::filesystem::path(PVTWIN_SOURCE_DIR) / "doc" / "contracts.md");
+  const std::string opening = "\n`" + std::string(kEffectNames.front()) + "`, ";
+  std::size_t at = text.find(opening);
+  if (at == std::string::npos) return {};
+  const std::size_t end = text.find(".\n", at);
+  std::vector<std::string> names;
+  while (true) {
+    const std::size_t open = text.find('`', at);
+    if (open == std::string::npos || open > end) break;
+    const std::size_t close = text.find('`', open + 1);
+    names.push_back(text.substr(open + 1, close - open - 1));
+    at = close + 1;
+  }
+  return names;
+}
 
-TEST(EffectRegistry, HoldsTheVocabularyOnceInItsOrder) {
+// The registry is the list of effects (core/common/effect_list.h): one
+// module per name, in its order, each named as there and owning exactly
+// the parameter slots param_list.inc assigns to it.
+TEST(EffectRegistry, IsTheListOfEffects) {
   const auto& registry = EffectRegistry();
-  ASSERT_EQ(registry.size(), std::size(kVocabulary));
+  ASSERT_EQ(registry.size(), kNumEffects);
   for (std::size_t i = 0; i < registry.size(); ++i) {
-    EXPECT_EQ(registry[i]->name, kVocabulary[i]);
-    EXPECT_EQ(FindEffect(kVocabulary[i]), registry[i]);
+    const Effect e = static_cast<Effect>(i);
+    EXPECT_EQ(registry[i]->name, EffectName(e));
+    EXPECT_EQ(FindEffect(EffectName(e)), registry[i]);
+    EXPECT_EQ(registry[i]->params, EffectParams(e)) << registry[i]->name;
+    EXPECT_FALSE(registry[i]->params.empty()) << registry[i]->name;
+    for (Param p : registry[i]->params) {
+      EXPECT_EQ(EffectOfParam(p), e) << registry[i]->name << " " << Info(p).name;
+    }
   }
   EXPECT_EQ(FindEffect("none"), nullptr);
   EXPECT_EQ(FindEffect("unknown"), nullptr);
+}
+
+// Every parameter slot is the base model's or one module's, never two.
+TEST(EffectRegistry, EverySlotHasOneOwner) {
+  std::vector<int> owners(kNumParams, 0);
+  for (const EffectModule* m : EffectRegistry()) {
+    for (Param p : m->params) ++owners[static_cast<std::size_t>(p)];
+  }
+  for (std::size_t i = 0; i < kNumParams; ++i) {
+    const Param p = static_cast<Param>(i);
+    EXPECT_EQ(owners[i], EffectOfParam(p).has_value() ? 1 : 0) << Info(p).name;
+  }
+  // The base model keeps its own (the paper's A_PVT, η_PVref, U_front …).
+  EXPECT_FALSE(EffectOfParam(Param::kAreaM2).has_value());
+  EXPECT_FALSE(EffectOfParam(Param::kUFrontWM2K).has_value());
+}
+
+// doc/contracts.md's vocabulary paragraph names the list's effects, in its
+// order.
+TEST(EffectRegistry, ContractsVocabularyIsTheList) {
+  const std::vector<std::string> documented = ContractsVocabulary();
+  ASSERT_EQ(documented.size(), kNumEffects) << "doc/contracts.md's vocabulary paragraph";
+  for (std::size_t i = 0; i < kNumEffects; ++i) EXPECT_EQ(documented[i], kEffectNames[i]);
 }
 
 TEST(EffectRegistry, EveryModuleIsComplete) {

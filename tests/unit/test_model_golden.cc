@@ -10,8 +10,10 @@
 #include <cstring>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "core/common/effect_list.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
 #include "core/synth/weather_generator.h"
@@ -73,11 +75,9 @@ TEST(ModelGolden, OutputsOfTable6VariantsAndEffectsAreBitIdentical) {
 #include "tests/unit/model_golden_hashes.inc"
   };
   std::vector<std::string> variants = PaperVariants();
-  for (const char* e : {"capacitance", "second_node", "wind", "sky_radiation", "iam",
-                        "flow_dependent_u", "transport_delay", "pv_clipping", "shading", "soiling",
-                        "clock_offset", "irradiance_bias"}) {
-    variants.push_back(std::string("1Nr+") + e);
-  }
+  // Every effect of the list (core/common/effect_list.h): an effect without
+  // a recorded hash fails below.
+  for (std::string_view e : kEffectNames) variants.push_back("1Nr+" + std::string(e));
   variants.push_back(
       "2N2Cr+wind+transport_delay+flow_dependent_u+pv_clipping+shading+soiling+"
       "clock_offset+irradiance_bias");

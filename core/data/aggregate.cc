@@ -87,6 +87,12 @@ bool AggregateSamples(std::span<const Sample> samples, const AggregateOptions& o
   Series raw = SeriesFromSamples(samples, period_s);
   Series corrected = raw;
   ApplyPaperCorrections(&corrected);
+  // The samples' edges applied the limits already (the Modbus poller, the
+  // CSV reader of pvtwin import): on their samples this finds nothing. It
+  // stays because table sample_5s is also written by other programs (SQL)
+  // and the store's read of it does not check: this is that read's edge,
+  // and it flags the minute (kQcRejectedValues) as the poller's rejections
+  // are. Should the store's sample read apply the limits, this can go.
   ApplyPhysicalLimits(&corrected, options.area_m2);
 
   // Minute groups [group_begin[k], group_begin[k + 1]) of sample indices.

@@ -1,10 +1,21 @@
-// Physical limits of the canonical channels: one table, used by every path
-// data enter pvtwin through (the CSV reader, the Modbus poller's QC, the
-// store's reads of 1-min rows and forecast inputs), so that the fits never
-// see a value no sensor can deliver (−300 °C, 1e308 W, negative wind, an
-// angle of incidence of 500°). A value outside its channel's limits is
-// treated as missing, and the reader that can name file, line and column
-// says so.
+// Physical limits of the canonical channels: one table, applied once on each
+// path at the edge where data enter pvtwin, so that the fits never see a
+// value no sensor can deliver (−300 °C, 1e308 W, negative wind, an angle of
+// incidence of 500°). A value outside its channel's limits is treated as
+// missing, and the reader that can name file, line and column says so.
+// The edges:
+//  * live data: the Modbus poller's QC (io/modbus/modbus_poller.cc; `pvtwin
+//    poll --once` says why it rejects, io/modbus/modbus_read_once.cc);
+//  * files: the CSV reader (io/files/csv.cc);
+//  * rows in the store that other programs may have written: the store's
+//    reads of 1-min rows, interval rows and forecast inputs (io/store/), and
+//    of 5 s samples through the 1-min aggregation (core/data/aggregate.cc);
+//  * provider weather: the resampling to 1-min rows (core/forecast/
+//    weather_resample.cc), where interpolation, transposition and the wind's
+//    height correction make new channel values (the provider's file,
+//    io/weather/weather_file.cc, is read against bounds of its own
+//    variables first: hourly means at 2 m and 10 m, not yet channels).
+// Stages after an edge trust what came in.
 //
 // The limits are wide on purpose: they catch broken readings, not unusual
 // weather. Sources:

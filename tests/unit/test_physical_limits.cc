@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <sstream>
+#include <string>
 
 #include "core/common/diagnostic.h"
 #include "core/common/units.h"
@@ -87,6 +89,63 @@ TEST(PhysicalLimits, AggregationRejectsOutOfLimitSamples) {
   EXPECT_EQ(m.rows[Channel::kTAmbC][0], 10.0);  // the −300 °C sample is left out
   EXPECT_EQ(m.rows[Channel::kPElW][0], 150.0);
   EXPECT_TRUE(m.qc_flags[0] & kQcRejectedValues);
+}
+
+// The file path applies the limits once, at its edge: the CSV reader names
+// the cell and makes it missing; the samples it gives go through the store
+// and the aggregation without a second rejection (no minute flagged
+// kQcRejectedValues for it, nothing left for a later ApplyPhysicalLimits to
+// count), and the minute is the mean of the other samples.
+TEST(PhysicalLimits, ACsvCellOutOfLimitsIsRejectedAndCountedOnceOnItsWayToTheStore) {
+  std::ostringstream csv;
+  csv << "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
+  for (int i = 0; i < 12; ++i) {
+    csv << "2024-06-01T10:00:" << (i < 2 ? "0" : "") << 5 * i << "Z,20,30,0.03,600,"
+        << (i == 4 ? "-300" : std::to_string(10 + i)) << ",150\n";
+  }
+  std::istringstream in(csv.str());
+  CsvReadOptions csv_options;
+  csv_options.area_m2 = 1.8;
+  Series series;
+  Diagnostics errors, warnings;
+  ASSERT_TRUE(ParseCanonicalCsv(in, "in.csv", csv_options, &series, &errors, &warnings));
+  std::size_t named = 0;
+  std::string all;
+  for (const Diagnostic& w : warnings) {
+    all += w.ToString() + "\n";
+    if (w.rule.find("outside") == std::string::npos) continue;
+    ++named;
+    EXPECT_EQ(w.line, 6);  // the header, then rows 0 … 4
+    EXPECT_EQ(w.field, "t_amb_c");
+  }
+  EXPECT_EQ(named, 1u) << all;
+  ASSERT_EQ(series.size(), 12u);
+  EXPECT_TRUE(std::isnan(series[Channel::kTAmbC][4]));
+  Series again = series;
+  EXPECT_EQ(ApplyPhysicalLimits(&again, 1.8).Total(), 0u);
+
+  testing::ScratchDir dir("limits_csv_once");
+  StoreOptions options;
+  options.aggregate.area_m2 = 1.8;
+  std::string error;
+  std::unique_ptr<Store> store = Store::Open((dir / "pvtwin.db").string(), options, &error);
+  ASSERT_TRUE(store) << error;
+  ASSERT_TRUE(store->InsertSamples(SamplesFromSeries(series), &error)) << error;
+  int written = 0;
+  ASSERT_TRUE(store->AggregateMinutes(series.time_s.back() + 60, &written, &error)) << error;
+  ASSERT_EQ(written, 1);
+  MinuteRows minutes;
+  ASSERT_TRUE(
+      store->ReadMinuteRows(series.time_s.front(), series.time_s.back() + 60, &minutes, &error))
+      << error;
+  ASSERT_EQ(minutes.rows.size(), 1u);
+  EXPECT_EQ(minutes.n_samples[0], 12);
+  EXPECT_FALSE(minutes.qc_flags[0] & kQcRejectedValues);
+  // The mean of 10 … 21 °C without the rejected sample's 14 °C.
+  double sum = 0.0;
+  for (int i = 0; i < 12; ++i) sum += i == 4 ? 0.0 : 10.0 + i;
+  EXPECT_NEAR(minutes.rows[Channel::kTAmbC][0], sum / 11.0, 1e-9);
+  EXPECT_EQ(minutes.rows[Channel::kPElW][0], 150.0);
 }
 
 TEST(PhysicalLimits, StoreReadsLeaveOutRowsOtherProgramsWroteOutOfLimits) {

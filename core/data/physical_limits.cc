@@ -1,6 +1,5 @@
 #include "core/data/physical_limits.h"
 
-#include <charconv>
 #include <cmath>
 
 #include "core/common/units.h"
@@ -16,12 +15,6 @@ constexpr double kQThLoWM2 = -5000.0, kQThHiWM2 = 2500.0;
 // Short-wave irradiance (physical_limits.h says why): the largest zero
 // offset of a pyranometer below, the BSRN limit with cloud enhancement above.
 constexpr double kIrradianceLoWM2 = -30.0, kIrradianceHiWM2 = 2500.0;
-
-std::string Format(double x) {
-  char buf[32];
-  const auto result = std::to_chars(buf, buf + sizeof buf, x);
-  return std::string(buf, result.ptr);
-}
 
 }  // namespace
 
@@ -60,13 +53,6 @@ PhysicalLimit PhysicalLimitOf(Channel c, double area_m2) {
       break;
   }
   return {std::nan(""), std::nan("")};
-}
-
-std::string DescribeLimit(Channel c, double area_m2) {
-  PhysicalLimit limit = PhysicalLimitOf(c, area_m2);
-  if (c == Channel::kAoiRad) limit = {RadToDeg(limit.lo), RadToDeg(limit.hi)};
-  return "[" + Format(limit.lo) + ", " + Format(limit.hi) + "] " +
-         std::string(kChannels[static_cast<std::size_t>(c)].unit);
 }
 
 std::size_t LimitViolations::Total() const {

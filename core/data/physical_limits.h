@@ -49,7 +49,6 @@
 
 #include <array>
 #include <cstddef>
-#include <string>
 
 #include "core/common/channels.h"
 #include "core/common/series.h"
@@ -57,7 +56,8 @@
 namespace pvtwin {
 
 struct PhysicalLimit {
-  double lo = 0.0;  // in the channel's unit as core holds it (aoi in rad)
+  double lo = 0.0;  // in the channel's unit as core holds it (aoi in rad; the
+                    // readers convert at the edge, io/files/csv.h's DescribeCsvLimit)
   double hi = 0.0;
   bool Contains(double x) const { return x >= lo && x <= hi; }
 };
@@ -68,9 +68,6 @@ inline constexpr double kMaxAreaM2 = 1e6;
 
 // The limits of channel c for a field of area_m2 (≤ 0: unknown, kMaxAreaM2).
 PhysicalLimit PhysicalLimitOf(Channel c, double area_m2);
-
-// "[lo, hi] unit" in the unit of the CSV column (aoi in degrees).
-std::string DescribeLimit(Channel c, double area_m2);
 
 // What ApplyPhysicalLimits changed, per channel.
 struct LimitViolations {

@@ -190,7 +190,7 @@ PowerCheckResult CheckPowerAgainstDatasheet(const Series& s, const Plant& plant,
         static_cast<double>(s.time_s[rows.back()] - s.time_s[rows.front()]) / 3600.0;
     const double dtm_dt_k_h = span_h > 0.0 ? (h.t_m_last - h.t_m_first) / span_h : 0.0;
     if (h.g < o.min_g_w_m2 || h.t_amb < o.min_t_amb_c || (has_wind && h.wind > o.max_wind_m_s) ||
-        std::fabs(dtm_dt_k_h) > o.max_dtm_dt_k_h || RadToDeg(h.max_aoi_rad) > o.max_aoi_deg) {
+        std::fabs(dtm_dt_k_h) > o.max_dtm_dt_k_h || h.max_aoi_rad > o.max_aoi_rad) {
       continue;
     }
     const double dt = h.t_m - h.t_amb;

@@ -14,6 +14,7 @@
 #include "core/common/params.h"
 #include "core/common/plant.h"
 #include "core/common/series.h"
+#include "core/common/units.h"
 #include "core/model/variant.h"
 
 namespace pvtwin {
@@ -124,7 +125,7 @@ struct PowerCheckOptions {
   double min_t_amb_c = 5.0;
   double max_wind_m_s = 10.0;
   double max_dtm_dt_k_h = 5.0;
-  double max_aoi_deg = 80.0;
+  double max_aoi_rad = DegToRad(80.0);  // the hour's largest angle of incidence (SunPeek)
 };
 
 struct PowerCheckResult {

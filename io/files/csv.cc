@@ -543,7 +543,7 @@ class CsvParser {
     if (out_of_limits_[c]++ < kNamedOutOfLimits) {
       warnings_.push_back({path_, line_no, column.name, std::string(cell),
                            "outside the physical limits " +
-                               DescribeLimit(*column.channel, options_.area_m2) +
+                               DescribeCsvLimit(*column.channel, options_.area_m2) +
                                ": read as missing"});
     }
   }
@@ -555,7 +555,7 @@ class CsvParser {
       if (n <= kNamedOutOfLimits) continue;
       warnings_.push_back({path_, 0, column.name, "",
                            std::to_string(n - kNamedOutOfLimits) + " more values outside " +
-                               DescribeLimit(*column.channel, options_.area_m2) +
+                               DescribeCsvLimit(*column.channel, options_.area_m2) +
                                " read as missing (" + std::to_string(n) + " in all)"});
     }
   }
@@ -660,6 +660,13 @@ bool ReadInTwoHalves(const std::string& path, std::ifstream& in, const CsvReadOp
 }
 
 }  // namespace
+
+std::string DescribeCsvLimit(Channel c, double area_m2) {
+  PhysicalLimit limit = PhysicalLimitOf(c, area_m2);
+  if (c == Channel::kAoiRad) limit = {RadToDeg(limit.lo), RadToDeg(limit.hi)};
+  return "[" + FormatNumber(limit.lo) + ", " + FormatNumber(limit.hi) + "] " +
+         std::string(kChannels[static_cast<std::size_t>(c)].unit);
+}
 
 bool ReadCanonicalCsv(const std::string& path, const CsvReadOptions& options, Series* out,
                       Diagnostics* errors, Diagnostics* warnings) {

@@ -64,6 +64,11 @@ struct CsvReadOptions {
   std::size_t two_thread_bytes = kCsvTwoThreadBytes;
 };
 
+// The physical limits of channel c (core/data/physical_limits.h) as "[lo,
+// hi] unit" in the unit of its CSV column (aoi_deg in degrees: core holds
+// radians, the CSV edge converts).
+std::string DescribeCsvLimit(Channel c, double area_m2);
+
 // Reads the file at path. Returns true if it was read without errors; then
 // *out holds the series (it is not written otherwise). Errors go to *errors
 // (not null); warnings go to *warnings (may be null to discard them).

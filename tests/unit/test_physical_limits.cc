@@ -33,7 +33,7 @@ TEST(PhysicalLimits, TheTableHoldsThePublishedLimitsAndScalesWithTheArea) {
   EXPECT_EQ(PhysicalLimitOf(Channel::kMdotKgS, 2.0).hi, 2.0);
   EXPECT_EQ(PhysicalLimitOf(Channel::kPElW, 0.0).hi, 600.0 * kMaxAreaM2);  // area unknown
   EXPECT_FALSE(PhysicalLimitOf(Channel::kAoiRad, 2.0).Contains(DegToRad(500.0)));
-  EXPECT_EQ(DescribeLimit(Channel::kAoiRad, 2.0), "[0, 180] °");
+  EXPECT_EQ(DescribeCsvLimit(Channel::kAoiRad, 2.0), "[0, 180] °");  // the CSV edge: degrees
   // Irradiance: down to the ±30 W/m² zero offset a) of the least accurate
   // pyranometer class of ISO 9060, no further; a night reading of −30 W/m²
   // is an offset, −30.5 or −50 W/m² is not.

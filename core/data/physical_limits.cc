@@ -55,6 +55,20 @@ PhysicalLimit PhysicalLimitOf(Channel c, double area_m2) {
   return {std::nan(""), std::nan("")};
 }
 
+PhysicalLimit ProviderLimitOf(ProviderQuantity q) {
+  switch (q) {
+    case ProviderQuantity::kAirTemperatureC:
+      return PhysicalLimitOf(Channel::kTAmbC, 0.0);
+    case ProviderQuantity::kPercent:
+      return {0.0, 100.0};
+    case ProviderQuantity::kWindAt10mMS:
+      return {0.0, 113.0};
+    case ProviderQuantity::kIrradianceWM2:
+      return {0.0, 1500.0};
+  }
+  return {std::nan(""), std::nan("")};
+}
+
 std::size_t LimitViolations::Total() const {
   std::size_t total = 0;
   for (const std::size_t n : count) total += n;

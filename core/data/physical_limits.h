@@ -69,6 +69,20 @@ inline constexpr double kMaxAreaM2 = 1e6;
 // The limits of channel c for a field of area_m2 (≤ 0: unknown, kMaxAreaM2).
 PhysicalLimit PhysicalLimitOf(Channel c, double area_m2);
 
+// A forecast provider's values before they are channels (read by
+// io/weather/weather_file.cc): hourly or 15-min values of the provider's own
+// variables, in pvtwin's units.
+enum class ProviderQuantity {
+  kAirTemperatureC,  // temperature_2m, dew_point_2m: the air temperature's limits
+  kPercent,          // relative_humidity_2m, cloud_cover: 0 … 100 %
+  kWindAt10mMS,      // wind_speed_10m: 0 … 113 m/s, the strongest gust recorded
+                     // (113 m/s, Barrow Island, 10 April 1996; WMO archive)
+  kIrradianceWM2,    // the short-wave variables: 0 … 1500 W/m² (BSRN's physically
+                     // possible bound for GHI near 1400 W/m²)
+};
+
+PhysicalLimit ProviderLimitOf(ProviderQuantity q);
+
 // What ApplyPhysicalLimits changed, per channel.
 struct LimitViolations {
   std::array<std::size_t, kNumChannels> count{};

@@ -74,13 +74,18 @@ const std::vector<OpenMeteoVariable>& Variables() {
   return kVariables;
 }
 
-// Physical bounds per variable in pvtwin's unit (after conversion): a value
-// outside is read as missing with a note (as the CSV reader does).
-std::pair<double, double> BoundsOf(const std::string& name) {
-  if (name == "temperature_2m" || name == "dew_point_2m") return {-90.0, 60.0};
-  if (name == "relative_humidity_2m" || name == "cloud_cover") return {0.0, 100.0};
-  if (name == "wind_speed_10m") return {0.0, 113.0};
-  return {0.0, 1500.0};  // irradiance (BSRN's physically possible bound for GHI near 1400)
+// Physical limits per variable in pvtwin's unit (after conversion; the
+// table: core/data/physical_limits.h): a value outside is read as missing
+// with a note (as the CSV reader does).
+PhysicalLimit LimitOf(const std::string& name) {
+  if (name == "temperature_2m" || name == "dew_point_2m") {
+    return ProviderLimitOf(ProviderQuantity::kAirTemperatureC);
+  }
+  if (name == "relative_humidity_2m" || name == "cloud_cover") {
+    return ProviderLimitOf(ProviderQuantity::kPercent);
+  }
+  if (name == "wind_speed_10m") return ProviderLimitOf(ProviderQuantity::kWindAt10mMS);
+  return ProviderLimitOf(ProviderQuantity::kIrradianceWM2);
 }
 
 class OpenMeteoReader {
@@ -234,7 +239,7 @@ class OpenMeteoReader {
     }
     std::optional<double> factor = UnitFactorOf(units, v);
     if (!factor) return false;
-    const auto [lo, hi] = BoundsOf(v.name);
+    const PhysicalLimit limit = LimitOf(v.name);
     std::size_t nulls = 0, outside = 0;
     values->assign(n, kNaN);
     for (std::size_t i = 0; i < n; ++i) {
@@ -247,7 +252,7 @@ class OpenMeteoReader {
         return false;
       }
       const double x = array[i].get<double>() * *factor;
-      if (x < lo || x > hi) {
+      if (!limit.Contains(x)) {
         ++outside;
         continue;
       }

@@ -52,6 +52,20 @@ TEST(PhysicalLimits, TheTableHoldsThePublishedLimitsAndScalesWithTheArea) {
   }
 }
 
+// A provider's weather is read against the same table: its air temperature
+// against the channel's, the other variables against limits of their own
+// (the recorded gust, percentages, BSRN's GHI bound).
+TEST(PhysicalLimits, ProviderWeatherLimitsLiveInTheTable) {
+  const PhysicalLimit air = ProviderLimitOf(ProviderQuantity::kAirTemperatureC);
+  EXPECT_EQ(air.lo, PhysicalLimitOf(Channel::kTAmbC, 0.0).lo);
+  EXPECT_EQ(air.hi, PhysicalLimitOf(Channel::kTAmbC, 0.0).hi);
+  EXPECT_TRUE(ProviderLimitOf(ProviderQuantity::kWindAt10mMS).Contains(113.0));
+  EXPECT_FALSE(ProviderLimitOf(ProviderQuantity::kWindAt10mMS).Contains(-0.1));
+  EXPECT_FALSE(ProviderLimitOf(ProviderQuantity::kPercent).Contains(100.5));
+  EXPECT_FALSE(ProviderLimitOf(ProviderQuantity::kIrradianceWM2).Contains(-1.0));
+  EXPECT_TRUE(ProviderLimitOf(ProviderQuantity::kIrradianceWM2).Contains(1400.0));
+}
+
 TEST(PhysicalLimits, ApplyMakesOutOfLimitCellsMissingAndCountsThem) {
   Series s;
   s.time_s = {0, 60, 120};

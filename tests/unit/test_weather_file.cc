@@ -218,6 +218,39 @@ TEST(WeatherFile, NullsAreMissingNotZero) {
   EXPECT_EQ(file.notes.size(), 2u);
 }
 
+// Values outside the physical limits of a provider's variables
+// (core/data/physical_limits.h, ProviderLimitOf) are missing with one note
+// per variable; the limits themselves are kept (1500 W/m², 100 %, 113 m/s).
+TEST(WeatherFile, ValuesOutsideThePhysicalLimitsAreMissingWithANote) {
+  WeatherFile file;
+  Diagnostics errors;
+  const std::string text = Hourly([](auto& j) {
+    j["hourly_units"]["wind_speed_10m"] = "m/s";
+    j["hourly"]["shortwave_radiation"][11] = 1500.5;
+    j["hourly"]["shortwave_radiation"][12] = 1500;
+    j["hourly"]["cloud_cover"][4] = 100.5;
+    j["hourly"]["cloud_cover"][5] = 100;
+    j["hourly"]["wind_speed_10m"][3] = 113.5;
+    j["hourly"]["wind_speed_10m"][6] = 113;
+    j["hourly"]["temperature_2m"][2] = 60.5;
+  });
+  ASSERT_TRUE(ParseWeatherFile(text, "l.json", &file, &errors));
+  EXPECT_TRUE(std::isnan(file.weather.ghi_w_m2[11]));
+  EXPECT_EQ(file.weather.ghi_w_m2[12], 1500.0);
+  EXPECT_TRUE(std::isnan(file.weather.cloud_cover_pct[4]));
+  EXPECT_EQ(file.weather.cloud_cover_pct[5], 100.0);
+  EXPECT_TRUE(std::isnan(file.weather.wind_m_s[3]));
+  EXPECT_EQ(file.weather.wind_m_s[6], 113.0);
+  EXPECT_TRUE(std::isnan(file.weather.t_amb_c[2]));
+  EXPECT_EQ(file.missing_values, 4u);
+  ASSERT_EQ(file.notes.size(), 4u);
+  for (const std::string& note : file.notes) {
+    EXPECT_NE(note.find(": 1 values outside the physical limits, read as missing"),
+              std::string::npos)
+        << note;
+  }
+}
+
 TEST(WeatherFile, CsvErrorsNameLineAndColumn) {
   const std::string e = ErrorsOf("time,t_amb_c\n2024-06-01T10:00:00Z,20\n", "c.csv");
   EXPECT_NE(e.find("c.csv:1: g_poa_w_m2: required column missing"), std::string::npos) << e;

@@ -96,6 +96,7 @@ bool Service::LoadCurrentParameters() {
   params_id_ = row.id;
   params_ = file.values;
   params_json_ = row.params_json;
+  last_calibration_ = {row.id, "accepted", static_cast<double>(row.run_at)};
   return true;
 }
 
@@ -358,6 +359,7 @@ std::int64_t Service::RecordCalibration(Store::CalibrationRow row) {
   status_.calibrating = false;
   ++status_.calibrations;
   status_.last_calibration = row.status + ": " + row.reason;
+  last_calibration_ = {row.id, row.status, static_cast<double>(row.run_at)};
   LogToStderr(row.status == "accepted" ? kNotice : kWarning,
               "calibration " + std::to_string(row.id) + " " + row.status + ": " + row.reason);
   return row.id;

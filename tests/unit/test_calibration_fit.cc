@@ -62,7 +62,9 @@ TEST(CalibrationFit, WhatCalibrateWritesReadsBackToTheSameText) {
   // The parameter values are those of the file's "params".
   const nlohmann::ordered_json params = nlohmann::ordered_json::parse(text)["params"];
   for (const FitParameter& p : fit.parameters) {
-    if (params.contains(p.name)) EXPECT_EQ(p.value, params[p.name].get<double>()) << p.name;
+    if (params.contains(p.name)) {
+      EXPECT_EQ(p.value, params[p.name].get<double>()) << p.name;
+    }
   }
 }
 

@@ -305,6 +305,10 @@ void ReadDiagnosis(SectionReader& r, DiagnosisConfig* d) {
   r.Integer("keep", kOptional, Closed(1, 1000), &d->keep);
 }
 
+void ReadLog(SectionReader& r, LogConfig* log) {
+  r.Integer("status_min", kOptional, Closed(0, 1440), &log->status_min);
+}
+
 void ReadMonitor(SectionReader& r, MonitorConfig* m) {
   r.Integer("drift_days", kOptional, Closed(2, 365), &m->drift_days);
   r.Integer("alarm_days", kOptional, Closed(1, 60), &m->alarm_days);
@@ -405,6 +409,7 @@ void ReadDocument(const toml::table& root, const SourceText& source, const std::
       {"calibration", [](SectionReader& r, Config* c) { ReadCalibration(r, &c->calibration); }},
       {"forecast", [](SectionReader& r, Config* c) { ReadForecast(r, &c->forecast); }},
       {"diagnosis", [](SectionReader& r, Config* c) { ReadDiagnosis(r, &c->diagnosis); }},
+      {"log", [](SectionReader& r, Config* c) { ReadLog(r, &c->log); }},
       {"monitor", [](SectionReader& r, Config* c) { ReadMonitor(r, &c->monitor); }},
       {"sim", [](SectionReader& r, Config* c) { ReadSim(r, &c->sim); }},
       {"upload", [](SectionReader& r, Config* c) { ReadUpload(r, &c->upload); }},

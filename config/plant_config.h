@@ -15,6 +15,7 @@
 //   [forecast]     horizon_h, refresh_min, weather_url, weather_refresh_min,
 //                  weather_timeout_s
 //   [diagnosis]    enabled, every_days, timeout_s, keep (the nightly diagnosis)
+//   [log]          status_min (the daemon's health line)
 //   [monitor]      drift_days, alarm_days, datasheet_eta0, datasheet_c1_w_m2k …
 //                  datasheet_c6_s_m, datasheet_kd, power_check_safety_factor
 //                  (the daily checks)
@@ -82,6 +83,14 @@ struct DiagnosisConfig {
   int keep = 10;            // [1, 1000] HTML reports kept in <state dir>/reports
 };
 
+// [log]: what the daemon says about itself while it runs.
+struct LogConfig {
+  // Minutes of the daemon's clock between two health lines (samples per
+  // device, devices up, last calibration and forecast; also systemd's
+  // STATUS=), [0, 1440]; 0 = none.
+  int status_min = 15;
+};
+
 // [monitor]: what the daemon checks day by day (core/monitoring.h).
 struct MonitorConfig {
   int drift_days = 28;  // [2, 365]: accepted calibrations of this many days for the drift check
@@ -133,6 +142,7 @@ struct Config {
   CalibrationConfig calibration;
   ForecastConfig forecast;
   DiagnosisConfig diagnosis;
+  LogConfig log;
   MonitorConfig monitor;
   SimConfig sim;
   UploadConfig upload;

@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "core/common/heap.h"
@@ -18,6 +17,7 @@
 #include "core/fit/iso9806.h"
 #include "daemon/commands/commands.h"
 #include "daemon/commands/inputs.h"
+#include "daemon/service/calibration_fit.h"
 #include "io/files/params_json.h"
 #include "io/platform/quantity_text.h"
 #include "io/platform/time_format.h"
@@ -172,47 +172,26 @@ void PrintIsoEquivalents(const Plant& plant, const ModelSpec& spec, const ParamV
       iso.c5_j_m2k);
 }
 
-// The "fit" object of params.json. An undefined nMAE (no output to
-// normalise by) is written as null.
-std::string FitJson(const IdentSummary& s, const ErrorMetrics* held_out) {
-  auto metrics = [](const ErrorMetrics& e) {
-    nlohmann::ordered_json m;
-    m["rows"] = e.rows;
-    m["mae_p_el_w"] = e.mae_p_el_w;
-    m["mae_q_th_w"] = e.mae_q_th_w;
-    m["mae_p_el_w_m2"] = e.mae_p_el_w_m2;
-    m["mae_q_th_w_m2"] = e.mae_q_th_w_m2;
-    m["nmae_p_el"] = e.nmae_p_el;  // NaN is written as null
-    m["nmae_q_th"] = e.nmae_q_th;
-    return m;
-  };
-  nlohmann::ordered_json j;
-  j["algorithm"] = s.algorithm;
-  j["termination"] = std::string(ToString(s.termination));
-  j["initial_cost_w_m2"] = s.initial_cost_w_m2;
-  j["final_cost_w_m2"] = s.final_cost_w_m2;
-  j["simulations"] = s.evaluations;
-  j["runtime_s"] = s.runtime_s;
-  j["train"] = metrics(s.train);
-  if (held_out) j["held_out"] = metrics(*held_out);
-  j["at_bounds"] = s.AtBounds();
-  // Every parameter as the table prints it (the daemon stores them in
-  // calibration_param).
-  j["parameters"] = nlohmann::ordered_json::array();
+// The "fit" object of params.json (daemon/service/calibration_fit.h): the
+// fit's summary and every parameter as the table prints it (the daemon
+// stores them in calibration_param).
+CalibrationFit FitOf(const IdentSummary& s, const ErrorMetrics* held_out) {
+  CalibrationFit fit;
+  fit.algorithm = s.algorithm;
+  fit.termination = std::string(ToString(s.termination));
+  fit.initial_cost_w_m2 = s.initial_cost_w_m2;
+  fit.final_cost_w_m2 = s.final_cost_w_m2;
+  fit.simulations = s.evaluations;
+  fit.runtime_s = s.runtime_s;
+  fit.train = s.train;
+  if (held_out) fit.held_out = *held_out;
+  fit.at_bounds = s.AtBounds();
   for (const ParamEstimate& e : s.estimates) {
-    const double se = StdErrorInUnit(e);
-    j["parameters"].push_back({{"name", std::string(Info(e.param).name)},
-                               {"value", e.value},
-                               {"std_error", se},  // NaN is written as null
-                               {"unit", std::string(Info(e.param).unit)},
-                               {"status", StatusOf(e)}});
+    fit.parameters.push_back({std::string(Info(e.param).name), e.value, StdErrorInUnit(e),
+                              std::string(Info(e.param).unit), StatusOf(e)});
+    if (e.undetermined) fit.undetermined.push_back(std::string(Info(e.param).name));
   }
-  j["undetermined"] = nlohmann::ordered_json::array();
-  for (const ParamEstimate& e : s.estimates) {
-    if (e.undetermined)
-      j["undetermined"].push_back(kParamTable[static_cast<std::size_t>(e.param)].name);
-  }
-  return j.dump();
+  return fit;
 }
 
 bool ParamSetOrReport(const std::string& option, const std::vector<std::string>& names,
@@ -391,7 +370,7 @@ int RunCalibrate(const CalibrateArgs& a) {
     std::string error;
     const std::string text =
         FormatParamsJson(spec.Name(), summary.params, UsedParams(spec),
-                         FitJson(summary, a.test_csv.empty() ? nullptr : &held_out));
+                         FitOf(summary, a.test_csv.empty() ? nullptr : &held_out).ToJson());
     if (!WriteTextFileAtomically(a.out, text, &error)) {
       std::cerr << error << "\n";
       return kExitRuntime;

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "config/plant_config.h"
 #include "core/common/clock.h"
@@ -19,11 +21,22 @@
 
 namespace pvtwin::service_detail {
 
-bool Service::LoadAndApplyConfig(bool initial) {
+bool Service::LoadAndApplyConfig(bool initial, std::string* outcome) {
+  // One read of the file: the text parsed is the text compared at the next
+  // reload.
+  std::string text;
   Config config;
   Diagnostics errors;
-  if (!LoadConfig(options_.config_path, &config, &errors)) {
+  std::ifstream in(options_.config_path, std::ios::binary);
+  std::ostringstream read;
+  read << in.rdbuf();
+  text = read.str();
+  const bool loaded = in ? ParseConfig(text, options_.config_path, &config, &errors)
+                         : LoadConfig(options_.config_path, &config, &errors);
+  if (!loaded) {
     for (const Diagnostic& d : errors) LogToStderr(kErr, d.ToString());
+    *outcome = errors.empty() ? "the config could not be read" : errors.front().ToString();
+    if (errors.size() > 1) *outcome += " (and " + std::to_string(errors.size() - 1) + " more)";
     return false;
   }
   ModelSpec spec;
@@ -31,36 +44,24 @@ bool Service::LoadAndApplyConfig(bool initial) {
   [[maybe_unused]] const bool parsed = ParseVariant(config.calibration.variant, &spec, &error);
   assert(parsed && "LoadConfig checks the variant");
   if (!UseTimeZone(config.calibration.timezone, &error)) {
-    LogToStderr(kErr, options_.config_path + ": [calibration] " + error);
+    *outcome = options_.config_path + ": [calibration] " + error;
+    LogToStderr(kErr, *outcome);
     return false;
   }
   ParseClockTime(config.calibration.at, &at_hour_, &at_minute_);
   if (!options_.db_path.empty()) config.storage.path = options_.db_path;
   if (!initial) {
-    // The store and the poller own a file and connections; they keep the
-    // settings they were started with.
-    if (config.storage.path != config_.storage.path ||
-        config.poll.period_s != config_.poll.period_s)
-      LogToStderr(kWarning, "reload: [storage] and [poll] changes take effect after a restart");
-    if (config.plant.fluid_cp_j_kgk != config_.plant.fluid_cp_j_kgk) {
-      LogToStderr(kWarning,
-                  "reload: the 1-min aggregation uses the new [plant] fluid_cp_j_kgk after a "
-                  "restart");
-    }
-    if (config.upload.enabled != config_.upload.enabled ||
-        config.upload.url != config_.upload.url ||
-        config.upload.plant_id != config_.upload.plant_id)
-      LogToStderr(kWarning, "reload: [upload] changes take effect after a restart");
+    *outcome = LogConfigChanges(config_text_, text);
+    // The store, the poller and the upload own a file and connections;
+    // they keep the settings they were started with (kNeedsRestart).
     config.upload = config_.upload;
-    if (config.modbus.devices.size() != config_.modbus.devices.size() ||
-        config.modbus.points.size() != config_.modbus.points.size())
-      LogToStderr(kWarning, "reload: [[modbus.*]] changes take effect after a restart");
     config.storage = config_.storage;
     config.poll = config_.poll;
     config.modbus = config_.modbus;
   }
   const bool spec_changed = !initial && spec.Name() != spec_.Name();
   config_ = config;
+  config_text_ = text;
   spec_ = spec;
   if (spec_changed) {
     LogToStderr(kNotice, "reload: variant is now " + spec_.Name() +
@@ -150,7 +151,8 @@ void Service::Shutdown() {
 }
 
 int Service::Run() {
-  if (!LoadAndApplyConfig(true)) return 2;
+  std::string outcome;
+  if (!LoadAndApplyConfig(true, &outcome)) return 2;
   clock_ = options_.sim_start_s > 0
                ? std::make_unique<ScaledClock>(options_.sim_start_s, options_.wall_anchor_s,
                                                options_.speed)
@@ -183,6 +185,7 @@ int Service::Run() {
                                                device_events_.emplace_back(priority, line);
                                              });
     poller_->Start([this](const Sample& s) { queue_.Push(s); });
+    StartDeviceCounts();
   } else {
     LogToStderr(kNotice,
                 "no [[modbus.device]] in the config: polling is off; calibrations and "
@@ -197,6 +200,8 @@ int Service::Run() {
                                                                 at_hour_, at_minute_));
   next_forecast_s_ = have_params_ ? now : INFINITY;
   next_retention_s_ = now;
+  last_status_s_ = now;
+  ArmHealthReport();
   const double watchdog_s = WatchdogIntervalS();
   NotifyReady("polling " + std::to_string(config_.modbus.devices.size()) + " devices into " +
               config_.storage.path);
@@ -211,17 +216,7 @@ int Service::Run() {
   const double pass_s = std::min(config_.poll.period_s, clock_->speed());
   while (!stop.load()) {
     clock_->SleepUntil(Now() + pass_s, stop);
-    if (options_.reload && options_.reload->exchange(false)) {
-      NotifyReloading();
-      LogToStderr(kInfo, "SIGHUP: reloading " + options_.config_path);
-      if (!LoadAndApplyConfig(false)) {
-        LogToStderr(kErr, "reload failed; the old config stays");
-      } else {
-        RecordPlant();
-        UpdateWeatherFetch();
-      }
-      NotifyReady("reloaded");
-    }
+    if (options_.reload && options_.reload->exchange(false)) Reload();
     if (!StoreStillAtPath()) return 1;
     StoreSamples();
     Aggregate();
@@ -242,6 +237,7 @@ int Service::Run() {
       next_watchdog_wall_s_ = WallNowS() + watchdog_s;
     }
     UpdateDeviceStatus();
+    MaybeReportHealth();
     status_.now_s = Now();
     status_.calibration_id = params_id_;
     if (options_.on_tick && !options_.on_tick(status_)) break;

@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "core/fit/identification.h"
 #include "core/model/thermal_model.h"
+#include "daemon/service/calibration_fit.h"
 #include "daemon/service/service_internal.h"
 #include "io/files/csv.h"
 #include "io/files/params_json.h"
@@ -57,23 +57,16 @@ std::optional<ErrorMetrics> HeldOutErrors(const Series& test, const Plant& plant
   return e;
 }
 
-// The "parameters" list of calibrate's fit JSON as calibration_param rows;
-// entries without a name or a numeric value are skipped.
-std::vector<Store::CalibrationParamRow> ParamRowsOf(const nlohmann::json& fit) {
+// The parameters of calibrate's fit as calibration_param rows.
+std::vector<Store::CalibrationParamRow> ParamRowsOf(const CalibrationFit& fit) {
   std::vector<Store::CalibrationParamRow> rows;
-  for (const nlohmann::json& p : fit.value("parameters", nlohmann::json::array())) {
-    if (!p.is_object() || !p.contains("name") || !p["name"].is_string() || !p.contains("value") ||
-        !p["value"].is_number()) {
-      continue;
-    }
+  for (const FitParameter& p : fit.parameters) {
     Store::CalibrationParamRow row;
-    row.name = p["name"].get<std::string>();
-    row.value = p["value"].get<double>();
-    row.std_error = p.contains("std_error") && p["std_error"].is_number()
-                        ? p["std_error"].get<double>()
-                        : std::nan("");
-    row.unit = p.value("unit", "");
-    row.status = p.value("status", "");
+    row.name = p.name;
+    row.value = p.value;
+    row.std_error = p.std_error;
+    row.unit = p.unit;
+    row.status = p.status;
     rows.push_back(std::move(row));
   }
   return rows;
@@ -103,6 +96,7 @@ bool Service::LoadCurrentParameters() {
   params_id_ = row.id;
   params_ = file.values;
   params_json_ = row.params_json;
+  last_calibration_ = {row.id, "accepted", static_cast<double>(row.run_at)};
   return true;
 }
 
@@ -271,8 +265,8 @@ void Service::FinishRefit(int exit_code) {
                     "); the held-out-checked parameters stay");
     return;
   }
-  const nlohmann::json fit =
-      nlohmann::json::parse(text, nullptr, false).value("fit", nlohmann::json::object());
+  CalibrationFit fit;
+  CalibrationFit::FromParamsJson(text, &fit);  // parsed above: an object
   const std::string note = "; refit on the whole window (held-out days included) in " +
                            Format("%.1f", WallNowS() - child_started_wall_s_) + " s";
   std::string error;
@@ -310,9 +304,9 @@ void Service::FinishCalibration(int exit_code) {
     RecordCalibration(row);
     return;
   }
-  const nlohmann::json fit =
-      nlohmann::json::parse(text, nullptr, false).value("fit", nlohmann::json::object());
-  row.n_evals = fit.value("simulations", 0L);
+  CalibrationFit fit;
+  CalibrationFit::FromParamsJson(text, &fit);  // parsed above: an object
+  row.n_evals = fit.simulations;
   row.params_json = text;
   row.params = ParamRowsOf(fit);
   const std::optional<ErrorMetrics> fresh =
@@ -329,16 +323,12 @@ void Service::FinishCalibration(int exit_code) {
   row.heldout_mae_w = fresh->mae_p_el_w + fresh->mae_q_th_w;
   std::optional<ErrorMetrics> current;
   if (have_params_) current = HeldOutErrors(job_test_, config_.plant, spec_, params_);
-  std::vector<std::string> at_bounds;
-  for (const auto& name : fit.value("at_bounds", nlohmann::json::array())) {
-    if (name.is_string()) at_bounds.push_back(name.get<std::string>());
-  }
   const double tolerance_w_m2 =
       current ? cli::HeldOutDifferenceSe(job_test_, config_.plant, spec_, file.values, params_)
               : 0.0;
   const cli::AcceptanceDecision decision = cli::DecideCalibration(
       fresh->objective_w_m2(),
-      current ? std::optional<double>(current->objective_w_m2()) : std::nullopt, at_bounds,
+      current ? std::optional<double>(current->objective_w_m2()) : std::nullopt, fit.at_bounds,
       config_.plant.area_m2, tolerance_w_m2);
   row.reason = decision.reason + "; " + HeldOutText();
   if (current) row.reason += " (current: calibration " + std::to_string(params_id_) + ")";
@@ -369,6 +359,7 @@ std::int64_t Service::RecordCalibration(Store::CalibrationRow row) {
   status_.calibrating = false;
   ++status_.calibrations;
   status_.last_calibration = row.status + ": " + row.reason;
+  last_calibration_ = {row.id, row.status, static_cast<double>(row.run_at)};
   LogToStderr(row.status == "accepted" ? kNotice : kWarning,
               "calibration " + std::to_string(row.id) + " " + row.status + ": " + row.reason);
   return row.id;

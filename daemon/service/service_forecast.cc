@@ -2,6 +2,8 @@
 // issued every [forecast] refresh_min and after each accepted calibration,
 // with what the window teaches replayed once per day and calibration.
 #include <cmath>
+#include <initializer_list>
+#include <utility>
 
 #include "core/forecast/forecast.h"
 #include "core/forecast/forecast_bands.h"
@@ -10,6 +12,34 @@
 #include "io/platform/time_format.h"
 
 namespace pvtwin::service_detail {
+
+namespace {
+
+// "weather forecast 1200, persisted 240; operation typical 1440": where
+// the rows' inputs came from, the sources with rows only. The whole account
+// (channels, weather sources, the operation choice, the bands) is the
+// forecast rows' `inputs` column.
+std::string InputsInBrief(const ForecastInputUse& use) {
+  const auto list = [](std::initializer_list<std::pair<const char*, std::size_t>> counts) {
+    std::string text;
+    for (const auto& count : counts) {
+      if (count.second == 0) continue;
+      text += (text.empty() ? " " : ", ") + std::string(count.first) + " " +
+              std::to_string(count.second);
+    }
+    return text.empty() ? std::string(" none") : text;
+  };
+  return "weather" +
+         list({{"forecast", use.weather_forecast},
+               {"persisted", use.weather_persistence},
+               {"missing", use.weather_missing}}) +
+         "; operation" +
+         list({{"plan", use.operation_plan},
+               {"typical", use.operation_typical},
+               {"learned", use.operation_learned}});
+}
+
+}  // namespace
 
 void Service::IssueForecast() {
   if (!have_params_) return;
@@ -76,9 +106,10 @@ void Service::IssueForecast() {
   }
   ++status_.forecasts;
   status_.last_forecast_rows = rows.size();
+  last_forecast_issued_at_ = request.issued_at_s;
   LogToStderr(kInfo, "forecast issued at " + FormatIsoUtc(request.issued_at_s) + ": " +
                          std::to_string(rows.size()) + " rows, calibration " +
-                         std::to_string(params_id_) + "; " + inputs);
+                         std::to_string(params_id_) + "; " + InputsInBrief(forecast.inputs));
 }
 
 void Service::UpdateForecastStats(const Series& history, const ForecastRequest& request) {

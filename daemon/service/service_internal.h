@@ -9,6 +9,8 @@
 //   service_diagnose.cc     the daily checks and the nightly diagnosis
 //   service_forecast.cc     forecast issues and the window's replay
 //   service_workers.cc      the upload and weather-fetch threads
+//   service_reload.cc       SIGHUP: the config read again, its changes logged
+//   service_health.cc       the health line and systemd's STATUS=
 #pragma once
 
 #include <cstdint>
@@ -82,7 +84,16 @@ class Service {
   int Run();
 
  private:
-  bool LoadAndApplyConfig(bool initial);
+  // Reads the config file and applies it: false when it has errors (they
+  // are logged, *outcome is the first). On a reload (initial false) the
+  // changed keys are logged and *outcome summarises them; what a reload
+  // cannot apply keeps its running value (service_reload.cc).
+  bool LoadAndApplyConfig(bool initial, std::string* outcome);
+  // SIGHUP (service_reload.cc).
+  void Reload();
+  // Logs each key that differs between the two config texts; returns "no
+  // change" or "N keys changed[, M need a restart: …]".
+  std::string LogConfigChanges(const std::string& old_text, const std::string& new_text);
   void StoreSamples();
   void Aggregate();
   void MaybeStartCalibration();
@@ -115,6 +126,13 @@ class Service {
   // Starts, restarts (after a reload changed them) or stops the weather
   // fetch to match [forecast] weather_url and the plant.
   void UpdateWeatherFetch();
+  // The health line (service_health.cc).
+  void StartDeviceCounts();
+  void CountStoredSamples(const std::vector<Sample>& samples);
+  void ArmHealthReport();
+  void MaybeReportHealth();
+  std::string CalibrationHealth() const;
+  std::string ForecastHealth(bool brief) const;
   double Now() const { return clock_->NowS(); }
 
   ServiceOptions options_;
@@ -174,6 +192,26 @@ class Service {
   void UpdateForecastStats(const Series& history, const ForecastRequest& request);
   double next_retention_s_ = 0.0;
   double next_watchdog_wall_s_ = 0.0;
+  // The config file's text as last applied, compared at the next reload.
+  std::string config_text_;
+  // Health line: samples per device since the last line (a channel mask of
+  // each device's points), the last calibration attempt and forecast.
+  struct DeviceCounts {
+    std::string name;
+    std::uint32_t channels = 0;
+    std::uint64_t stored = 0;
+    std::uint64_t rejected = 0;
+  };
+  std::vector<DeviceCounts> device_counts_;
+  std::uint64_t samples_since_status_ = 0;
+  double last_status_s_ = 0.0;
+  double next_status_s_ = 0.0;
+  struct LastCalibration {
+    std::int64_t id = 0;
+    std::string status;  // empty: none seen
+    double run_at_s = 0.0;
+  } last_calibration_;
+  std::int64_t last_forecast_issued_at_ = -1;
 };
 
 }  // namespace pvtwin::service_detail

@@ -29,6 +29,7 @@ void Service::StoreSamples() {
   if (store_failing_) LogToStderr(kNotice, "storing samples works again");
   store_failing_ = false;
   status_.samples_stored += pending_.size();
+  CountStoredSamples(pending_);
   pending_.clear();
 }
 

@@ -272,6 +272,25 @@ TEST(ConfigLoad, DiagnosisAndMonitorSections) {
   EXPECT_EQ(errors[4].ToString(), "config.toml:13: alarm_days = 2.5: expected an integer");
 }
 
+// [log] status_min: the health line's period, 0 turning it off.
+TEST(ConfigLoad, LogSectionStatusMin) {
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(ParseConfig(kMinimalPlant, "config.toml", &config, &errors));
+  EXPECT_EQ(config.log.status_min, 15);
+  for (const int minutes : {0, 1, 1440}) {
+    ASSERT_TRUE(ParseConfig(std::string(kMinimalPlant) + "[log]\nstatus_min = " +
+                                std::to_string(minutes) + "\n",
+                            "config.toml", &config, &errors));
+    EXPECT_EQ(config.log.status_min, minutes);
+  }
+  EXPECT_FALSE(ParseConfig(std::string(kMinimalPlant) + "[log]\nstatus_min = 2.5\nlevel = 3\n",
+                           "config.toml", &config, &errors));
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].ToString(), "config.toml:8: status_min = 2.5: expected an integer");
+  EXPECT_EQ(errors[1].ToString(), "config.toml:9: level = 3: unknown key");
+}
+
 TEST(ConfigLoad, UploadSectionIsOptionalWithDocumentedDefaults) {
   Config config;
   Diagnostics errors;

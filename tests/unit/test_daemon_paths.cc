@@ -12,11 +12,13 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <regex>
+#include <sstream>
 #include <thread>
 
 #include "config/config_edit.h"
@@ -165,7 +167,7 @@ TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
       << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
   ::kill(daemon_.pid(), SIGHUP);
   ASSERT_TRUE(WaitFor(10, [&] {
-    return Log().find("reload failed; the old config stays") != std::string::npos;
+    return Log().find("; running with the previous config") != std::string::npos;
   })) << Log();
   EXPECT_NE(Log().find("period_s = 7: must be a whole number of seconds that divides 60"),
             std::string::npos)
@@ -174,6 +176,40 @@ TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
   ::kill(daemon_.pid(), SIGTERM);
   EXPECT_TRUE(notify.WaitFor("STOPPING=1", 10)) << notify.received();
   EXPECT_EQ(daemon_.Stop(0, 10.0), 0) << Log();
+}
+
+// A reload says what it changed, key by key with the old and the new value,
+// which of the keys it cannot apply (the store, the poller and the upload
+// keep what they were started with), and that nothing changed when nothing
+// did.
+TEST_F(DaemonPaths, AReloadLogsEachChangedKeyAndWhatNeedsARestart) {
+  WriteConfig(Settings());
+  StartDaemon(kJune1, 1.0);
+  ::kill(daemon_.pid(), SIGHUP);
+  ASSERT_TRUE(WaitFor(10, [&] { return Log().find("reload: no change") != std::string::npos; }))
+      << Log();
+
+  DaemonSettings changed = Settings();
+  changed.refresh_min = 30;
+  changed.poll_period_s = 10;
+  WriteConfig(changed);
+  ::kill(daemon_.pid(), SIGHUP);
+  ASSERT_TRUE(WaitFor(10, [&] {
+    return Log().find("reload: 2 keys changed") != std::string::npos;
+  })) << Log();
+  const std::string log = Log();
+  EXPECT_TRUE(std::regex_search(
+      log, std::regex("info: reload: \\[forecast\\] refresh_min 60(\\.0)? → 30(\\.0)?\n")))
+      << log;
+  EXPECT_TRUE(std::regex_search(log, std::regex("warning: reload: \\[poll\\] period_s 5(\\.0)? → "
+                                                "10(\\.0)?; needs a restart \\(")))
+      << log;
+  EXPECT_NE(log.find("reload: 2 keys changed, 1 needs a restart: [poll] period_s"),
+            std::string::npos)
+      << log;
+  // The applied key only: the storage path stayed.
+  EXPECT_EQ(log.find("[storage]"), std::string::npos) << log;
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
 }
 
 // A daemon started on the store of another plant (a copied config pointing
@@ -539,6 +575,69 @@ TEST_F(LiveDaemon, AggregatesWithTheConfiguredPeriodAndFluid) {
   EXPECT_GE(worst, 0.0);
   EXPECT_LT(worst, 1e-9);
   EXPECT_GT(db.Number("SELECT max(abs(q_th_w))" + full), 10.0) << "no heat to compare";
+}
+
+// Watching the daemon (issue 54): every [log] status_min a health line with
+// the samples each device delivered, the devices up, the last calibration
+// and forecast, and the same in systemd's STATUS=; a failed reload is the
+// STATUS until the next health line; no log line runs over 200 characters
+// (a forecast's once ran to 800).
+TEST_F(LiveDaemon, AHealthLineEveryStatusMinAndSystemdStatusKeptCurrent) {
+  const std::int64_t t0 = kJune1 + 10 * 3600;  // a June morning
+  ImportHistory(t0 - 120, 3);  // calibrated and forecast at the start
+  StartSim(t0, 60.0, {});
+  WriteLiveConfig(Settings(), "3650");
+  std::ofstream(dir_ / "pvtwin.toml", std::ios::app) << "\n[log]\nstatus_min = 1\n";
+  NotifySocket notify(dir_ / "notify.sock");
+  ::setenv("NOTIFY_SOCKET", (dir_ / "notify.sock").c_str(), 1);
+  StartDaemon(t0, 60.0);  // a simulated minute per second
+  ::unsetenv("NOTIFY_SOCKET");
+  // Lines "status: 2/2 devices up; samples stored/rejected in 1 min:
+  // collector 12/0, weather 12/0; calibration 1 accepted 10 s ago; forecast
+  // issued ..., 9 s ago".
+  const std::regex line(
+      "info: status: ([0-9]+)/([0-9]+) devices up; samples stored/rejected in [0-9.]+ (s|min): "
+      "collector ([0-9]+)/([0-9]+), weather ([0-9]+)/([0-9]+); calibration 1 accepted [0-9.]+ "
+      "(s|min) ago; forecast issued 2024-06-01T[0-9:]+Z, [0-9.]+ (s|min) ago\n");
+  std::smatch m;
+  std::string log;
+  ASSERT_TRUE(WaitFor(40, [&] {
+    log = Log();
+    return std::regex_search(log, m, line);
+  })) << log;
+  EXPECT_EQ(m.str(2), "2");
+  // A minute holds 12 periods of 5 s; a loaded machine delivers some late
+  // or merges them, never many more.
+  for (const int device : {4, 6}) {
+    const int samples = std::stoi(m.str(device)) + std::stoi(m.str(device + 1));
+    EXPECT_GE(samples, 4) << m[0];
+    EXPECT_LE(samples, 24) << m[0];
+  }
+  ASSERT_TRUE(notify.WaitFor("; calibration 1 accepted ", 20)) << notify.received();
+  EXPECT_NE(notify.received().find("STATUS=2/2 devices up, "), std::string::npos)
+      << notify.received();
+
+  // A reload with an error: the STATUS says so until the next health line.
+  const std::string valid = ReadFile(dir_ / "pvtwin.toml");
+  std::ofstream(dir_ / "pvtwin.toml")
+      << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
+  ::kill(daemon_.pid(), SIGHUP);
+  ASSERT_TRUE(notify.WaitFor("STATUS=reload failed: ", 10)) << notify.received();
+  EXPECT_TRUE(std::regex_search(notify.received(),
+                                std::regex("STATUS=reload failed: [^\\]]*period_s = 7: [^\\]]*; "
+                                           "running with the previous config")))
+      << notify.received();
+  ASSERT_TRUE(notify.WaitFor("STATUS=2/2 devices up, ", 10)) << notify.received();
+
+  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  std::istringstream lines(Log());
+  std::size_t longest = 0;
+  for (std::string l; std::getline(lines, l);) {
+    EXPECT_LE(l.size(), 200u) << l;
+    longest = std::max(longest, l.size());
+  }
+  EXPECT_GT(longest, 0u);
+  EXPECT_NE(Log().find("forecast issued at "), std::string::npos) << Log();
 }
 
 // Each device offline for 1, 10, 60 and 600 simulated minutes while the

@@ -341,8 +341,12 @@ double MeasuredSkyTemperatureC(const Series& s, std::size_t i) {
   return KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
 }
 
+namespace {
+
+// The clear-sky estimate of row i, °C: Berdahl & Martin from the dew point
+// where the row has a relative humidity (*from_dew_point), else Swinbank.
 double EstimatedSkyTemperatureC(const Series& s, const Plant& plant, std::size_t i,
-                                 bool* from_dew_point) {
+                                bool* from_dew_point) {
   const double t_air_c = s.At(Channel::kTAmbC, i);
   const double t_dew_c = DewPointC(t_air_c, s.At(AirChannel::kRhPct, i));
   *from_dew_point = std::isfinite(t_dew_c);
@@ -355,6 +359,8 @@ double EstimatedSkyTemperatureC(const Series& s, const Plant& plant, std::size_t
   const double eps_clear = BerdahlMartinClearSkyEmittance(t_dew_c, solar_hour, p_air_hpa);
   return KToC(SkyTemperatureFromEmittanceK(eps_clear, CToK(t_air_c)));
 }
+
+}  // namespace
 
 std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::string* note,
                                      SkyUsed* used) {
@@ -402,7 +408,7 @@ std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::s
   if (excess.size() < 30 || 2 * static_cast<std::size_t>(warmer) <= excess.size()) return measured;
   std::nth_element(excess.begin(), excess.begin() + excess.size() / 2, excess.end());
   if (note != nullptr) {
-    char text[200];
+    char text[256];
     std::snprintf(text, sizeof(text),
                   "the long-wave channel is implausible: it puts the sky more than 2 K above the "
                   "air on %zu of %zu rows in full sun (median %+.1f K); ",

@@ -27,7 +27,9 @@ TEST(PhysicalRanges, EveryParameterHasASourceAndNoNarrowerRangeThanTable3) {
     EXPECT_LE(range.lower, range.upper) << Info(p).name;
     EXPECT_LE(wide.lower, table.lower) << Info(p).name;
     EXPECT_GE(wide.upper, table.upper) << Info(p).name;
-    if (Info(p).scale == ParamScale::kLog) EXPECT_GT(wide.lower, 0.0) << Info(p).name;
+    if (Info(p).scale == ParamScale::kLog) {
+      EXPECT_GT(wide.lower, 0.0) << Info(p).name;
+    }
   }
   EXPECT_GE(PhysicalRangeOf(Param::kEpsPvt, plant).upper, 0.94);
   EXPECT_GT(WidenedInfo(Param::kEpsPvt, plant).upper, ResolvedInfo(Param::kEpsPvt, plant).upper);

@@ -73,4 +73,36 @@ constexpr std::optional<Channel> ChannelFromName(std::string_view name) {
   return std::nullopt;
 }
 
+// Air channels that only the sky estimate reads (SkyTemperaturesC,
+// core/model/thermal_model.h): the canonical CSV's optional columns rh_pct
+// and p_air_hpa. Series carries them beside the channels above; they are no
+// model input of the paper, so the SQLite store, the Modbus register map and
+// the physical limits of the CSV reader do not know them (the sky estimate
+// skips a value outside 0 < RH ≤ 100 %, 300 ≤ p ≤ 1100 hPa).
+enum class AirChannel : std::size_t {
+  kRhPct,    // relative humidity of the ambient air, %
+  kPAirHpa,  // air pressure, hPa
+  kCount
+};
+
+inline constexpr std::size_t kNumAirChannels = static_cast<std::size_t>(AirChannel::kCount);
+
+struct AirChannelInfo {
+  AirChannel channel;
+  std::string_view name;  // canonical CSV column name
+  std::string_view unit;
+};
+
+inline constexpr std::array<AirChannelInfo, kNumAirChannels> kAirChannels = {{
+    {AirChannel::kRhPct, "rh_pct", "%"},
+    {AirChannel::kPAirHpa, "p_air_hpa", "hPa"},
+}};
+
+constexpr std::optional<AirChannel> AirChannelFromName(std::string_view name) {
+  for (const AirChannelInfo& info : kAirChannels) {
+    if (info.name == name) return info.channel;
+  }
+  return std::nullopt;
+}
+
 }  // namespace pvtwin

@@ -78,6 +78,7 @@ struct Drivers {
   // Non-empty when the sky temperature is not the measured channel's: why
   // (an implausible long-wave channel, or [plant] sky = "estimated").
   std::string sky_note;
+  SkyUsed sky_used = SkyUsed::kMeasured;  // which sky t_sky_c holds
 
   std::size_t size() const { return time_s.size(); }
 };

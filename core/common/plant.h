@@ -9,7 +9,16 @@ namespace pvtwin {
 enum class SkySource {
   kAuto,       // the long-wave channel, unless it is implausible (then kEstimated)
   kMeasured,   // t_sky_c, else lw_down_w_m2, always
-  kEstimated,  // from the air temperature (Swinbank 1963)
+  kEstimated,  // from the air temperature and dew point (Berdahl & Martin 1984) where the
+               // data have rh_pct, else from the air temperature (Swinbank 1963)
+};
+
+// Which sky the model's sky temperature is, as SkySource chose it
+// (SkyTemperaturesC, core/model/thermal_model.h).
+enum class SkyUsed {
+  kMeasured,        // t_sky_c, else lw_down_w_m2
+  kAirTemperature,  // estimated from t_amb_c (Swinbank 1963)
+  kDewPoint,        // estimated from t_amb_c and rh_pct (Berdahl & Martin 1984)
 };
 
 struct Plant {

@@ -11,6 +11,9 @@ Series Series::Slice(std::size_t begin, std::size_t end) const {
       out.columns[c].assign(columns[c].begin() + begin, columns[c].begin() + end);
     }
   }
+  for (std::size_t c = 0; c < kNumAirChannels; ++c) {
+    if (!air[c].empty()) out.air[c].assign(air[c].begin() + begin, air[c].begin() + end);
+  }
   return out;
 }
 

@@ -20,6 +20,8 @@ struct Series {
   std::vector<std::int64_t> time_s;
   double step_s = 0.0;  // nominal spacing of the rows
   std::array<std::vector<double>, kNumChannels> columns;
+  // The air channels (channels.h AirChannel), empty when absent, as columns.
+  std::array<std::vector<double>, kNumAirChannels> air;
 
   std::size_t size() const { return time_s.size(); }
   bool Has(Channel c) const { return !columns[static_cast<std::size_t>(c)].empty(); }
@@ -29,6 +31,15 @@ struct Series {
   }
   // Value of channel c in row i, NaN if the channel is absent.
   double At(Channel c, std::size_t i) const {
+    const auto& col = (*this)[c];
+    return col.empty() ? std::nan("") : col[i];
+  }
+  bool Has(AirChannel c) const { return !air[static_cast<std::size_t>(c)].empty(); }
+  std::vector<double>& operator[](AirChannel c) { return air[static_cast<std::size_t>(c)]; }
+  const std::vector<double>& operator[](AirChannel c) const {
+    return air[static_cast<std::size_t>(c)];
+  }
+  double At(AirChannel c, std::size_t i) const {
     const auto& col = (*this)[c];
     return col.empty() ? std::nan("") : col[i];
   }

@@ -1,5 +1,6 @@
 #include "core/data/resample.h"
 
+#include <array>
 #include <cassert>
 #include <charconv>
 #include <cmath>
@@ -52,6 +53,12 @@ bool Resample(const Series& in, double step_s, Series* out, std::string* error,
     if (channel != Channel::kValid && in.Has(channel)) channels.push_back(channel);
   }
   const bool has_valid = in.Has(Channel::kValid);
+  std::vector<AirChannel> air;  // the air channels present, averaged alike
+  for (std::size_t c = 0; c < kNumAirChannels; ++c) {
+    if (in.Has(static_cast<AirChannel>(c))) air.push_back(static_cast<AirChannel>(c));
+  }
+  std::array<double, kNumAirChannels> air_sum{};
+  std::array<int, kNumAirChannels> air_present{};
 
   Series result;
   result.step_s = step_s;
@@ -69,6 +76,8 @@ bool Resample(const Series& in, double step_s, Series* out, std::string* error,
     bool all_valid = true;
     std::fill(sum.begin(), sum.end(), 0.0);
     std::fill(present.begin(), present.end(), 0);
+    air_sum.fill(0.0);
+    air_present.fill(0);
     for (; end < in.size() && in.time_s[end] < start_s + bucket_s; ++end) {
       if (has_valid && in[Channel::kValid][end] == 0.0) all_valid = false;
       for (const Channel c : channels) {
@@ -78,12 +87,23 @@ bool Resample(const Series& in, double step_s, Series* out, std::string* error,
           ++present[static_cast<std::size_t>(c)];
         }
       }
+      for (const AirChannel c : air) {
+        const double x = in[c][end];
+        if (!std::isnan(x)) {
+          air_sum[static_cast<std::size_t>(c)] += x;
+          ++air_present[static_cast<std::size_t>(c)];
+        }
+      }
     }
     const auto n_rows = static_cast<int>(end - begin);
     result.time_s.push_back(start_s);
     for (const Channel c : channels) {
       const auto k = static_cast<std::size_t>(c);
       result[c].push_back(present[k] > 0 ? sum[k] / present[k] : std::nan(""));
+    }
+    for (const AirChannel c : air) {
+      const auto k = static_cast<std::size_t>(c);
+      result[c].push_back(air_present[k] > 0 ? air_sum[k] / air_present[k] : std::nan(""));
     }
     valid.push_back(all_valid && 2.0 * n_rows >= expected_rows ? 1.0 : 0.0);
     counts.push_back(n_rows);

@@ -58,9 +58,14 @@ bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
   progress("diagnosis: " + std::to_string(train_days) + " training days, " +
            std::to_string(heldout_days) + " held-out days, step " + FixedDecimals(r.step_s, 0) +
            " s; fitting the base model " + r.base_variant);
-  const IdentSummary base_fit =
-      Identify(base_train.drivers, base_train.meas, StartParams(plant), options.ident);
-  r.identifications = 1;
+  RangedFit ranged = IdentifyInRanges(base_train.drivers, base_train.meas, StartParams(plant),
+                                      options);
+  const IdentSummary& base_fit = ranged.fit;
+  r.identifications = ranged.refitted.empty() ? 1 : 2;
+  r.base_refitted = ranged.refitted;
+  for (const RefittedParam& refit : ranged.refitted) {
+    r.notes.push_back("base model " + r.base_variant + ": " + RefittedSentence(refit));
+  }
   if (!base_fit.ok) {
     *error = "identification of the base model " + r.base_variant +
              " failed: " + base_fit.failure_reason;

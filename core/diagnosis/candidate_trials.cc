@@ -63,7 +63,13 @@ std::vector<std::string> AtBounds(const EffectModule& effect, const ModelSpec& s
   for (const Param param : effect.params) {
     if (!used.test(static_cast<std::size_t>(param))) continue;
     ++used_params;
-    const ParamInfo info = ResolvedInfo(param, plant);
+    // The range the fit searched: Table 3's, or the physical range of a re-fit.
+    ParamInfo info = ResolvedInfo(param, plant);
+    for (const ParamEstimate& e : t.estimates) {
+      if (e.param != param) continue;
+      info.lower = e.lower;
+      info.upper = e.upper;
+    }
     const double v = ParamOf(t.params, param);
     const double tol = 1e-3 * (info.upper - info.lower);
     if (v <= info.lower + tol) {
@@ -232,6 +238,7 @@ std::vector<EffectCandidate> SelectCandidates(const TrialInputs& in, const Model
 struct FormFit {
   Part train;
   IdentSummary fit;
+  std::vector<RefittedParam> refitted;  // parameters re-fitted in their physical range
   std::string failure;  // the part could not be prepared
 };
 
@@ -251,7 +258,9 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
     effect.start_from_residuals(
         ResidualsForStart(in.base->train.drivers, in.base->train_sim, in.base->train.meas), &start);
   }
-  f.fit = Identify(f.train.drivers, f.train.meas, start, in.options->ident);
+  RangedFit ranged = IdentifyInRanges(f.train.drivers, f.train.meas, start, *in.options);
+  f.fit = std::move(ranged.fit);
+  f.refitted = std::move(ranged.refitted);
   return f;
 }
 
@@ -316,6 +325,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   }
   const IdentSummary& fit = best.fit;
   t.params = fit.params;
+  t.refitted = best.refitted;
   if (c.module->advice_for != nullptr) t.advice = c.module->advice_for(c.spec, fit.params, plant);
   for (const ParamEstimate& e : fit.estimates) {
     if (std::find(c.module->params.begin(), c.module->params.end(), e.param) !=
@@ -383,6 +393,7 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
        << "per " << test_unit << ": lower on " << t.test.positives << " of " << t.test.pairs
        << " (Wilcoxon p = " << PValue(t.test.wilcoxon_p) << ")";
     if (!t.signature_check.empty()) ev << "; " << t.signature_check;
+    for (const RefittedParam& r : t.refitted) ev << "; " << RefittedSentence(r);
     for (const std::string& c : t.cautions) ev << "; against it: " << c;
   } else {
     ev << "not tested: " << t.failure;

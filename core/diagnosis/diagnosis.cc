@@ -106,6 +106,7 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   r.extrapolation = st::FindExtrapolation(base_fit, options);
   r.sensors = st::CheckSensors(data, plant);
   if (!base_fit.train.drivers.sky_note.empty()) r.notes.push_back(base_fit.train.drivers.sky_note);
+  r.sky_used = base_fit.train.drivers.sky_used;
   if (!split.cleanings.empty()) {
     std::string days;
     for (const Cleaning& c : split.cleanings) {

@@ -122,6 +122,14 @@ struct DiagnosisOptions {
   // Smallest step that is a sensor fault, K: twice the tolerance of a
   // class-A Pt100 at 25 °C (IEC 60751: ±(0.15 + 0.002·|T|) K).
   double min_temperature_offset_k = 0.4;
+  // A free parameter that ends a fit (the base model's, a candidate's) at a
+  // bound of Table 3's range is re-fitted within the hull of that range and
+  // its physical range (core/common/physical_ranges.h), from the first fit;
+  // the re-fit is used when it lowers the training cost. Table 3's ranges are
+  // start values ±50 % for ε_PVT and η_PVref: a plant outside them is a real
+  // plant (issue 52, item 3). A model whose start values lie outside Table
+  // 3's range (built on such a re-fit) keeps the physical range for them.
+  bool refit_in_physical_ranges = true;
   // Effects to try (names of the vocabulary); empty = every candidate.
   std::vector<std::string> effects;
   LocaliseOptions where;
@@ -156,6 +164,21 @@ struct Extrapolation {
   double heldout_low = 0.0, heldout_high = 0.0;  // 1st, 99th percentile
   double share_outside = 0.0;
 };
+
+// A parameter that ended a fit at a bound of Table 3's range, re-fitted
+// within the hull of that range and its physical range
+// (DiagnosisOptions::refit_in_physical_ranges).
+struct RefittedParam {
+  Param param = Param::kCount;
+  double table_bound = 0.0;         // the Table 3 bound the first fit ended at
+  double lower = 0.0, upper = 0.0;  // the range of the re-fit
+  double value = 0.0;               // where the re-fit ended
+  bool used = false;                // the re-fit lowered the training cost: its parameters count
+};
+
+// "ε_PVT at its Table 3 bound 0.225, re-fitted in 0–0.95: 0.41" (", not used:
+// no lower training cost" when the first fit stayed).
+std::string RefittedSentence(const RefittedParam& r);
 
 // The decisive test of one effect against the model it was added to.
 struct EffectTrial {
@@ -204,6 +227,9 @@ struct EffectTrial {
   // Effect parameters that ended at a bound or that the data do not
   // determine: "P_limit at its upper bound 300", "n_flow = 0.079 ± 0.247 (not determined)".
   std::vector<std::string> at_bounds;
+  // Parameters (of the whole model) re-fitted in their physical range
+  // because the fit left them at a Table 3 bound; also named in `evidence`.
+  std::vector<RefittedParam> refitted;
   PartialCorrelation evidence_corr;  // residual evidence (stronger output)
   std::string evidence_output;       // "p_el" or "q_th"
   std::string evidence;              // one sentence
@@ -284,6 +310,11 @@ struct DiagnosisResult {
   std::string test_unit;        // "day" or "hour"
   bool low_confidence = false;  // fewer held-out days than min_test_units
   std::vector<std::string> notes;
+  // The base model's parameters re-fitted in their physical range (also in notes).
+  std::vector<RefittedParam> base_refitted;
+  // Which sky the models ran on (SkyTemperaturesC; notes say why an
+  // estimate replaced the long-wave channel).
+  SkyUsed sky_used = SkyUsed::kMeasured;
   DiagnosisTrace trace;
   int identifications = 0;
   double wall_time_s = 0.0;

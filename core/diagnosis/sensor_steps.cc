@@ -79,7 +79,10 @@ std::optional<SensorFinding> FindInletOffsetStep(const Series& data, const Split
   if (!PreparePart(data, plant, base, split.data_start_s, split.cleanings, &all, &why)) {
     return std::nullopt;
   }
-  const IdentSummary fit = Identify(all.drivers, all.meas, start, options.ident);
+  // The final model's parameters as they are, in the ranges they were found in (no re-fit).
+  DiagnosisOptions ranges = options;
+  ranges.refit_in_physical_ranges = false;
+  const IdentSummary fit = IdentifyInRanges(all.drivers, all.meas, start, ranges).fit;
   if (!fit.ok) return std::nullopt;
   SimOutputs sim;
   Simulate(all.drivers, fit.params, &sim);

@@ -8,7 +8,8 @@
 //   6. noise_floor.cc       the MAE that sensor noise alone gives
 //   7. verdict.cc           the verdict and its sentence
 //   8. report_model.cc      the days table and the trace the report plots
-// Helpers shared by the stages are in stage_common.cc. No stage knows an
+// Helpers shared by the stages are in stage_common.cc; every fit of the
+// stages runs through IdentifyInRanges (physical_refit.cc). No stage knows an
 // effect by name: what differs between effects is asked of the candidate's
 // module (EffectCandidate::module).
 #pragma once
@@ -89,6 +90,18 @@ LossDifferenceTest CompareLosses(const Score& before, const Score& after, const 
 // Residual (predicted − measured) of one output over the objective rows, NaN elsewhere.
 std::vector<double> Residual(const Measurements& m, const std::vector<double>& pred,
                              const std::vector<double>& meas);
+
+// Identify with the diagnosis's ranges (physical_refit.cc): Table 3's, the
+// physical range for a parameter whose start lies outside Table 3's, and,
+// with options.refit_in_physical_ranges, a re-fit in the physical range of
+// every free parameter the first fit left at a Table 3 bound that the
+// physical range extends (used when it lowers the training cost).
+struct RangedFit {
+  IdentSummary fit;
+  std::vector<RefittedParam> refitted;
+};
+RangedFit IdentifyInRanges(const Drivers& drivers, const Measurements& meas,
+                           const ParamVector& start, const DiagnosisOptions& options);
 
 // --- 1. Split ---
 struct Split {

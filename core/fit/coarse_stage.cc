@@ -93,7 +93,7 @@ FreeSet SelectFree(const Drivers& drivers, const ParamVector& start, const Ident
   FreeSet fs;
   fs.base = start;
   for (std::size_t i = 0; i < kNumParams; ++i) {
-    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), drivers.plant);
+    const ParamInfo info = SearchInfo(static_cast<Param>(i), drivers.plant, options);
     fs.base[i] = std::clamp(fs.base[i], info.lower, info.upper);
     if (used.test(i) && requested.test(i) && info.upper > info.lower) {
       fs.free.push_back(static_cast<Param>(i));

@@ -13,7 +13,7 @@ std::vector<ParamEstimate> Estimates(const Drivers& drivers, const FreeSet& fs, 
   const ParamVector& best = fine.best();
   for (std::size_t i = 0; i < kNumParams; ++i) {
     if (!used.test(i)) continue;
-    const ParamInfo info = ResolvedInfo(static_cast<Param>(i), drivers.plant);
+    const ParamInfo info = SearchInfo(static_cast<Param>(i), drivers.plant, options);
     ParamEstimate e;
     e.param = info.param;
     e.value = best[i];

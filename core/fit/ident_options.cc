@@ -98,7 +98,26 @@ bool IdentOptions::IsValid(std::string* why) const {
     return fail("polish_stop_prediction_factor", polish_stop_prediction_factor, "must be >= 0");
   if (min_rows < 1) return fail("min_rows", min_rows, "must be >= 1");
   if (threads < 1 || threads > 2) return fail("threads", threads, "must be 1 or 2");
+  for (const ParamInfo& r : search_ranges) {
+    const std::string field = "search_ranges[" + std::string(Info(r.param).name) + "]";
+    if (!(std::isfinite(r.lower) && std::isfinite(r.upper) && r.lower <= r.upper)) {
+      return fail(field + ".upper", r.upper, "must be finite and >= its lower bound");
+    }
+    if (Info(r.param).scale == ParamScale::kLog && !(r.lower > 0.0)) {
+      return fail(field + ".lower", r.lower, "must be > 0 for a log-scaled parameter");
+    }
+  }
   return true;
+}
+
+ParamInfo SearchInfo(Param p, const Plant& plant, const IdentOptions& options) {
+  ParamInfo info = ResolvedInfo(p, plant);
+  for (const ParamInfo& r : options.search_ranges) {
+    if (r.param != p) continue;
+    info.lower = r.lower;
+    info.upper = r.upper;
+  }
+  return info;
 }
 
 std::vector<std::string> IdentSummary::AtBounds() const {

@@ -133,6 +133,12 @@ struct IdentOptions {
   double polish_stop_prediction_factor = 1.0;
   // Fewest objective rows accepted.
   int min_rows = 30;
+  // Search ranges that replace Table 3's (ResolvedInfo) for some
+  // parameters: param, lower and upper of each entry count, the rest of the
+  // entry is ignored. The gap diagnosis re-fits a parameter that ended at a
+  // Table 3 bound in its physical range this way
+  // (core/common/physical_ranges.h). Empty: Table 3's for every parameter.
+  std::vector<ParamInfo> search_ranges;
   // Take lad_lm's Jacobian, the gradient of NLopt's gradient methods (kLbfgs,
   // kMma) and the identifiability analysis's sensitivity matrix from the
   // model run with sensitivities (core/model/sensitivities.h) where it
@@ -159,6 +165,10 @@ struct IdentOptions {
   // False if a field is out of range; *why names field, value and rule.
   bool IsValid(std::string* why) const;
 };
+
+// The search range of p in a fit with these options: Table 3's at the
+// plant (ResolvedInfo), or the entry of options.search_ranges for p.
+ParamInfo SearchInfo(Param p, const Plant& plant, const IdentOptions& options);
 
 struct ParamEstimate {
   Param param;

@@ -39,7 +39,7 @@ void FillEffectDrivers(const Series& s, const Plant& plant, const ModelSpec& spe
   const std::size_t n = s.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   d->wind_m_s = s.Has(Channel::kWindMS) ? s[Channel::kWindMS] : std::vector<double>(n, nan);
-  d->t_sky_c = SkyTemperaturesC(s, plant, &d->sky_note);
+  d->t_sky_c = SkyTemperaturesC(s, plant, &d->sky_note, &d->sky_used);
   d->sun_azimuth_rad.resize(n);
   d->sun_elevation_rad.resize(n);
   d->g_beam_w_m2.assign(n, nan);
@@ -341,21 +341,58 @@ double MeasuredSkyTemperatureC(const Series& s, std::size_t i) {
   return KToC(SkyTemperatureK(s[Channel::kLwDownWM2][i]));
 }
 
-std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::string* note) {
+namespace {
+
+// The clear-sky estimate of row i, °C: Berdahl & Martin from the dew point
+// where the row has a relative humidity (*from_dew_point), else Swinbank.
+double EstimatedSkyTemperatureC(const Series& s, const Plant& plant, std::size_t i,
+                                bool* from_dew_point) {
+  const double t_air_c = s.At(Channel::kTAmbC, i);
+  const double t_dew_c = DewPointC(t_air_c, s.At(AirChannel::kRhPct, i));
+  *from_dew_point = std::isfinite(t_dew_c);
+  if (!*from_dew_point) return KToC(SwinbankSkyTemperatureK(CToK(t_air_c)));
+  // Hours from local mean solar midnight at the row's middle.
+  const double utc_hour = static_cast<double>(s.time_s[i]) / 3600.0 + 0.5 * s.step_s / 3600.0;
+  const double solar_hour = std::fmod(utc_hour + RadToDeg(plant.longitude_rad) / 15.0, 24.0);
+  double p_air_hpa = s.At(AirChannel::kPAirHpa, i);
+  if (!(p_air_hpa >= 300.0 && p_air_hpa <= 1100.0)) p_air_hpa = std::nan("");
+  const double eps_clear = BerdahlMartinClearSkyEmittance(t_dew_c, solar_hour, p_air_hpa);
+  return KToC(SkyTemperatureFromEmittanceK(eps_clear, CToK(t_air_c)));
+}
+
+}  // namespace
+
+std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::string* note,
+                                     SkyUsed* used) {
   const std::size_t n = s.size();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (note != nullptr) note->clear();
   std::vector<double> measured(n, nan), estimated(n, nan);
+  std::vector<std::uint8_t> dew(n, 0);
   ForRowHalves(n, kRowsToSplit, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       measured[i] = MeasuredSkyTemperatureC(s, i);
-      estimated[i] = KToC(SwinbankSkyTemperatureK(CToK(s.At(Channel::kTAmbC, i))));
+      bool from_dew_point = false;
+      estimated[i] = EstimatedSkyTemperatureC(s, plant, i, &from_dew_point);
+      dew[i] = from_dew_point ? 1 : 0;
     }
   });
-  const char* kHow = "the sky temperature is estimated from the air temperature (Swinbank 1963)";
+  const auto dew_rows = static_cast<std::size_t>(std::count(dew.begin(), dew.end(), 1));
+  const SkyUsed estimate = dew_rows > 0 ? SkyUsed::kDewPoint : SkyUsed::kAirTemperature;
+  std::string how =
+      "the sky temperature is estimated from the air temperature (Swinbank 1963)";
+  if (dew_rows > 0) {
+    how = "the sky temperature is estimated from the air temperature and dew point (clear-sky "
+          "emittance of Berdahl & Martin 1984 with the hour and pressure corrections of Martin "
+          "& Berdahl 1984; dew point from rh_pct by Magnus with Alduchov & Eskridge 1996) on " +
+          std::to_string(dew_rows) + " of " + std::to_string(n) + " rows" +
+          (dew_rows < n ? ", from the air temperature alone (Swinbank 1963) on the rest" : "");
+  }
+  if (used != nullptr) *used = SkyUsed::kMeasured;
   if (plant.sky == SkySource::kMeasured) return measured;
   if (plant.sky == SkySource::kEstimated) {
-    if (note != nullptr) *note = std::string(kHow) + " as [plant] sky = \"estimated\" asks";
+    if (note != nullptr) *note = how + " as [plant] sky = \"estimated\" asks";
+    if (used != nullptr) *used = estimate;
     return estimated;
   }
   const Channel sun = s.Has(Channel::kGPoaWM2) ? Channel::kGPoaWM2 : Channel::kGhiWM2;
@@ -371,14 +408,14 @@ std::vector<double> SkyTemperaturesC(const Series& s, const Plant& plant, std::s
   if (excess.size() < 30 || 2 * static_cast<std::size_t>(warmer) <= excess.size()) return measured;
   std::nth_element(excess.begin(), excess.begin() + excess.size() / 2, excess.end());
   if (note != nullptr) {
-    char text[320];
+    char text[256];
     std::snprintf(text, sizeof(text),
                   "the long-wave channel is implausible: it puts the sky more than 2 K above the "
-                  "air on %zu of %zu rows in full sun (median %+.1f K); %s instead ([plant] sky "
-                  "= \"measured\" keeps the channel)",
-                  static_cast<std::size_t>(warmer), excess.size(), excess[excess.size() / 2], kHow);
-    *note = text;
+                  "air on %zu of %zu rows in full sun (median %+.1f K); ",
+                  static_cast<std::size_t>(warmer), excess.size(), excess[excess.size() / 2]);
+    *note = text + how + " instead ([plant] sky = \"measured\" keeps the channel)";
   }
+  if (used != nullptr) *used = estimate;
   return estimated;
 }
 

@@ -67,14 +67,19 @@ bool PrepareDrivers(const Series& series, const Plant& plant, const ModelSpec& s
 double MeasuredSkyTemperatureC(const Series& series, std::size_t i);
 
 // The sky temperature of every row, °C, as plant.sky says: the measured
-// t_sky_c (else the equivalent of lw_down_w_m2, paper 3.1), or the Swinbank
-// estimate from t_amb_c. kAuto uses the measured channel unless it is
+// t_sky_c (else the equivalent of lw_down_w_m2, paper 3.1), or an estimate:
+// where the row has rh_pct (Series' air channels), the clear sky of Berdahl
+// & Martin from the dew point (with p_air_hpa's pressure correction where
+// given; core/physics/sky_radiation.h), else Swinbank's from t_amb_c alone.
+// kAuto uses the measured channel unless it is
 // implausible: among at least 30 rows in full sun (in-plane or global
 // irradiance ≥ 600 W/m²) more than half put the sky more than 2 K above the
 // air, which no clear sky does (the same rule as the sensor check
 // sky_warmer_than_air, core/monitor/monitoring.h). *note (may be null) says
-// why when the estimate is used, "" otherwise. NaN where the source is.
-std::vector<double> SkyTemperaturesC(const Series& series, const Plant& plant, std::string* note);
+// why when the estimate is used, "" otherwise; *used (may be null) which
+// sky it is. NaN where the source is.
+std::vector<double> SkyTemperaturesC(const Series& series, const Plant& plant, std::string* note,
+                                     SkyUsed* used = nullptr);
 
 // soiling: cleanings (rain or washing) at these unix times reset the soiling
 // loss; recomputes drivers->days_since_clean. Times need not be sorted.

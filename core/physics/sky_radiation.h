@@ -22,6 +22,47 @@ inline double SwinbankSkyTemperatureK(double t_air_k) {
   return 0.0552 * t_air_k * std::sqrt(t_air_k);
 }
 
+// Dew point from air temperature and relative humidity by the Magnus
+// formula with the coefficients of Alduchov & Eskridge (1996), "Improved
+// Magnus form approximation of saturation vapor pressure", J. Appl. Meteor.
+// 35, 601–609 (their AERK: e_s = 6.1094·exp(17.625·t/(243.04 + t)) hPa):
+//   γ = ln(RH/100) + a·t/(b + t),   t_d = b·γ/(a − γ),   a = 17.625, b = 243.04 °C
+// t_air_c in °C, rh_pct in % (0 < RH ≤ 100), result in °C. Holds for
+// −40 … 50 °C. NaN outside 0 < RH ≤ 100.
+inline double DewPointC(double t_air_c, double rh_pct) {
+  constexpr double kA = 17.625, kB = 243.04;
+  if (!(rh_pct > 0.0 && rh_pct <= 100.0)) return std::nan("");
+  const double gamma = std::log(rh_pct / 100.0) + kA * t_air_c / (kB + t_air_c);
+  return kB * gamma / (kA - gamma);
+}
+
+// Clear-sky emittance from the dew point, Berdahl & Martin (1984),
+// "Emissivity of clear skies", Solar Energy 32, 663–664, with the diurnal and
+// pressure (site elevation) corrections of Martin & Berdahl (1984),
+// "Characteristics of infrared sky radiation in the United States", Solar
+// Energy 33, 321–336:
+//   ε_clr = 0.711 + 0.56·(t_d/100) + 0.73·(t_d/100)²
+//           + 0.013·cos(2π·h/24) + 0.00012·(p − 1000)
+// t_d = t_dew_c (°C), h = solar_hour (hours from local solar midnight),
+// p = p_air_hpa (hPa). A NaN p leaves its correction out (sea level). Fitted
+// on dew points of −20 … 30 °C. Duffie & Beckman (Solar Engineering of
+// Thermal Processes, 4th ed., eq. 3.9.2) give the same without the pressure
+// term as T_sky = T_air·ε_clr^(1/4).
+inline double BerdahlMartinClearSkyEmittance(double t_dew_c, double solar_hour,
+                                             double p_air_hpa) {
+  constexpr double kTwoPi = 6.283185307179586;
+  const double x = t_dew_c / 100.0;
+  const double pressure = std::isnan(p_air_hpa) ? 0.0 : 0.00012 * (p_air_hpa - 1000.0);
+  return 0.711 + 0.56 * x + 0.73 * x * x + 0.013 * std::cos(kTwoPi * solar_hour / 24.0) +
+         pressure;
+}
+
+// Equivalent sky temperature of a sky of emittance eps_sky over air at
+// t_air_k: σ·T_sky⁴ = ε_sky·σ·T_air⁴, so T_sky = ε_sky^(1/4)·T_air (K).
+inline double SkyTemperatureFromEmittanceK(double eps_sky, double t_air_k) {
+  return std::sqrt(std::sqrt(eps_sky)) * t_air_k;
+}
+
 // Net long-wave loss of the PV surface to the sky per m² (W/m²):
 //   q_rad = ε_PVT·σ·(T_PV⁴ − T_sky⁴)
 // which is the paper's U_rad·(T_PV − T_sky) with (paper eq. 2.6, per m²)

@@ -187,6 +187,7 @@ enum class Conversion {
 struct Column {
   std::string name;                // as written in the header
   std::optional<Channel> channel;  // nullopt: the time column or an ignored one
+  std::optional<AirChannel> air;   // an air channel (rh_pct, p_air_hpa), unchecked
   Conversion conversion = Conversion::kNone;
   PhysicalLimit limit;  // PhysicalLimitOf(*channel, the options' area), when channel is set
 };
@@ -276,6 +277,7 @@ class CsvParser {
     append(&series_.time_s, later.series_.time_s);
     for (const Column& column : columns_) {
       if (column.channel) append(&series_[*column.channel], later.series_[*column.channel]);
+      if (column.air) append(&series_[*column.air], later.series_[*column.air]);
     }
     last_line_ += later.last_line_;
     return true;
@@ -337,6 +339,7 @@ class CsvParser {
     series_.time_s.reserve(rows);
     for (const Column& column : columns_) {
       if (column.channel) series_[*column.channel].reserve(rows);
+      if (column.air) series_[*column.air].reserve(rows);
     }
   }
 
@@ -378,7 +381,14 @@ class CsvParser {
       } else if (channel == Channel::kAoiRad) {
         column.conversion = Conversion::kDegToRad;
       }
-      if (!channel) {
+      if (!channel && AirChannelFromName(name)) {
+        column.air = AirChannelFromName(name);
+        const bool seen = std::any_of(columns_.begin(), columns_.end(),
+                                      [&](const Column& c) { return c.air == column.air; });
+        if (seen) Error(1, name, "", "duplicate column");
+        column.limit = {-std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity()};
+      } else if (!channel) {
         warnings_.push_back({path_, 1,
                              name.empty() ? "column " + std::to_string(i + 1) : std::string(name),
                              "", "unknown column ignored"});
@@ -425,6 +435,7 @@ class CsvParser {
 
     for (const Column& column : columns_) {
       if (column.channel) series_[*column.channel].clear();
+      if (column.air) series_[*column.air].clear();
     }
     return true;
   }
@@ -473,6 +484,7 @@ class CsvParser {
     for (std::size_t i = 0; i < columns_.size(); ++i) {
       const Column& column = columns_[i];
       if (column.channel) series_[*column.channel].push_back(ReadCell(line_no, column, fields_[i]));
+      if (column.air) series_[*column.air].push_back(ReadCell(line_no, column, fields_[i]));
     }
   }
 

@@ -6,7 +6,8 @@
 //     Rows must be strictly increasing in time, each within
 //     1980-01-01T00:00:00Z .. 2200-01-01T00:00:00Z (a time before is a clock
 //     at its zero or a relative time, e.g. -5, not a measurement).
-//   * Every other known column goes to its Channel (core/channels.h).
+//   * Every other known column goes to its Channel (core/channels.h); rh_pct
+//     and p_air_hpa go to Series' air channels (AirChannel), unchecked.
 //     `flow_l_h` becomes kMdotKgS: kg/s = L/h · ρ / 3.6e6, with ρ from
 //     CsvReadOptions; `aoi_deg` becomes kAoiRad in radians. `valid` is 0 or 1.
 //   * Empty cells and "nan" (any case) are missing values (NaN).

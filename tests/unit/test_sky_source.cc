@@ -65,6 +65,70 @@ TEST(SkySource, AnImplausibleChannelIsReplacedAndSaysWhy) {
   EXPECT_NE(note.find("estimated"), std::string::npos);
 }
 
+// Dew point by Magnus with Alduchov & Eskridge's coefficients against
+// psychrometric tables (dew point at 20 °C, 50 % RH: 9.3 °C; at 30 °C, 80 %:
+// 26.2 °C; at 0 °C, 100 %: 0 °C by definition), to their 0.1 K.
+TEST(SkySource, DewPointMatchesPsychrometricTables) {
+  EXPECT_NEAR(DewPointC(20.0, 50.0), 9.3, 0.05);
+  EXPECT_NEAR(DewPointC(30.0, 80.0), 26.2, 0.05);
+  EXPECT_NEAR(DewPointC(0.0, 100.0), 0.0, 1e-12);
+  EXPECT_TRUE(std::isnan(DewPointC(20.0, 0.0)));
+  EXPECT_TRUE(std::isnan(DewPointC(20.0, 120.0)));
+}
+
+// Berdahl & Martin's clear-sky emittance by hand from the published formula
+// ε = 0.711 + 0.56·(t_d/100) + 0.73·(t_d/100)² + 0.013·cos(2π·h/24)
+//     + 0.00012·(p − 1000):
+//   t_d = 10 °C: 0.711 + 0.056 + 0.0073 = 0.7743;
+//   at midnight (cos 0 = 1): + 0.013 = 0.7873, without a pressure;
+//   at solar noon (cos π = −1) and 950 hPa: 0.7743 − 0.013 − 0.006 = 0.7553.
+//   t_d = −10 °C at 6 h (cos π/2 = 0), 1000 hPa: 0.711 − 0.056 + 0.0073 = 0.6623.
+// The sky temperature of ε = 0.7553 over 25 °C air: 0.7553^¼ = 0.932245,
+// × 298.15 K = 277.95 K.
+TEST(SkySource, BerdahlMartinEmittanceByHand) {
+  const double nan = std::nan("");
+  EXPECT_NEAR(BerdahlMartinClearSkyEmittance(10.0, 0.0, nan), 0.7873, 1e-12);
+  EXPECT_NEAR(BerdahlMartinClearSkyEmittance(10.0, 12.0, 950.0), 0.7553, 1e-12);
+  EXPECT_NEAR(BerdahlMartinClearSkyEmittance(-10.0, 6.0, 1000.0), 0.6623, 1e-12);
+  EXPECT_NEAR(SkyTemperatureFromEmittanceK(0.7553, 298.15), 277.95, 0.01);
+}
+
+// With rh_pct in the data the estimate that replaces an implausible
+// long-wave channel is the dew-point sky, and the note names it. Rows at
+// 30 °C, 40 % RH, 950 hPa, 2024-06-01 12:00 UTC onwards at longitude 0:
+// t_d = 14.93 °C (Magnus); at noon ε = 0.711 + 0.0836 + 0.0163 − 0.013 −
+// 0.006 = 0.7919, T_sky = 0.7919^¼ · 303.15 K = 285.97 K (12.8 °C), 5.4 K
+// colder than Swinbank's 18.2 °C.
+TEST(SkySource, WithHumidityTheDewPointSkyReplacesTheChannel) {
+  Plant plant;
+  Series s = Sunny(15.0, 60);
+  s[AirChannel::kRhPct].assign(s.size(), 40.0);
+  s[AirChannel::kPAirHpa].assign(s.size(), 950.0);
+  std::string note;
+  SkyUsed used = SkyUsed::kMeasured;
+  const std::vector<double> t = SkyTemperaturesC(s, plant, &note, &used);
+  EXPECT_EQ(used, SkyUsed::kDewPoint);
+  EXPECT_NE(note.find("implausible"), std::string::npos) << note;
+  EXPECT_NE(note.find("Berdahl & Martin"), std::string::npos) << note;
+  EXPECT_EQ(note.find("on the rest"), std::string::npos) << note;
+  const double t_d = DewPointC(30.0, 40.0);
+  EXPECT_NEAR(t_d, 14.93, 0.01);
+  // Row 0 starts at 12:00 UTC, its middle is 12:00:30: h = 12.00833.
+  const double eps = BerdahlMartinClearSkyEmittance(t_d, 12.0 + 30.0 / 3600.0, 950.0);
+  EXPECT_NEAR(t[0], KToC(std::sqrt(std::sqrt(eps)) * CToK(30.0)), 1e-9);
+  EXPECT_NEAR(t[0], 12.82, 0.01);
+  // A row without humidity falls back to Swinbank, and the note says so.
+  s[AirChannel::kRhPct][5] = std::nan("");
+  const std::vector<double> u = SkyTemperaturesC(s, plant, &note, &used);
+  EXPECT_NEAR(u[5], KToC(SwinbankSkyTemperatureK(CToK(30.0))), 1e-9);
+  EXPECT_NE(note.find("59 of 60 rows"), std::string::npos) << note;
+  EXPECT_NE(note.find("Swinbank"), std::string::npos) << note;
+  // Without the channel, the air-temperature sky.
+  s[AirChannel::kRhPct].clear();
+  SkyTemperaturesC(s, plant, &note, &used);
+  EXPECT_EQ(used, SkyUsed::kAirTemperature);
+}
+
 TEST(SkySource, TheConfigKeyTakesThreeWordsAndNamesItsLine) {
   Config config;
   Diagnostics errors;

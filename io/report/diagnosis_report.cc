@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/common/params.h"
 #include "io/files/params_json.h"
 #include "io/report/svg_plot.h"
 
@@ -99,6 +100,33 @@ std::vector<double> Edges(double lo, double hi, double step) {
   return e;
 }
 
+// Parameters a fit left at a Table 3 bound and re-fitted in their physical
+// range (core/common/physical_ranges.h).
+Json RefittedJson(const std::vector<RefittedParam>& refitted) {
+  Json out = Json::array();
+  for (const RefittedParam& f : refitted) {
+    out.push_back(Json{{"param", std::string(Info(f.param).name)},
+                       {"table3_bound", Number(f.table_bound)},
+                       {"lower", Number(f.lower)},
+                       {"upper", Number(f.upper)},
+                       {"value", Number(f.value)},
+                       {"used", f.used}});
+  }
+  return out;
+}
+
+const char* SkyName(SkyUsed sky) {
+  switch (sky) {
+    case SkyUsed::kMeasured:
+      return "measured";
+    case SkyUsed::kAirTemperature:
+      return "air_temperature";
+    case SkyUsed::kDewPoint:
+      return "dew_point";
+  }
+  return "measured";
+}
+
 }  // namespace
 
 std::string DiagnosisReportJson(const DiagnosisResult& r) {
@@ -130,6 +158,7 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
     e["heldout_mae_before_w"] = Number(t.heldout_mae_before_w);
     e["heldout_mae_after_w"] = Number(t.fit_ok ? t.heldout_mae_after_w : std::nan(""));
     e["evidence"] = t.evidence;
+    e["refitted"] = RefittedJson(t.refitted);
     e["variant"] = t.variant;
     e["tested_against"] = t.tested_against;
     e["accepted_at_step"] = t.accepted_at_step;
@@ -218,6 +247,8 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
   j["test_unit"] = r.test_unit;
   j["low_confidence"] = r.low_confidence;
   j["notes"] = r.notes;
+  j["base_refitted"] = RefittedJson(r.base_refitted);
+  j["sky"] = SkyName(r.sky_used);
   Json skipped = Json::array();
   for (const SkippedEffect& s : r.skipped)
     skipped.push_back(Json{{"name", s.name}, {"why", s.why}});

@@ -279,7 +279,18 @@ TEST(DiagnosisReport, JsonHasTheDesignKeys) {
   e.heldout_mae_before_w = 52.5;
   e.heldout_mae_after_w = 34.1;
   e.evidence = "because";
+  RefittedParam eps;
+  eps.param = Param::kEpsPvt;
+  eps.table_bound = 0.225;
+  eps.lower = 0.0;
+  eps.upper = 0.95;
+  eps.value = 0.41;
+  eps.used = true;
+  e.refitted.push_back(eps);
   r.effects.push_back(e);
+  r.base_refitted.push_back(eps);
+  r.base_refitted.back().used = false;
+  r.sky_used = SkyUsed::kDewPoint;
   r.ladder.push_back({});
   r.verdict = "pv_clipping";
   const nlohmann::json j = nlohmann::json::parse(DiagnosisReportJson(r));
@@ -302,6 +313,16 @@ TEST(DiagnosisReport, JsonHasTheDesignKeys) {
   EXPECT_DOUBLE_EQ(ej.at("heldout_mae_before_w").get<double>(), 52.5);
   EXPECT_DOUBLE_EQ(ej.at("heldout_mae_after_w").get<double>(), 34.1);
   EXPECT_EQ(ej.at("evidence"), "because");
+  ASSERT_EQ(ej.at("refitted").size(), 1u);
+  const nlohmann::json& rj = ej["refitted"][0];
+  EXPECT_EQ(rj.at("param"), "eps_pvt");
+  EXPECT_DOUBLE_EQ(rj.at("table3_bound").get<double>(), 0.225);
+  EXPECT_DOUBLE_EQ(rj.at("upper").get<double>(), 0.95);
+  EXPECT_DOUBLE_EQ(rj.at("value").get<double>(), 0.41);
+  EXPECT_EQ(rj.at("used"), true);
+  ASSERT_EQ(j.at("base_refitted").size(), 1u);
+  EXPECT_EQ(j["base_refitted"][0].at("used"), false);
+  EXPECT_EQ(j.at("sky"), "dew_point");
   EXPECT_EQ(j.at("verdict"), "pv_clipping");
 
   const std::string html = DiagnosisReportHtml(r);

@@ -13,6 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/plant_config.h"
+#include "core/model/variant.h"
+#include "daemon/service/monitor.h"
 #include "daemon/service/window_data.h"
 #include "io/store/store.h"
 #include "tests/support/run_pvtwin.h"
@@ -187,6 +190,36 @@ TEST_F(IntervalStore, WithoutRecordNothingIsWritten) {
   RawDb db(dir_ / "t.db");
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM qc_event"), 0.0);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM diagnosis"), 0.0);
+}
+
+// The daemon's daily checks (daemon/service/monitor.h) on a store that holds
+// the interval rows only, the night after day 1 (2017-08-07): the sensor
+// checks of the last two days run on those rows and name the long-wave
+// channel in qc_event and the log.
+TEST_F(IntervalStore, TheDailyChecksRecordTheLongWaveChannelOfIntervalRows) {
+  ImportHtwDays();
+  Config config;
+  Diagnostics errors;
+  ASSERT_TRUE(LoadConfig((kData / "plant.toml").string(), &config, &errors));
+  std::string error;
+  std::unique_ptr<Store> store = Store::Open((dir_ / "t.db").string(), &error);
+  ASSERT_TRUE(store) << error;
+  cli::DailyCheckInputs in;
+  in.config = &config;
+  ASSERT_TRUE(ParseVariant("2N1CcolwrI", &in.spec, &error)) << error;
+  in.now_s = 1502150400;  // 2017-08-08T00:00:00Z
+  bool logged = false;
+  for (const auto& line : cli::RunDailyChecks(*store, in)) {
+    logged = logged || line.second.find("sensor lw_down_w_m2: sky_warmer_than_air") == 0;
+  }
+  EXPECT_TRUE(logged);
+  RawDb db(dir_ / "t.db");
+  const auto rows = db.Rows("SELECT DISTINCT channel, kind FROM qc_event");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0][0], "lw_down_w_m2");
+  EXPECT_EQ(rows[0][1], "sky_warmer_than_air");
+  // Day 1 only: day 3 lies before the two days the check looks at.
+  EXPECT_EQ(db.Number("SELECT MIN(start_ts) >= 1502064000 FROM qc_event"), 1.0);
 }
 
 // A window with no rows in either table is still bad input, naming both.

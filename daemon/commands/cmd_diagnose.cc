@@ -215,8 +215,8 @@ double DiagnosisStep(const DiagnoseArgs& a, const WindowData& window) {
 }
 
 // The monitor's sensor checks (core/monitor/monitoring.h) over interval rows,
-// into qc_event: the daily checks of the daemon see 1-min rows only, so the
-// faults of imported logger data are recorded here.
+// into qc_event: the daemon's daily checks look at the last two days only, so
+// the faults of imported logger history are recorded here.
 bool RecordIntervalSensorFaults(Store& store, const Series& rows, const Plant& plant) {
   const std::vector<SensorFault> faults = FindSensorFaults(rows, plant);
   std::string error;

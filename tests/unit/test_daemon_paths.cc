@@ -87,27 +87,17 @@ class DaemonPaths : public ::testing::Test {
   std::string DbPath() const { return (dir_ / "pvtwin.db").string(); }
   std::string Log() const { return ReadFile(dir_ / "daemon.log"); }
 
-  // `days` of the example plant's history up to `end`, imported at 1 min.
-  void ImportHistory(std::int64_t end, int days) {
+  // `days` of the example plant's history up to `end`, imported at 1 min
+  // (measurement_1min) or as a coarser logger's rows (measurement_interval).
+  void ImportHistory(std::int64_t end, int days, int step_s = 60) {
     fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
     auto run = RunPvtwin(dir_.path(), "sim --config sim.toml --export history.csv --days " +
-                                          std::to_string(days) + " --step 60 --start " +
+                                          std::to_string(days) + " --step " +
+                                          std::to_string(step_s) + " --start " +
                                           std::to_string(end - days * kDay));
     ASSERT_EQ(run.exit_code, 0) << run.err;
     run = RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + DbPath());
     ASSERT_EQ(run.exit_code, 0) << run.err;
-  }
-
-  // The same history from a 2-min logger: imported into measurement_interval.
-  void ImportIntervalHistory(std::int64_t end, int days) {
-    fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
-    auto run = RunPvtwin(dir_.path(), "sim --config sim.toml --export history.csv --days " +
-                                          std::to_string(days) + " --step 120 --start " +
-                                          std::to_string(end - days * kDay));
-    ASSERT_EQ(run.exit_code, 0) << run.err;
-    run = RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + DbPath());
-    ASSERT_EQ(run.exit_code, 0) << run.err;
-    ASSERT_NE(run.err.find("into measurement_interval"), std::string::npos) << run.err;
   }
 
   // A config without devices: the daemon works on the imported data.
@@ -419,7 +409,7 @@ TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
 // [calibration] step_s of 60 s gives way), judges it on a held-out day and
 // accepts it; before, it was skipped as "0.0 days of 1-min data".
 TEST_F(DaemonPaths, IntervalHistoryIsCalibratedAtItsOwnStep) {
-  ImportIntervalHistory(kJune1, 4);
+  ImportHistory(kJune1, 4, 120);
   WriteConfig(Settings());
   StartDaemon(kJune1, 60.0);
   Db db(DbPath());

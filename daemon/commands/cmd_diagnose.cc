@@ -16,10 +16,12 @@
 #include "core/common/clock.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/diagnosis/diagnosis_selftest.h"
+#include "core/monitor/monitoring.h"
 #include "core/synth/synthetic_plant.h"
 #include "daemon/commands/commands.h"
 #include "daemon/commands/inputs.h"
 #include "daemon/service/store_cli.h"
+#include "daemon/service/window_data.h"
 #include "io/report/diagnosis_report.h"
 #include "io/platform/quantity_text.h"
 #include "io/store/store.h"
@@ -159,10 +161,11 @@ bool RecordDiagnosis(Store& store, const DiagnosisResult& r, std::int64_t from_t
   return true;
 }
 
-// The store's 1-min rows of [--from, --to) (default: the [calibration]
-// window up to now).
+// The store's rows of [--from, --to) (default: the [calibration] window up
+// to now): its 1-min rows, or without them its measurement_interval rows at
+// their own step (daemon/service/window_data.h).
 bool ReadStoreWindow(const DiagnoseArgs& a, const Config& config, std::unique_ptr<Store>* store,
-                     Series* series, std::int64_t* from_out, std::int64_t* to_out) {
+                     WindowData* window, std::int64_t* from_out, std::int64_t* to_out) {
   std::int64_t& from_ts = *from_out;
   std::int64_t& to_ts = *to_out;
   if (!ParseTimeOrReport("--to", a.to, &to_ts)) return false;
@@ -182,15 +185,47 @@ bool ReadStoreWindow(const DiagnoseArgs& a, const Config& config, std::unique_pt
                                : OpenStoreReadOnlyOrReport(a.db, StoreOptionsFor(config), store);
   if (!opened) return false;
   std::string error;
-  if (!(*store)->ReadMinutes(from_ts, to_ts, series, &error)) {
+  if (!ReadWindowData(**store, from_ts, to_ts, window, &error)) {
     std::cerr << error << "\n";
     return false;
   }
-  if (series->size() == 0) {
-    std::cerr << "--db = " << a.db << ": no measurement_1min rows in " << FormatIsoUtc(from_ts)
-              << " .. " << FormatIsoUtc(to_ts) << "\n";
+  if (window->source == WindowSource::kNone) {
+    std::cerr << "--db = " << a.db << ": no measurement_1min or measurement_interval rows in "
+              << FormatIsoUtc(from_ts) << " .. " << FormatIsoUtc(to_ts) << "\n";
     return false;
   }
+  if (window->source == WindowSource::kIntervals) {
+    std::cerr << "--db = " << a.db << ": no 1-min rows in " << FormatIsoUtc(from_ts) << " .. "
+              << FormatIsoUtc(to_ts) << "; diagnosing the " << window->rows.size() << " "
+              << window->Describe() << " at their own step\n";
+  }
+  return true;
+}
+
+// The model step of a diagnosis of the store's window: --step, or the step of
+// interval rows when --step is finer than they are or no multiple of theirs
+// (the daemon passes its [calibration] step_s, made for 1-min rows). 0: the
+// data's own.
+double DiagnosisStep(const DiagnoseArgs& a, const WindowData& window) {
+  if (window.source != WindowSource::kIntervals || a.step_s <= 0.0) return a.step_s;
+  if (StepForData(a.step_s, window.rows.step_s) == a.step_s) return a.step_s;
+  std::cerr << "--step = " << a.step_s << ": not a multiple of the interval rows' step; "
+            << "diagnosing at their step of " << window.rows.step_s << " s\n";
+  return 0.0;  // the data's own
+}
+
+// The monitor's sensor checks (core/monitor/monitoring.h) over interval rows,
+// into qc_event: the daemon's daily checks look at the last two days only, so
+// the faults of imported logger history are recorded here.
+bool RecordIntervalSensorFaults(Store& store, const Series& rows, const Plant& plant) {
+  const std::vector<SensorFault> faults = FindSensorFaults(rows, plant);
+  std::string error;
+  if (!store.RecordSensorFaults(faults, &error)) {
+    std::cerr << error << "\n";
+    return false;
+  }
+  std::cerr << "recorded " << faults.size() << " sensor fault(s) of the interval rows in qc_event"
+            << "\n";
   return true;
 }
 
@@ -198,7 +233,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   if (!DieWithParent(a.parent_pid)) return kExitRuntime;
   if (a.csv.empty() == a.db.empty()) {
     std::cerr << "diagnose: give either --csv (a canonical CSV) or --db (the store's "
-                 "measurement_1min)\n";
+                 "measurement_1min or measurement_interval)\n";
     return kExitBadInput;
   }
   if (a.record && a.db.empty()) {
@@ -229,11 +264,19 @@ int RunDiagnose(const DiagnoseArgs& a) {
     std::cerr << "diagnose: " << why << "\n";
     return kExitBadInput;
   }
-  Series series;
+  WindowData window;
+  Series& series = window.rows;
   std::unique_ptr<Store> store;
   std::int64_t from_ts = 0, to_ts = 0;
   if (!a.db.empty()) {
-    if (!ReadStoreWindow(a, config, &store, &series, &from_ts, &to_ts)) return kExitBadInput;
+    if (!ReadStoreWindow(a, config, &store, &window, &from_ts, &to_ts)) return kExitBadInput;
+    options.step_s = DiagnosisStep(a, window);
+    // The sensor checks do not need the model: recorded even when the
+    // diagnosis cannot run.
+    if (a.record && window.source == WindowSource::kIntervals &&
+        !RecordIntervalSensorFaults(*store, series, config.plant)) {
+      return kExitRuntime;
+    }
   } else if (!LoadCsvOrReport(a.csv, config, &series)) {
     return kExitBadInput;
   }
@@ -426,13 +469,16 @@ void RegisterDiagnose(CLI::App& app) {
   cmd->add_option("--config", args->config, "TOML config with the [plant] section")->required();
   cmd->add_option("--csv", args->csv, "canonical CSV with the measurements");
   cmd->add_option("--db", args->db,
-                  "instead of --csv: the measurement_1min rows of this SQLite store");
+                  "instead of --csv: the measurement_1min rows of this SQLite store, or its "
+                  "measurement_interval rows at their own step when the window has no 1-min "
+                  "rows");
   cmd->add_option("--from", args->from,
                   "with --db: first time, ISO 8601, a date or relative such as -14d (default: "
                   "--to minus [calibration] window_days)");
   cmd->add_option("--to", args->to, "with --db: end time, exclusive (default: now)");
   cmd->add_flag("--record", args->record,
-                "with --db: write the result as a row of the store's diagnosis table");
+                "with --db: write the result as a row of the store's diagnosis table (and, "
+                "for measurement_interval rows, their sensor faults to qc_event)");
   cmd->add_option("--calibration-id", args->calibration_id,
                   "with --record: the calibration whose window is diagnosed");
   cmd->add_option("--run-at", args->run_at,

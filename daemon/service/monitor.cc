@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/monitor/monitoring.h"
+#include "daemon/service/window_data.h"
 #include "io/platform/log.h"
 #include "io/files/params_json.h"
 #include "io/platform/time_format.h"
@@ -198,15 +199,17 @@ void CheckDatasheetPower(Store& store, const DailyCheckInputs& in, const Series&
 
 std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const DailyCheckInputs& in) {
   LogLines log;
-  // One read of the 1-min rows for every check: from the first day of the
-  // calibration window up to now.
-  Series window;
+  // One read for every check: from the first day of the calibration window
+  // up to now, its 1-min rows or without them its interval rows at their
+  // step (window_data.h).
+  WindowData data;
   std::string read_error;
   const std::int64_t first = in.now_s / kDayS * kDayS - in.config->calibration.window_days * kDayS;
-  if (!store.ReadMinutes(first, in.now_s, &window, &read_error)) {
+  if (!ReadWindowData(store, first, in.now_s, &data, &read_error)) {
     log.push_back({kErr, "daily checks: " + read_error});
     return log;
   }
+  const Series& window = data.rows;
   CheckSensors(store, in, window, &log);
   CheckDatasheetPower(store, in, window, &log);
   Store::CalibrationRow cal;

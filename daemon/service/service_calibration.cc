@@ -13,6 +13,7 @@
 #include "core/model/thermal_model.h"
 #include "daemon/service/calibration_fit.h"
 #include "daemon/service/service_internal.h"
+#include "daemon/service/window_data.h"
 #include "io/files/csv.h"
 #include "io/files/params_json.h"
 #include "io/platform/local_time.h"
@@ -113,19 +114,23 @@ void Service::MaybeStartCalibration() {
   row.variant = spec_.Name();
   row.window_start = begin;
   row.window_end = end;
-  Series window;
+  // Its 1-min rows, or without them its interval rows at their own step.
+  cli::WindowData data;
   std::string error;
-  if (!store_->ReadMinutes(begin, end, &window, &error)) {
+  if (!cli::ReadWindowData(*store_, begin, end, &data, &error)) {
     row.status = "failed";
     row.reason = "reading the window failed: " + error;
     RecordCalibration(row);
     return;
   }
+  const Series& window = data.rows;
   const std::int64_t span = window.size() ? window.time_s.back() - window.time_s.front() : 0;
-  if (span < 2 * kDayS - 120) {
+  if (span < 2 * kDayS - static_cast<std::int64_t>(2 * window.step_s)) {
     row.status = "skipped";
-    row.reason = "window holds " + Format("%.1f", span / 86400.0) +
-                 " days of 1-min data; two are needed (training days and a held-out day)";
+    row.reason = "window holds " + Format("%.1f", span / 86400.0) + " days of " +
+                 (data.source == cli::WindowSource::kIntervals ? data.Describe()
+                                                                : std::string("1-min data")) +
+                 "; two are needed (training days and a held-out day)";
     RecordCalibration(row);
     if (!have_params_)
       next_calibration_s_ = std::min(next_calibration_s_, now + kUncalibratedRetryS);
@@ -134,7 +139,8 @@ void Service::MaybeStartCalibration() {
   // Held out: the last days, as many as it takes (up to 3) to hold two hours
   // with the pump running in sunshine; an overcast pump-off day cannot tell
   // two parameter sets apart.
-  const cli::HeldOutChoice held_out = cli::ChooseHeldOutDays(window, end);
+  const auto two_hours_rows = static_cast<std::size_t>(std::lround(7200.0 / window.step_s));
+  const cli::HeldOutChoice held_out = cli::ChooseHeldOutDays(window, end, 3, two_hours_rows);
   const std::int64_t test_start = end - held_out.days * kDayS;
   const Series train = window.Between(begin, test_start);
   job_test_ = window.Between(test_start, end);
@@ -156,7 +162,8 @@ void Service::MaybeStartCalibration() {
   job_kind_ = JobKind::kHeldOut;
   status_.calibrating = true;
   LogToStderr(kInfo, "calibration of " + spec_.Name() + " started on " + FormatIsoUtc(begin) +
-                         " .. " + FormatIsoUtc(end) + " (" + HeldOutText() + ")");
+                         " .. " + FormatIsoUtc(end) + " (" + data.Describe() + ", " +
+                         HeldOutText() + ")");
 }
 
 bool Service::StartCalibrateChild(const Series& data, const std::string& csv_name,
@@ -182,7 +189,8 @@ bool Service::StartCalibrateChild(const Series& data, const std::string& csv_nam
                                    "--variant",
                                    spec_.Name(),
                                    "--step",
-                                   Format("%.0f", config_.calibration.step_s),
+                                   Format("%.0f", cli::StepForData(config_.calibration.step_s,
+                                                                   data.step_s)),
                                    "--ftol",
                                    Format("%g", options_.calibration_ftol),
                                    "--out",

@@ -99,7 +99,8 @@ class Service {
   void MaybeStartCalibration();
   void CheckCalibration();
   void FinishCalibration(int exit_code);
-  // Writes data to job_dir_/csv_name and starts `pvtwin calibrate` on it.
+  // Writes data to job_dir_/csv_name and starts `pvtwin calibrate` on it, at
+  // [calibration] step_s or, when that is no multiple of data's, at data's.
   bool StartCalibrateChild(const Series& data, const std::string& csv_name, std::string* error);
   void StartRefit();
   void FinishRefit(int exit_code);

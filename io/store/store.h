@@ -54,7 +54,8 @@
 //       minutes above one (2-, 10-, 15-min logger data): the values stand for
 //       the interval [ts, ts + step_s) as the logger gave them. They are not
 //       split into 1-min rows, which would invent what happened inside the
-//       interval; the daemon's calibration reads measurement_1min only.
+//       interval. A window without 1-min rows is read from here at the rows'
+//       step (daemon/service/window_data.h).
 //
 // Version 3 adds:
 //   calibration_param(calibration_id INTEGER, name TEXT, value REAL,

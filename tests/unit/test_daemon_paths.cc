@@ -89,11 +89,13 @@ class DaemonPaths : public ::testing::Test {
   std::string DbPath() const { return (dir_ / "pvtwin.db").string(); }
   std::string Log() const { return ReadFile(dir_ / "daemon.log"); }
 
-  // `days` of the example plant's history up to `end`, imported at 1 min.
-  void ImportHistory(std::int64_t end, int days) {
+  // `days` of the example plant's history up to `end`, imported at 1 min
+  // (measurement_1min) or as a coarser logger's rows (measurement_interval).
+  void ImportHistory(std::int64_t end, int days, int step_s = 60) {
     fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
     auto run = RunPvtwin(dir_.path(), "sim --config sim.toml --export history.csv --days " +
-                                          std::to_string(days) + " --step 60 --start " +
+                                          std::to_string(days) + " --step " +
+                                          std::to_string(step_s) + " --start " +
                                           std::to_string(end - days * kDay));
     ASSERT_EQ(run.exit_code, 0) << run.err;
     run = RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + DbPath());
@@ -435,6 +437,33 @@ TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
   EXPECT_TRUE(fs::exists(dir_ / "reports" / "diagnosis-2024-06-01.html")) << Log();
   int code = 0;
   EXPECT_FALSE(daemon_.Finished(&code)) << "the daemon stopped: " << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
+// A plant whose history came from a 2-min logger (measurement_interval, no
+// 1-min rows): the nightly calibration fits it at the rows' step (the
+// [calibration] step_s of 60 s gives way), judges it on a held-out day and
+// accepts it; before, it was skipped as "0.0 days of 1-min data".
+TEST_F(DaemonPaths, IntervalHistoryIsCalibratedAtItsOwnStep) {
+  ImportHistory(kJune1, 4, 120);
+  WriteConfig(Settings());
+  StartDaemon(kJune1, 60.0);
+  Db db(DbPath());
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
+  })) << Log();
+  EXPECT_EQ(db.Number("SELECT count(*) FROM measurement_1min"), 0);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE status = 'skipped'"), 0) << Log();
+  EXPECT_NE(Log().find("(2-min rows of measurement_interval, last day held out, "),
+            std::string::npos)
+      << Log();
+  std::vector<fs::path> logs;
+  for (const auto& e : fs::recursive_directory_iterator(dir_ / "calibration")) {
+    if (e.path().filename() == "calibrate.log") logs.push_back(e.path());
+  }
+  ASSERT_FALSE(logs.empty());
+  const std::string calibrate_log = ReadFile(logs.front());
+  EXPECT_NE(calibrate_log.find("step 120 s"), std::string::npos) << calibrate_log;
   EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
 }
 

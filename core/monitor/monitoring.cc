@@ -31,19 +31,6 @@ double DayOfYear(std::int64_t t_s) {
   return static_cast<double>((day - jan1).count() + 1);
 }
 
-// pi and its band for one output; NaN where not scored.
-void ScoreOutput(double meas_wh, double model_wh, double mae_w, double hours, bool scored,
-                 double* pi, double* low, double* high) {
-  if (!scored) {
-    *pi = *low = *high = kNaN;
-    return;
-  }
-  const double bound_wh = mae_w * hours;
-  *pi = meas_wh / model_wh;
-  *low = meas_wh / (model_wh + bound_wh);
-  *high = model_wh > bound_wh ? meas_wh / (model_wh - bound_wh) : kNaN;
-}
-
 }  // namespace
 
 bool ScoreDay(const Series& minutes, std::int64_t day_start_s, const Plant& plant,
@@ -71,26 +58,11 @@ bool ScoreDay(const Series& minutes, std::int64_t day_start_s, const Plant& plan
   const bool enough = p.valid_minutes >= options.min_valid_minutes;
   p.scored_el = enough && p.e_el_model_wh >= options.min_el_wh_m2 * plant.area_m2;
   p.scored_th = enough && p.e_th_model_wh >= options.min_th_wh_m2 * plant.area_m2;
-  const double hours = p.valid_minutes * (day.step_s > 0 ? day.step_s : 60.0) / 3600.0;
-  ScoreOutput(p.e_el_meas_wh, p.e_el_model_wh, options.heldout_mae_p_el_w, hours, p.scored_el,
-              &p.pi_el, &p.pi_el_low, &p.pi_el_high);
-  ScoreOutput(p.e_th_meas_wh, p.e_th_model_wh, options.heldout_mae_q_th_w, hours, p.scored_th,
-              &p.pi_th, &p.pi_th_low, &p.pi_th_high);
+  p.pi_el = p.scored_el ? p.e_el_meas_wh / p.e_el_model_wh : kNaN;
+  p.pi_th = p.scored_th ? p.e_th_meas_wh / p.e_th_model_wh : kNaN;
+  p.pi_el_low = p.pi_el_high = p.pi_th_low = p.pi_th_high = kNaN;
   *out = p;
   return true;
-}
-
-int DaysBelowBand(std::span<const DayPerformance> days, bool thermal) {
-  int run = 0;
-  for (auto it = days.rbegin(); it != days.rend(); ++it) {
-    const bool scored = thermal ? it->scored_th : it->scored_el;
-    if (!scored) continue;
-    const double high = thermal ? it->pi_th_high : it->pi_el_high;
-    // An unbounded band (NaN high) never lies below 1.
-    if (!(high < 1.0)) break;
-    ++run;
-  }
-  return run;
 }
 
 std::optional<ParameterDrift> DetectDrift(std::span<const ParameterPoint> points) {

@@ -26,17 +26,10 @@ namespace pvtwin {
 // temperature, flow), gives the energies the plant should have delivered;
 // pi = measured / expected over the minutes where both are known (valid
 // rows with model inputs and measured outputs, as the calibration's
-// objective). The band is the range of pi the model's own error allows: its
-// held-out MAE, summed over the day's minutes, bounds the error of the
-// expected energy (Σ|error| ≥ |Σ error|), so
-//   pi_low = E_meas / (E_model + MAE·T),   pi_high = E_meas / (E_model − MAE·T)
-// with T the day's scored hours (pi_high is unbounded, NaN, when MAE·T ≥
-// E_model). A day below its band (pi_high < 1) produced less than any model
-// error seen on held-out data explains.
+// objective). The band [pi_low, pi_high] is the 10–90 % band of the daily
+// error of the model (index_band.h), set apart from the day's own score.
 
 struct PerformanceOptions {
-  double heldout_mae_p_el_w = 0.0;  // of the accepted calibration
-  double heldout_mae_q_th_w = 0.0;
   // A day is scored when it has this many minutes and its expected energy
   // reaches the minimum per m² of collector; otherwise its row is written
   // with the energies and pi left NaN (marked, not scored).
@@ -50,23 +43,20 @@ struct DayPerformance {
   int valid_minutes = 0;
   double e_el_meas_wh = 0.0, e_el_model_wh = 0.0;
   double e_th_meas_wh = 0.0, e_th_model_wh = 0.0;
-  // NaN when the day is not scored for that output.
+  // NaN when the day is not scored for that output; the band NaN until
+  // SetIndexBands (index_band.h) gives it one.
   double pi_el = 0.0, pi_el_low = 0.0, pi_el_high = 0.0;
   double pi_th = 0.0, pi_th_low = 0.0, pi_th_high = 0.0;
   bool scored_el = false, scored_th = false;
 };
 
 // Scores the day [day_start_s, day_start_s + 86400) of 1-min rows (rows
-// outside the day are ignored). False and *error when the model cannot run on
-// the rows (a channel the variant needs is missing).
+// outside the day are ignored): energies and pi, the band NaN. False and
+// *error when the model cannot run on the rows (a channel the variant needs
+// is missing).
 bool ScoreDay(const Series& minutes, std::int64_t day_start_s, const Plant& plant,
               const ModelSpec& spec, const ParamVector& params, const PerformanceOptions& options,
               DayPerformance* out, std::string* error);
-
-// Consecutive scored days at the end of days (in time order) whose band lies
-// below 1 for the given output ("el" or "th"); days not scored for it are
-// skipped, neither breaking nor extending the run.
-int DaysBelowBand(std::span<const DayPerformance> days, bool thermal);
 
 // ---------------------------------------------------------------------------
 // Drift of an identified parameter across accepted calibrations.

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <span>
 
+#include "core/monitor/index_band.h"
 #include "core/monitor/monitoring.h"
 #include "daemon/service/window_data.h"
-#include "io/platform/log.h"
 #include "io/files/params_json.h"
+#include "io/platform/log.h"
 #include "io/platform/time_format.h"
 
 namespace pvtwin::cli {
@@ -26,78 +28,92 @@ std::string Fixed(double x, int decimals) {
 
 std::string Day(std::int64_t t) { return FormatIsoUtc(t).substr(0, 10); }
 
+// The band and alarm rules with [monitor]'s settings (index_band.h).
+IndexCusumOptions CusumOptionsOf(const Config& config) {
+  IndexCusumOptions options;
+  options.min_days = config.monitor.alarm_days;
+  return options;
+}
+
+// The performance_daily rows a night's scoring and alarm look back on: the
+// reference days of the oldest day it may score, and the CUSUM's days
+// before them that decide which of them are suspect.
+std::int64_t LookBackStart(const DailyCheckInputs& in, const IndexBandOptions& bands) {
+  const std::int64_t today = in.now_s / kDayS * kDayS;
+  return today - (in.config->calibration.window_days + 2 * bands.reference_days) * kDayS;
+}
+
 // performance_daily for every whole UTC day of the calibration window that
-// has no row yet, with the accepted parameters. Returns the newest day it
-// scored (-1: none).
+// has no row yet, with the accepted parameters, each day's band from the
+// days before it (index_band.h). Returns the first day it scored (-1: none).
 std::int64_t ScoreNewDays(Store& store, const DailyCheckInputs& in, const Series& minutes,
                           const Store::CalibrationRow& cal, const ParamVector& params,
                           LogLines* log) {
-  std::int64_t newest = -1;
+  std::int64_t first_scored = -1;
+  const IndexBandOptions bands;
+  const IndexCusumOptions cusum = CusumOptionsOf(*in.config);
   const std::int64_t today = in.now_s / kDayS * kDayS;
   const std::int64_t first = today - in.config->calibration.window_days * kDayS;
   std::string error;
-  std::vector<DayPerformance> done;
-  if (!store.ReadPerformanceDays(first, today, &done, &error)) {
+  std::vector<DayPerformance> known;  // stored rows and the new ones, in time order
+  if (!store.ReadPerformanceDays(LookBackStart(in, bands), today, &known, &error)) {
     log->push_back({kErr, "daily checks: " + error});
-    return newest;
+    return first_scored;
   }
-  PerformanceOptions options;
-  options.heldout_mae_p_el_w = cal.mae_p_el_w;
-  options.heldout_mae_q_th_w = cal.mae_q_th_w;
-  std::size_t k = 0;
   for (std::int64_t day = first; day < today; day += kDayS) {
-    while (k < done.size() && done[k].day_start_s < day) ++k;
-    if (k < done.size() && done[k].day_start_s == day) continue;
+    const auto at =
+        std::lower_bound(known.begin(), known.end(), day,
+                         [](const DayPerformance& d, std::int64_t t) { return d.day_start_s < t; });
+    if (at != known.end() && at->day_start_s == day) continue;
     const Series rows = minutes.Between(day, day + kDayS);
     if (rows.size() == 0) continue;
     DayPerformance p;
-    if (!ScoreDay(rows, day, in.config->plant, in.spec, params, options, &p, &error)) {
+    if (!ScoreDay(rows, day, in.config->plant, in.spec, params, PerformanceOptions{}, &p, &error)) {
       log->push_back({kWarning, "performance of " + Day(day) + " not scored: " + error});
       continue;
     }
+    const auto earlier = static_cast<std::size_t>(at - known.begin());
+    SetIndexBands(std::span<const DayPerformance>(known.data(), earlier), bands, cusum, &p);
     if (!store.WritePerformanceDay(p, cal.id, &error)) {
       log->push_back({kErr, "daily checks: " + error});
-      return newest;
+      return first_scored;
     }
-    newest = day;
+    known.insert(known.begin() + static_cast<std::ptrdiff_t>(earlier), p);
+    if (first_scored < 0) first_scored = day;
   }
-  return newest;
+  return first_scored;
 }
 
-// An alarm when the newest scored days lie below their band alarm_days in a
-// row, raised on each night that adds a day to the run (newest_scored: the
-// newest day scored this night).
-void CheckPerformanceAlarm(Store& store, const DailyCheckInputs& in, std::int64_t newest_scored,
+// The performance alarm (index_band.h: a one-sided CUSUM of the days'
+// standardised errors), raised for each day scored this night (from
+// first_scored on) on which the CUSUM of an output reaches its decision
+// interval.
+void CheckPerformanceAlarm(Store& store, const DailyCheckInputs& in, std::int64_t first_scored,
                            LogLines* log) {
-  const int alarm_days = in.config->monitor.alarm_days;
+  if (first_scored < 0) return;
+  const IndexCusumOptions cusum = CusumOptionsOf(*in.config);
   const std::int64_t today = in.now_s / kDayS * kDayS;
   std::vector<DayPerformance> days;
   std::string error;
-  if (!store.ReadPerformanceDays(today - 3 * alarm_days * kDayS - 14 * kDayS, today, &days,
-                                 &error)) {
+  if (!store.ReadPerformanceDays(LookBackStart(in, IndexBandOptions{}), today, &days, &error)) {
     log->push_back({kErr, "daily checks: " + error});
     return;
   }
   for (const bool thermal : {false, true}) {
-    const int run = DaysBelowBand(days, thermal);
-    if (run < alarm_days) continue;
-    const DayPerformance* last = nullptr;
-    for (auto it = days.rbegin(); it != days.rend() && last == nullptr; ++it) {
-      if (thermal ? it->scored_th : it->scored_el) last = &*it;
+    for (const IndexDay& c : FollowIndex(days, thermal, IndexBandOptions{}, cusum)) {
+      if (!c.alarm || c.day_start_s < first_scored) continue;
+      const std::string message =
+          std::string(thermal ? "heat" : "electricity") +
+          " below the calibrated model: the evidence of " + std::to_string(c.run_days) +
+          " days together (CUSUM " + Fixed(c.s, 2) + " σ ≥ " + Fixed(cusum.h_sigma, 1) +
+          " σ); on " + Day(c.day_start_s) + " pi = " + Fixed(c.pi, 3) + ", band " +
+          Fixed(c.low, 3) + "–" + Fixed(c.high, 3) + " from the model's daily errors";
+      if (!store.InsertMonitorEvent(in.now_s, thermal ? "performance_low_th" : "performance_low_el",
+                                    "warning", message, &error)) {
+        log->push_back({kErr, "daily checks: " + error});
+      }
+      log->push_back({kWarning, message});
     }
-    if (last->day_start_s != newest_scored) continue;  // raised on the night it was scored
-    const double pi = thermal ? last->pi_th : last->pi_el;
-    const double high = thermal ? last->pi_th_high : last->pi_el_high;
-    const std::string message = std::string(thermal ? "heat" : "electricity") +
-                                " below the calibrated model on " + std::to_string(run) +
-                                " days in a row: on " + Day(last->day_start_s) +
-                                " pi = " + Fixed(pi, 3) + ", at most " + Fixed(high, 3) +
-                                " with the model's held-out error";
-    if (!store.InsertMonitorEvent(in.now_s, thermal ? "performance_low_th" : "performance_low_el",
-                                  "warning", message, &error)) {
-      log->push_back({kErr, "daily checks: " + error});
-    }
-    log->push_back({kWarning, message});
   }
 }
 
@@ -233,8 +249,9 @@ std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const Dail
   ParseVariant(cal.variant, &spec, &variant_error);  // the calibration's own variant
   DailyCheckInputs with_variant = in;
   with_variant.spec = spec;
-  const std::int64_t newest = ScoreNewDays(store, with_variant, window, cal, file.values, &log);
-  CheckPerformanceAlarm(store, in, newest, &log);
+  const std::int64_t first_scored =
+      ScoreNewDays(store, with_variant, window, cal, file.values, &log);
+  CheckPerformanceAlarm(store, in, first_scored, &log);
   if (in.accepted_now) CheckDrift(store, in, cal, &log);
   return log;
 }

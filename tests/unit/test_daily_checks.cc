@@ -1,17 +1,19 @@
-// daemon/service/monitor.h on a real SQLite file: a week of synthetic 1-min data from
-// a known truth, of which the last four days lost 15 % of P_el and one
+// daemon/service/monitor.h on a real SQLite file: two weeks of synthetic 1-min data
+// from a known truth, of which the last four days lost 15 % of P_el and one
 // night's air temperature froze, and the truth's parameters as the accepted
-// calibration. The daily checks score every day, raise the performance alarm
-// for electricity only, record the frozen sensor, and find a drift across
-// accepted calibrations; the event view lists it all, newest first.
+// calibration. The daily checks score every day, band each from the days
+// before, raise the performance alarm for electricity only (on the third
+// low day: the evidence of three days together), record the frozen sensor,
+// and find a drift across accepted calibrations; the event view lists it
+// all, newest first.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/synth/synthetic_plant.h"
 #include "daemon/service/monitor.h"
-#include "io/platform/log.h"
 #include "io/files/params_json.h"
+#include "io/platform/log.h"
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
@@ -21,7 +23,8 @@ namespace {
 
 constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
 constexpr std::int64_t kDayS = 86400;
-constexpr int kDays = 7;
+constexpr int kDays = 14;
+constexpr int kLossDay = 10;  // P_el at 85 % from this day on
 
 class DailyChecks : public ::testing::Test {
  protected:
@@ -39,7 +42,7 @@ class DailyChecks : public ::testing::Test {
     Series s = MakeSyntheticPlantData(config_.plant, weather, testing::SpecOf("2N1Ccolwr"), truth,
                                       RealisticSensorNoise(5));
     for (std::size_t i = 0; i < s.size(); ++i) {
-      if (s.time_s[i] >= kJune1 + 3 * kDayS) s[Channel::kPElW][i] *= 0.85;
+      if (s.time_s[i] >= kJune1 + kLossDay * kDayS) s[Channel::kPElW][i] *= 0.85;
       // t_amb frozen 01:00–03:00 of the last day.
       const std::int64_t t = s.time_s[i] - (kJune1 + (kDays - 1) * kDayS);
       if (t >= 3600 && t < 3 * 3600) s[Channel::kTAmbC][i] = 11.5;
@@ -86,24 +89,33 @@ TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
   const auto log = RunDailyChecks(*store_, Inputs(false));
   testing::RawDb db(dir_ / "pvtwin.db");
   EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily"), kDays);
-  // Days 1–3 as the truth, days 4–7 at 85 % of P_el, heat unchanged.
+  // Days before kLossDay as the truth, the rest at 85 % of P_el, heat unchanged.
   for (int d = 0; d < kDays; ++d) {
     const std::string day = std::to_string(kJune1 + d * kDayS);
     const double pi_el = db.Number("SELECT pi_el FROM performance_daily WHERE day = " + day);
     const double pi_th = db.Number("SELECT pi_th FROM performance_daily WHERE day = " + day);
-    EXPECT_NEAR(pi_el, d < 3 ? 1.0 : 0.85, 0.005) << d;
+    EXPECT_NEAR(pi_el, d < kLossDay ? 1.0 : 0.85, 0.005) << d;
     EXPECT_NEAR(pi_th, 1.0, 0.01) << d;
   }
-  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily WHERE pi_el_high < 1"), 4);
-  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily WHERE pi_th_high < 1"), 0);
-  // One alarm, for electricity, and its log line.
+  // A band from the ninth day on (nine days before it), every loss day's
+  // below 1.
+  const std::string loss = std::to_string(kJune1 + kLossDay * kDayS);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily WHERE pi_el_low IS NOT NULL"),
+            kDays - 9);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily WHERE day >= " + loss +
+                      " AND pi_el_high < 1"),
+            kDays - kLossDay);
+  // One alarm, for electricity, on the third loss day (the alarm's days
+  // leave the reference, and the CUSUM starts again), and its log line.
   EXPECT_EQ(db.Rows("SELECT kind, severity FROM monitor_event"),
             (std::vector<std::vector<std::string>>{{"performance_low_el", "warning"}}));
   bool logged = false;
   for (const auto& [priority, line] : log) {
-    logged |= priority == kWarning && line.find(
-                                          "electricity below the calibrated model on 4 days "
-                                          "in a row") != std::string::npos;
+    logged |= priority == kWarning &&
+              line.find(
+                  "electricity below the calibrated model: the evidence of 3 days "
+                  "together") != std::string::npos &&
+              line.find("on 2024-06-13") != std::string::npos;
   }
   EXPECT_TRUE(logged);
   // The frozen air temperature: an interval from the second frozen minute.

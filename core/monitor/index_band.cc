@@ -1,0 +1,127 @@
+#include "core/monitor/index_band.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace pvtwin {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::int64_t kDayS = 86400;
+constexpr double kZ90 = 1.2815515655446004;  // Φ⁻¹(0.9): the band is the 10–90 % one
+
+// The split-conformal quantiles of n errors (Vovk et al. 2005; Lei et al.,
+// JASA 113, 2018): the ⌊0.1·(n + 1)⌋-th and the ⌈0.9·(n + 1)⌉-th smallest.
+// A new exchangeable error lies below the first, and above the second, with
+// probability at most 0.1 each, so between them with probability at least
+// 0.8 (and below 0.8 + 2/(n + 1): 86 % for 28 days). NaN below 9 errors,
+// where the first rank is 0.
+struct ConformalQuantiles {
+  double q10 = kNaN, q90 = kNaN;
+};
+ConformalQuantiles QuantilesOf(std::vector<double> errors) {
+  const std::size_t n = errors.size();
+  const std::size_t low_rank = (n + 1) / 10, high_rank = std::min(n, (9 * (n + 1) + 9) / 10);
+  if (low_rank < 1) return {};
+  std::sort(errors.begin(), errors.end());
+  return {errors[low_rank - 1], errors[high_rank - 1]};
+}
+
+// The errors ln pi of the reference days of `today`: of the days before it
+// in the reference window that are not suspect, the `neighbours` nearest
+// in ln expected energy (ties: the more recent).
+std::vector<double> ReferenceErrors(const std::vector<IndexDay>& before, const IndexDay& today,
+                                    const IndexBandOptions& options) {
+  std::vector<const IndexDay*> days;
+  for (const IndexDay& d : before) {
+    if (d.day_start_s >= today.day_start_s - options.reference_days * kDayS && !d.suspect) {
+      days.push_back(&d);
+    }
+  }
+  const double log_e = std::log(today.e_model_wh);
+  auto distance = [log_e](const IndexDay* d) { return std::fabs(std::log(d->e_model_wh) - log_e); };
+  std::stable_sort(days.begin(), days.end(), [&distance](const IndexDay* a, const IndexDay* b) {
+    const double da = distance(a), db = distance(b);
+    return da < db || (da == db && a->day_start_s > b->day_start_s);
+  });
+  if (days.size() > static_cast<std::size_t>(options.neighbours)) {
+    days.resize(static_cast<std::size_t>(options.neighbours));
+  }
+  std::vector<double> errors;
+  for (const IndexDay* d : days) errors.push_back(std::log(d->pi));
+  return errors;
+}
+
+// The band of the day and its part in the CUSUM (s, run: the state before it).
+void Follow(std::vector<double> errors, const IndexBandOptions& bands,
+            const IndexCusumOptions& cusum, double* s, int* run, IndexDay* day) {
+  day->low = day->high = kNaN;
+  if (static_cast<int>(errors.size()) < bands.min_reference_days) return;
+  const ConformalQuantiles q = QuantilesOf(std::move(errors));
+  if (std::isnan(q.q10)) return;
+  const double q10 = q.q10, q90 = q.q90;
+  day->low = day->pi * std::exp(-q90);
+  day->high = day->pi * std::exp(-q10);
+  const double sigma = (q90 - q10) / (2.0 * kZ90);
+  if (!(sigma > 0.0)) return;  // a reference without spread: a band, no evidence
+  day->banded = true;
+  day->z = (std::log(day->pi) - 0.5 * (q10 + q90)) / sigma;
+  *s = std::max(0.0, *s - day->z - cusum.k_sigma);
+  *run = *s > 0.0 ? *run + 1 : 0;
+  day->s = *s;
+  day->run_days = *run;
+  day->alarm = *s >= cusum.h_sigma && *run >= cusum.min_days;
+}
+
+}  // namespace
+
+std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool thermal,
+                                  const IndexBandOptions& bands, const IndexCusumOptions& cusum) {
+  std::vector<IndexDay> out;
+  double s = 0.0;
+  int run = 0;
+  for (const DayPerformance& d : days) {
+    IndexDay day;
+    day.day_start_s = d.day_start_s;
+    day.pi = thermal ? d.pi_th : d.pi_el;
+    day.e_model_wh = thermal ? d.e_th_model_wh : d.e_el_model_wh;
+    if (!(thermal ? d.scored_th : d.scored_el) || !(day.pi > 0.0) || !std::isfinite(day.pi) ||
+        !(day.e_model_wh > 0.0)) {
+      continue;
+    }
+    Follow(ReferenceErrors(out, day, bands), bands, cusum, &s, &run, &day);
+    out.push_back(day);
+    if (!day.banded) continue;
+    // The open excursion's days (this one included) are suspect; when S is
+    // back at 0 they were noise. An earlier excursion ended at a day with S
+    // at 0 or at an alarm, whose days stay out.
+    const bool open = run > 0;
+    for (auto it = out.rbegin(); it != out.rend(); ++it) {
+      if (it != out.rbegin() && it->banded && (it->run_days == 0 || it->alarm)) break;
+      if (it->banded) it->suspect = open;
+    }
+    if (day.alarm) {
+      s = 0.0;
+      run = 0;
+    }
+  }
+  return out;
+}
+
+void SetIndexBands(std::span<const DayPerformance> earlier, const IndexBandOptions& bands,
+                   const IndexCusumOptions& cusum, DayPerformance* day) {
+  std::vector<DayPerformance> days(earlier.begin(), earlier.end());
+  days.push_back(*day);
+  for (const bool thermal : {false, true}) {
+    if (!(thermal ? day->scored_th : day->scored_el)) continue;
+    const std::vector<IndexDay> followed = FollowIndex(days, thermal, bands, cusum);
+    const bool found = !followed.empty() && followed.back().day_start_s == day->day_start_s;
+    (thermal ? day->pi_th_low : day->pi_el_low) = found ? followed.back().low : kNaN;
+    (thermal ? day->pi_th_high : day->pi_el_high) = found ? followed.back().high : kNaN;
+  }
+}
+
+}  // namespace pvtwin

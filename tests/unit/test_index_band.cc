@@ -1,0 +1,215 @@
+// core/monitor/index_band.h on analytic cases: the band of a day is the
+// split-conformal 10–90 % band of the reference days' errors (type-7
+// quantiles by hand), holds 1 on 80 % of exchangeable days, and the CUSUM
+// alarms on several moderately low days together, never on one day's band
+// edge; days of an alarm stay out of later references.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "core/monitor/index_band.h"
+
+namespace pvtwin {
+namespace {
+
+constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
+constexpr std::int64_t kDayS = 86400;
+constexpr double kZ90 = 1.2815515655446004;
+
+// A day scored for electricity only, with pi = exp(error).
+DayPerformance DayWithError(int d, double error) {
+  DayPerformance p;
+  p.day_start_s = kJune1 + d * kDayS;
+  p.scored_el = true;
+  p.pi_el = std::exp(error);
+  p.e_el_model_wh = 1000.0;  // every day alike: the nearest are the most recent
+  p.pi_el_low = p.pi_el_high = std::nan("");
+  p.pi_th = p.pi_th_low = p.pi_th_high = std::nan("");
+  return p;
+}
+
+// Days 0 … n−1 with the given errors, each banded from the days before.
+std::vector<DayPerformance> Banded(const std::vector<double>& errors,
+                                   const IndexBandOptions& bands = {},
+                                   const IndexCusumOptions& cusum = {}) {
+  std::vector<DayPerformance> days;
+  for (std::size_t d = 0; d < errors.size(); ++d) {
+    DayPerformance p = DayWithError(static_cast<int>(d), errors[d]);
+    SetIndexBands(days, bands, cusum, &p);
+    days.push_back(p);
+  }
+  return days;
+}
+
+// The ranks of the split-conformal quantiles among n reference errors.
+struct Ranks {
+  std::size_t low, high;
+};
+Ranks ConformalRanks(std::size_t n) {
+  return {
+      static_cast<std::size_t>(std::floor(0.1 * static_cast<double>(n + 1) + 1e-9)),
+      std::min(n, static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(n + 1) - 1e-9)))};
+}
+
+TEST(IndexBand, TheSplitConformalQuantilesOfTheReferenceDaysErrors) {
+  // 20 reference days with errors −0.05, −0.045, …, 0.045 in a shuffled
+  // order (7·d mod 20).
+  std::vector<double> errors;
+  for (int d = 0; d < 20; ++d) errors.push_back(0.005 * ((7 * d) % 20 - 10));
+  std::vector<DayPerformance> earlier;
+  for (int d = 0; d < 20; ++d) earlier.push_back(DayWithError(d, errors[d]));
+  IndexBandOptions all;
+  all.neighbours = all.reference_days;
+  DayPerformance today = DayWithError(20, 0.02);
+  SetIndexBands(earlier, all, IndexCusumOptions{}, &today);
+  // n = 20: the ⌊2.1⌋ = 2nd and the ⌈18.9⌉ = 19th smallest.
+  const double q10 = -0.045, q90 = 0.04;
+  EXPECT_NEAR(today.pi_el_low, std::exp(0.02 - q90), 1e-12);
+  EXPECT_NEAR(today.pi_el_high, std::exp(0.02 - q10), 1e-12);
+  EXPECT_TRUE(std::isnan(today.pi_th_low));  // not scored for heat: no band
+  // One reference day fewer than min_reference_days: no band.
+  IndexBandOptions strict = all;
+  strict.min_reference_days = 21;
+  DayPerformance early = DayWithError(20, 0.02);
+  SetIndexBands(earlier, strict, IndexCusumOptions{}, &early);
+  EXPECT_TRUE(std::isnan(early.pi_el_low) && std::isnan(early.pi_el_high));
+  // Days older than reference_days are not part of it: days 10 … 19, whose
+  // ranks 1 and 10 are their extremes.
+  IndexBandOptions recent = all;
+  recent.reference_days = 10;
+  DayPerformance later = DayWithError(20, 0.02);
+  SetIndexBands(earlier, recent, IndexCusumOptions{}, &later);
+  const auto [lo, hi] = std::minmax_element(errors.begin() + 10, errors.end());
+  EXPECT_NEAR(later.pi_el_low, std::exp(0.02 - *hi), 1e-12);
+  EXPECT_NEAR(later.pi_el_high, std::exp(0.02 - *lo), 1e-12);
+  EXPECT_GT(*lo, -0.045);  // the older days' quantile is not among them
+}
+
+TEST(IndexBand, HoldsOneOnAtLeastEightyPercentOfDaysWhoseErrorsAreExchangeable) {
+  // A biased model (errors around −4 %, σ 3 %): the band follows the bias.
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> error(-0.04, 0.03);
+  std::vector<double> errors(400);
+  for (double& e : errors) e = error(rng);
+  IndexCusumOptions never;
+  never.k_sigma = 1e9;  // S stays 0: no alarm, no suspect days, the band alone
+  const IndexBandOptions bands;
+  const std::vector<DayPerformance> days = Banded(errors, bands, never);
+  int banded = 0, hold = 0;
+  double expected = 0.0;  // Σ (high rank − low rank)/(n + 1) over the banded days
+  for (std::size_t d = 0; d < days.size(); ++d) {
+    if (std::isnan(days[d].pi_el_low)) continue;
+    ++banded;
+    hold += days[d].pi_el_low <= 1.0 && 1.0 <= days[d].pi_el_high;
+    const std::size_t n = std::min<std::size_t>(d, static_cast<std::size_t>(bands.neighbours));
+    const Ranks r = ConformalRanks(n);
+    expected += static_cast<double>(r.high - r.low) / static_cast<double>(n + 1);
+  }
+  EXPECT_EQ(banded, 400 - 9);
+  expected /= banded;
+  EXPECT_GE(expected, 0.8);
+  EXPECT_LE(expected, 0.9);
+  // Binomial spread over 391 days: ± 1.8 %.
+  EXPECT_NEAR(static_cast<double>(hold) / banded, expected, 0.05);
+}
+
+TEST(IndexBand, ADayIsJudgedAgainstTheDaysMostLikeItInExpectedEnergy) {
+  // 14 clear days (2000 Wh expected, the model 2 % high) and 14 overcast
+  // ones (500 Wh, the model 1 % low), alternating, each with ±0.2 % noise.
+  std::vector<DayPerformance> earlier;
+  for (int d = 0; d < 28; ++d) {
+    const bool clear = d % 2 == 0;
+    DayPerformance p = DayWithError(d, (clear ? -0.02 : 0.01) + 0.002 * ((d / 2) % 3 - 1));
+    p.e_el_model_wh = clear ? 2000.0 : 500.0;
+    earlier.push_back(p);
+  }
+  // A clear day 2 % low is within its band (the clear days' error); an
+  // overcast one 2 % low is below it.
+  DayPerformance clear = DayWithError(28, -0.02), overcast = DayWithError(28, -0.02);
+  clear.e_el_model_wh = 1900.0;
+  overcast.e_el_model_wh = 550.0;
+  SetIndexBands(earlier, IndexBandOptions{}, IndexCusumOptions{}, &clear);
+  SetIndexBands(earlier, IndexBandOptions{}, IndexCusumOptions{}, &overcast);
+  EXPECT_NEAR(clear.pi_el_low, std::exp(-0.02 - (-0.02 + 0.002)), 1e-12);
+  EXPECT_NEAR(clear.pi_el_high, std::exp(-0.02 - (-0.02 - 0.002)), 1e-12);
+  EXPECT_LT(overcast.pi_el_high, 1.0);
+  EXPECT_NEAR(overcast.pi_el_high, std::exp(-0.02 - (0.01 - 0.002)), 1e-12);
+}
+
+TEST(IndexCusum, ThreeDaysTwoSigmaLowAlarmOneBandEdgeDoesNot) {
+  // Reference: 20 days alternating ∓σ·z90, so that every band's 10 and 90 %
+  // quantiles are −a and a, and its σ is known.
+  const double sigma = 0.03, a = sigma * kZ90;
+  std::vector<double> errors;
+  for (int d = 0; d < 20; ++d) errors.push_back(d % 2 == 0 ? -a : a);
+  // One day at its band's lower edge (z = −z90), then two normal days, then
+  // three days 2.1σ low.
+  errors.push_back(-a);
+  errors.push_back(0.0);
+  errors.push_back(0.0);
+  for (int d = 0; d < 3; ++d) errors.push_back(-2.1 * sigma);
+  IndexBandOptions bands;
+  bands.reference_days = 20;  // exactly the alternating days at day 20
+  bands.neighbours = 20;
+  const std::vector<DayPerformance> days = Banded(errors, bands);
+  const std::vector<IndexDay> run = FollowIndex(days, false, bands, IndexCusumOptions{});
+  ASSERT_EQ(run.size(), errors.size());
+  EXPECT_FALSE(run[8].banded);  // eight reference days: no band, no part in the CUSUM
+  EXPECT_TRUE(run[9].banded);
+  // Day 20: the band edge, z = −z90, S = z90 − 1 = 0.28: no alarm.
+  const IndexDay& edge = run[20];
+  EXPECT_EQ(edge.day_start_s, kJune1 + 20 * kDayS);
+  EXPECT_NEAR(edge.z, -kZ90, 1e-9);
+  EXPECT_NEAR(edge.s, kZ90 - 1.0, 1e-9);
+  EXPECT_FALSE(edge.alarm);
+  EXPECT_NEAR(days[20].pi_el_high, 1.0, 1e-12);  // the top of its band touches 1
+  // Days 23–25, 2.1σ low each: S = 1.1, 2.2, 3.3 σ; the alarm on the third.
+  for (int d = 23; d <= 25; ++d) {
+    const IndexDay& c = run[static_cast<std::size_t>(d)];
+    ASSERT_EQ(c.day_start_s, kJune1 + d * kDayS);
+    EXPECT_EQ(c.alarm, d == 25) << d;
+    EXPECT_EQ(c.run_days, d - 22) << d;
+  }
+  int alarms = 0;
+  for (const IndexDay& c : run) alarms += c.alarm;
+  EXPECT_EQ(alarms, 1);
+}
+
+TEST(IndexCusum, OneVeryLowDayWaitsForTheMinimumRunAndTheAlarmDaysLeaveTheReference) {
+  std::vector<double> errors(14, 0.0);
+  for (int d = 0; d < 14; ++d) errors[static_cast<std::size_t>(d)] = 0.02 * ((d % 5) - 2) / 2.0;
+  errors.push_back(-0.5);  // snow on the field: far below any band
+  errors.push_back(0.0);
+  errors.push_back(0.0);
+  const std::vector<DayPerformance> days = Banded(errors);
+  IndexCusumOptions options;
+  options.min_days = 3;
+  std::vector<IndexDay> run = FollowIndex(days, false, IndexBandOptions{}, options);
+  ASSERT_EQ(run.size(), 17u);
+  // Day 14 alone does not alarm; the alarm waits for the third day of its
+  // excursion, which the low day keeps open.
+  EXPECT_FALSE(run[14].alarm);
+  EXPECT_FALSE(run[15].alarm);
+  EXPECT_TRUE(run[16].alarm);
+  EXPECT_EQ(run[16].run_days, 3);
+  for (std::size_t k = 0; k < run.size(); ++k) EXPECT_EQ(run[k].suspect, k >= 14) << k;
+  // The alarm's days do not widen the next day's reference: its band is
+  // the one of the 14 calm days alone.
+  std::vector<DayPerformance> calm(days.begin(), days.begin() + 14);
+  DayPerformance next = DayWithError(17, 0.0), next_calm = DayWithError(17, 0.0);
+  SetIndexBands(days, IndexBandOptions{}, options, &next);
+  SetIndexBands(calm, IndexBandOptions{}, options, &next_calm);
+  EXPECT_NEAR(next.pi_el_low, next_calm.pi_el_low, 1e-12);
+  EXPECT_NEAR(next.pi_el_high, next_calm.pi_el_high, 1e-12);
+  // With min_days = 1 the same day alarms at once.
+  options.min_days = 1;
+  run = FollowIndex(days, false, IndexBandOptions{}, options);
+  EXPECT_TRUE(run[14].alarm);
+  EXPECT_FALSE(run[15].alarm);  // S starts again from 0 after it
+}
+
+}  // namespace
+}  // namespace pvtwin

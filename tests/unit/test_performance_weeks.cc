@@ -1,0 +1,180 @@
+// The performance index's band and alarm (core/monitor/index_band.h) as the
+// daemon runs them (daemon/service/monitor.h, night after night on a real
+// SQLite file), on synthetic weeks from core/synth: the truth `pvtwin sim`
+// serves ("2N2CrI+wind+transport_delay", other structure than the
+// calibrated 2N1Ccolwr), drawn clear, broken and overcast days, variable
+// flow, realistic sensor noise. The model is fitted on the first
+// kTrainDays (accepted, as the daemon's first calibration) and kept; the
+// nights after score a day each. Issue 53's targets: on the healthy plant
+// the index band holds 1 on at least 80 % of the days (over the
+// development seeds, each output) and no alarm; with pv_clipping switched
+// on from kSwitchDay (the module's typical inverter limit, 120 W/m²) the
+// electricity alarm comes within three clear days.
+//
+// Seeds: development 1, 2, 3 (the rule was designed on these); final check
+// 31, 32, 33, run once: PVTWIN_PI_SEEDS=31,32,33 (doc/monitoring.md has
+// the figures of both).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "core/fit/identification.h"
+#include "core/synth/synthetic_plant.h"
+#include "daemon/service/monitor.h"
+#include "io/files/params_json.h"
+#include "tests/support/effect_named.h"
+#include "tests/support/files.h"
+#include "tests/support/sqlite_db.h"
+#include "tests/support/synthetic_series.h"
+
+namespace pvtwin::cli {
+namespace {
+
+constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
+constexpr std::int64_t kDayS = 86400;
+constexpr int kDays = 30;
+constexpr int kTrainDays = 10;  // the first calibration's window; scored the first night
+constexpr int kSwitchDay = 18;  // pv_clipping from this day on
+constexpr const char* kTruth = "2N2CrI+wind+transport_delay";
+constexpr const char* kModel = "2N1Ccolwr";
+
+std::vector<std::uint64_t> Seeds() {
+  const char* env = std::getenv("PVTWIN_PI_SEEDS");
+  std::vector<std::uint64_t> seeds;
+  std::stringstream list(env != nullptr ? env : "1,2,3");
+  std::string item;
+  while (std::getline(list, item, ',')) seeds.push_back(std::stoull(item));
+  return seeds;
+}
+
+WeatherOptions WeatherOf(std::uint64_t seed) {
+  WeatherOptions w;
+  w.start_time_s = kJune1;
+  w.num_days = kDays;
+  w.step_s = 60.0;
+  w.seed = seed;
+  w.flow_mode = FlowMode::kVariable;
+  return w;
+}
+
+// What one run of the monitor over the days after training shows.
+struct RunFigures {
+  int banded_el = 0, hold_el = 0, banded_th = 0, hold_th = 0;
+  int alarms = 0;            // performance_low_* events
+  int first_alarm_day = -1;  // the day scored the night of the first electricity alarm
+};
+
+// Writes `data` to a new store with `params` as the accepted calibration of
+// the first kTrainDays, and runs the daily checks every night after.
+RunFigures Monitor(const Series& data, const ParamVector& params, const Config& config) {
+  testing::ScratchDir dir("performance_weeks");
+  std::string error;
+  std::unique_ptr<Store> store = Store::Open((dir.path() / "pvtwin.db").string(), &error);
+  EXPECT_NE(store, nullptr) << error;
+  EXPECT_TRUE(store->WriteMinutes(data, &error)) << error;
+  Store::CalibrationRow row;
+  row.run_at = kJune1 + kTrainDays * kDayS;
+  row.variant = kModel;
+  row.window_start = kJune1;
+  row.window_end = row.run_at;
+  row.status = "accepted";
+  row.accepted = true;
+  row.params_json = FormatParamsJson(kModel, params, {}, "");
+  EXPECT_TRUE(store->InsertCalibration(&row, &error)) << error;
+  DailyCheckInputs in;
+  in.config = &config;
+  in.spec = testing::SpecOf(kModel);
+  for (int night = kTrainDays; night <= kDays; ++night) {
+    in.now_s = kJune1 + night * kDayS + 2 * 3600;
+    RunDailyChecks(*store, in);
+  }
+  testing::RawDb db(dir.path() / "pvtwin.db");
+  RunFigures f;
+  const std::string monitored =
+      " FROM performance_daily WHERE day >= " + std::to_string(kJune1 + kTrainDays * kDayS);
+  f.banded_el =
+      static_cast<int>(db.Number("SELECT count(*)" + monitored + " AND pi_el_low IS NOT NULL"));
+  f.hold_el = static_cast<int>(
+      db.Number("SELECT count(*)" + monitored + " AND pi_el_low <= 1 AND pi_el_high >= 1"));
+  f.banded_th =
+      static_cast<int>(db.Number("SELECT count(*)" + monitored + " AND pi_th_low IS NOT NULL"));
+  f.hold_th = static_cast<int>(
+      db.Number("SELECT count(*)" + monitored + " AND pi_th_low <= 1 AND pi_th_high >= 1"));
+  f.alarms = static_cast<int>(
+      db.Number("SELECT count(*) FROM monitor_event WHERE kind LIKE 'performance_low%'"));
+  if (db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'performance_low_el'") > 0) {
+    const double ts =
+        db.Number("SELECT min(ts) FROM monitor_event WHERE kind = 'performance_low_el'");
+    f.first_alarm_day = static_cast<int>((static_cast<std::int64_t>(ts) - kJune1) / kDayS) - 1;
+  }
+  return f;
+}
+
+TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeClearDays) {
+  const Plant plant = DesignExamplePlant();
+  Config config;
+  config.plant = plant;
+  config.calibration.variant = kModel;
+  const ModelSpec truth_spec = testing::SpecOf(kTruth);
+  const ModelSpec clipping_spec = testing::SpecOf(std::string(kTruth) + "+pv_clipping");
+  const ModelSpec model = testing::SpecOf(kModel);
+  ParamVector clipping_truth = ReferenceTruthParams(plant);
+  for (const auto& [param, value] : testing::EffectNamed("pv_clipping").typical_truth) {
+    clipping_truth[static_cast<std::size_t>(param)] = value;
+  }
+  int banded_el = 0, hold_el = 0, banded_th = 0, hold_th = 0;
+  for (const std::uint64_t seed : Seeds()) {
+    const WeatherOptions weather = WeatherOf(seed);
+    const Series healthy = MakeSyntheticPlantData(
+        plant, weather, truth_spec, ReferenceTruthParams(plant), RealisticSensorNoise(seed));
+    const Series clipped = MakeSyntheticPlantData(plant, weather, clipping_spec, clipping_truth,
+                                                  RealisticSensorNoise(seed));
+    ASSERT_EQ(healthy.size(), clipped.size());
+    Series switched = healthy;  // pv_clipping from kSwitchDay on
+    for (std::size_t c = 0; c < kNumChannels; ++c) {
+      for (std::size_t i = 0; i < switched.size() && !switched.columns[c].empty(); ++i) {
+        if (switched.time_s[i] >= kJune1 + kSwitchDay * kDayS) {
+          switched.columns[c][i] = clipped.columns[c][i];
+        }
+      }
+    }
+    // The first calibration: the first kTrainDays, from the start values.
+    const Series train = healthy.Between(kJune1, kJune1 + kTrainDays * kDayS);
+    Drivers drivers;
+    std::string error;
+    ASSERT_TRUE(PrepareDrivers(train, plant, model, &drivers, &error)) << error;
+    const IdentSummary fit =
+        Identify(drivers, MakeMeasurements(train, drivers), StartParams(plant), IdentOptions{});
+    ASSERT_TRUE(fit.ok) << fit.BriefReport();
+
+    const RunFigures h = Monitor(healthy, fit.params, config);
+    const RunFigures s = Monitor(switched, fit.params, config);
+    const std::vector<DayType> types = DayTypesFor(weather);
+    int clear_days = 0;  // from the switch to the alarm's day, both included
+    for (int d = kSwitchDay; d <= s.first_alarm_day; ++d) {
+      clear_days += types[static_cast<std::size_t>(d)] == DayType::kClear;
+    }
+    std::printf(
+        "seed %llu: healthy band holds 1 on %d/%d days (P_el), %d/%d (Q_u), %d alarm(s); "
+        "clipping from day %d: first alarm on day %d, %d clear day(s) after the switch\n",
+        static_cast<unsigned long long>(seed), h.hold_el, h.banded_el, h.hold_th, h.banded_th,
+        h.alarms, kSwitchDay, s.first_alarm_day, clear_days);
+    EXPECT_EQ(h.alarms, 0) << "seed " << seed;
+    EXPECT_GE(s.first_alarm_day, kSwitchDay) << "seed " << seed;
+    EXPECT_LE(clear_days, 3) << "seed " << seed;
+    banded_el += h.banded_el, hold_el += h.hold_el;
+    banded_th += h.banded_th, hold_th += h.hold_th;
+  }
+  std::printf("all seeds: the band holds 1 on %d/%d days (P_el), %d/%d (Q_u)\n", hold_el, banded_el,
+              hold_th, banded_th);
+  EXPECT_GE(hold_el, 0.8 * banded_el);
+  EXPECT_GE(hold_th, 0.8 * banded_th);
+  EXPECT_GT(banded_el, 0);
+  EXPECT_GT(banded_th, 0);
+}
+
+}  // namespace
+}  // namespace pvtwin::cli

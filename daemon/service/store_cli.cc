@@ -9,6 +9,7 @@ StoreOptions StoreOptionsFor(const Config& config) {
   options.aggregate.sample_period_s = config.poll.period_s;
   options.aggregate.fluid_cp_j_kgk = config.plant.fluid_cp_j_kgk;
   options.aggregate.area_m2 = config.plant.area_m2;
+  options.time_zone = config.calibration.timezone;
   return options;
 }
 

@@ -1,6 +1,8 @@
 #include "io/platform/local_time.h"
 
 #include <charconv>
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <set>
@@ -83,7 +85,67 @@ int OffsetAt(std::int64_t t) {
   return static_cast<int>(tm.tm_gmtoff);
 }
 
+constexpr std::int64_t kDayS = 86400;
+
+std::int64_t FloorDiv(std::int64_t a, std::int64_t b) { return a / b - (a % b < 0 ? 1 : 0); }
+
+// Days since 1970-01-01 of the civil date at the instant t: in UTC, or in
+// the process's zone.
+std::int64_t DayNumberAt(std::int64_t t, bool utc) {
+  if (utc) return FloorDiv(t, kDayS);
+  const auto tt = static_cast<std::time_t>(t);
+  std::tm tm{};
+  ::localtime_r(&tt, &tm);
+  const std::chrono::year_month_day ymd{std::chrono::year{tm.tm_year + 1900},
+                                        std::chrono::month{static_cast<unsigned>(tm.tm_mon + 1)},
+                                        std::chrono::day{static_cast<unsigned>(tm.tm_mday)}};
+  return std::chrono::sys_days{ymd}.time_since_epoch().count();
+}
+
+// The first instant whose civil date is day_number or later. Every zone's
+// offset lies within ±26 h of UTC, so the date two days either side of the
+// UTC midnight brackets it; the date never goes back across midnight in the
+// zones of today's tz database, so halving the bracket finds the instant.
+std::int64_t DayStart(std::int64_t day_number, bool utc) {
+  if (utc) return day_number * kDayS;
+  std::int64_t before = (day_number - 2) * kDayS;  // its date is earlier
+  std::int64_t after = (day_number + 2) * kDayS;   // its date is day_number or later
+  while (after - before > 1) {
+    const std::int64_t mid = before + (after - before) / 2;
+    (DayNumberAt(mid, false) >= day_number ? after : before) = mid;
+  }
+  return after;
+}
+
+std::string DateText(std::int64_t day_number) {
+  const std::chrono::year_month_day ymd{std::chrono::sys_days{std::chrono::days{day_number}}};
+  char text[16];
+  std::snprintf(text, sizeof text, "%04d-%02u-%02u", static_cast<int>(ymd.year()),
+                static_cast<unsigned>(ymd.month()), static_cast<unsigned>(ymd.day()));
+  return text;
+}
+
 }  // namespace
+
+bool LocalDaysOverlapping(const std::string& iana, std::int64_t from_s, std::int64_t to_s,
+                          std::vector<LocalDay>* days, std::string* error) {
+  days->clear();
+  const bool utc = iana == "UTC";
+  if (!utc) {
+    const char* current = std::getenv("TZ");
+    if ((current == nullptr || iana != current) && !UseTimeZone(iana, error)) return false;
+  }
+  if (to_s <= from_s) return true;
+  const std::int64_t last = DayNumberAt(to_s - 1, utc);
+  std::int64_t start = DayStart(DayNumberAt(from_s, utc), utc);
+  for (std::int64_t day = DayNumberAt(from_s, utc); day <= last; ++day) {
+    const std::int64_t end = DayStart(day + 1, utc);
+    // A date the zone skipped (Samoa, 2011-12-30) has no instants.
+    if (end > start) days->push_back({DateText(day), start, end});
+    start = end;
+  }
+  return true;
+}
 
 std::optional<NaiveTimeZone> NaiveTimeZone::Parse(const std::string& text, std::string* error) {
   NaiveTimeZone zone;

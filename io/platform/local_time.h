@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace pvtwin {
 
@@ -21,6 +22,24 @@ bool UseTimeZone(const std::string& iana, std::string* error);
 // jumps over it), the first minute after the jump; on a day when it occurs
 // twice (the clock falls back over it), only the first occurrence.
 std::int64_t NextLocalTime(std::int64_t now_s, int hour, int minute);
+
+// A civil day of a zone: its date and the UTC instants [start_s, end_s) it
+// spans, from one local midnight to the next: 24 h, or 23 h / 25 h on the
+// days daylight saving time begins / ends.
+struct LocalDay {
+  std::string date;  // "YYYY-MM-DD", the local civil date
+  std::int64_t start_s = 0, end_s = 0;
+};
+
+// The civil days of the zone iana that overlap [from_s, to_s), in time order
+// (none when to_s <= from_s). "UTC" is reckoned without the process's zone;
+// any other zone is made the process's TZ first unless it already is (as
+// UseTimeZone, so not while another thread reads local time: the daemon
+// sets the same zone at start-up). A day that starts at a time the clock
+// skips begins at the first instant after the jump. False and *error when
+// the zone does not exist.
+bool LocalDaysOverlapping(const std::string& iana, std::int64_t from_s, std::int64_t to_s,
+                          std::vector<LocalDay>* days, std::string* error);
 
 // The zone of naive time stamps: "2024-06-01 12:00" written by a logger that
 // keeps local time and says nothing about it. Either a zone of the tz

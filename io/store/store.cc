@@ -6,7 +6,9 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "io/platform/local_time.h"
 #include "io/store/store_impl.h"
 
 namespace pvtwin {
@@ -53,6 +55,13 @@ std::unique_ptr<Store> Store::Open(const std::string& path, std::string* error) 
 std::unique_ptr<Store> Store::Open(const std::string& path, const StoreOptions& options,
                                    std::string* error) {
   assert(error != nullptr);
+  std::vector<LocalDay> no_days;
+  std::string why;
+  if (!options.time_zone.empty() &&
+      !LocalDaysOverlapping(options.time_zone, 0, 0, &no_days, &why)) {
+    *error = path + ": local days: " + why;
+    return nullptr;
+  }
   auto impl = std::make_unique<Impl>();
   impl->path = path;
   impl->options = options;
@@ -98,7 +107,7 @@ std::unique_ptr<Store> Store::Open(const std::string& path, const StoreOptions& 
     return nullptr;
   }
 
-  if (!impl->Migrate(error)) return nullptr;
+  if (!impl->Migrate(error) || !impl->SyncLocalDays(error)) return nullptr;
   return std::unique_ptr<Store>(new Store(std::move(impl)));
 }
 

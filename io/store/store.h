@@ -139,6 +139,35 @@
 //   view forecast_skill gains coverage_p_el, coverage_q_th: the band's
 //       coverage of each output alone (coverage_p10_p90 pools both).
 //
+// Version 9 adds (issue 54; doc/sql.md "Local days"):
+//   local_day(day TEXT PRIMARY KEY, start_ts INTEGER, end_ts INTEGER)
+//       the civil days of StoreOptions::time_zone ([calibration] timezone,
+//       UTC for a store that was never given one):
+//       day the local date 'YYYY-MM-DD', [start_ts, end_ts) its UTC
+//       seconds from one local midnight to the next (86400 s, or 82800 /
+//       90000 on the days daylight saving time begins / ends). The store
+//       writes the days from the first to the last measurement (1-min and
+//       interval rows) and two days ahead, when it writes measurements and
+//       at Open; a store opened with another zone than the one its rows
+//       were made in (local_day_zone) makes them again, one opened without
+//       a zone keeps them.
+//   local_day_zone(id = 1, zone TEXT)
+//       the zone local_day was made in.
+//   view forecast_skill_local(day, <the columns of forecast_skill after day>)
+//       forecast_skill per local day: day the local date (TEXT), each minute
+//       scored with the newest forecast issued at or before the local
+//       midnight that starts its day.
+//   view performance_daily_local(day, e_el_meas_wh, e_el_model_wh,
+//                                e_th_meas_wh, e_th_model_wh, pi_el, pi_th,
+//                                valid_minutes)
+//       per local day: measured energies summed from measurement_1min (valid
+//       not 0); model energies apportioned from the performance_daily rows
+//       of the UTC days the local day overlaps, each by the share of that
+//       UTC day's in-plane irradiation (g_poa_w_m2 above 0) measured within
+//       the local day (by its share of minutes when the UTC day has none);
+//       pi = measured / model when every such UTC day is scored for the
+//       output and the model energy is not 0, else NULL.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -164,12 +193,13 @@
 // Retention: ApplyRetention deletes sample_5s rows older than
 // raw_retention_days (config [storage]), after aggregating any of their
 // minutes that have no measurement_1min row yet. 1-min rows and calibrations
-// are kept. Of the forecast rows older than that, only the two that the
-// views use are kept for each ts (the newest issue, shown by
-// forecast_latest, and the newest issue before the day began, scored by
-// forecast_skill): hourly 24 h forecasts would otherwise add 1440 rows per
-// hour (about 3 MiB a day, pvtwin-bench store), and both views return the
-// same rows before and after pruning.
+// are kept. Of the forecast rows older than that, only the (up to three)
+// that the views use are kept for each ts (the newest issue, shown by
+// forecast_latest, the newest issue before the UTC day began, scored by
+// forecast_skill, and the newest issue before the local day began, scored
+// by forecast_skill_local): hourly 24 h forecasts would otherwise add 1440
+// rows per hour (about 3 MiB a day, pvtwin-bench store), and the views
+// return the same rows before and after pruning.
 //
 // Threads: one Store is one connection, guarded by a mutex; another thread
 // (the calibration worker) may share it or, better for long reads, open its
@@ -191,7 +221,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 8;
+inline constexpr int kStoreSchemaVersion = 9;
 // NULL in a row struct.
 inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
@@ -204,6 +234,14 @@ struct StoreOptions {
   int busy_retries = 2;
   // How AggregateMinutes averages: poll period and fluid c_p (plant config).
   AggregateOptions aggregate;
+  // The IANA zone of the local days (local_day and the *_local views):
+  // [calibration] timezone. Empty: the zone the store's local days were
+  // made in, UTC for a new store (a caller that does not know the config
+  // leaves them as they are). "UTC" is reckoned without the process's zone;
+  // any other zone becomes the process's TZ when it is not already
+  // (io/platform/local_time.h LocalDaysOverlapping). Open refuses a zone the
+  // tz database does not have.
+  std::string time_zone;
   // Where Open says that it migrates an existing store (one kNotice line,
   // "<db>: migrating store schema <old> → <new> (backup: <db>.schema-v<old>.bak)"):
   // the daemon's log on stderr unless the caller says otherwise; empty:
@@ -374,7 +412,7 @@ class Store {
   // forecasts of [cut − 7 days, cut) (meant to run daily).
   bool ApplyRetention(std::int64_t now_ts, int raw_retention_days, std::string* error);
   // Deletes the forecast rows with from_ts <= ts < to_ts that neither
-  // forecast_latest nor forecast_skill uses.
+  // forecast_latest, forecast_skill nor forecast_skill_local uses.
   bool PruneForecasts(std::int64_t from_ts, std::int64_t to_ts, std::string* error);
 
   bool InsertCalibration(CalibrationRow* row, std::string* error);  // sets row->id

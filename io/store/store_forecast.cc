@@ -111,13 +111,19 @@ bool Store::PruneForecasts(std::int64_t from_ts, std::int64_t to_ts, std::string
 }
 
 DbStatus Store::Impl::PruneForecasts(std::int64_t from_ts, std::int64_t to_ts) {
-  // A row survives if forecast_latest shows it or forecast_skill scores it.
+  // A row survives if forecast_latest shows it or forecast_skill or
+  // forecast_skill_local scores it (the local day of ts: the local_day row
+  // with the latest start at or before it).
   sqlite3_stmt* stmt = nullptr;
   DbStatus s = Prepare(
       "DELETE FROM forecast WHERE ts >= ? AND ts < ?"
       " AND issued_at != (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = forecast.ts)"
       " AND issued_at IS NOT (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = forecast.ts"
-      "  AND g.issued_at <= forecast.ts - ((forecast.ts % 86400) + 86400) % 86400)",
+      "  AND g.issued_at <= forecast.ts - ((forecast.ts % 86400) + 86400) % 86400)"
+      " AND issued_at IS NOT (SELECT MAX(g.issued_at) FROM local_day d CROSS JOIN forecast g"
+      "  ON g.ts = forecast.ts AND g.issued_at <= d.start_ts"
+      "  WHERE d.start_ts = (SELECT MAX(e.start_ts) FROM local_day e"
+      "   WHERE e.start_ts <= forecast.ts) AND d.end_ts > forecast.ts)",
       &stmt);
   if (!s.ok()) return s;
   sqlite3_bind_int64(stmt, 1, from_ts);

@@ -3,7 +3,8 @@
 // store.cc opens and closes the store, store_schema.cc holds the schema and
 // its migrations, store_samples.cc the measurements and forecast inputs,
 // store_forecast.cc calibrations, forecasts and their scores,
-// store_monitoring.cc events, sensor faults and diagnoses. Not included
+// store_monitoring.cc events, sensor faults and diagnoses, store_local_day.cc
+// the local days of the configured zone. Not included
 // outside io/store.
 #ifndef PVTWIN_IO_STORE_STORE_IMPL_H_
 #define PVTWIN_IO_STORE_STORE_IMPL_H_
@@ -131,6 +132,9 @@ struct Store::Impl {
   // of the first minute not yet known to be done in this process (the whole
   // table after Open).
   std::int64_t aggregate_scan_from = store_detail::kNoLowerBound;
+  // The zone of local_day: options.time_zone, or when that is empty the
+  // zone the store's local_day was made in (UTC for a new store); set at Open.
+  std::string zone = "UTC";
   // What Open's migration did (Store::upgrade).
   SchemaUpgrade upgrade;
 
@@ -315,7 +319,17 @@ struct Store::Impl {
   // Copies the database as this connection sees it into target_path
   // (SQLite's online backup; Store::BackupTo without the lock).
   bool BackupTo(const std::string& target_path, std::string* error);
-  // Writes the rows of `minutes` into measurement_1min (inside a transaction).
+  // Inserts the local_day rows (store_local_day.cc) of the days that
+  // overlap [from_ts, to_ts) and the two days after it, keeping rows that
+  // exist (inside a transaction).
+  DbStatus CoverLocalDays(std::int64_t from_ts, std::int64_t to_ts);
+  // At Open: sets zone, and makes local_day anew for the days of the stored
+  // measurements when it was made in another zone, or not yet.
+  bool SyncLocalDays(std::string* error);
+  // Covers the local days from the first to the last stored measurement.
+  DbStatus CoverMeasuredDays();
+  // Writes the rows of `minutes` into measurement_1min and covers their
+  // local days (inside a transaction).
   DbStatus WriteMinuteRows(const MinuteRows& minutes, bool replace, bool imported);
   DbStatus InsertCalibrationParams(std::int64_t calibration_id,
                                    const std::vector<CalibrationParamRow>& params);
@@ -326,7 +340,7 @@ struct Store::Impl {
   template <typename Row, typename FromStatement>
   bool ReadRows(const std::string& sql, const std::string& what, std::int64_t from, std::int64_t to,
                 FromStatement from_statement, std::vector<Row>* out, std::string* error);
-  // Deletes the forecast rows in [from_ts, to_ts) that neither view uses.
+  // Deletes the forecast rows in [from_ts, to_ts) that no view uses.
   DbStatus PruneForecasts(std::int64_t from_ts, std::int64_t to_ts);
   bool ReadInputTable(const std::string& table, std::span<const Channel> channels,
                       std::int64_t from, std::int64_t to, Series* out, std::string* error,

@@ -137,7 +137,9 @@ DbStatus Store::Impl::WriteMinuteRows(const MinuteRows& minutes, bool replace, b
     s = db.StepDone(stmt, "write 1-min row ts " + std::to_string(rows.time_s[i]));
     if (!s.ok()) return s;
   }
-  return {};
+  if (rows.size() == 0) return {};
+  const auto [first, last] = std::minmax_element(rows.time_s.begin(), rows.time_s.end());
+  return db.CoverLocalDays(*first, *last + kMinuteS);
 }
 
 DbStatus Store::Impl::AggregateRange(std::int64_t from_ts, std::int64_t to_ts, bool all,
@@ -284,7 +286,9 @@ bool Store::WriteIntervalRows(const Series& rows, std::string* error) {
           s = db.StepDone(stmt, "write interval row ts " + std::to_string(rows.time_s[i]));
           if (!s.ok()) return s;
         }
-        return DbStatus{};
+        if (rows.size() == 0) return DbStatus{};
+        const auto range = std::minmax_element(rows.time_s.begin(), rows.time_s.end());
+        return db.CoverLocalDays(*range.first, *range.second + step_s);
       },
       error);
 }

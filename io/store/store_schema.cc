@@ -148,6 +148,20 @@ std::vector<std::string> SchemaV5() {
   };
 }
 
+// One scored minute of forecast_skill (version 6 on) after its day: the
+// errors, the reference's errors where the forecast has a value, and whether
+// the measurement lies in a band of width (NULL without one); m the
+// measurement, f the forecast.
+constexpr const char* kSkillPairColumns =
+    "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
+    "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
+    "  CASE WHEN f.p_el_w IS NOT NULL THEN f.p_el_w_ref - m.p_el_w END AS ref_p,"
+    "  CASE WHEN f.q_th_w IS NOT NULL THEN f.q_th_w_ref - m.q_th_w END AS ref_q,"
+    "  CASE WHEN f.p_el_w_p90 > f.p_el_w_p10 AND m.p_el_w IS NOT NULL"
+    "   THEN m.p_el_w BETWEEN f.p_el_w_p10 AND f.p_el_w_p90 END AS in_p,"
+    "  CASE WHEN f.q_th_w_p90 > f.q_th_w_p10 AND m.q_th_w IS NOT NULL"
+    "   THEN m.q_th_w BETWEEN f.q_th_w_p10 AND f.q_th_w_p90 END AS in_q";
+
 // Version 6: forecasts with uncertainty bands and the reference forecast
 // they are scored against (issue 15, core/forecast/forecast_bands.h); the
 // views gain the bands, the skill against the reference, the band's
@@ -176,15 +190,8 @@ std::vector<std::string> SchemaV6() {
       "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, "
       "skill_q_th, coverage_p10_p90, minutes) AS "
       "WITH pairs AS ("
-      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
-      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
-      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
-      "  CASE WHEN f.p_el_w IS NOT NULL THEN f.p_el_w_ref - m.p_el_w END AS ref_p,"
-      "  CASE WHEN f.q_th_w IS NOT NULL THEN f.q_th_w_ref - m.q_th_w END AS ref_q,"
-      "  CASE WHEN f.p_el_w_p90 > f.p_el_w_p10 AND m.p_el_w IS NOT NULL"
-      "   THEN m.p_el_w BETWEEN f.p_el_w_p10 AND f.p_el_w_p90 END AS in_p,"
-      "  CASE WHEN f.q_th_w_p90 > f.q_th_w_p10 AND m.q_th_w IS NOT NULL"
-      "   THEN m.q_th_w BETWEEN f.q_th_w_p10 AND f.q_th_w_p90 END AS in_q"
+      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day," +
+      std::string(kSkillPairColumns) +
       " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
       "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
       "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
@@ -224,6 +231,42 @@ std::vector<std::string> SchemaV7() {
   };
 }
 
+// The columns of forecast_skill from version 8 on (and of
+// forecast_skill_local, version 9).
+constexpr const char* kSkillColumnsV8 =
+    "(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
+    "coverage_p10_p90, minutes, coverage_p_el, coverage_q_th)";
+
+// forecast_skill's columns (version 8 on) from its CTE `pairs`, per day.
+std::string SkillAggregatesV8() {
+  const std::string min_minutes = std::to_string(kMinScoredMinutes);
+  const std::string enough = " CASE WHEN COUNT(*) >= " + min_minutes + " THEN";
+  return " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
+         "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
+         "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END)),"
+         "  " +
+         enough +
+         " 1.0 -"
+         "   SUM(CASE WHEN ref_p IS NOT NULL THEN ABS(err_p) END) /"
+         "   NULLIF(SUM(CASE WHEN err_p IS NOT NULL THEN ABS(ref_p) END), 0) END,"
+         "  " +
+         enough +
+         " 1.0 -"
+         "   SUM(CASE WHEN ref_q IS NOT NULL THEN ABS(err_q) END) /"
+         "   NULLIF(SUM(CASE WHEN err_q IS NOT NULL THEN ABS(ref_q) END), 0) END,"
+         "  " +
+         enough +
+         "   (TOTAL(in_p) + TOTAL(in_q)) / NULLIF(COUNT(in_p) + COUNT(in_q), 0) END,"
+         "  COUNT(*),"
+         "  " +
+         enough +
+         " TOTAL(in_p) / NULLIF(COUNT(in_p), 0) END,"
+         "  " +
+         enough +
+         " TOTAL(in_q) / NULLIF(COUNT(in_q), 0) END"
+         " FROM pairs GROUP BY day";
+}
+
 // Version 8: the median of each output beside the band (the point forecast
 // is the model's run on the expected inputs; p50 = point + the median of its
 // held-out errors, core/forecast/forecast_bands.h), and the band's coverage
@@ -242,58 +285,88 @@ std::vector<std::string> SchemaV8() {
       "f.p_el_w_p90, f.q_th_w_p10, f.q_th_w_p90, f.p_el_w_p50, f.q_th_w_p50 FROM forecast f "
       "WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)");
   s.push_back("DROP VIEW forecast_skill");
-  const std::string min_minutes = std::to_string(kMinScoredMinutes);
-  const std::string enough = " CASE WHEN COUNT(*) >= " + min_minutes + " THEN";
-  s.push_back(
-      "CREATE VIEW forecast_skill(day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, "
-      "skill_q_th, coverage_p10_p90, minutes, coverage_p_el, coverage_q_th) AS "
-      "WITH pairs AS ("
-      " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day,"
-      "  f.p_el_w - m.p_el_w AS err_p, CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
-      "  f.q_th_w - m.q_th_w AS err_q, CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
-      "  CASE WHEN f.p_el_w IS NOT NULL THEN f.p_el_w_ref - m.p_el_w END AS ref_p,"
-      "  CASE WHEN f.q_th_w IS NOT NULL THEN f.q_th_w_ref - m.q_th_w END AS ref_q,"
-      "  CASE WHEN f.p_el_w_p90 > f.p_el_w_p10 AND m.p_el_w IS NOT NULL"
-      "   THEN m.p_el_w BETWEEN f.p_el_w_p10 AND f.p_el_w_p90 END AS in_p,"
-      "  CASE WHEN f.q_th_w_p90 > f.q_th_w_p10 AND m.q_th_w IS NOT NULL"
-      "   THEN m.q_th_w BETWEEN f.q_th_w_p10 AND f.q_th_w_p90 END AS in_q"
-      " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
-      "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
-      "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
-      " WHERE m.valid IS NULL OR m.valid != 0)"
-      " SELECT day, AVG(ABS(err_p)), AVG(ABS(err_q)),"
-      "  AVG(ABS(err_p)) / AVG(ABS(CASE WHEN err_p IS NOT NULL THEN meas_p END)),"
-      "  AVG(ABS(err_q)) / AVG(ABS(CASE WHEN err_q IS NOT NULL THEN meas_q END)),"
-      "  " +
-      enough +
-      " 1.0 -"
-      "   SUM(CASE WHEN ref_p IS NOT NULL THEN ABS(err_p) END) /"
-      "   NULLIF(SUM(CASE WHEN err_p IS NOT NULL THEN ABS(ref_p) END), 0) END,"
-      "  " +
-      enough +
-      " 1.0 -"
-      "   SUM(CASE WHEN ref_q IS NOT NULL THEN ABS(err_q) END) /"
-      "   NULLIF(SUM(CASE WHEN err_q IS NOT NULL THEN ABS(ref_q) END), 0) END,"
-      "  " +
-      enough +
-      "   (TOTAL(in_p) + TOTAL(in_q)) / NULLIF(COUNT(in_p) + COUNT(in_q), 0) END,"
-      "  COUNT(*),"
-      "  " +
-      enough +
-      " TOTAL(in_p) / NULLIF(COUNT(in_p), 0) END,"
-      "  " +
-      enough +
-      " TOTAL(in_q) / NULLIF(COUNT(in_q), 0) END"
-      " FROM pairs GROUP BY day");
+  s.push_back(std::string("CREATE VIEW forecast_skill") + kSkillColumnsV8 +
+              " AS "
+              "WITH pairs AS ("
+              " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day," +
+              kSkillPairColumns +
+              " FROM measurement_1min m CROSS JOIN forecast f ON f.ts = m.ts"
+              "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+              "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+              " WHERE m.valid IS NULL OR m.valid != 0)" +
+              SkillAggregatesV8());
   return s;
+}
+
+// performance_daily_local (version 9, io/store/store.h): `part` is a local
+// day's valid minutes within one UTC day, `shared` adds that UTC day's
+// performance_daily row and the share of its irradiation (or, without
+// irradiation, of its minutes) that falls in the local day.
+std::string PerformanceDailyLocal() {
+  const std::string valid = "(m.valid IS NULL OR m.valid != 0)";
+  const std::string utc_day_minutes =
+      "FROM measurement_1min m WHERE m.ts >= p.utc_day AND m.ts < p.utc_day + 86400 AND " + valid;
+  return "CREATE VIEW performance_daily_local(day, e_el_meas_wh, e_el_model_wh, e_th_meas_wh, "
+         "e_th_model_wh, pi_el, pi_th, valid_minutes) AS "
+         "WITH part AS ("
+         " SELECT d.day AS day, m.ts - ((m.ts % 86400) + 86400) % 86400 AS utc_day,"
+         "  TOTAL(m.p_el_w) / 60.0 AS e_el, TOTAL(m.q_th_w) / 60.0 AS e_th,"
+         "  TOTAL(MAX(m.g_poa_w_m2, 0)) AS g, COUNT(*) AS n"
+         " FROM local_day d CROSS JOIN measurement_1min m ON m.ts >= d.start_ts"
+         "  AND m.ts < d.end_ts WHERE " +
+         valid +
+         " GROUP BY d.day, utc_day),"
+         " whole AS ("
+         " SELECT p.*, (SELECT TOTAL(MAX(m.g_poa_w_m2, 0)) " +
+         utc_day_minutes + ") AS day_g, (SELECT COUNT(*) " + utc_day_minutes +
+         ") AS day_n FROM part p),"
+         " shared AS ("
+         " SELECT w.day, w.e_el, w.e_th, w.n, pd.day AS pd_day, pd.pi_el, pd.pi_th,"
+         "  pd.e_el_model_wh, pd.e_th_model_wh,"
+         "  CASE WHEN w.day_g > 0 THEN w.g / w.day_g ELSE CAST(w.n AS REAL) / w.day_n END AS share"
+         " FROM whole w LEFT JOIN performance_daily pd ON pd.day = w.utc_day)"
+         " SELECT day, SUM(e_el),"
+         "  CASE WHEN COUNT(pd_day) = COUNT(*) THEN SUM(e_el_model_wh * share) END, SUM(e_th),"
+         "  CASE WHEN COUNT(pd_day) = COUNT(*) THEN SUM(e_th_model_wh * share) END,"
+         "  CASE WHEN COUNT(pi_el) = COUNT(*) THEN SUM(e_el) / SUM(e_el_model_wh * share) END,"
+         "  CASE WHEN COUNT(pi_th) = COUNT(*) THEN SUM(e_th) / SUM(e_th_model_wh * share) END,"
+         "  SUM(n)"
+         " FROM shared GROUP BY day";
+}
+
+// Version 9: local days (issue 54). SQLite knows no time zones, so the store
+// writes each local day's UTC bounds (store_local_day.cc) and the local views
+// group minutes by joining them. forecast_skill_local scores each minute
+// against the newest issue at or before its local midnight.
+std::vector<std::string> SchemaV9() {
+  return {
+      "CREATE TABLE local_day(day TEXT PRIMARY KEY, start_ts INTEGER NOT NULL, end_ts INTEGER "
+      "NOT NULL) WITHOUT ROWID",
+      "CREATE UNIQUE INDEX local_day_by_start ON local_day(start_ts)",
+      "CREATE TABLE local_day_zone(id INTEGER PRIMARY KEY CHECK(id = 1), zone TEXT NOT NULL)",
+      std::string("CREATE VIEW forecast_skill_local") + kSkillColumnsV8 +
+          " AS "
+          "WITH pairs AS ("
+          " SELECT d.day AS day," +
+          kSkillPairColumns +
+          " FROM local_day d CROSS JOIN measurement_1min m ON m.ts >= d.start_ts"
+          "  AND m.ts < d.end_ts"
+          " CROSS JOIN forecast f ON f.ts = m.ts"
+          "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+          "   AND g.issued_at <= d.start_ts)"
+          " WHERE m.valid IS NULL OR m.valid != 0)" +
+          SkillAggregatesV8(),
+      PerformanceDailyLocal(),
+  };
 }
 
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3}, {4, &SchemaV4},
-                                 {5, &SchemaV5}, {6, &SchemaV6}, {7, &SchemaV7}, {8, &SchemaV8}};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3},
+                                 {4, &SchemaV4}, {5, &SchemaV5}, {6, &SchemaV6},
+                                 {7, &SchemaV7}, {8, &SchemaV8}, {9, &SchemaV9}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 

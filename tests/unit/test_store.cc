@@ -126,12 +126,21 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
   EXPECT_EQ(qc[1], "few_samples");
   EXPECT_EQ(qc[8], "imported");
   EXPECT_NE(std::find(qc.begin(), qc.end(), "missing_p_el_w"), qc.end());
+  // Version 9: the local days and the views by local day (issue 54).
+  EXPECT_EQ(db.Columns("local_day"), (std::vector<std::string>{"day", "start_ts", "end_ts"}));
+  EXPECT_EQ(db.Columns("local_day_zone"), (std::vector<std::string>{"id", "zone"}));
+  EXPECT_EQ(db.Columns("forecast_skill_local"), db.Columns("forecast_skill"));
+  EXPECT_EQ(db.Columns("performance_daily_local"),
+            (std::vector<std::string>{"day", "e_el_meas_wh", "e_el_model_wh", "e_th_meas_wh",
+                                      "e_th_model_wh", "pi_el", "pi_th", "valid_minutes"}));
   EXPECT_EQ(db.Rows("SELECT name FROM sqlite_master WHERE type = 'view' ORDER BY name"),
             (std::vector<std::vector<std::string>>{{"event"},
                                                    {"forecast_latest"},
                                                    {"forecast_skill"},
+                                                   {"forecast_skill_local"},
                                                    {"measurement_qc"},
-                                                   {"parameter_history"}}));
+                                                   {"parameter_history"},
+                                                   {"performance_daily_local"}}));
 }
 
 // A store written by version 1 is migrated on open to the current version
@@ -144,10 +153,14 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   }
   {
     RawDb db(DbPath());
-    // Back to what version 1 wrote: without the tables and views of 2 to 6
+    // Back to what version 1 wrote: without the tables and views of 2 to 9
     // (version 1's two forecast views stand in as views of those names,
     // which version 6 replaces).
-    for (const char* sql : {"DROP VIEW forecast_latest",
+    for (const char* sql : {"DROP VIEW performance_daily_local",
+                            "DROP VIEW forecast_skill_local",
+                            "DROP TABLE local_day_zone",
+                            "DROP TABLE local_day",
+                            "DROP VIEW forecast_latest",
                             "DROP VIEW forecast_skill",
                             "ALTER TABLE forecast DROP COLUMN p_el_w_p10",
                             "ALTER TABLE forecast DROP COLUMN p_el_w_p90",

@@ -38,8 +38,9 @@ class StoreMigrationTest : public testing::TempDirTest {
   }
 
   // A store with three samples, taken back to what version 7 wrote: version
-  // 8's columns dropped and its views as version 7 had them (their columns
-  // do not matter to the migration, which drops and creates them).
+  // 9's tables and views and version 8's columns dropped, and its views as
+  // version 7 had them (their columns do not matter to the migration, which
+  // drops and creates them).
   void MakeVersion7Store() {
     {
       std::vector<std::string> lines;
@@ -58,8 +59,12 @@ class StoreMigrationTest : public testing::TempDirTest {
     RawDb db(DbPath());
     // Each later version's objects go first (a new version adds its own
     // here), then version 8's.
-    static_assert(kStoreSchemaVersion == 8, "take the new version's objects back here too");
+    static_assert(kStoreSchemaVersion == 9, "take the new version's objects back here too");
     std::vector<std::string> downgrade = {
+        "DROP VIEW performance_daily_local",
+        "DROP VIEW forecast_skill_local",
+        "DROP TABLE local_day_zone",
+        "DROP TABLE local_day",
         "DROP VIEW forecast_latest",
         "DROP VIEW forecast_skill",
         "ALTER TABLE forecast DROP COLUMN p_el_w_p50",

@@ -58,10 +58,11 @@ class StoreMigrationTest : public testing::TempDirTest {
     RawDb db(DbPath());
     // Each later version's objects go first (a new version adds its own
     // here), then version 8's.
-    static_assert(kStoreSchemaVersion == 8, "take the new version's objects back here too");
+    static_assert(kStoreSchemaVersion == 10, "take the new version's objects back here too");
     std::vector<std::string> downgrade = {
         "DROP VIEW forecast_latest",
         "DROP VIEW forecast_skill",
+        "ALTER TABLE forecast DROP COLUMN basis",  // version 10 (version 9 reserved)
         "ALTER TABLE forecast DROP COLUMN p_el_w_p50",
         "ALTER TABLE forecast DROP COLUMN q_th_w_p50",
         "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",

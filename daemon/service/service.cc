@@ -198,13 +198,14 @@ int Service::Run() {
                             ? now
                             : static_cast<double>(NextLocalTime(static_cast<std::int64_t>(now),
                                                                 at_hour_, at_minute_));
-  next_forecast_s_ = have_params_ ? now : INFINITY;
+  next_forecast_s_ = now;
   next_retention_s_ = now;
   last_status_s_ = now;
   ArmHealthReport();
   const double watchdog_s = WatchdogIntervalS();
   NotifyReady("polling " + std::to_string(config_.modbus.devices.size()) + " devices into " +
               config_.storage.path);
+  if (have_params_) SetState("calibration " + std::to_string(params_id_) + " in use");
   LogToStderr(kInfo, "ready: " + config_.storage.path + ", variant " + spec_.Name() +
                          ", next calibration " +
                          FormatIsoUtc(static_cast<std::int64_t>(next_calibration_s_)));
@@ -225,7 +226,7 @@ int Service::Run() {
     MaybeStartCalibration();
     // A fresh weather forecast is used at once, not at the next refresh.
     const bool fresh_weather = weather_ && weather_->TakeFresh();
-    if (Now() >= next_forecast_s_ || (fresh_weather && have_params_)) IssueForecast();
+    if (Now() >= next_forecast_s_ || fresh_weather) IssueForecast();
     if (Now() >= next_retention_s_) {
       next_retention_s_ = Now() + kRetentionPeriodS;
       if (!store_->ApplyRetention(static_cast<std::int64_t>(Now()),

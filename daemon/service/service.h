@@ -19,7 +19,9 @@
 // held-out error (MAE P_el + MAE Q_u, the paper's objective) is at most the
 // current parameters' on the same day. Every attempt is a `calibration` row.
 // A daemon without accepted parameters calibrates as soon as it has two days
-// of data instead of waiting for the night.
+// of data instead of waiting for the night; until then it forecasts from the
+// start values (core/forecast/start_value_forecast.h, basis 'start_values')
+// and the wait is a state ("waiting for history: 3.2 h of 48 h"), logged once.
 #pragma once
 
 #include <atomic>
@@ -42,6 +44,10 @@ struct ServiceStatus {
   std::size_t last_forecast_rows = 0;
   int devices_up = 0;
   int devices = 0;
+  // The daemon's state as the systemd status line shows it (sd_notify
+  // STATUS=): "waiting for history: 3.2 h of 48 h" before the first
+  // calibration, then "calibration 7 in use".
+  std::string state;
 };
 
 struct ServiceOptions {

@@ -12,6 +12,7 @@
 #include "core/fit/identification.h"
 #include "core/model/thermal_model.h"
 #include "daemon/service/calibration_fit.h"
+#include "daemon/service/notify.h"
 #include "daemon/service/service_internal.h"
 #include "daemon/service/window_data.h"
 #include "io/files/csv.h"
@@ -125,15 +126,18 @@ void Service::MaybeStartCalibration() {
   }
   const Series& window = data.rows;
   const std::int64_t span = window.size() ? window.time_s.back() - window.time_s.front() : 0;
-  if (span < 2 * kDayS - static_cast<std::int64_t>(2 * window.step_s)) {
+  const std::int64_t min_span_s = 2 * kDayS - static_cast<std::int64_t>(2 * window.step_s);
+  if (span < min_span_s && !have_params_) {
+    RecordWaitForHistory(row, span);
+    return;
+  }
+  if (span < min_span_s) {
     row.status = "skipped";
     row.reason = "window holds " + Format("%.1f", span / 86400.0) + " days of " +
                  (data.source == cli::WindowSource::kIntervals ? data.Describe()
                                                                 : std::string("1-min data")) +
                  "; two are needed (training days and a held-out day)";
     RecordCalibration(row);
-    if (!have_params_)
-      next_calibration_s_ = std::min(next_calibration_s_, now + kUncalibratedRetryS);
     return;
   }
   // Held out: the last days, as many as it takes (up to 3) to hold two hours
@@ -358,7 +362,7 @@ void Service::FinishCalibration(int exit_code) {
   }
 }
 
-std::int64_t Service::RecordCalibration(Store::CalibrationRow row) {
+std::int64_t Service::RecordCalibration(Store::CalibrationRow row, int priority) {
   std::string error;
   if (!store_->InsertCalibration(&row, &error)) {
     LogToStderr(kErr, "recording the calibration failed: " + error);
@@ -368,9 +372,40 @@ std::int64_t Service::RecordCalibration(Store::CalibrationRow row) {
   ++status_.calibrations;
   status_.last_calibration = row.status + ": " + row.reason;
   last_calibration_ = {row.id, row.status, static_cast<double>(row.run_at)};
-  LogToStderr(row.status == "accepted" ? kNotice : kWarning,
+  if (priority < 0) priority = row.status == "accepted" ? kNotice : kWarning;
+  LogToStderr(priority,
               "calibration " + std::to_string(row.id) + " " + row.status + ": " + row.reason);
+  if (row.accepted && row.id > 0) SetState("calibration " + std::to_string(row.id) + " in use");
   return row.id;
+}
+
+void Service::RecordWaitForHistory(Store::CalibrationRow row, std::int64_t span_s) {
+  const double now = Now();
+  const std::string state =
+      "waiting for history: " + Format("%.1f", static_cast<double>(span_s) / 3600.0) + " h of 48 h";
+  row.status = "skipped";
+  row.reason = state + " (two days of 1-min data are needed: training days and a held-out day)";
+  RecordCalibration(row, kDebug);
+  next_calibration_s_ = std::min(next_calibration_s_, now + kUncalibratedRetryS);
+  SetState(state);
+  if (waiting_announced_) return;
+  waiting_announced_ = true;
+  const std::string line =
+      state +
+      "; forecasts from the start values (basis = 'start_values') until the first "
+      "calibration";
+  LogToStderr(kInfo, line);
+  std::string error;
+  if (!store_->InsertMonitorEvent(static_cast<std::int64_t>(now), "calibration_waiting", "info",
+                                  line, &error)) {
+    LogToStderr(kWarning, "recording the wait for history failed: " + error);
+  }
+}
+
+void Service::SetState(const std::string& state) {
+  if (state == status_.state) return;
+  status_.state = state;
+  NotifyStatus(state);
 }
 
 }  // namespace pvtwin::service_detail

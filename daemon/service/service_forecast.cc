@@ -7,6 +7,7 @@
 
 #include "core/forecast/forecast.h"
 #include "core/forecast/forecast_bands.h"
+#include "core/forecast/start_value_forecast.h"
 #include "daemon/service/service_internal.h"
 #include "io/platform/log.h"
 #include "io/platform/time_format.h"
@@ -39,27 +40,28 @@ std::string InputsInBrief(const ForecastInputUse& use) {
                {"learned", use.operation_learned}});
 }
 
+// The request of an issue now: whole minutes, the configured horizon.
+ForecastRequest RequestAt(double now_s, double horizon_h) {
+  ForecastRequest request;
+  request.issued_at_s = static_cast<std::int64_t>(std::floor(now_s / 60.0)) * 60;
+  request.horizon_s = horizon_h * 3600.0;
+  return request;
+}
+
 }  // namespace
 
-void Service::IssueForecast() {
-  if (!have_params_) return;
-  const double now = Now();
-  next_forecast_s_ = now + config_.forecast.refresh_min * 60.0;
-  ForecastRequest request;
-  request.issued_at_s = static_cast<std::int64_t>(std::floor(now / 60.0)) * 60;
-  request.horizon_s = config_.forecast.horizon_h * 3600.0;
+bool Service::ReadForecastInputs(const ForecastRequest& request, std::int64_t history_s,
+                                 Series* history, Series* weather, Series* plan) {
   const std::int64_t horizon_end =
       request.issued_at_s + static_cast<std::int64_t>(request.horizon_s);
-  Series history, weather, plan;
   std::string error;
-  const std::int64_t history_from = request.issued_at_s - config_.calibration.window_days * kDayS;
   Store::TextCells weather_text, plan_text;
-  if (!store_->ReadMinutes(history_from, request.issued_at_s, &history, &error) ||
-      !store_->ReadWeatherForecast(request.issued_at_s, horizon_end, &weather, &error,
+  if (!store_->ReadMinutes(request.issued_at_s - history_s, request.issued_at_s, history, &error) ||
+      !store_->ReadWeatherForecast(request.issued_at_s, horizon_end, weather, &error,
                                    &weather_text) ||
-      !store_->ReadOperationPlan(request.issued_at_s, horizon_end, &plan, &error, &plan_text)) {
+      !store_->ReadOperationPlan(request.issued_at_s, horizon_end, plan, &error, &plan_text)) {
     LogToStderr(kErr, "forecast inputs could not be read: " + error);
-    return;
+    return false;
   }
   // Text where a number belongs (an `sqlite3 .import` of empty cells): read
   // as missing, said once for as long as it stays the same.
@@ -70,18 +72,75 @@ void Service::IssueForecast() {
     LogToStderr(kWarning, "forecast inputs: " + text_warning);
   }
   text_cells_warned_ = text_warning;
+  return true;
+}
+
+void Service::IssueForecast() {
+  if (!have_params_) {
+    IssueStartValueForecast();
+    return;
+  }
+  const double now = Now();
+  next_forecast_s_ = now + config_.forecast.refresh_min * 60.0;
+  const ForecastRequest request = RequestAt(now, config_.forecast.horizon_h);
+  Series history, weather, plan;
+  if (!ReadForecastInputs(request, config_.calibration.window_days * kDayS, &history, &weather,
+                          &plan)) {
+    return;
+  }
   UpdateForecastStats(history, request);
   BandedForecast banded;
+  std::string error;
   if (!MakeBandedForecast(config_.plant, spec_, params_, history, weather, plan, request,
                           forecast_stats_, &banded, &error)) {
     LogToStderr(kWarning, "no forecast issued: " + error);
     return;
   }
   Forecast& forecast = banded.forecast;
+  const std::int64_t horizon_end =
+      request.issued_at_s + static_cast<std::int64_t>(request.horizon_s);
   if (weather.size() > 0 && !store_->ReadWeatherSources(request.issued_at_s, horizon_end,
                                                         &forecast.inputs.weather_sources, &error)) {
     LogToStderr(kWarning, "the weather_forecast sources could not be read: " + error);
   }
+  WriteForecast(request, ForecastBasis::kCalibrated, banded, banded.Inputs(),
+                InputsInBrief(forecast.inputs));
+}
+
+// No calibration yet: the start values, retried soon while the model cannot
+// run (no measured minute yet); deferred while a first fit runs, whose
+// parameters forecast as soon as they are accepted.
+void Service::IssueStartValueForecast() {
+  if (child_.running()) return;
+  const double now = Now();
+  const ForecastRequest request = RequestAt(now, config_.forecast.horizon_h);
+  Series history, weather, plan;
+  if (!ReadForecastInputs(request, kDayS, &history, &weather, &plan)) {
+    next_forecast_s_ = now + kStartValueRetryS;
+    return;
+  }
+  StartValueForecast start;
+  std::string error;
+  if (!MakeStartValueForecast(config_.plant, spec_, history, weather, plan, request,
+                              StartValueOptions{}, &start, &error)) {
+    next_forecast_s_ = now + kStartValueRetryS;
+    if (error != start_value_error_) {
+      LogToStderr(kInfo, "no forecast from the start values yet (retried every " +
+                             Format("%.0f", kStartValueRetryS / 60.0) + " min): " + error);
+    }
+    start_value_error_ = error;
+    return;
+  }
+  start_value_error_.clear();
+  next_forecast_s_ = now + config_.forecast.refresh_min * 60.0;
+  WriteForecast(request, ForecastBasis::kStartValues, start.banded, start.inputs,
+                "start values, clear-sky index " + Format("%.2f", start.clear_sky_index));
+}
+
+bool Service::WriteForecast(const ForecastRequest& request, ForecastBasis basis,
+                            const BandedForecast& banded, const std::string& inputs,
+                            const std::string& brief) {
+  const Forecast& forecast = banded.forecast;
   std::vector<Store::ForecastRow> rows(forecast.rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     Store::ForecastRow& r = rows[i];
@@ -99,17 +158,22 @@ void Service::IssueForecast() {
     r.p_el_w_ref = forecast.reference[Channel::kPElW][i];
     r.q_th_w_ref = forecast.reference[Channel::kQThW][i];
   }
-  const std::string inputs = banded.Inputs();
-  if (!store_->InsertForecast(request.issued_at_s, params_id_, inputs, rows, &error)) {
+  const bool calibrated = basis == ForecastBasis::kCalibrated;
+  std::string error;
+  if (!store_->InsertForecast(request.issued_at_s, calibrated ? params_id_ : 0, basis, inputs, rows,
+                              &error)) {
     LogToStderr(kErr, "writing the forecast failed: " + error);
-    return;
+    return false;
   }
   ++status_.forecasts;
   status_.last_forecast_rows = rows.size();
   last_forecast_issued_at_ = request.issued_at_s;
   LogToStderr(kInfo, "forecast issued at " + FormatIsoUtc(request.issued_at_s) + ": " +
-                         std::to_string(rows.size()) + " rows, calibration " +
-                         std::to_string(params_id_) + "; " + InputsInBrief(forecast.inputs));
+                         std::to_string(rows.size()) + " rows, " +
+                         (calibrated ? "calibration " + std::to_string(params_id_)
+                                     : std::string("start values")) +
+                         "; " + brief);
+  return true;
 }
 
 void Service::UpdateForecastStats(const Series& history, const ForecastRequest& request) {

@@ -65,6 +65,8 @@ void Service::ArmHealthReport() {
 }
 
 std::string Service::CalibrationHealth() const {
+  // A new plant's wait: "waiting for history: 3.2 h of 48 h".
+  if (!have_params_ && status_.state.rfind("waiting for history", 0) == 0) return status_.state;
   if (last_calibration_.status.empty()) return "no calibration yet";
   std::string text = "calibration " + std::to_string(last_calibration_.id) + " " +
                      last_calibration_.status + " " +

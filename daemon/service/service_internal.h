@@ -27,6 +27,7 @@
 #include "core/common/sample.h"
 #include "core/forecast/forecast.h"
 #include "core/forecast/forecast_bands.h"
+#include "core/forecast/start_value_forecast.h"
 #include "core/model/variant.h"
 #include "daemon/service/calibration_acceptance.h"
 #include "daemon/service/nightly_diagnosis.h"
@@ -47,10 +48,12 @@ inline constexpr std::int64_t kDayS = 86400;
 inline constexpr std::size_t kMaxPendingSamples = 17280;
 // A daemon without parameters retries a calibration it lacked data for.
 inline constexpr double kUncalibratedRetryS = 3600.0;
+// A plant without parameters retries a start-value forecast the model could
+// not run yet (no measured minute) this often.
+inline constexpr double kStartValueRetryS = 300.0;
 inline constexpr double kRetentionPeriodS = 3600.0;
 // Calibration run directories kept (calibration/run-<run_at>), the running one included.
 inline constexpr std::size_t kKeptCalibrationRuns = 5;
-
 
 inline std::string Format(const char* fmt, double a) {
   char buf[64];
@@ -110,10 +113,27 @@ class Service {
   void DailyChecks(bool accepted_now);
   // The nightly diagnosis child (daemon/service/nightly_diagnosis.h), when due.
   void MaybeStartDiagnosis();
-  // Inserts the row and returns its id (0 when it could not be stored).
-  std::int64_t RecordCalibration(Store::CalibrationRow row);
+  // Inserts the row and returns its id (0 when it could not be stored);
+  // logs it at `priority` (default: notice when accepted, else warning).
+  std::int64_t RecordCalibration(Store::CalibrationRow row, int priority = -1);
+  // A plant without parameters and less than two days of data: the wait is
+  // a state (info once, the status line), not a warning per attempt.
+  void RecordWaitForHistory(Store::CalibrationRow row, std::int64_t span_s);
+  // The daemon's state for the systemd status line and ServiceStatus.
+  void SetState(const std::string& state);
   bool LoadCurrentParameters();
   void IssueForecast();
+  // Before the first accepted calibration (core/forecast/start_value_forecast.h).
+  void IssueStartValueForecast();
+  // The history of the last history_s, the weather forecast and the plan
+  // over the horizon of `request`; false after logging.
+  bool ReadForecastInputs(const ForecastRequest& request, std::int64_t history_s, Series* history,
+                          Series* weather, Series* plan);
+  // Stores one issue and logs it (brief: the inputs in a few words); false
+  // after logging.
+  bool WriteForecast(const ForecastRequest& request, ForecastBasis basis,
+                     const BandedForecast& banded, const std::string& inputs,
+                     const std::string& brief);
   void Shutdown();
   // False (after logging, stopping and saving the open store beside it)
   // when the database file was deleted or replaced under the daemon.
@@ -175,6 +195,8 @@ class Service {
   double next_calibration_s_ = 0.0;
   // Current parameters.
   bool have_params_ = false;
+  bool waiting_announced_ = false;  // the wait for history was logged and recorded
+  std::string start_value_error_;   // why the last start-value forecast could not be made
   std::int64_t params_id_ = 0;
   ParamVector params_{};
   std::string params_json_;

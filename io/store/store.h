@@ -168,6 +168,18 @@
 //       pi = measured / model when every such UTC day is scored for the
 //       output and the model energy is not 0, else NULL.
 //
+// Version 10 adds (issue 53, day one; core/forecast/start_value_forecast.h):
+//   forecast.basis TEXT NOT NULL DEFAULT 'calibrated'
+//       'calibrated' (the accepted calibration's parameters; every row
+//       written before) or 'start_values' (a plant without an accepted
+//       calibration: Table 3's start values, calibration_id NULL, the band
+//       the start-value envelope).
+//   view forecast_latest gains basis.
+//   view event leaves out the calibrations skipped before the first
+//       accepted one (a new plant waiting for its two days of history);
+//       the daemon marks that wait with one monitor_event of kind
+//       calibration_waiting, severity info.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -221,9 +233,17 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 9;
+inline constexpr int kStoreSchemaVersion = 10;
 // NULL in a row struct.
 inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
+
+// What a forecast issue's parameters are (forecast.basis, version 10): an
+// accepted calibration's, or the start values of a plant without one
+// (core/forecast/start_value_forecast.h).
+enum class ForecastBasis { kCalibrated, kStartValues };
+inline const char* ForecastBasisName(ForecastBasis basis) {
+  return basis == ForecastBasis::kStartValues ? "start_values" : "calibrated";
+}
 
 struct StoreOptions {
   // SQLite waits busy_timeout_ms for a lock, per attempt; the whole
@@ -424,8 +444,12 @@ class Store {
                                const std::string& reason_note, std::string* error);
   bool LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error);
 
-  // Upserts one forecast issue (all rows in one transaction).
+  // Upserts one forecast issue (all rows in one transaction); without a
+  // basis, a calibrated one. calibration_id 0: NULL.
   bool InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
+                      const std::string& inputs, const std::vector<ForecastRow>& rows,
+                      std::string* error);
+  bool InsertForecast(std::int64_t issued_at, std::int64_t calibration_id, ForecastBasis basis,
                       const std::string& inputs, const std::vector<ForecastRow>& rows,
                       std::string* error);
 

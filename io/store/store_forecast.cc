@@ -268,6 +268,12 @@ bool Store::LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::str
 bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
                            const std::string& inputs, const std::vector<ForecastRow>& rows,
                            std::string* error) {
+  return InsertForecast(issued_at, calibration_id, ForecastBasis::kCalibrated, inputs, rows, error);
+}
+
+bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id, ForecastBasis basis,
+                           const std::string& inputs, const std::vector<ForecastRow>& rows,
+                           std::string* error) {
   Impl& db = *impl_;
   std::lock_guard lock(db.mutex);
   return db.Run(
@@ -277,8 +283,8 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
         DbStatus s = db.Prepare(
             "INSERT OR REPLACE INTO forecast(issued_at, ts, calibration_id, p_el_w, q_th_w, "
             "t_pv_c, t_out_c, inputs, p_el_w_p10, p_el_w_p90, q_th_w_p10, q_th_w_p90, "
-            "p_el_w_ref, q_th_w_ref, p_el_w_p50, q_th_w_p50) "
-            "VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            "p_el_w_ref, q_th_w_ref, p_el_w_p50, q_th_w_p50, basis) "
+            "VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             &stmt);
         if (!s.ok()) return s;
         for (const ForecastRow& row : rows) {
@@ -299,6 +305,7 @@ bool Store::InsertForecast(std::int64_t issued_at, std::int64_t calibration_id,
                            row.p_el_w_ref, row.q_th_w_ref, row.p_el_w_p50, row.q_th_w_p50}) {
             BindReal(stmt, column++, v);
           }
+          sqlite3_bind_text(stmt, column++, ForecastBasisName(basis), -1, SQLITE_STATIC);
           s = db.StepDone(stmt, "insert forecast row ts " + std::to_string(row.ts));
           if (!s.ok()) return s;
         }

@@ -104,6 +104,26 @@ std::string QcFlagColumns() {
   return "CREATE VIEW measurement_qc(" + names + ") AS SELECT " + exprs + " FROM measurement_1min";
 }
 
+// The view event: monitor_event, qc_event, the calibrations that
+// calibration_filter (a condition on calibration row c, "1" for all) keeps,
+// and the diagnoses, newest first.
+std::string EventView(const std::string& calibration_filter) {
+  return "CREATE VIEW event(ts, kind, severity, message) AS"
+         " SELECT ts, kind, severity, message FROM monitor_event"
+         " UNION ALL SELECT start_ts, 'qc_' || kind, 'warning', channel || ': ' || detail"
+         "  FROM qc_event"
+         " UNION ALL SELECT run_at, 'calibration_' || status,"
+         "  CASE WHEN accepted = 1 THEN 'info' ELSE 'warning' END,"
+         "  'calibration ' || id || ' (' || variant || '): ' || status ||"
+         "  COALESCE(': ' || reason, '') FROM calibration" +
+         std::string(calibration_filter == "1" ? "" : " c WHERE " + calibration_filter) +
+         " UNION ALL SELECT run_at, 'diagnosis',"
+         "  CASE WHEN verdict = 'none' THEN 'info' ELSE 'warning' END,"
+         "  'diagnosis of ' || base_variant || ': ' || verdict ||"
+         "  CASE WHEN low_confidence = 1 THEN ' (low confidence)' ELSE '' END FROM diagnosis"
+         " ORDER BY 1 DESC";
+}
+
 // Version 4: what the twin watches day by day (core/monitoring.h) and the
 // one list of events an operator reads first.
 std::vector<std::string> SchemaV4() {
@@ -122,19 +142,7 @@ std::vector<std::string> SchemaV4() {
       "INTEGER, window_start INTEGER, window_end INTEGER, base_variant TEXT, verdict TEXT, "
       "low_confidence INTEGER, shrink_pct REAL, bias_p_el_w REAL, bias_q_th_w REAL, "
       "report_json TEXT)",
-      "CREATE VIEW event(ts, kind, severity, message) AS"
-      " SELECT ts, kind, severity, message FROM monitor_event"
-      " UNION ALL SELECT start_ts, 'qc_' || kind, 'warning', channel || ': ' || detail"
-      "  FROM qc_event"
-      " UNION ALL SELECT run_at, 'calibration_' || status,"
-      "  CASE WHEN accepted = 1 THEN 'info' ELSE 'warning' END,"
-      "  'calibration ' || id || ' (' || variant || '): ' || status ||"
-      "  COALESCE(': ' || reason, '') FROM calibration"
-      " UNION ALL SELECT run_at, 'diagnosis',"
-      "  CASE WHEN verdict = 'none' THEN 'info' ELSE 'warning' END,"
-      "  'diagnosis of ' || base_variant || ': ' || verdict ||"
-      "  CASE WHEN low_confidence = 1 THEN ' (low confidence)' ELSE '' END FROM diagnosis"
-      " ORDER BY 1 DESC",
+      EventView("1"),
   };
 }
 
@@ -360,13 +368,34 @@ std::vector<std::string> SchemaV9() {
   };
 }
 
+// Version 10 (issue 53, day one): each forecast says whether it comes from
+// an accepted calibration or from the start values of a plant without one
+// (core/forecast/start_value_forecast.h); rows written before were
+// calibrated. forecast_latest shows it last. A new plant's wait for its two
+// days of history (calibrations skipped before the first accepted one) is
+// no warning in event: the daemon writes one info event for it instead.
+std::vector<std::string> SchemaV10() {
+  return {
+      "ALTER TABLE forecast ADD COLUMN basis TEXT NOT NULL DEFAULT 'calibrated'",
+      "DROP VIEW forecast_latest",
+      "CREATE VIEW forecast_latest(ts, issued_at, p_el_w, q_th_w, t_pv_c, t_out_c, p_el_w_p10, "
+      "p_el_w_p90, q_th_w_p10, q_th_w_p90, p_el_w_p50, q_th_w_p50, basis) AS "
+      "SELECT f.ts, f.issued_at, f.p_el_w, f.q_th_w, f.t_pv_c, f.t_out_c, f.p_el_w_p10, "
+      "f.p_el_w_p90, f.q_th_w_p10, f.q_th_w_p90, f.p_el_w_p50, f.q_th_w_p50, f.basis FROM "
+      "forecast f WHERE f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = f.ts)",
+      "DROP VIEW event",
+      EventView("c.status != 'skipped' OR EXISTS (SELECT 1 FROM calibration a WHERE a.accepted = "
+                "1 AND a.run_at <= c.run_at)"),
+  };
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2}, {3, &SchemaV3},
-                                 {4, &SchemaV4}, {5, &SchemaV5}, {6, &SchemaV6},
-                                 {7, &SchemaV7}, {8, &SchemaV8}, {9, &SchemaV9}};
+const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2},  {3, &SchemaV3}, {4, &SchemaV4},
+                                 {5, &SchemaV5}, {6, &SchemaV6},  {7, &SchemaV7}, {8, &SchemaV8},
+                                 {9, &SchemaV9}, {10, &SchemaV10}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 

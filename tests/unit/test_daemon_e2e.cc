@@ -70,13 +70,16 @@ class DaemonE2E : public ::testing::Test {
     ASSERT_TRUE(fs::exists(kExampleMap)) << kExampleMap;
     fs::copy_file(kExampleMap, dir_ / "sim.toml");
     const std::string truth = truth_variant_.empty() ? "" : " --truth-variant " + truth_variant_;
-    const auto exported = RunPvtwin(
-        dir_.path(), "sim --config sim.toml --export history.csv --days 14 --step 60 --start " +
-                         std::to_string(t0_ - 14 * 86400) + truth);
-    ASSERT_EQ(exported.exit_code, 0) << exported.err;
-    const auto imported =
-        RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + Db());
-    ASSERT_EQ(imported.exit_code, 0) << imported.err;
+    if (history_days_ > 0) {
+      const auto exported = RunPvtwin(
+          dir_.path(), "sim --config sim.toml --export history.csv --days " +
+                           std::to_string(history_days_) + " --step 60 --start " +
+                           std::to_string(t0_ - history_days_ * 86400) + truth);
+      ASSERT_EQ(exported.exit_code, 0) << exported.err;
+      const auto imported =
+          RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + Db());
+      ASSERT_EQ(imported.exit_code, 0) << imported.err;
+    }
     anchor_ = WallNowS();
     std::string error;
     std::vector<std::string> sim_args = {PVTWIN_BINARY,
@@ -134,6 +137,7 @@ class DaemonE2E : public ::testing::Test {
 
   ScratchDir dir_{"e2e"};
   std::int64_t t0_ = kMorning;       // simulated time at which live polling starts
+  int history_days_ = 14;            // imported before t0_; 0: a new, empty store
   double speed_ = kSpeed;            // simulated seconds per wall second
   std::string truth_variant_;        // of `pvtwin sim`; empty: its default
   std::vector<std::string> faults_;  // `pvtwin sim --fault` specs
@@ -188,6 +192,11 @@ TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
   EXPECT_EQ(db.Count("SELECT count(*) FROM measurement_1min" + live + " AND ts % 60 != 0"), 0);
   EXPECT_EQ(db.Count("SELECT count(*) FROM (SELECT issued_at FROM forecast GROUP BY issued_at "
                      "HAVING count(*) != 1440)"),
+            0);
+  // Two weeks of history: the first fit starts at once, and no forecast
+  // from the start values is issued while it runs.
+  EXPECT_EQ(db.Count("SELECT count(*) FROM forecast WHERE basis IS NOT 'calibrated' OR "
+                     "calibration_id IS NULL"),
             0);
   // The forecast issued before midnight is scored once the new day's
   // measurements exist (20 simulated minutes after the start: 10 s here).
@@ -339,6 +348,112 @@ TEST_F(DaemonE2E, AReaderHoldingATransactionDoesNotStopIngestion) {
                            std::to_string(t0_)),
             0);
   reader.Exec("COMMIT");
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+}
+
+// A new plant: an empty store, the simulator's plant polled live from 08:00
+// UTC. Within the first simulated hour the store holds a forecast from the
+// start values, banded, flagged basis = 'start_values'; the wait for two days
+// of history is one info line, one info event and a state, not a warning per
+// hourly attempt (issue 53).
+class DaemonE2EDayOne : public DaemonE2E {
+ protected:
+  DaemonE2EDayOne() {
+    history_days_ = 0;
+    speed_ = 360.0;  // a simulated hour in 10 s
+  }
+};
+
+TEST_F(DaemonE2EDayOne, ForecastsFromTheStartValuesAndWaitsWithoutAWarning) {
+  StartDaemon();
+  // The daemon creates the store: a connection opened before would see none.
+  ASSERT_TRUE(WaitFor(30, [&] { return fs::exists(Db()); })) << DaemonLog();
+  const class Db db(Db());
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Count("SELECT count(*) FROM forecast WHERE basis = 'start_values'") >= 1440;
+  })) << DaemonLog();
+  EXPECT_LT(db.Count("SELECT min(issued_at) FROM forecast"), t0_ + 3600) << DaemonLog();
+  EXPECT_EQ(db.Count("SELECT count(*) FROM forecast WHERE basis IS NOT 'start_values' OR "
+                     "calibration_id IS NOT NULL"),
+            0);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM forecast_latest WHERE basis IS NOT 'start_values'"), 0);
+  // Every row's band holds its point, whose median it is; the day's band
+  // has a width.
+  EXPECT_EQ(db.Count("SELECT count(*) FROM forecast_latest WHERE NOT (p_el_w_p10 <= p_el_w AND "
+                     "p_el_w <= p_el_w_p90 AND q_th_w_p10 <= q_th_w AND q_th_w <= q_th_w_p90 AND "
+                     "p_el_w_p50 = p_el_w AND q_th_w_p50 = q_th_w)"),
+            0);
+  EXPECT_GT(db.Count("SELECT count(*) FROM forecast_latest WHERE p_el_w_p90 > p_el_w_p10 + 1"), 300);
+  EXPECT_NE(db.Text("SELECT inputs FROM forecast LIMIT 1").find("start values (Table 3"),
+            std::string::npos);
+  // Two hourly attempts: both recorded, the second with the history grown.
+  ASSERT_TRUE(WaitFor(60, [&] {
+    return db.Count("SELECT count(*) FROM calibration WHERE status = 'skipped'") >= 2;
+  })) << DaemonLog();
+  EXPECT_EQ(db.Count("SELECT count(*) FROM calibration WHERE status != 'skipped' OR reason NOT "
+                     "LIKE 'waiting for history: % h of 48 h%'"),
+            0)
+      << db.Text("SELECT group_concat(reason, ' | ') FROM calibration");
+  EXPECT_NE(db.Text("SELECT reason FROM calibration ORDER BY id DESC LIMIT 1")
+                .rfind("waiting for history: 0.0 h", 0),
+            0u);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM event WHERE severity != 'info'"), 0)
+      << db.Text("SELECT group_concat(message, ' | ') FROM event");
+  EXPECT_EQ(db.Count("SELECT count(*) FROM event WHERE kind = 'calibration_waiting'"), 1);
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  const std::string log = DaemonLog();
+  EXPECT_EQ(log.find(" warning: "), std::string::npos) << log;
+  std::size_t announced = 0;
+  for (std::size_t at = log.find("info: waiting for history"); at != std::string::npos;
+       at = log.find("info: waiting for history", at + 1)) {
+    ++announced;
+  }
+  EXPECT_EQ(announced, 1u) << log;
+}
+
+// The second day's end: 47.5 h of history at the start, so the first
+// attempt waits and the start values forecast; an hour later the first fit
+// is accepted and the forecasts are calibrated from then on.
+class DaemonE2EDayTwo : public DaemonE2E {
+ protected:
+  DaemonE2EDayTwo() {
+    history_days_ = 2;
+    speed_ = 360.0;
+  }
+};
+
+TEST_F(DaemonE2EDayTwo, TheFirstAcceptedCalibrationTurnsTheForecastsCalibrated) {
+  {
+    const class Db setup(Db());
+    setup.Exec("DELETE FROM measurement_1min WHERE ts < " + std::to_string(t0_ - 171000));
+  }
+  StartDaemon();
+  const class Db db(Db());
+  ASSERT_TRUE(WaitFor(120, [&] {
+    return db.Count("SELECT count(*) FROM forecast WHERE basis = 'calibrated'") >= 1440;
+  })) << DaemonLog();
+  const std::string accepted_at =
+      db.Text("SELECT run_at FROM calibration WHERE status = 'accepted' ORDER BY id LIMIT 1");
+  ASSERT_FALSE(accepted_at.empty()) << DaemonLog();
+  EXPECT_GE(db.Count("SELECT count(*) FROM forecast WHERE basis = 'start_values' AND issued_at < " +
+                     accepted_at),
+            1440)
+      << DaemonLog();
+  // The fit runs for simulated minutes; the first calibrated issue follows
+  // it, and no forecast from the start values comes after.
+  const std::string first_calibrated =
+      db.Text("SELECT min(issued_at) FROM forecast WHERE basis = 'calibrated'");
+  EXPECT_EQ(db.Count("SELECT count(*) FROM forecast WHERE basis = 'start_values' AND issued_at >= " +
+                     first_calibrated),
+            0);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM forecast f WHERE basis = 'calibrated' AND "
+                     "calibration_id IS NOT (SELECT id FROM calibration WHERE accepted = 1 ORDER "
+                     "BY id LIMIT 1)"),
+            0);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM forecast_latest WHERE ts >= " + first_calibrated +
+                     " AND basis IS NOT 'calibrated'"),
+            0);
+  EXPECT_EQ(db.Count("SELECT count(*) FROM event WHERE kind = 'calibration_skipped'"), 0);
   EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
 }
 

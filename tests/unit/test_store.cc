@@ -75,16 +75,16 @@ TEST_F(StoreTest, SchemaHasTheContractsTablesViewsAndColumns) {
                                       "status", "mae_p_el_w", "mae_q_th_w", "runtime_s", "n_evals",
                                       "params_json", "reason", "heldout_mae_w", "accepted"}));
   // Version 6 appended the bands and the reference (issue 15), version 8
-  // the medians and the coverage per output (issue 53).
+  // the medians and the coverage per output, version 10 the basis (issue 53).
   EXPECT_EQ(db.Columns("forecast"),
             (std::vector<std::string>{"issued_at", "ts", "calibration_id", "p_el_w", "q_th_w",
                                       "t_pv_c", "t_out_c", "inputs", "p_el_w_p10", "p_el_w_p90",
                                       "q_th_w_p10", "q_th_w_p90", "p_el_w_ref", "q_th_w_ref",
-                                      "p_el_w_p50", "q_th_w_p50"}));
+                                      "p_el_w_p50", "q_th_w_p50", "basis"}));
   EXPECT_EQ(db.Columns("forecast_latest"),
             (std::vector<std::string>{"ts", "issued_at", "p_el_w", "q_th_w", "t_pv_c", "t_out_c",
                                       "p_el_w_p10", "p_el_w_p90", "q_th_w_p10", "q_th_w_p90",
-                                      "p_el_w_p50", "q_th_w_p50"}));
+                                      "p_el_w_p50", "q_th_w_p50", "basis"}));
   EXPECT_EQ(db.Columns("forecast_skill"),
             (std::vector<std::string>{"day", "mae_p_el_w", "mae_q_th_w", "nmae_p_el", "nmae_q_th",
                                       "skill_p_el", "skill_q_th", "coverage_p10_p90", "minutes",
@@ -153,7 +153,8 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   }
   {
     RawDb db(DbPath());
-    // Back to what version 1 wrote: without the tables and views of 2 to 9
+    ASSERT_EQ(db.Exec("INSERT INTO forecast(issued_at, ts, p_el_w) VALUES(0, 60, 1)"), SQLITE_OK);
+    // Back to what version 1 wrote: without the tables and views of 2 to 10
     // (version 1's two forecast views stand in as views of those names,
     // which version 6 replaces).
     for (const char* sql : {"DROP VIEW performance_daily_local",
@@ -162,6 +163,7 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
                             "DROP TABLE local_day",
                             "DROP VIEW forecast_latest",
                             "DROP VIEW forecast_skill",
+                            "ALTER TABLE forecast DROP COLUMN basis",
                             "ALTER TABLE forecast DROP COLUMN p_el_w_p10",
                             "ALTER TABLE forecast DROP COLUMN p_el_w_p90",
                             "ALTER TABLE forecast DROP COLUMN q_th_w_p10",
@@ -204,6 +206,9 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM pragma_table_info('forecast_skill') WHERE name IN "
                       "('coverage_p_el', 'coverage_q_th')"),
             2.0);
+  // Version 10: a row written before is a calibrated forecast.
+  EXPECT_EQ(db.Rows("SELECT basis FROM forecast_latest"),
+            (std::vector<std::vector<std::string>>{{"calibrated"}}));
 }
 
 TEST_F(StoreTest, EveryNewStoreGetsItsOwnIdentityAndKeepsItWhenReopened) {
@@ -518,6 +523,53 @@ TEST_F(StoreTest, ForecastLatestPicksTheNewestIssueForEachTime) {
   EXPECT_EQ(latest[0].ts, t + 60);
   EXPECT_EQ(latest[0].p_el_w, 102.0);
   EXPECT_EQ(latest[1].t_out_c, 132.0);
+}
+
+// Day one (issue 53): a forecast from the start values is flagged in the
+// table and in forecast_latest; the calibrations skipped before the first
+// accepted one (a new plant waiting for its history) stay in `calibration`
+// but are no warning in `event`, a skip after it still is.
+TEST_F(StoreTest, StartValueForecastsAreFlaggedAndTheFirstWaitIsNoWarningInEvent) {
+  auto store = OpenStore();
+  std::string error;
+  const std::int64_t t = kMinute0;
+  ASSERT_TRUE(store->InsertForecast(t - 1000, 0, ForecastBasis::kStartValues, "start values",
+                                    {{t, 1, 10, 20, 30}, {t + 60, 2, 11, 21, 31}}, &error))
+      << error;
+  ASSERT_TRUE(store->InsertForecast(t - 500, 7, "bands", {{t + 60, 102, 111, 121, 131}}, &error))
+      << error;
+  RawDb db(DbPath());
+  const std::string ts = std::to_string(t);
+  EXPECT_EQ(db.Rows("SELECT ts - " + ts + ", basis, calibration_id FROM forecast ORDER BY "
+                    "issued_at, ts"),
+            (std::vector<std::vector<std::string>>{{"0", "start_values", "NULL"},
+                                                   {"60", "start_values", "NULL"},
+                                                   {"60", "calibrated", "7"}}));
+  EXPECT_EQ(db.Rows("SELECT ts - " + ts + ", basis FROM forecast_latest ORDER BY ts"),
+            (std::vector<std::vector<std::string>>{{"0", "start_values"}, {"60", "calibrated"}}));
+
+  const auto calibration = [&](std::int64_t run_at, const char* status, const char* reason) {
+    Store::CalibrationRow r;
+    r.run_at = run_at;
+    r.variant = "2N1Ccolwr";
+    r.status = status;
+    r.accepted = std::string(status) == "accepted";
+    r.reason = reason;
+    ASSERT_TRUE(store->InsertCalibration(&r, &error)) << error;
+  };
+  calibration(t, "skipped", "waiting for history: 0.0 h of 48 h");
+  calibration(t + 3600, "skipped", "waiting for history: 1.0 h of 48 h");
+  calibration(t + 2 * 86400, "accepted", "first parameters of this database");
+  calibration(t + 9 * 86400, "skipped", "window holds 1.2 days of 1-min data; two are needed");
+  ASSERT_TRUE(store->InsertMonitorEvent(t, "calibration_waiting", "info",
+                                        "waiting for history: 0.0 h of 48 h", &error))
+      << error;
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM calibration"), 4.0);
+  EXPECT_EQ(db.Rows("SELECT ts - " + ts + ", kind, severity FROM event ORDER BY ts"),
+            (std::vector<std::vector<std::string>>{
+                {"0", "calibration_waiting", "info"},
+                {std::to_string(2 * 86400), "calibration_accepted", "info"},
+                {std::to_string(9 * 86400), "calibration_skipped", "warning"}}));
 }
 
 TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements) {

@@ -59,7 +59,7 @@ class StoreMigrationTest : public testing::TempDirTest {
     RawDb db(DbPath());
     // Each later version's objects go first (a new version adds its own
     // here), then version 8's.
-    static_assert(kStoreSchemaVersion == 9, "take the new version's objects back here too");
+    static_assert(kStoreSchemaVersion == 10, "take the new version's objects back here too");
     std::vector<std::string> downgrade = {
         "DROP VIEW performance_daily_local",
         "DROP VIEW forecast_skill_local",
@@ -67,6 +67,7 @@ class StoreMigrationTest : public testing::TempDirTest {
         "DROP TABLE local_day",
         "DROP VIEW forecast_latest",
         "DROP VIEW forecast_skill",
+        "ALTER TABLE forecast DROP COLUMN basis",  // version 10
         "ALTER TABLE forecast DROP COLUMN p_el_w_p50",
         "ALTER TABLE forecast DROP COLUMN q_th_w_p50",
         "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",

@@ -5,23 +5,55 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <mutex>
 #include <set>
 
 #include "config/plant_config.h"
 
 namespace pvtwin {
 
+namespace {
+
+// The C library knows one zone per process (TZ). Every function here that
+// reads local time names the zone it needs and holds this lock while TZ is
+// that zone, so a weather file read on a worker thread (its naive times in
+// "GMT") can never move the daemon's schedule or its local days to another
+// zone, and no two threads set and read TZ at once.
+std::mutex& ZoneMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+std::string& ScheduleZone() {  // UseTimeZone's zone; "" = the ambient TZ
+  static std::string zone;
+  return zone;
+}
+
+// With the lock held: makes TZ `iana` ("" leaves it as it is).
+void SwitchZoneLocked(const std::string& iana) {
+  if (iana.empty()) return;
+  const char* current = std::getenv("TZ");
+  if (current != nullptr && iana == current) return;
+  ::setenv("TZ", iana.c_str(), 1);
+  ::tzset();
+}
+
+}  // namespace
+
 bool UseTimeZone(const std::string& iana, std::string* error) {
   if (!TimeZoneExists(iana)) {
     *error = "timezone = \"" + iana + "\": not a zone of the tz database (e.g. \"Europe/Vienna\")";
     return false;
   }
-  ::setenv("TZ", iana.c_str(), 1);
-  ::tzset();
+  const std::lock_guard lock(ZoneMutex());
+  ScheduleZone() = iana;
+  SwitchZoneLocked(iana);
   return true;
 }
 
 std::int64_t NextLocalTime(std::int64_t now_s, int hour, int minute) {
+  const std::lock_guard lock(ZoneMutex());
+  SwitchZoneLocked(ScheduleZone());
   const int target = hour * 60 + minute;
   auto local = [](std::int64_t t, int* minute_of_day, int* day_of_year) {
     const std::time_t tt = static_cast<std::time_t>(t);
@@ -131,10 +163,12 @@ bool LocalDaysOverlapping(const std::string& iana, std::int64_t from_s, std::int
                           std::vector<LocalDay>* days, std::string* error) {
   days->clear();
   const bool utc = iana == "UTC";
-  if (!utc) {
-    const char* current = std::getenv("TZ");
-    if ((current == nullptr || iana != current) && !UseTimeZone(iana, error)) return false;
+  if (!utc && !TimeZoneExists(iana)) {
+    *error = "timezone = \"" + iana + "\": not a zone of the tz database (e.g. \"Europe/Vienna\")";
+    return false;
   }
+  const std::lock_guard lock(ZoneMutex());
+  if (!utc) SwitchZoneLocked(iana);
   if (to_s <= from_s) return true;
   const std::int64_t last = DayNumberAt(to_s - 1, utc);
   std::int64_t start = DayStart(DayNumberAt(from_s, utc), utc);
@@ -154,8 +188,7 @@ std::optional<NaiveTimeZone> NaiveTimeZone::Parse(const std::string& text, std::
     zone.fixed_offset_s_ = offset;
     return zone;
   }
-  std::string why;
-  if (!UseTimeZone(text, &why)) {
+  if (!TimeZoneExists(text)) {
     *error = "\"" + text +
              "\": expected a zone of the tz database (e.g. \"Europe/Vienna\", daylight saving "
              "time included) or a fixed offset from UTC (e.g. \"+01:00\")";
@@ -172,6 +205,8 @@ int NaiveTimeZone::Resolve(std::int64_t wall_s, std::int64_t utc_s[2]) const {
   // The offsets in force a day either side hold every offset that can apply
   // at wall_s (zones change their offset at most once a day); each gives a
   // candidate instant, which counts if the zone has that offset then.
+  const std::lock_guard lock(ZoneMutex());
+  SwitchZoneLocked(name_);
   const std::set<int> offsets = {OffsetAt(wall_s - 86400), OffsetAt(wall_s),
                                  OffsetAt(wall_s + 86400)};
   int n = 0;

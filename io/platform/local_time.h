@@ -13,8 +13,9 @@
 
 namespace pvtwin {
 
-// Makes `iana` the zone of localtime_r for this process. False (and *error)
-// when the zone does not exist.
+// Makes `iana` the zone of NextLocalTime (the daemon's schedule) and of
+// localtime_r for this process. False (and *error) when the zone does not
+// exist.
 bool UseTimeZone(const std::string& iana, std::string* error);
 
 // The first whole minute strictly after now_s at which the local clock reads
@@ -43,9 +44,11 @@ bool LocalDaysOverlapping(const std::string& iana, std::int64_t from_s, std::int
 
 // The zone of naive time stamps: "2024-06-01 12:00" written by a logger that
 // keeps local time and says nothing about it. Either a zone of the tz
-// database (daylight saving time included; Parse makes it the process's TZ,
-// as UseTimeZone) or a fixed offset from UTC, "+01:00", "-05:30", "UTC+1"
-// (for a logger that keeps standard time all year).
+// database (daylight saving time included; Resolve uses it without changing
+// the zone of NextLocalTime) or a fixed offset from UTC, "+01:00", "-05:30",
+// "UTC+1" (for a logger that keeps standard time all year). Safe to use on
+// any thread: every local-time function here holds one lock while it sets
+// and reads the process's TZ.
 class NaiveTimeZone {
  public:
   // nullopt and *error (naming the accepted forms) when text is neither.

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <ctime>
+#include <optional>
+#include <vector>
 
 #include "config/plant_config.h"
 
@@ -57,6 +59,28 @@ TEST_F(LocalTime, FallBackRunsOnlyAtTheFirstOccurrence) {
 
 TEST_F(LocalTime, Midnight) {
   EXPECT_EQ(NextLocalTime(Utc(2024, 6, 1, 12), 0, 0), Utc(2024, 6, 1, 22));
+}
+
+// A weather file's naive times in another zone (Open-Meteo with
+// timezone=GMT, read on the daemon's weather thread) must not move the
+// schedule: the nightly run stays at 02:00 in Vienna.
+TEST_F(LocalTime, ANaiveZoneReadElsewhereLeavesTheScheduleZone) {
+  std::string error;
+  const std::optional<NaiveTimeZone> gmt = NaiveTimeZone::Parse("America/New_York", &error);
+  ASSERT_TRUE(gmt.has_value()) << error;
+  std::int64_t utc[2] = {0, 0};
+  ASSERT_EQ(gmt->Resolve(Utc(2024, 1, 10, 12), utc), 1);  // 12:00 in New York: 17:00 UTC
+  EXPECT_EQ(utc[0], Utc(2024, 1, 10, 17));
+  EXPECT_EQ(NextLocalTime(Utc(2024, 1, 10, 12), 2, 0), Utc(2024, 1, 11, 1));
+  std::vector<LocalDay> days;
+  ASSERT_TRUE(LocalDaysOverlapping("Asia/Tokyo", Utc(2024, 1, 10, 0), Utc(2024, 1, 10, 1), &days,
+                                   &error))
+      << error;
+  ASSERT_EQ(days.size(), 1u);
+  EXPECT_EQ(days[0].start_s, Utc(2024, 1, 9, 15));  // Tokyo's midnight, UTC+9
+  EXPECT_EQ(NextLocalTime(Utc(2024, 6, 1, 12), 2, 0), Utc(2024, 6, 2, 0));
+  ASSERT_EQ(gmt->Resolve(Utc(2024, 6, 10, 12), utc), 1);  // daylight saving time: UTC-4
+  EXPECT_EQ(utc[0], Utc(2024, 6, 10, 16));
 }
 
 TEST(TimeZone, UnknownZonesAreRejected) {

@@ -94,7 +94,7 @@ struct LogConfig {
 // [monitor]: what the daemon checks day by day (core/monitoring.h).
 struct MonitorConfig {
   int drift_days = 28;  // [2, 365]: accepted calibrations of this many days for the drift check
-  int alarm_days = 3;   // [1, 60]: days below the performance band in a row before an alarm
+  int alarm_days = 3;   // [1, 60]: fewest scored days of a CUSUM alarm (core/monitor/index_band.h)
   // The collector's datasheet (ISO 9806) for the nightly power check
   // (core/monitoring.h); datasheet_eta0 = 0 (default): no check.
   double datasheet_eta0 = 0.0;             // [0, 1]

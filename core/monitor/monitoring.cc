@@ -46,14 +46,16 @@ bool ScoreDay(const Series& minutes, std::int64_t day_start_s, const Plant& plan
     Simulate(drivers, params, &sim);
     const Measurements meas = MakeMeasurements(day, drivers);
     const double h = day.step_s / 3600.0;  // hours per row
+    double valid_s = 0.0;                  // rows of 2-, 10- or 15-min data count their minutes
     for (const std::uint32_t i : meas.rows) {
       if (!std::isfinite(sim.p_el_w[i]) || !std::isfinite(sim.q_th_w[i])) continue;
-      ++p.valid_minutes;
+      valid_s += day.step_s;
       p.e_el_meas_wh += meas.p_el_w[i] * h;
       p.e_el_model_wh += sim.p_el_w[i] * h;
       p.e_th_meas_wh += meas.q_th_w[i] * h;
       p.e_th_model_wh += sim.q_th_w[i] * h;
     }
+    p.valid_minutes = static_cast<int>(std::floor(valid_s / 60.0 + 1e-9));
   }
   const bool enough = p.valid_minutes >= options.min_valid_minutes;
   p.scored_el = enough && p.e_el_model_wh >= options.min_el_wh_m2 * plant.area_m2;

@@ -84,6 +84,30 @@ TEST(Performance, ADayWithTooFewMinutesIsMarkedNotScored) {
   EXPECT_GT(p.e_el_meas_wh, 0.0);  // the energies are still there
 }
 
+// A 2-min logger's rows (measurement_interval) count the minutes they cover:
+// three hours are 180 minutes, enough to score, not 90.
+TEST(Performance, RowsOfACoarserLoggerCountTheMinutesTheyCover) {
+  const Plant plant = DesignExamplePlant();
+  WeatherOptions weather;
+  weather.start_time_s = kJune1;
+  weather.num_days = 1;
+  weather.step_s = 120.0;
+  weather.seed = 7;
+  weather.day_types = {DayType::kClear};
+  const Series s = MakeSyntheticPlantData(plant, weather, testing::SpecOf("2N1Ccolwr"),
+                                          ReferenceTruthParams(plant), RealisticSensorNoise(3))
+                       .Between(kJune1 + 9 * 3600, kJune1 + 12 * 3600);
+  ASSERT_EQ(s.size(), 90u);
+  DayPerformance p;
+  std::string error;
+  ASSERT_TRUE(ScoreDay(s, kJune1, plant, testing::SpecOf("2N1Ccolwr"), ReferenceTruthParams(plant),
+                       PerformanceOptions{}, &p, &error))
+      << error;
+  EXPECT_EQ(p.valid_minutes, 180);
+  EXPECT_TRUE(p.scored_el);
+  EXPECT_NEAR(p.pi_el, 1.0, 0.01);
+}
+
 TEST(Drift, OneDirectionBeyondTwiceTheCombinedErrorIsADrift) {
   const ParameterPoint rising[] = {{0, 10.0, 0.2}, {86400, 10.4, 0.2}, {2 * 86400, 10.9, 0.2}};
   const std::optional<ParameterDrift> d = DetectDrift(rising);

@@ -132,7 +132,7 @@ TEST(SensorFaults, FoundWherePlanted) {
   const Plant plant = DesignExamplePlant();
   Series s = ClearDays(plant, 1);
   s.Ensure(Channel::kLwDownWM2);
-  auto row = [&s](int hour, int minute) {
+  auto row = [](int hour, int minute) {
     return static_cast<std::size_t>((hour * 3600 + minute * 60) / 60);
   };
   // t_amb frozen 02:00–03:30 (90 min), p_el missing 09:00–09:20, a heat

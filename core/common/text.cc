@@ -1,5 +1,6 @@
 #include "core/common/text.h"
 
+#include <cstdio>
 #include <sstream>
 
 namespace pvtwin {
@@ -10,6 +11,12 @@ std::string FixedDecimals(double x, int digits) {
   s.precision(digits);
   s << x;
   return s.str();
+}
+
+std::string SignificantDigits(double x, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+  return buf;
 }
 
 }  // namespace pvtwin

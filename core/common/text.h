@@ -9,4 +9,7 @@ namespace pvtwin {
 // x with `digits` decimals ("12.35").
 std::string FixedDecimals(double x, int digits);
 
+// x with `digits` significant digits, as printf's %g ("0.225", "1e+03").
+std::string SignificantDigits(double x, int digits);
+
 }  // namespace pvtwin

@@ -4,21 +4,16 @@
 // fit counts. See IdentifyInRanges (stages.h).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "core/common/physical_ranges.h"
+#include "core/common/text.h"
 #include "core/diagnosis/stages.h"
 
 namespace pvtwin {
 
 namespace {
 
-// x with three significant digits ("0.225", "1e+03").
-std::string Significant(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
+std::string Significant(double x) { return SignificantDigits(x, 3); }
 
 }  // namespace
 

@@ -1,7 +1,6 @@
 #include "daemon/service/weather_import.h"
 
-#include <cstdio>
-
+#include "core/common/text.h"
 #include "core/forecast/weather_resample.h"
 #include "io/platform/time_format.h"
 
@@ -9,11 +8,7 @@ namespace pvtwin::cli {
 
 namespace {
 
-std::string Rounded(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
+std::string Rounded(double x) { return SignificantDigits(x, 3); }
 
 // The rows of `rows` whose flag is `flagged` (no flags: all are unflagged).
 Series RowsFlagged(const Series& rows, const std::vector<std::uint8_t>& flags, bool flagged) {

@@ -23,11 +23,11 @@ namespace {
 constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
 constexpr std::int64_t kDayS = 86400;
 
-Series ClearDays(const Plant& plant, int days) {
+Series ClearDays(const Plant& plant, int days, double step_s = 60.0) {
   WeatherOptions weather;
   weather.start_time_s = kJune1;
   weather.num_days = days;
-  weather.step_s = 60.0;
+  weather.step_s = step_s;
   weather.seed = 7;
   weather.day_types = {DayType::kClear};
   return MakeSyntheticPlantData(plant, weather, testing::SpecOf("2N1Ccolwr"),
@@ -88,15 +88,7 @@ TEST(Performance, ADayWithTooFewMinutesIsMarkedNotScored) {
 // three hours are 180 minutes, enough to score, not 90.
 TEST(Performance, RowsOfACoarserLoggerCountTheMinutesTheyCover) {
   const Plant plant = DesignExamplePlant();
-  WeatherOptions weather;
-  weather.start_time_s = kJune1;
-  weather.num_days = 1;
-  weather.step_s = 120.0;
-  weather.seed = 7;
-  weather.day_types = {DayType::kClear};
-  const Series s = MakeSyntheticPlantData(plant, weather, testing::SpecOf("2N1Ccolwr"),
-                                          ReferenceTruthParams(plant), RealisticSensorNoise(3))
-                       .Between(kJune1 + 9 * 3600, kJune1 + 12 * 3600);
+  const Series s = ClearDays(plant, 1, 120.0).Between(kJune1 + 9 * 3600, kJune1 + 12 * 3600);
   ASSERT_EQ(s.size(), 90u);
   DayPerformance p;
   std::string error;

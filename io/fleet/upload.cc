@@ -18,7 +18,7 @@
 #include <map>
 #include <set>
 
-#include "core/forecast/forecast.h"
+#include "io/fleet/central_views.h"
 
 namespace pvtwin {
 
@@ -26,15 +26,15 @@ const std::vector<UploadTable>& UploadTables() {
   // Tables of the store (io/store/store.h and doc/contracts.md "Operation contracts");
   // those the local store does not have are left out.
   static const std::vector<UploadTable> tables = {
-      {"measurement_1min", {"ts"}, {"ts"}, {}, {}},
-      {"calibration", {"id"}, {"id"}, {}, {}},
-      {"calibration_param", {"calibration_id", "name"}, {"calibration_id", "name"}, {}, {}},
-      {"diagnosis", {"id"}, {"id"}, {}, {}},
-      {"performance_daily", {"day"}, {"day"}, {}, {}},
-      {"qc_event", {"id"}, {"id"}, {}, {}},
-      {"monitor_event", {"id"}, {"id"}, {}, {}},
-      {"measurement_interval", {"ts"}, {"ts"}, {}, {}},
-      {"forecast", {"ts", "issued_at"}, {"ts"}, "issued_at", "ts"},
+      {"measurement_1min", {"ts"}, {"ts"}, {}, {}, {}},
+      {"calibration", {"id"}, {"id"}, {}, {}, {}},
+      {"calibration_param", {"calibration_id", "name"}, {"calibration_id", "name"}, {}, {}, {}},
+      {"diagnosis", {"id"}, {"id"}, {}, {}, {}},
+      {"performance_daily", {"day"}, {"day"}, {}, {}, {}},
+      {"qc_event", {"id"}, {"id"}, {}, {}, {}},
+      {"monitor_event", {"id"}, {"id"}, {}, {}, {}},
+      {"measurement_interval", {"ts"}, {"ts"}, {}, {}, {}},
+      {"forecast", {"ts", "issued_at"}, {"ts"}, "issued_at", "ts", "forecast_day_ahead"},
   };
   return tables;
 }
@@ -251,6 +251,15 @@ void AppendCell(sqlite3_stmt* stmt, int i, PgType type, std::string* out) {
 
 std::int64_t NowS() { return static_cast<std::int64_t>(std::time(nullptr)); }
 
+// 00:00 UTC of the UTC day of a unix-seconds expression, in SQLite's and in
+// PostgreSQL's SQL (the store's forecast_skill rule, negative times too).
+std::string SqliteDayStart(const std::string& ts) {
+  return "(" + ts + " - ((" + ts + " % 86400) + 86400) % 86400)";
+}
+std::string PgDayStart(const std::string& ts) {
+  return "(" + ts + " - mod(mod(" + ts + ", 86400) + 86400, 86400))";
+}
+
 }  // namespace
 
 struct Uploader::Impl {
@@ -277,15 +286,14 @@ struct Uploader::Impl {
   bool BindStore(PgError* error);
   bool MigrateCentral(PgError* error);
   std::string CentralTableDdl(const Table& t) const;
-  std::string PlantLatestDdl(bool has_qc_event) const;
-  static std::string EventDdl(const std::set<std::string>& present);
-  static std::string ForecastSkillDdl(const std::set<std::string>& present,
-                                      const std::set<std::string>& forecast_columns);
+  std::string DayAheadTableDdl(const UploadTable& spec, bool exists) const;
   bool UploadBatch(const Table& t, std::int64_t* settled, bool* full, PgError* error);
   bool ReadBatch(const Table& t, std::int64_t hwm, std::string* copy, std::int64_t* rows_sent,
                  std::int64_t* max_seq, std::int64_t* settled, std::int64_t* keep_from,
                  std::string* error);
   bool SendBatch(const Table& t, const std::string& copy, std::int64_t keep_from, PgError* error);
+  static std::string DayAheadUpsert(const Table& t, const std::string& cols,
+                                    const std::string& updates);
 };
 
 namespace {
@@ -381,46 +389,68 @@ bool Uploader::Impl::ForgetUploads(std::string* error) {
 }
 
 // Triggers that queue every inserted or updated row of the table, and the
-// rows already there (once, when the triggers are new).
+// rows already there (once, when the triggers are new). Triggers of an
+// older pvtwin (another text) are replaced, and the rows queued again.
 bool Uploader::Impl::InstallTable(const UploadTable& spec, std::string* error) {
   const std::string name(spec.name);
   const std::string trigger = "upload_queue_" + name;
-  bool installed = false;
-  if (!local.Query(
-          "SELECT 1 FROM sqlite_schema WHERE type = 'trigger' AND name = ?", {},
-          [&](sqlite3_stmt*) { installed = true; }, error, trigger + "_insert")) {
-    return false;
-  }
-  if (installed) return true;
   const std::string k1 = std::string(spec.local_key[0]);
   const std::string k2 = spec.local_key.size() > 1 ? std::string(spec.local_key[1]) : "";
   assert(spec.newest_column.empty() ||
          (spec.local_key.size() == 2 && spec.central_key.size() == 1 &&
           spec.central_key[0] == spec.local_key[0] && spec.local_key[1] == spec.newest_column));
+  assert(spec.day_ahead_table.empty() ||
+         (!spec.newest_column.empty() && spec.keep_column == spec.local_key[0]));
   const std::string new_k2 = k2.empty() ? "''" : "NEW." + k2;
   // The key's old entry goes; with newest_column (local key = central key,
   // newest_column) so do the entries of older rows of the same central key:
   // the queue keeps one entry per central row however often it is re-issued.
-  const std::string same = spec.newest_column.empty() ? " = " : " <= ";
+  // With day_ahead_table it keeps two: an older day-ahead row's entry stays
+  // when the new row is no day-ahead row.
+  std::string same = spec.newest_column.empty() ? " = " + new_k2 : " <= " + new_k2;
+  if (!spec.day_ahead_table.empty()) {
+    const std::string day = SqliteDayStart("NEW." + k1);
+    same += " AND (k2 > " + day + " OR " + new_k2 + " <= " + day + ")";
+  }
   const std::string body = " ON " + name + " BEGIN DELETE FROM upload_queue WHERE table_name = '" +
-                           name + "' AND k1 = NEW." + k1 + " AND k2" + same + new_k2 +
+                           name + "' AND k1 = NEW." + k1 + " AND k2" + same +
                            "; INSERT INTO upload_queue(table_name, k1, k2) VALUES('" + name +
                            "', NEW." + k1 + ", " + new_k2 + "); END";
+  const std::string insert_sql = "CREATE TRIGGER " + trigger + "_insert AFTER INSERT" + body;
+  std::string installed;
+  if (!local.Query(
+          "SELECT sql FROM sqlite_schema WHERE type = 'trigger' AND name = ?", {},
+          [&](sqlite3_stmt* stmt) { installed = ColumnText(stmt, 0); }, error,
+          trigger + "_insert")) {
+    return false;
+  }
+  if (installed == insert_sql) return true;
   // The rows already stored; of a table with newest_column only the newest
-  // row per central key (the others would be replaced centrally anyway).
+  // row per central key (the others would be replaced centrally anyway),
+  // and the newest day-ahead row, within the rows kept centrally.
   std::string backfill = "INSERT OR IGNORE INTO upload_queue(table_name, k1, k2) SELECT '" + name +
                          "', " + k1 + ", " + (k2.empty() ? "''" : k2) + " FROM " + name;
   if (!spec.newest_column.empty()) {
     const std::string newest(spec.newest_column);
+    const std::string keep(spec.keep_column);
     std::string same_key;
     for (const std::string_view c : spec.central_key) {
       same_key += " AND g." + std::string(c) + " = " + name + "." + std::string(c);
     }
-    backfill += " WHERE " + newest + " = (SELECT MAX(g." + newest + ") FROM " + name + " g WHERE " +
-                same_key.substr(5) + ")";
+    const std::string newest_of_key =
+        "(SELECT MAX(g." + newest + ") FROM " + name + " g WHERE " + same_key.substr(5);
+    backfill += " WHERE (" + newest + " = " + newest_of_key + ")";
+    if (!spec.day_ahead_table.empty()) {
+      backfill += " OR " + newest + " = " + newest_of_key + " AND g." + newest +
+                  " <= " + SqliteDayStart(name + "." + keep) + ")";
+    }
+    backfill += ") AND " + keep + " >= (SELECT MAX(" + newest + ") FROM " + name + ") - " +
+                std::to_string(static_cast<std::int64_t>(settings.forecast_days) * 86400);
   }
   backfill += " ORDER BY " + Join(spec.local_key);
-  return local.Exec("CREATE TRIGGER " + trigger + "_insert AFTER INSERT" + body, error) &&
+  return local.Exec("DROP TRIGGER IF EXISTS " + trigger + "_insert", error) &&
+         local.Exec("DROP TRIGGER IF EXISTS " + trigger + "_update", error) &&
+         local.Exec(insert_sql, error) &&
          local.Exec("CREATE TRIGGER " + trigger + "_update AFTER UPDATE" + body, error) &&
          local.Exec(backfill, error) &&
          local.Exec("INSERT OR IGNORE INTO upload_state(table_name) VALUES('" + name + "')", error);
@@ -448,116 +478,28 @@ std::string Uploader::Impl::CentralTableDdl(const Table& t) const {
   return sql;
 }
 
-std::string Uploader::Impl::PlantLatestDdl(bool has_qc_event) const {
-  const std::string alarms =
-      has_qc_event
-          ? "(SELECT count(*) FROM qc_event e WHERE e.plant_id = p.plant_id AND e.end_ts IS NULL)"
-          : "NULL::bigint";
-  return "CREATE OR REPLACE VIEW plant_latest AS SELECT p.plant_id, p.last_upload_at, "
-         "m.ts AS measurement_ts, m.p_el_w, m.q_th_w, m.t_in_c, m.t_out_c, m.g_poa_w_m2, "
-         "m.t_amb_c, f.issued_at AS forecast_issued_at, c.id AS calibration_id, "
-         "c.run_at AS calibration_run_at, c.variant AS calibration_variant, " +
-         alarms +
-         " AS open_alarms FROM plant p "
-         "LEFT JOIN LATERAL (SELECT * FROM measurement_1min x WHERE x.plant_id = p.plant_id "
-         "ORDER BY x.ts DESC LIMIT 1) m ON true "
-         "LEFT JOIN LATERAL (SELECT max(x.issued_at) AS issued_at FROM forecast x "
-         "WHERE x.plant_id = p.plant_id) f ON true "
-         "LEFT JOIN LATERAL (SELECT * FROM calibration x WHERE x.plant_id = p.plant_id "
-         "AND x.accepted <> 0 ORDER BY x.run_at DESC, x.id DESC LIMIT 1) c ON true;";
-}
-
-// view event(plant_id, ts, kind, severity, message): the store's event view
-// (io/store/store.h) over every plant, from the tables that exist.
-std::string Uploader::Impl::EventDdl(const std::set<std::string>& present) {
-  const std::vector<std::pair<std::string, std::string>> branches = {
-      {"monitor_event", "SELECT plant_id, ts, kind, severity, message FROM monitor_event"},
-      {"qc_event",
-       "SELECT plant_id, start_ts, 'qc_' || kind, 'warning', channel || ': ' || detail "
-       "FROM qc_event"},
-      {"calibration",
-       "SELECT plant_id, run_at, 'calibration_' || status, CASE WHEN accepted = 1 THEN 'info' "
-       "ELSE 'warning' END, 'calibration ' || id || ' (' || variant || '): ' || status || "
-       "COALESCE(': ' || reason, '') FROM calibration"},
-      {"diagnosis",
-       "SELECT plant_id, run_at, 'diagnosis', CASE WHEN verdict = 'none' THEN 'info' ELSE "
-       "'warning' END, 'diagnosis of ' || base_variant || ': ' || verdict || CASE WHEN "
-       "low_confidence = 1 THEN ' (low confidence)' ELSE '' END FROM diagnosis"},
-  };
-  std::string body;
-  for (const auto& [table, select] : branches) {
-    if (present.count(table)) body += (body.empty() ? "" : " UNION ALL ") + select;
+// The day-ahead table of spec (version 5). New: made like the table, with
+// its qualifying rows (the migration from version 4); else the columns
+// this plant's table has are added.
+std::string Uploader::Impl::DayAheadTableDdl(const UploadTable& spec, bool exists) const {
+  const std::string name = QuoteIdent(std::string(spec.name));
+  const std::string day_ahead = QuoteIdent(std::string(spec.day_ahead_table));
+  if (!exists) {
+    return "CREATE TABLE " + day_ahead + " (LIKE " + name +
+           " INCLUDING DEFAULTS INCLUDING CONSTRAINTS INCLUDING INDEXES); INSERT INTO " +
+           day_ahead + " SELECT * FROM " + name + " WHERE " +
+           QuoteIdent(std::string(spec.newest_column)) +
+           " <= " + PgDayStart(QuoteIdent(std::string(spec.keep_column))) + ";";
   }
-  if (body.empty()) {
-    body = "SELECT NULL::text, NULL::bigint, NULL::text, NULL::text, NULL::text WHERE false";
+  std::string sql;
+  for (const Table& t : tables) {
+    if (t.spec != &spec) continue;
+    for (const Column& c : t.columns) {
+      sql += "ALTER TABLE " + day_ahead + " ADD COLUMN IF NOT EXISTS " + QuoteIdent(c.name) + " " +
+             PgTypeName(c.type) + ";";
+    }
   }
-  return "CREATE OR REPLACE VIEW event(plant_id, ts, kind, severity, message) AS " + body + ";";
-}
-
-// view forecast_skill(plant_id, day, ...): the store's forecast_skill
-// (io/store/store.h) over every plant, from what is kept centrally: the
-// newest issue of each ts, scored where it was issued at or before the
-// start of the ts's UTC day (a day-ahead forecast, as the store scores).
-// Columns a plant's store does not have yet are NULL.
-std::string Uploader::Impl::ForecastSkillDdl(const std::set<std::string>& present,
-                                             const std::set<std::string>& forecast_columns) {
-  const std::string head =
-      "CREATE OR REPLACE VIEW forecast_skill(plant_id, day, mae_p_el_w, mae_q_th_w, nmae_p_el, "
-      "nmae_q_th, skill_p_el, skill_q_th, coverage_p10_p90, minutes, coverage_p_el, "
-      "coverage_q_th) AS ";
-  if (!present.count("forecast") || !present.count("measurement_1min")) {
-    return head +
-           "SELECT NULL::text, NULL::bigint, NULL::double precision, NULL::double precision, "
-           "NULL::double precision, NULL::double precision, NULL::double precision, NULL::double "
-           "precision, NULL::double precision, NULL::bigint, NULL::double precision, NULL::double "
-           "precision WHERE false;";
-  }
-  const auto f = [&forecast_columns](const std::string& column) {
-    return forecast_columns.count(column) ? "f." + column : std::string("NULL::double precision");
-  };
-  const std::string enough =
-      " CASE WHEN count(*) >= " + std::to_string(kMinScoredMinutes) + " THEN";
-  return head +
-         "WITH pairs AS (SELECT m.plant_id, m.ts - mod(mod(m.ts, 86400) + 86400, 86400) AS day,"
-         " f.p_el_w - m.p_el_w AS err_p,"
-         " CASE WHEN f.p_el_w IS NOT NULL THEN m.p_el_w END AS meas_p,"
-         " f.q_th_w - m.q_th_w AS err_q,"
-         " CASE WHEN f.q_th_w IS NOT NULL THEN m.q_th_w END AS meas_q,"
-         " CASE WHEN f.p_el_w IS NOT NULL THEN " +
-         f("p_el_w_ref") +
-         " - m.p_el_w END AS ref_p,"
-         " CASE WHEN f.q_th_w IS NOT NULL THEN " +
-         f("q_th_w_ref") +
-         " - m.q_th_w END AS ref_q,"
-         " CASE WHEN " +
-         f("p_el_w_p90") + " > " + f("p_el_w_p10") +
-         " AND m.p_el_w IS NOT NULL THEN (m.p_el_w BETWEEN " + f("p_el_w_p10") + " AND " +
-         f("p_el_w_p90") +
-         ")::int END AS in_p,"
-         " CASE WHEN " +
-         f("q_th_w_p90") + " > " + f("q_th_w_p10") +
-         " AND m.q_th_w IS NOT NULL THEN (m.q_th_w BETWEEN " + f("q_th_w_p10") + " AND " +
-         f("q_th_w_p90") +
-         ")::int END AS in_q"
-         " FROM measurement_1min m JOIN forecast f ON f.plant_id = m.plant_id AND f.ts = m.ts"
-         " AND f.issued_at <= m.ts - mod(mod(m.ts, 86400) + 86400, 86400)"
-         " WHERE m.valid IS NULL OR m.valid <> 0)"
-         " SELECT plant_id, day, avg(abs(err_p)), avg(abs(err_q)),"
-         " avg(abs(err_p)) / nullif(avg(abs(CASE WHEN err_p IS NOT NULL THEN meas_p END)), 0),"
-         " avg(abs(err_q)) / nullif(avg(abs(CASE WHEN err_q IS NOT NULL THEN meas_q END)), 0)," +
-         enough +
-         " 1.0 - sum(CASE WHEN ref_p IS NOT NULL THEN abs(err_p) END) /"
-         " nullif(sum(CASE WHEN err_p IS NOT NULL THEN abs(ref_p) END), 0) END," +
-         enough +
-         " 1.0 - sum(CASE WHEN ref_q IS NOT NULL THEN abs(err_q) END) /"
-         " nullif(sum(CASE WHEN err_q IS NOT NULL THEN abs(ref_q) END), 0) END," +
-         enough +
-         " (coalesce(sum(in_p), 0) + coalesce(sum(in_q), 0))::double precision /"
-         " nullif(count(in_p) + count(in_q), 0) END,"
-         " count(*)," +
-         enough + " sum(in_p)::double precision / nullif(count(in_p), 0) END," + enough +
-         " sum(in_q)::double precision / nullif(count(in_q), 0) END"
-         " FROM pairs GROUP BY plant_id, day;";
+  return sql;
 }
 
 // True when the schema version, every table and column and the view exist
@@ -578,15 +520,25 @@ bool Uploader::Impl::CentralSchemaComplete(bool* complete, PgError* error) {
       std::find(plant->second.begin(), plant->second.end(), "store_id") != plant->second.end() &&
       central.count("plant_latest") && central.count("event") && central.count("forecast_skill");
   for (const Table& t : tables) {
-    const auto it = central.find(std::string(t.spec->name));
-    if (it == central.end()) {
-      *complete = false;
-      continue;
-    }
-    for (const Column& c : t.columns) {
-      if (std::find(it->second.begin(), it->second.end(), c.name) == it->second.end()) {
+    for (const std::string_view name : {t.spec->name, t.spec->day_ahead_table}) {
+      if (name.empty()) continue;
+      const auto it = central.find(std::string(name));
+      if (it == central.end()) {
         *complete = false;
+        continue;
       }
+      for (const Column& c : t.columns) {
+        if (std::find(it->second.begin(), it->second.end(), c.name) == it->second.end()) {
+          *complete = false;
+        }
+      }
+    }
+  }
+  // Another plant's table without its day-ahead table (version 4).
+  for (const UploadTable& spec : UploadTables()) {
+    if (!spec.day_ahead_table.empty() && central.count(std::string(spec.name)) &&
+        !central.count(std::string(spec.day_ahead_table))) {
+      *complete = false;
     }
   }
   if (central.count("pvtwin_schema")) {
@@ -731,6 +683,14 @@ bool Uploader::Impl::MigrateCentral(PgError* error) {
     sql += CentralTableDdl(t);
     present.insert(std::string(t.spec->name));
   }
+  // Version 5: the day-ahead tables, of this plant's tables and of those
+  // other plants brought.
+  for (const UploadTable& spec : UploadTables()) {
+    const std::string day_ahead(spec.day_ahead_table);
+    if (day_ahead.empty() || !present.count(std::string(spec.name))) continue;
+    sql += DayAheadTableDdl(spec, present.count(day_ahead) > 0);
+    present.insert(day_ahead);
+  }
   sql +=
       "CREATE TABLE IF NOT EXISTS plant(plant_id text PRIMARY KEY, "
       "first_upload_at bigint, last_upload_at bigint);"
@@ -772,8 +732,15 @@ bool Uploader::Impl::ReadBatch(const Table& t, std::int64_t hwm, std::string* co
     for (const std::string_view c : spec.central_key) {
       same_key += " AND g." + std::string(c) + " = t." + std::string(c);
     }
-    on += " AND t." + newest + " = (SELECT max(g." + newest + ") FROM " + name + " g WHERE " +
-          same_key.substr(5) + ") AND t." + std::string(spec.keep_column) + " >= ?";
+    // The newest row of its central key, or its newest day-ahead row.
+    const std::string newest_of_key =
+        "(SELECT max(g." + newest + ") FROM " + name + " g WHERE " + same_key.substr(5);
+    on += " AND (t." + newest + " = " + newest_of_key + ")";
+    if (!spec.day_ahead_table.empty()) {
+      on += " OR t." + newest + " = " + newest_of_key + " AND g." + newest +
+            " <= " + SqliteDayStart("t." + std::string(spec.keep_column)) + ")";
+    }
+    on += ") AND t." + std::string(spec.keep_column) + " >= ?";
     params.push_back(*keep_from);
   }
   std::string columns;
@@ -804,6 +771,22 @@ bool Uploader::Impl::ReadBatch(const Table& t, std::int64_t hwm, std::string* co
         copy->push_back('\n');
       },
       error, name);
+}
+
+// The staged rows that are day-ahead rows (newest_column at or before
+// 00:00 UTC of keep_column's day), the newest per central key, into
+// day_ahead_table; a row there is replaced only by one at least as new.
+std::string Uploader::Impl::DayAheadUpsert(const Table& t, const std::string& cols,
+                                           const std::string& updates) {
+  const UploadTable& spec = *t.spec;
+  const std::string table = QuoteIdent(std::string(spec.day_ahead_table));
+  const std::string newest = QuoteIdent(std::string(spec.newest_column));
+  const std::string central_key = Join(spec.central_key);
+  return "INSERT INTO " + table + "(" + cols + ") SELECT DISTINCT ON (" + central_key + ") " +
+         cols + " FROM pvtwin_stage WHERE " + newest +
+         " <= " + PgDayStart(QuoteIdent(std::string(spec.keep_column))) + " ORDER BY " +
+         central_key + ", " + newest + " DESC ON CONFLICT (plant_id, " + central_key +
+         ") DO UPDATE SET " + updates + " WHERE " + table + "." + newest + " <= EXCLUDED." + newest;
 }
 
 bool Uploader::Impl::SendBatch(const Table& t, const std::string& copy, std::int64_t keep_from,
@@ -838,14 +821,20 @@ bool Uploader::Impl::SendBatch(const Table& t, const std::string& copy, std::int
       pg->Exec("BEGIN; CREATE TEMP TABLE pvtwin_stage (LIKE " + name + ") ON COMMIT DROP", error) &&
       pg->CopyIn("COPY pvtwin_stage(" + cols + ") FROM STDIN", copy, error) &&
       pg->Exec(insert, error) &&
+      (spec.day_ahead_table.empty() || pg->Exec(DayAheadUpsert(t, cols, updates), error)) &&
       pg->Query(
           "UPDATE plant SET last_upload_at = extract(epoch FROM now())::bigint "
           "WHERE plant_id = $1",
           plant, nullptr, error);
   if (ok && !spec.keep_column.empty()) {
-    ok = pg->Query("DELETE FROM " + name + " WHERE plant_id = $1 AND " +
-                       QuoteIdent(std::string(spec.keep_column)) + " < $2",
-                   {settings.plant_id, std::to_string(keep_from)}, nullptr, error);
+    // The day-ahead table is pruned by the same rule.
+    for (const std::string_view table : {spec.name, spec.day_ahead_table}) {
+      if (table.empty()) continue;
+      ok = ok &&
+           pg->Query("DELETE FROM " + QuoteIdent(std::string(table)) + " WHERE plant_id = $1 AND " +
+                         QuoteIdent(std::string(spec.keep_column)) + " < $2",
+                     {settings.plant_id, std::to_string(keep_from)}, nullptr, error);
+    }
   }
   ok = ok && pg->Exec("COMMIT", error);
   if (!ok) {

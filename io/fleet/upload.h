@@ -42,6 +42,15 @@
 //       forecast is keyed (plant_id, ts): only the newest issue of each ts
 //       is kept, and rows older than [upload] forecast_days before the
 //       plant's newest issue are deleted.
+//   forecast_day_ahead (version 5): the columns and key of forecast,
+//       holding per ts the newest issue made at or before 00:00 UTC of ts's
+//       UTC day (the day-ahead issue the store's forecast_skill scores).
+//       Every batch of forecast rows upserts its qualifying rows there too,
+//       replacing a row only by one at least as new, so that the order of
+//       arrival does not matter; pruned as forecast is. The local queue keeps,
+//       per ts, the entry of the newest qualifying issue besides the newest
+//       one, so that an hourly re-issue does not drop the day-ahead row
+//       before it was sent. Made from forecast's rows when it is created.
 //   view plant_latest(plant_id, last_upload_at, measurement_ts, p_el_w,
 //       q_th_w, t_in_c, t_out_c, g_poa_w_m2, t_amb_c, forecast_issued_at,
 //       calibration_id, calibration_run_at, calibration_variant,
@@ -54,12 +63,9 @@
 //   view forecast_skill(plant_id, day, mae_p_el_w, mae_q_th_w, nmae_p_el,
 //       nmae_q_th, skill_p_el, skill_q_th, coverage_p10_p90, minutes,
 //       coverage_p_el, coverage_q_th) (version 4): the store's forecast_skill
-//       per plant and UTC day, with the same columns and rules, over the
-//       rows kept centrally: since forecast keeps only the newest issue of
-//       each ts, a minute is scored only where that issue was made at or
-//       before 00:00 UTC of its day (a plant that re-issues during the day
-//       has fewer scored minutes centrally than in its store; the store's
-//       view is the reference).
+//       per plant and UTC day, with the same columns and rules; from
+//       version 5 on over forecast_day_ahead, so that it equals the store's
+//       for the days whose forecasts are kept centrally.
 // A session advisory lock per plant_id lets one uploader at a time send a
 // plant's rows (a second one, or two plants configured with one plant_id,
 // is refused with a message).
@@ -84,7 +90,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kCentralSchemaVersion = 4;
+inline constexpr int kCentralSchemaVersion = 5;
 
 // One uploaded table. Adding a table of the store to the fleet is one entry
 // of UploadTables().
@@ -100,6 +106,11 @@ struct UploadTable {
   // per central row.
   std::string_view newest_column;
   std::string_view keep_column;
+  // When set (with newest_column): a second central table of the same
+  // columns and key that keeps, per central key, the newest row whose
+  // newest_column is at or before 00:00 UTC of keep_column's UTC day (a
+  // day-ahead forecast), which the table itself loses to later issues.
+  std::string_view day_ahead_table;
 };
 const std::vector<UploadTable>& UploadTables();
 

@@ -119,7 +119,11 @@ RunFigures Monitor(const Series& data, const ParamVector& params, const Config& 
   return f;
 }
 
-TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeClearDays) {
+// Runs each seed's healthy and switched weeks and checks: no alarm on the
+// healthy plant, the clipping alarm within three clear days of the switch;
+// with `coverage`, the band holds 1 on 80 % of the healthy days over the
+// seeds, each output.
+void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
   const Plant plant = DesignExamplePlant();
   Config config;
   config.plant = plant;
@@ -132,7 +136,7 @@ TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeCle
     clipping_truth[static_cast<std::size_t>(param)] = value;
   }
   int banded_el = 0, hold_el = 0, banded_th = 0, hold_th = 0;
-  for (const std::uint64_t seed : Seeds()) {
+  for (const std::uint64_t seed : seeds) {
     const WeatherOptions weather = WeatherOf(seed);
     const Series healthy = MakeSyntheticPlantData(
         plant, weather, truth_spec, ReferenceTruthParams(plant), RealisticSensorNoise(seed));
@@ -176,10 +180,23 @@ TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeCle
   }
   std::printf("all seeds: the band holds 1 on %d/%d days (P_el), %d/%d (Q_u)\n", hold_el, banded_el,
               hold_th, banded_th);
+  if (!coverage) return;
   EXPECT_GE(hold_el, 0.8 * banded_el);
   EXPECT_GE(hold_th, 0.8 * banded_th);
   EXPECT_GT(banded_el, 0);
   EXPECT_GT(banded_th, 0);
+}
+
+TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeClearDays) {
+  CheckSeeds(Seeds(), true);
+}
+
+// Development seeds 43 and 54 open with 11 and 10 overcast days: the model,
+// fitted on them, is 2 % high on the clear days after (electricity), which
+// the nearest days, all overcast, judged many σ low: 5 false alarms each
+// before the regime test (index_band.h), none with it.
+TEST(PerformanceWeeks, AHistoryThatStartsOvercastRaisesNoFalseAlarmOnTheClearDaysAfter) {
+  CheckSeeds({43, 54}, false);
 }
 
 }  // namespace

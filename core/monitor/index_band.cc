@@ -30,11 +30,15 @@ ConformalQuantiles QuantilesOf(std::vector<double> errors) {
   return {errors[low_rank - 1], errors[high_rank - 1]};
 }
 
-// The errors ln pi of the reference days of `today`: of the days before it
-// in the reference window that are not suspect, the `neighbours` nearest
-// in ln expected energy (ties: the more recent).
-std::vector<double> ReferenceErrors(const std::vector<IndexDay>& before, const IndexDay& today,
-                                    const IndexBandOptions& options) {
+// The reference days of `today`: of the days before it in the reference
+// window that are not suspect, the `neighbours` nearest in ln expected
+// energy (ties: the more recent); their errors ln pi and their regimes.
+struct Reference {
+  std::vector<double> errors;      // ln pi
+  std::vector<double> log_e_model;  // ln expected energy (Wh)
+};
+Reference ReferenceOf(const std::vector<IndexDay>& before, const IndexDay& today,
+                      const IndexBandOptions& options) {
   std::vector<const IndexDay*> days;
   for (const IndexDay& d : before) {
     if (d.day_start_s >= today.day_start_s - options.reference_days * kDayS && !d.suspect) {
@@ -50,17 +54,29 @@ std::vector<double> ReferenceErrors(const std::vector<IndexDay>& before, const I
   if (days.size() > static_cast<std::size_t>(options.neighbours)) {
     days.resize(static_cast<std::size_t>(options.neighbours));
   }
-  std::vector<double> errors;
-  for (const IndexDay* d : days) errors.push_back(std::log(d->pi));
-  return errors;
+  Reference reference;
+  for (const IndexDay* d : days) {
+    reference.errors.push_back(std::log(d->pi));
+    reference.log_e_model.push_back(std::log(d->e_model_wh));
+  }
+  return reference;
 }
 
 // The band of the day and its part in the CUSUM (s, run: the state before it).
-void Follow(std::vector<double> errors, const IndexBandOptions& bands,
-            const IndexCusumOptions& cusum, double* s, int* run, IndexDay* day) {
+void Follow(Reference reference, const IndexBandOptions& bands, const IndexCusumOptions& cusum,
+            double* s, int* run, IndexDay* day) {
   day->low = day->high = kNaN;
-  if (static_cast<int>(errors.size()) < bands.min_reference_days) return;
-  const ConformalQuantiles q = QuantilesOf(std::move(errors));
+  if (static_cast<int>(reference.errors.size()) < bands.min_reference_days) return;
+  // The regime test (index_band.h): the day's ln expected energy no farther
+  // beyond its reference days' conformal range than that range is wide.
+  const ConformalQuantiles regime = QuantilesOf(std::move(reference.log_e_model));
+  const double log_e = std::log(day->e_model_wh);
+  const double width = regime.q90 - regime.q10;
+  if (!(regime.q10 - width <= log_e && log_e <= regime.q90 + width)) {
+    day->withheld = true;
+    return;
+  }
+  const ConformalQuantiles q = QuantilesOf(std::move(reference.errors));
   if (std::isnan(q.q10)) return;
   const double q10 = q.q10, q90 = q.q90;
   day->low = day->pi * std::exp(-q90);
@@ -92,7 +108,7 @@ std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool the
         !(day.e_model_wh > 0.0)) {
       continue;
     }
-    Follow(ReferenceErrors(out, day, bands), bands, cusum, &s, &run, &day);
+    Follow(ReferenceOf(out, day, bands), bands, cusum, &s, &run, &day);
     out.push_back(day);
     if (!day.banded) continue;
     // The open excursion's days (this one included) are suspect; when S is

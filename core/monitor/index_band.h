@@ -34,6 +34,22 @@
 // their quantiles by irradiance class. With fewer than min_reference_days
 // of them the day has no band (NaN), and takes no part in the alarm.
 //
+// Regime test (issue 53: a history that starts in another weather). The
+// band assumes the day's (regime, error) exchangeable with its reference
+// days'; the regime x = ln E_model is known before the error. With the
+// same conformal ranks, x_10 ≤ x_90 of the reference days' x: a day
+// outside [x_10, x_90] is ordinary (probability up to 2/(n + 1), 13 % for
+// 14 days: the clearest day of a month, on which a clipping inverter
+// shows, is one), but a day beyond it by more than its width w = x_90 −
+// x_10 is farther from every reference day than they lie from one another:
+// the references hold no evidence of the model's error in its regime (the
+// first clear day after 10 overcast ones, whose energy is 3 times theirs,
+// and the model's error on it 2 % lower). Such a day's judgement is
+// withheld: no band (NaN), no part in the CUSUM (IndexDay::withheld); it
+// stays a reference day for the days after, so the next day of its regime
+// is judged. No tuned number: the ranks are the band's, the distance the
+// reference selection's, the scale the references' own.
+//
 // Alarm: Page's one-sided CUSUM (E. S. Page, "Continuous inspection
 // schemes", Biometrika 41, 1954) of the standardised daily errors, with the
 // reference's location c = (q10 + q90)/2 and scale σ = (q90 − q10)/(2·z90),
@@ -90,6 +106,11 @@ struct IndexDay {
   double e_model_wh = 0.0;       // the output's expected energy: the day's regime
   double low = 0.0, high = 0.0;  // the band; NaN without enough reference days
   bool banded = false;           // has a band, and so a part in the CUSUM
+  // Judgement withheld: enough reference days, but the day's expected
+  // energy lies beyond their conformal range by more than its width (a
+  // regime they do not hold); no band (NaN), no part in the CUSUM, still a
+  // reference for later days.
+  bool withheld = false;
   double z = 0.0;                // standardised error of the day (σ); 0 without a band
   double s = 0.0;                // S after the day (σ); after an alarm the next starts from 0
   int run_days = 0;              // days of the excursion up to this day (0: S is 0)

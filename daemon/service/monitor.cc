@@ -101,6 +101,13 @@ void CheckPerformanceAlarm(Store& store, const DailyCheckInputs& in, std::int64_
   }
   for (const bool thermal : {false, true}) {
     for (const IndexDay& c : FollowIndex(days, thermal, IndexBandOptions{}, cusum)) {
+      if (c.withheld && c.day_start_s >= first_scored) {
+        log->push_back({kInfo, std::string(thermal ? "heat" : "electricity") + " of " +
+                                   Day(c.day_start_s) + " not judged: its expected energy (" +
+                                   Fixed(c.e_model_wh / 1000.0, 2) +
+                                   " kWh) lies in a regime its reference days do not hold "
+                                   "(no band, no part in the alarm)"});
+      }
       if (!c.alarm || c.day_start_s < first_scored) continue;
       const std::string message =
           std::string(thermal ? "heat" : "electricity") +

@@ -117,13 +117,14 @@ TEST(IndexBand, HoldsOneOnAtLeastEightyPercentOfDaysWhoseErrorsAreExchangeable) 
 }
 
 TEST(IndexBand, ADayIsJudgedAgainstTheDaysMostLikeItInExpectedEnergy) {
-  // 14 clear days (2000 Wh expected, the model 2 % high) and 14 overcast
-  // ones (500 Wh, the model 1 % low), alternating, each with ±0.2 % noise.
+  // 14 clear days (2000 Wh expected ± 5 %, the model 2 % high) and 14
+  // overcast ones (500 Wh ± 5 %, the model 1 % low), alternating, each
+  // with ±0.2 % noise.
   std::vector<DayPerformance> earlier;
   for (int d = 0; d < 28; ++d) {
     const bool clear = d % 2 == 0;
     DayPerformance p = DayWithError(d, (clear ? -0.02 : 0.01) + 0.002 * ((d / 2) % 3 - 1));
-    p.e_el_model_wh = clear ? 2000.0 : 500.0;
+    p.e_el_model_wh = (clear ? 2000.0 : 500.0) * (1.0 + 0.05 * ((d / 2) % 3 - 1));
     earlier.push_back(p);
   }
   // A clear day 2 % low is within its band (the clear days' error); an
@@ -209,6 +210,50 @@ TEST(IndexCusum, OneVeryLowDayWaitsForTheMinimumRunAndTheAlarmDaysLeaveTheRefere
   run = FollowIndex(days, false, IndexBandOptions{}, options);
   EXPECT_TRUE(run[14].alarm);
   EXPECT_FALSE(run[15].alarm);  // S starts again from 0 after it
+}
+
+TEST(IndexBand, ADayOutsideItsReferencesRegimeIsNotJudgedAndAHealthyPlantDoesNotAlarm) {
+  // A history that starts in another regime: 12 overcast days (500–580 Wh
+  // expected, the model right within ±0.2 %), then clear days (2000–2040
+  // Wh, the model 2 % high: healthy, a regime effect of its structure). The
+  // first clear days' nearest days are overcast; judged against them, 2 %
+  // is 13 σ low, and the CUSUM alarms on the third clear day.
+  std::vector<double> errors;
+  std::vector<double> e_model_wh;
+  for (int d = 0; d < 40; ++d) {
+    const bool clear = d >= 12;
+    const double noise = 0.002 * (d % 3 - 1);
+    errors.push_back((clear ? -0.02 : 0.0) + noise);
+    e_model_wh.push_back(clear ? 2000.0 + 10.0 * ((7 * d) % 5) : 500.0 + 20.0 * (d % 5));
+  }
+  // From day 32 on, a fault: 5 % less on the clear days.
+  for (int d = 32; d < 40; ++d) errors[static_cast<std::size_t>(d)] -= 0.05;
+  const IndexBandOptions bands;
+  const IndexCusumOptions cusum;
+  std::vector<DayPerformance> days;
+  for (int d = 0; d < 40; ++d) {
+    DayPerformance p = DayWithError(d, errors[static_cast<std::size_t>(d)]);
+    p.e_el_model_wh = e_model_wh[static_cast<std::size_t>(d)];
+    SetIndexBands(days, bands, cusum, &p);
+    days.push_back(p);
+  }
+  const std::vector<IndexDay> run = FollowIndex(days, false, bands, cusum);
+  ASSERT_EQ(run.size(), 40u);
+  // Day 12, the first clear day: 12 reference days, all overcast, its
+  // expected energy beyond every one of theirs: judgement withheld.
+  EXPECT_TRUE(run[12].withheld);
+  EXPECT_FALSE(run[12].banded);
+  EXPECT_TRUE(std::isnan(days[12].pi_el_low) && std::isnan(days[12].pi_el_high));
+  // Day 13 lies within its references' range (day 12 among them): judged.
+  EXPECT_TRUE(run[13].banded);
+  EXPECT_FALSE(run[13].withheld);
+  // The healthy days raise no alarm; the fault does, on its third day.
+  int first_alarm = -1;
+  for (int d = 0; d < 40 && first_alarm < 0; ++d) {
+    if (run[static_cast<std::size_t>(d)].alarm) first_alarm = d;
+  }
+  EXPECT_GE(first_alarm, 32);
+  EXPECT_LE(first_alarm, 34);
 }
 
 }  // namespace

@@ -12,8 +12,14 @@
 // electricity alarm comes within three clear days.
 //
 // Seeds: development 1, 2, 3 (the rule was designed on these); final check
-// 31, 32, 33, run once: PVTWIN_PI_SEEDS=31,32,33 (doc/monitoring.md has
-// the figures of both).
+// 31, 32, 33, run once: PVTWIN_PI_SEEDS=31,32,33. The regime test (a day
+// whose expected energy its reference days do not hold is not judged) was
+// designed on development seeds 4, 7, 30, 43, 54, 67, chosen by their
+// weather alone (DayTypesFor: 30, 43, 54, 67 open with a mostly overcast
+// week, 43 and 54 with 10 or 11 overcast days; 7 opens with 11 clear days;
+// 4 mixed; each with clear days after kSwitchDay) and checked once on
+// final seeds 23, 29, 37, 61, 65, 71, chosen the same way before the rule
+// was changed (doc/validation.md has the figures).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -113,7 +119,11 @@ RunFigures Monitor(const Series& data, const ParamVector& params, const Config& 
   return f;
 }
 
-TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeClearDays) {
+// Runs each seed's healthy and switched weeks and checks: no alarm on the
+// healthy plant, the clipping alarm within three clear days of the switch;
+// with `coverage`, the band holds 1 on 80 % of the healthy days over the
+// seeds, each output.
+void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
   const Plant plant = DesignExamplePlant();
   Config config;
   config.plant = plant;
@@ -126,7 +136,7 @@ TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeCle
     clipping_truth[static_cast<std::size_t>(param)] = value;
   }
   int banded_el = 0, hold_el = 0, banded_th = 0, hold_th = 0;
-  for (const std::uint64_t seed : Seeds()) {
+  for (const std::uint64_t seed : seeds) {
     const WeatherOptions weather = WeatherOf(seed);
     const Series healthy = MakeSyntheticPlantData(
         plant, weather, truth_spec, ReferenceTruthParams(plant), RealisticSensorNoise(seed));
@@ -170,10 +180,23 @@ TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeCle
   }
   std::printf("all seeds: the band holds 1 on %d/%d days (P_el), %d/%d (Q_u)\n", hold_el, banded_el,
               hold_th, banded_th);
+  if (!coverage) return;
   EXPECT_GE(hold_el, 0.8 * banded_el);
   EXPECT_GE(hold_th, 0.8 * banded_th);
   EXPECT_GT(banded_el, 0);
   EXPECT_GT(banded_th, 0);
+}
+
+TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeClearDays) {
+  CheckSeeds(Seeds(), true);
+}
+
+// Development seeds 43 and 54 open with 11 and 10 overcast days: the model,
+// fitted on them, is 2 % high on the clear days after (electricity), which
+// the nearest days, all overcast, judged many σ low: 5 false alarms each
+// before the regime test (index_band.h), none with it.
+TEST(PerformanceWeeks, AHistoryThatStartsOvercastRaisesNoFalseAlarmOnTheClearDaysAfter) {
+  CheckSeeds({43, 54}, false);
 }
 
 }  // namespace

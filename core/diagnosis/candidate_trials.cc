@@ -430,7 +430,7 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
   }
   if (t.fit_ok) {
     if (t.forms.size() > 1) {
-      ev << "form " << t.form << " (lowest held-out MAE of its forms:";
+      ev << "form " << t.form << " (the lowest held-out objective of its forms; MAE P_el + Q_u:";
       for (const EffectTrial::FormResult& f : t.forms) {
         ev << " " << f.form << " "
            << (f.scored ? FixedDecimals(f.heldout_mae_after_w, 2) + " W" : "not scored");

@@ -264,18 +264,63 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
   return f;
 }
 
+// One form of a candidate fitted on the training days and scored on the
+// held-out days.
+struct ScoredForm {
+  NamedForm form;
+  FormFit fit;
+  Part heldout;
+  Score score;
+  double objective_w = kNaN;  // SelectionObjectiveW of score; NaN: not scored
+};
+
+// Fits and scores every form of the candidate; *best is the form with the
+// lowest held-out objective of the model selection (the first form when none
+// was scored, so that its failure is reported).
+std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderModel& current,
+                                         const EffectCandidate& c, std::size_t* best) {
+  const std::vector<NamedForm> forms =
+      c.forms.empty() ? std::vector<NamedForm>{{c.form, c.spec}} : c.forms;
+  std::vector<std::uint8_t> inside;
+  if (in.extrapolation != nullptr && !in.extrapolation->empty()) {
+    inside = RowsInsideTrainingRange(in.base->heldout.drivers, *in.extrapolation);
+  }
+  std::vector<ScoredForm> out(forms.size());
+  *best = 0;
+  for (std::size_t k = 0; k < forms.size(); ++k) {
+    ScoredForm& f = out[k];
+    f.form = forms[k];
+    f.fit = FitForm(in, current, *c.module, f.form.spec);
+    std::string why;
+    if (!f.fit.failure.empty()) continue;
+    if (!PreparePart(in.split->heldout_series, *in.plant, f.form.spec, in.split->data_start_s,
+                     in.split->cleanings, &f.heldout, &why)) {
+      f.fit.failure = why.empty() ? "the held-out days cannot be prepared" : why;
+      continue;
+    }
+    if (!f.fit.fit.ok) continue;
+    f.score = ScoreHeldout(f.heldout, f.fit.fit.params, in.base->units, in.plant->area_m2);
+    f.objective_w = SelectionObjectiveW(f.score, inside);
+    if (!std::isfinite(out[*best].objective_w) || f.objective_w < out[*best].objective_w) {
+      *best = k;
+    }
+  }
+  return out;
+}
+
 // The decisive test of one candidate: evidence on the base model's residuals
-// (step 1), re-identification of each of its forms (the one that fits the
-// training days best becomes the candidate's spec), the held-out score and
-// its tests.
+// (step 1), re-identification of each of its forms on the training days and
+// their held-out scores (the form with the lower held-out objective becomes
+// the candidate's spec; every form's score goes to *form_scores for the
+// model selection, which chooses the form again in each resample), the
+// held-out tests of that form.
 void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
-                  EffectCandidate* candidate, EffectTrial* trial, Score* score) {
+                  EffectCandidate* candidate, EffectTrial* trial, Score* score,
+                  std::vector<Score>* form_scores) {
   EffectCandidate& c = *candidate;
   EffectTrial& t = *trial;
   const Plant& plant = *in.plant;
   const DiagnosisOptions& options = *in.options;
-  const Series& heldout_series = in.split->heldout_series;
-  const std::int64_t data_start_s = in.split->data_start_s;
   const ModelSpec& current_spec = current.spec;
   const Score& current_score = current.score;
   const Score& base_score = in.base->score;
@@ -285,28 +330,26 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   t.signature = c.signature;
   t.advice = std::string(c.module->advice);
   t.heldout_mae_before_w = MaeSumW(current_score.errors);
-  std::string why;
+  std::size_t chosen = 0;
+  std::vector<ScoredForm> forms = FitAndScoreForms(in, current, c, &chosen);
   double fit_runtime_s = 0.0;
-  FormFit best;
-  bool have_best = false;
-  for (const ModelSpec& form : c.forms.empty() ? std::vector<ModelSpec>{c.spec} : c.forms) {
-    FormFit f = FitForm(in, current, *c.module, form);
-    fit_runtime_s += f.fit.runtime_s;
-    const bool better =
-        f.failure.empty() && f.fit.ok &&
-        (!have_best || !best.fit.ok || f.fit.final_cost_w_m2 < best.fit.final_cost_w_m2);
-    if (!have_best || better) {
-      best = std::move(f);
-      c.spec = form;
-      have_best = true;
-    }
+  for (ScoredForm& f : forms) {
+    fit_runtime_s += f.fit.fit.runtime_s;
+    t.forms.push_back({f.form.form, f.form.spec.Name(), std::isfinite(f.objective_w),
+                       std::isfinite(f.objective_w) ? MaeSumW(f.score.errors) : kNaN});
+    if (std::isfinite(f.objective_w)) form_scores->push_back(std::move(f.score));
   }
+  ScoredForm& best_form = forms[chosen];
+  c.spec = best_form.form.spec;
+  c.form = best_form.form.form;
+  t.form = c.form;
   t.variant = c.spec.Name();
   t.fit_runtime_s = fit_runtime_s;
-  Part ho;
-  if (!best.failure.empty() ||
-      !PreparePart(heldout_series, plant, c.spec, data_start_s, in.split->cleanings, &ho, &why)) {
-    t.failure = best.failure.empty() ? why : best.failure;
+  const FormFit& best = best_form.fit;
+  const Part& ho = best_form.heldout;
+  if (!best.failure.empty()) {
+    t.failure = best.failure;
+    form_scores->clear();
     return;
   }
   // Evidence on the base model's residuals (the gap being explained).
@@ -340,6 +383,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   *score = ScoreHeldout(ho, fit.params, in.base->units, plant.area_m2);
   if (!std::isfinite((*score).errors.objective_w_m2())) {
     t.failure = "non-finite held-out outputs";
+    form_scores->clear();
     return;
   }
   t.fit_ok = true;
@@ -385,6 +429,15 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
     ev << effect.sensor_evidence(t.sensor_estimate, t.sensor_p, t.sensor_days);
   }
   if (t.fit_ok) {
+    if (t.forms.size() > 1) {
+      ev << "form " << t.form << " (the lowest held-out objective of its forms; MAE P_el + Q_u:";
+      for (const EffectTrial::FormResult& f : t.forms) {
+        ev << " " << f.form << " "
+           << (f.scored ? FixedDecimals(f.heldout_mae_after_w, 2) + " W" : "not scored");
+        ev << (&f == &t.forms.back() ? "" : ",");
+      }
+      ev << "); ";
+    }
     ev << "re-identified " << t.variant << " lowers the held-out loss by "
        << FixedDecimals(t.heldout_test.mean_difference, 2)
        << " W per row (loss test z = " << FixedDecimals(t.heldout_test.z, 1)
@@ -422,11 +475,13 @@ StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& cur
   if (candidates.empty()) return out;
   out.trials.resize(candidates.size());
   out.scores.resize(candidates.size());
+  out.form_scores.resize(candidates.size());
   std::atomic<std::size_t> next{0};
   std::atomic<int> done{0};
   auto worker = [&] {
     for (std::size_t k = next++; k < candidates.size(); k = next++) {
-      TryCandidate(in, step, current, &candidates[k], &out.trials[k], &out.scores[k]);
+      TryCandidate(in, step, current, &candidates[k], &out.trials[k], &out.scores[k],
+                   &out.form_scores[k]);
       const int finished = ++done;
       in.progress(ProgressLine(step, finished, candidates.size(), out.trials[k], in.test_unit));
     }

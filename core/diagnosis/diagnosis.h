@@ -184,6 +184,17 @@ std::string RefittedSentence(const RefittedParam& r);
 struct EffectTrial {
   std::string name;
   std::string variant;         // the model with the effect
+  // The form judged (EffectModule::form or a diagnosis_forms name): the one
+  // with the lowest held-out objective of the model selection.
+  std::string form;
+  // Every form fitted, the judged one among them, with its held-out
+  // MAE P_el + MAE Q_u, W (scored = false: its fit failed).
+  struct FormResult {
+    std::string form, variant;
+    bool scored = false;
+    double heldout_mae_after_w = std::nan("");
+  };
+  std::vector<FormResult> forms;
   std::string tested_against;  // the model it was added to
   std::string explanation;
   std::string signature;

@@ -16,8 +16,10 @@ std::vector<EffectCandidate> CandidateEffects(const ModelSpec& base, const Serie
       if (skipped != nullptr) skipped->push_back({std::string(m->name), why});
       continue;
     }
-    std::vector<ModelSpec> forms = DiagnosisForms(base, *m);
-    out.push_back({std::string(m->name), forms.front(), std::move(forms), std::string(m->physics),
+    std::vector<NamedForm> forms = DiagnosisForms(base, *m);
+    const ModelSpec first = forms.front().spec;
+    const std::string form = forms.front().form;
+    out.push_back({std::string(m->name), first, std::move(forms), form, std::string(m->physics),
                    std::string(m->signature), m});
   }
   return out;

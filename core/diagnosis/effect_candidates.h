@@ -19,9 +19,11 @@ namespace pvtwin {
 struct EffectCandidate {
   std::string name;  // e.g. "pv_clipping"
   ModelSpec spec;    // the model with the effect added
-  // Every form of the effect to fit (DiagnosisForms; spec is the first); the
-  // trial judges the one that fits the training days best and sets spec to it.
-  std::vector<ModelSpec> forms;
+  // Every form of the effect to fit (DiagnosisForms; spec is the first's);
+  // the trial scores each on the held-out days and sets spec and form to the
+  // one with the lower held-out objective.
+  std::vector<NamedForm> forms;
+  std::string form;  // the name of spec's form
   std::string explanation;               // physics, one paragraph
   std::string signature;                 // what the residual evidence is correlated with
   const EffectModule* module = nullptr;  // what else differs between effects is asked here

@@ -43,15 +43,24 @@ double Confidences(const TrialInputs& in, int step, const Score& current, StepTr
     }
     return u;
   };
+  // Per trial, every form that was scored: the form is chosen again in each
+  // resample (the lowest objective of its forms), so that the confidence
+  // holds the choice of the form as well as that of the effect.
   std::vector<std::size_t> pool;
-  std::vector<UnitLoss> losses(st->trials.size());
+  std::vector<std::vector<UnitLoss>> losses(st->trials.size());
   for (std::size_t k = 0; k < st->trials.size(); ++k) {
     st->trials[k].confidence = 0.0;
     st->trials[k].confidence_beats = 0.0;
-    if (st->trials[k].fit_ok && st->scores[k].loss_w.size() == current.loss_w.size()) {
-      pool.push_back(k);
-      losses[k] = per_unit(st->scores[k]);
+    if (!st->trials[k].fit_ok) continue;
+    std::vector<const Score*> forms = {&st->scores[k]};
+    if (k < st->form_scores.size() && !st->form_scores[k].empty()) {
+      forms.clear();
+      for (const Score& s : st->form_scores[k]) forms.push_back(&s);
     }
+    for (const Score* s : forms) {
+      if (s->loss_w.size() == current.loss_w.size()) losses[k].push_back(per_unit(*s));
+    }
+    if (!losses[k].empty()) pool.push_back(k);
   }
   const UnitLoss before_loss = per_unit(current);
   if (units == 0 || pool.empty()) return 0.0;
@@ -78,7 +87,11 @@ double Confidences(const TrialInputs& in, int step, const Score& current, StepTr
     std::size_t best = st->trials.size();
     double best_objective = 0.0;
     for (const std::size_t k : pool) {
-      const double after = objective(losses[k]);
+      double after = std::nan("");
+      for (const UnitLoss& form : losses[k]) {
+        const double o = objective(form);
+        if (!std::isnan(o) && !(o >= after)) after = o;  // the lowest finite
+      }
       if (!(after <= keep * before)) continue;
       ++beats[k];
       if (best == st->trials.size() || after < best_objective) {

@@ -71,6 +71,16 @@ Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& 
 
 double MaeSumW(const ErrorMetrics& e) { return e.mae_p_el_w + e.mae_q_th_w; }
 
+double SelectionObjectiveW(const Score& score, const std::vector<std::uint8_t>& inside) {
+  double loss_w = 0.0, rows = 0.0;
+  for (std::size_t i = 0; i < score.loss_w.size(); ++i) {
+    if (!std::isfinite(score.loss_w[i]) || (!inside.empty() && inside[i] == 0)) continue;
+    loss_w += score.loss_w[i];
+    rows += 1.0;
+  }
+  return rows > 0.0 ? loss_w / rows : kNaN;
+}
+
 PairedTest CompareUnits(const Score& before, const Score& after) {
   std::vector<double> b, a;
   for (std::size_t k = 0; k < before.unit_objective_w_m2.size(); ++k) {

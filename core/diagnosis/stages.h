@@ -78,6 +78,11 @@ struct Score {
 Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& units,
                    double area_m2);
 
+// The pooled held-out objective of the model selection, W per row: the mean
+// of |e_P_el| + |e_Q_u| over the scored rows, only those with inside[i] ≠ 0
+// when `inside` is not empty (RowsInsideTrainingRange). NaN without rows.
+double SelectionObjectiveW(const Score& score, const std::vector<std::uint8_t>& inside);
+
 // One-sided paired test of the per-unit objectives: is `after` lower?
 PairedTest CompareUnits(const Score& before, const Score& after);
 
@@ -192,7 +197,10 @@ struct StepTrials {
   std::vector<EffectCandidate> candidates;
   std::vector<SkippedEffect> skipped;
   std::vector<EffectTrial> trials;  // per candidate
-  std::vector<Score> scores;        // per candidate
+  std::vector<Score> scores;        // per candidate: its chosen form's
+  // Per candidate: every form's held-out score (the chosen one among them);
+  // the model selection takes the best form of each resample.
+  std::vector<std::vector<Score>> form_scores;
 };
 // Step `step` of the ladder: every candidate effect added to `current`,
 // re-identified on the training days and scored on the held-out days, with

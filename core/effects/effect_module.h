@@ -116,6 +116,12 @@ struct OtherFormTruth {
 // other-form truths' per-day events (splitmix64).
 double UnitDraw(std::uint64_t seed, std::int64_t key);
 
+// One form of an effect that the diagnosis fits (EffectModule::diagnosis_forms).
+struct EffectForm {
+  std::string_view name;                   // effects[].form in report.json
+  void (*add)(ModelSpec* spec) = nullptr;  // adds the effect to spec in this form
+};
+
 struct EffectModule {
   std::string_view name;     // doc/contracts.md vocabulary, e.g. "pv_clipping"
   std::string_view physics;  // one paragraph of physics, for the report
@@ -149,11 +155,17 @@ struct EffectModule {
   bool (*in_spec)(const ModelSpec& spec) = nullptr;
   // Adds the effect to spec (WithEffect); null: spec->Add(*extension).
   void (*add_to_spec)(ModelSpec* spec) = nullptr;
+  // The name of add_to_spec's form in the report (effects[].form), e.g.
+  // "paper" for wind's 'w'; "standard" for an effect with one form.
+  std::string_view form = "standard";
   // Further forms of the effect that the diagnosis fits besides
   // add_to_spec's, each adding the effect to spec in its own form (wind: the
-  // physical "+wind" besides the paper's 'w'). The form with the lowest
-  // training objective is the one judged on the held-out days.
-  std::vector<void (*)(ModelSpec* spec)> diagnosis_forms;
+  // physical "+wind" besides the paper's 'w'; iam: on the thermal absorption
+  // only besides both outputs). Each is fitted on the training days and
+  // scored on the held-out days; the effect counts with the form that has
+  // the lower held-out objective, chosen again in every resample of the
+  // model selection (ladder.cc), so that the choice is inside the confidence.
+  std::vector<EffectForm> diagnosis_forms;
   // The extensions those forms add besides `extension` ("+pipe_volume" of
   // transport_delay), so that a variant naming one parses.
   std::vector<const ModelExtension*> form_extensions;

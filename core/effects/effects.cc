@@ -40,15 +40,15 @@ ModelSpec WithEffect(ModelSpec spec, const EffectModule& e) {
   return spec;
 }
 
-std::vector<ModelSpec> DiagnosisForms(const ModelSpec& spec, const EffectModule& e) {
-  std::vector<ModelSpec> forms = {WithEffect(spec, e)};
-  for (void (*add)(ModelSpec*) : e.diagnosis_forms) {
+std::vector<NamedForm> DiagnosisForms(const ModelSpec& spec, const EffectModule& e) {
+  std::vector<NamedForm> forms = {{std::string(e.form), WithEffect(spec, e)}};
+  for (const EffectForm& f : e.diagnosis_forms) {
     ModelSpec form = spec;
-    add(&form);
+    f.add(&form);
     const std::string name = form.Name();
     if (std::none_of(forms.begin(), forms.end(),
-                     [&name](const ModelSpec& f) { return f.Name() == name; })) {
-      forms.push_back(form);
+                     [&name](const NamedForm& g) { return g.spec.Name() == name; })) {
+      forms.push_back({std::string(f.name), form});
     }
   }
   return forms;

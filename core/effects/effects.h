@@ -29,9 +29,17 @@ bool CanAddEffect(const ModelSpec& spec, const EffectModule& effect, const Serie
 // extension). Adding a present effect returns spec unchanged.
 ModelSpec WithEffect(ModelSpec spec, const EffectModule& effect);
 
+// One form of an effect added to a spec, with the form's name
+// (EffectModule::form or a diagnosis_forms entry's).
+struct NamedForm {
+  std::string form;
+  ModelSpec spec;
+};
+
 // Every form of the effect that the diagnosis fits, added to spec: WithEffect
-// first, then each of EffectModule::diagnosis_forms that differs from it.
-std::vector<ModelSpec> DiagnosisForms(const ModelSpec& spec, const EffectModule& effect);
+// first (named EffectModule::form), then each of EffectModule::diagnosis_forms
+// that differs from it.
+std::vector<NamedForm> DiagnosisForms(const ModelSpec& spec, const EffectModule& effect);
 
 // Per-row value of the effect's signature (EffectModule::signature), for
 // residual evidence; NaN where undefined.

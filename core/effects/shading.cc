@@ -201,7 +201,8 @@ void ShadeTheBeam(const Drivers& d, const ParamVector& p, RunInputs* run) {
       const double s = present ? shaded[i] : 0.0;
       const double beam = std::isfinite(run->g_beam_w_m2[i]) ? run->g_beam_w_m2[i] : 0.0;
       g_abs[i] -= s * beam;
-      factor[i] = 1.0 - mismatch * s;
+      // Multiplies a factor set before (iam's "+iam_thermal").
+      factor[i] = (run->pv_factor != nullptr ? run->pv_factor[i] : 1.0) * (1.0 - mismatch * s);
     }
     lo = hi;
   }

@@ -133,7 +133,8 @@ const EffectModule& SkyRadiationEffect() {
         "sky temperature; clear nights then cool the model as they cool the collector.";
     m.in_spec = InSpec;
     m.add_to_spec = AddToSpec;
-    m.diagnosis_forms = {AddBroaderForm};
+    m.form = "paper";
+    m.diagnosis_forms = {{"cloud_offset", AddBroaderForm}};
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
     m.other_truth = &OtherTruth();

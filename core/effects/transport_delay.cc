@@ -324,7 +324,8 @@ const EffectModule& TransportDelayEffect() {
     m.extension = &Extension();
     m.form_extensions = {&VolumeExtension()};
     m.in_spec = InSpec;
-    m.diagnosis_forms = {AddVolumeForm};
+    m.form = "pure_delay";
+    m.diagnosis_forms = {{"pipe_with_mixing", AddVolumeForm}};
     m.advice_for = DelayAdvice;
     m.signature_values = Signature;
     m.shows_signature = ChangesFollowTheDelay;

@@ -118,7 +118,8 @@ const EffectModule& WindEffect() {
     m.extension = &Extension();
     m.in_spec = InSpec;
     m.add_to_spec = AddToSpec;
-    m.diagnosis_forms = {AddPhysicalForm};
+    m.form = "paper";
+    m.diagnosis_forms = {{"physical", AddPhysicalForm}};
     m.data_lacks = DataLacks;
     m.signature_values = Signature;
     m.other_truth = &OtherTruth();

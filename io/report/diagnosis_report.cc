@@ -160,6 +160,16 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
     e["evidence"] = t.evidence;
     e["refitted"] = RefittedJson(t.refitted);
     e["variant"] = t.variant;
+    if (!t.form.empty()) e["form"] = t.form;
+    if (t.forms.size() > 1) {
+      Json forms = Json::array();
+      for (const EffectTrial::FormResult& f : t.forms) {
+        forms.push_back(Json{{"form", f.form},
+                             {"variant", f.variant},
+                             {"heldout_mae_after_w", Number(f.heldout_mae_after_w)}});
+      }
+      e["forms"] = forms;
+    }
     e["tested_against"] = t.tested_against;
     e["accepted_at_step"] = t.accepted_at_step;
     e["p_value"] = Number(t.test.wilcoxon_p);

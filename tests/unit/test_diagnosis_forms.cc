@@ -1,7 +1,9 @@
 // The forms the diagnosis fits for an effect (EffectModule::diagnosis_forms)
 // and the broader candidate forms behind them: wind's physical "+wind"
 // besides the paper's 'w', the sky's cloud offset beyond the logged
-// long-wave, and the obstacle that stands on some days only.
+// long-wave, the IAM on the thermal absorption only besides both outputs,
+// and the obstacle that stands on some days only; a diagnosis names the
+// form on the output where the truth's IAM acts.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,12 +12,17 @@
 #include <string>
 #include <vector>
 
+#include "core/common/calendar.h"
 #include "core/common/units.h"
+#include "core/data/qc.h"
+#include "core/diagnosis/diagnosis.h"
 #include "core/effects/effects.h"
 #include "core/effects/iam.h"
 #include "core/effects/shading.h"
 #include "core/effects/sky_radiation.h"
+#include "core/model/thermal_model.h"
 #include "core/model/variant.h"
+#include "core/synth/synthetic_plant.h"
 #include "tests/support/effect_named.h"
 #include "tests/support/synthetic_series.h"
 
@@ -24,8 +31,8 @@ namespace {
 
 std::vector<std::string> FormNames(const char* base, const char* effect) {
   std::vector<std::string> names;
-  for (const ModelSpec& s : DiagnosisForms(testing::SpecOf(base), testing::EffectNamed(effect))) {
-    names.push_back(s.Name());
+  for (const NamedForm& f : DiagnosisForms(testing::SpecOf(base), testing::EffectNamed(effect))) {
+    names.push_back(f.spec.Name());
   }
   return names;
 }
@@ -45,9 +52,20 @@ TEST(DiagnosisForms, SkyIsFittedWithAndWithoutTheCloudOffset) {
       UsedParams(testing::SpecOf("1N1Cwr")).test(static_cast<std::size_t>(Param::kSkyCloudOffset)));
 }
 
+std::vector<std::string> FormLabels(const char* base, const char* effect) {
+  std::vector<std::string> labels;
+  for (const NamedForm& f : DiagnosisForms(testing::SpecOf(base), testing::EffectNamed(effect))) {
+    labels.push_back(f.form);
+  }
+  return labels;
+}
+
 TEST(DiagnosisForms, IamIsFittedAsThePaperWritesItAndWithAshraesB0Free) {
   EXPECT_EQ(FormNames("2N1Ccolwr", "iam"),
-            (std::vector<std::string>{"2N1CcolwrI", "2N1CcolwrI+iam"}));
+            (std::vector<std::string>{"2N1CcolwrI", "2N1CcolwrI+iam", "2N1CcolwrI+iam_thermal"}));
+  EXPECT_EQ(FormLabels("2N1Ccolwr", "iam"),
+            (std::vector<std::string>{"both_outputs", "both_outputs_fitted_b0", "thermal_only"}));
+  EXPECT_EQ(testing::SpecOf("2N1CcolwrI+iam_thermal").Name(), "2N1CcolwrI+iam_thermal");
   EXPECT_EQ(testing::SpecOf("2N1CcolwrI+iam").Name(), "2N1CcolwrI+iam");
   EXPECT_EQ(testing::SpecOf("2N1Ccolwr+iam").Name(), "2N1CcolwrI");  // '+iam' adds 'I' first
   EXPECT_TRUE(UsedParams(testing::SpecOf("2N1CcolwrI+iam"))
@@ -82,6 +100,101 @@ TEST(DiagnosisForms, AshraeIamByHand) {
 
 TEST(DiagnosisForms, AnEffectWithOneFormHasOnlyIt) {
   EXPECT_EQ(FormNames("1N1Cwr", "shading"), (std::vector<std::string>{"1N1Cwr+shading"}));
+  EXPECT_EQ(FormLabels("1N1Cwr", "shading"), (std::vector<std::string>{"standard"}));
+  EXPECT_EQ(FormLabels("1N1Cwr", "transport_delay"),
+            (std::vector<std::string>{"pure_delay", "pipe_with_mixing"}));
+}
+
+// "+iam_thermal": P_el = η(T_PV)·A·I_gt, as without the modifier: against
+// the model without it, P_el / (1 + f_corr,T·(T_PV − T_PVref)) is the same
+// on every row (only T_PV differs: the laminate absorbs I_at); with 'I'
+// alone it is lower where the modifier acts. The heat follows I_at as with
+// 'I'. Rows where the 'I' split leaves no absorbed irradiance are left out.
+TEST(DiagnosisForms, IamOnTheThermalAbsorptionOnlyLeavesPelAtTheIrradianceBeforeIt) {
+  const Plant plant = DesignExamplePlant();
+  SyntheticOptions synth;
+  std::string error;
+  ASSERT_TRUE(DefaultSyntheticOptions(plant, "1N1Cwr", 2, 5, &synth, &error)) << error;
+  const Series s = MakeSyntheticPlantData(plant, synth);
+  const ParamVector p = TruthParamsFor(plant, testing::SpecOf("1N1CwrI"));
+  auto run = [&](const char* variant) {
+    Drivers d;
+    std::string why;
+    EXPECT_TRUE(PrepareDrivers(s, plant, testing::SpecOf(variant), &d, &why)) << why;
+    SimOutputs out;
+    Simulate(d, p, &out);
+    return out;
+  };
+  const SimOutputs plain = run("1N1Cwr"), both = run("1N1CwrI");
+  const SimOutputs thermal = run("1N1CwrI+iam_thermal");
+  const double f_t = ParamOf(p, Param::kPvTempCoeffPerK);
+  auto at_ref_temp = [&](const SimOutputs& o, std::size_t i) {
+    return o.p_el_w[i] / (1.0 + f_t * (o.t_pv_c[i] - plant.pv_t_ref_c));
+  };
+  int rows = 0, lower_with_i = 0;
+  double q_gap = 0.0, q_scale = 0.0;
+  for (std::size_t i = 0; i < plain.p_el_w.size(); ++i) {
+    if (!std::isfinite(thermal.p_el_w[i]) || !(both.p_el_w[i] > 1.0)) continue;
+    ++rows;
+    EXPECT_NEAR(at_ref_temp(thermal, i), at_ref_temp(plain, i), 1e-9 * at_ref_temp(plain, i))
+        << "row " << i;
+    lower_with_i += at_ref_temp(both, i) < at_ref_temp(plain, i) - 1e-6 ? 1 : 0;
+    q_gap += std::fabs(thermal.q_th_w[i] - both.q_th_w[i]);
+    q_scale += std::fabs(both.q_th_w[i] - plain.q_th_w[i]);
+  }
+  ASSERT_GT(rows, 500);
+  EXPECT_GT(lower_with_i, rows / 2);
+  // The heat: much nearer to 'I' than to no modifier (it differs from 'I'
+  // by the electricity the laminate no longer loses to the modifier).
+  EXPECT_LT(q_gap, 0.3 * q_scale);
+}
+
+// A plant whose IAM acts where the truth puts it: the diagnosis names iam,
+// with the form on that output. 14 + 7 days at 1 min, base 1N1Cwr, the
+// paper's b0; a competitor that any thermal gap could take (second_node).
+DiagnosisResult DiagnoseIamTruth(const char* truth_variant) {
+  const Plant plant = DesignExamplePlant();
+  SyntheticOptions synth;
+  std::string error;
+  EXPECT_TRUE(DefaultSyntheticOptions(plant, truth_variant, 21, 2, &synth, &error)) << error;
+  const std::int64_t offset_s = SolarDayOffsetS(plant);
+  synth.weather.start_time_s =
+      SolarDayStartS(synth.weather.start_time_s, offset_s) + kSecondsPerDay;
+  Series s = MakeSyntheticPlantData(plant, synth);
+  ApplyPaperCorrections(&s);
+  DiagnosisOptions o;
+  o.train_days = 14;
+  o.heldout_days = 7;
+  o.effects = {"iam", "second_node"};
+  o.max_ladder_steps = 1;
+  DiagnosisResult r;
+  EXPECT_TRUE(Diagnose(s, plant, testing::SpecOf("1N1Cwr"), o, &r, &error)) << error;
+  return r;
+}
+
+const EffectTrial* TrialNamed(const DiagnosisResult& r, const std::string& name) {
+  for (const EffectTrial& t : r.effects) {
+    if (t.name == name) return &t;
+  }
+  return nullptr;
+}
+
+TEST(DiagnosisForms, IamOnTheThermalAbsorptionOnlyIsNamedWithThatForm) {
+  const DiagnosisResult r = DiagnoseIamTruth("1N1CwrI+iam_thermal");
+  EXPECT_EQ(r.verdict, "iam") << r.verdict_sentence;
+  const EffectTrial* t = TrialNamed(r, "iam");
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->form, "thermal_only") << t->evidence;
+  EXPECT_EQ(t->forms.size(), 3u);
+  EXPECT_NE(t->evidence.find("form " + t->form), std::string::npos) << t->evidence;
+}
+
+TEST(DiagnosisForms, IamOnBothOutputsIsNamedWithThatForm) {
+  const DiagnosisResult r = DiagnoseIamTruth("1N1CwrI");
+  EXPECT_EQ(r.verdict, "iam") << r.verdict_sentence;
+  const EffectTrial* t = TrialNamed(r, "iam");
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->form.rfind("both_outputs", 0), 0u) << t->form << ": " << t->evidence;
 }
 
 TEST(DiagnosisForms, SkyCloudOffsetByHand) {

@@ -229,7 +229,8 @@ TEST(ModelSensitivities, OneMinuteStepMatchesCentralDifferences) {
 std::vector<std::string> EffectVariants() {
   std::vector<std::string> out;
   for (const EffectModule* m : EffectRegistry()) {
-    std::vector<void (*)(ModelSpec*)> forms = m->diagnosis_forms;
+    std::vector<void (*)(ModelSpec*)> forms;
+    for (const EffectForm& f : m->diagnosis_forms) forms.push_back(f.add);
     if (m->add_to_spec != nullptr) forms.push_back(m->add_to_spec);
     std::vector<ModelSpec> specs;
     for (auto* add : forms) {

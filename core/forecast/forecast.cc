@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/data/resample.h"
 #include "core/forecast/operation_forecast.h"
 #include "core/forecast/weather_resample.h"
 #include "core/model/thermal_model.h"
@@ -16,7 +17,9 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // During the warm-up a missing minute (e.g. the one not yet aggregated when
-// the forecast is issued) holds the last measured value this long.
+// the forecast is issued) holds the last measured value this long; a
+// history at a coarser step (10-, 15-min interval rows) holds it one row,
+// the interval not yet logged when the forecast is issued.
 constexpr double kWarmupHoldS = 600.0;
 
 // Weather channels a forecast carries into the horizon (the model's inputs
@@ -97,9 +100,10 @@ template <class HorizonValue>
 void FillColumn(const Track& measured, std::size_t n_warm, Series* in, Channel c,
                 HorizonValue horizon_value) {
   std::vector<double>& col = in->Ensure(c);
+  const double hold_s = std::max(kWarmupHoldS, in->step_s);
   for (std::size_t k = 0; k < col.size(); ++k) {
     const std::int64_t t = in->time_s[k];
-    col[k] = k < n_warm ? measured.Held(t, kWarmupHoldS) : horizon_value(k - n_warm, t);
+    col[k] = k < n_warm ? measured.Held(t, hold_s) : horizon_value(k - n_warm, t);
   }
 }
 
@@ -358,6 +362,25 @@ void SmartPersistIrradiance(const Plant& plant, const Series& history, std::size
   }
 }
 
+// The weather forecast table as the forecast's rows need it: when the
+// forecast runs at a coarser step than the table's rows (interval history of
+// a 10- or 15-min logger against the table's 1-min rows), each row's mean
+// over [t, t + step_s), the grid at issued_at's phase; the model's inputs
+// are interval means, as the measured rows it was calibrated on, not the
+// table's value at the interval's start. Else the table itself.
+const Series& WeatherAtStep(const Series& table, const ForecastRequest& request,
+                            Series* averaged) {
+  if (table.size() == 0 || !(table.step_s > 0.0) || request.step_s <= table.step_s) return table;
+  const std::int64_t step = std::llround(request.step_s);
+  const std::int64_t phase = ((request.issued_at_s % step) + step) % step;
+  Series shifted = table;
+  for (std::int64_t& t : shifted.time_s) t -= phase;
+  std::string not_a_multiple;
+  if (!Resample(shifted, request.step_s, averaged, &not_a_multiple)) return table;
+  for (std::int64_t& t : averaged->time_s) t += phase;
+  return *averaged;
+}
+
 // Runs the model over `in` and keeps the horizon rows of its outputs.
 bool RunHorizon(const Plant& plant, const ModelSpec& spec, const ParamVector& params,
                 const Series& in, std::size_t n_warm, bool all_outputs, Series* rows,
@@ -406,8 +429,9 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
   Series in = MakeFrame(request, n_warm, n);
   ForecastInputUse use;
   use.rows = n - n_warm;
-  FillWeather(history, weather_forecast, request, n_warm, true, &in, &use,
-              &out->weather_from_forecast);
+  Series averaged;
+  FillWeather(history, WeatherAtStep(weather_forecast, request, &averaged), request, n_warm, true,
+              &in, &use, &out->weather_from_forecast);
   PumpRule rule;
   if (request.operation == OperationForecast::kLearned) {
     rule = LearnPumpRule(plant, request.operation_history ? *request.operation_history : history);

@@ -122,8 +122,12 @@ struct Forecast {
   Series inputs_used;
 };
 
-// history: measured 1-min rows up to issued_at (the calibration window or at
-// least the last day plus the warm-up); weather_forecast and operation_plan:
+// history: measured rows up to issued_at at request.step_s (1-min rows, or
+// a coarser logger's interval rows with issued_at on their grid; the
+// calibration window or at least the last day plus the warm-up); a warm-up
+// row missing in it holds the last value up to 10 min or one step, whichever
+// is longer. A weather_forecast finer than the step is averaged over each
+// row's interval. weather_forecast and operation_plan:
 // rows covering (part of) the horizon, possibly empty. Returns false with
 // *error when the history is too short to persist a day or warm up.
 bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& params,

@@ -96,8 +96,9 @@ struct ForecastErrors {
   std::array<std::size_t, kWeatherSources> days{};  // replayed days per source
 };
 
-// Replays the day-ahead forecasts over `history` (measured 1-min rows,
-// typically the calibration window) with `params`; past_weather_forecast:
+// Replays the day-ahead forecasts over `history` (measured rows at
+// request.step_s: 1-min rows, or interval rows whose errors are those of
+// interval means; typically the calibration window) with `params`; past_weather_forecast:
 // the weather_forecast rows over the same span (may be empty). request
 // gives step and warm-up (issued_at and horizon are set per day). Returns
 // false with *error only when the model cannot run on the history.

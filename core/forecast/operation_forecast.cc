@@ -14,9 +14,9 @@ namespace {
 
 constexpr double kGridStepWM2 = 25.0;
 constexpr double kGridMaxWM2 = 800.0;
-constexpr std::size_t kMinRows = 1440;     // a day of minutes
-constexpr std::size_t kMinHourRows = 10;   // on-minutes an hour needs for its own flow
-constexpr std::int64_t kMaxRowGapS = 600;  // a longer gap restarts the rule's state
+constexpr double kMinSpanS = 86400.0;     // rows of a day (1440 minutes, 96 15-min rows)
+constexpr std::size_t kMinHourRows = 10;   // on-rows an hour needs for its own flow
+constexpr std::int64_t kMaxRowGapS = 600;  // a longer gap (or row step) restarts the rule's state
 constexpr double kOnShareOfMedian = 0.1;   // flow above this share of the median is "on"
 
 struct Row {
@@ -27,12 +27,15 @@ struct Row {
 
 // Minutes the hysteresis rule (g_on, g_off) classifies right, of the rows
 // inside the rule's hours (outside them it is off).
-std::size_t Matches(const std::vector<Row>& rows, double g_on, double g_off) {
+// A gap is longer than max_gap_s (kMaxRowGapS, or one row of a coarser
+// step: consecutive 15-min rows are no gap).
+std::size_t Matches(const std::vector<Row>& rows, double g_on, double g_off,
+                    std::int64_t max_gap_s) {
   std::size_t right = 0;
   bool state = false;
   std::int64_t previous = std::numeric_limits<std::int64_t>::min() / 2;
   for (const Row& r : rows) {
-    if (r.t - previous > kMaxRowGapS) state = r.on;  // a gap: start from what was measured
+    if (r.t - previous > max_gap_s) state = r.on;  // a gap: start from what was measured
     previous = r.t;
     state = state ? r.g >= g_off : r.g >= g_on;
     right += state == r.on ? 1 : 0;
@@ -81,7 +84,12 @@ PumpRule LearnPumpRule(const Plant& plant, const Series& history) {
     on_hours.push_back(r.hour);
     flow_by_hour[static_cast<std::size_t>(r.hour) % 24].push_back(f);
   }
-  if (rows.size() < kMinRows || on_hours.size() < kMinHourRows || on_hours.size() == rows.size()) {
+  // A day of rows at the history's step (interval rows of a coarser logger
+  // count as the minutes they cover).
+  const double step_s = history.step_s > 0.0 ? history.step_s : 60.0;
+  const auto min_rows = static_cast<std::size_t>(std::lround(kMinSpanS / step_s));
+  const std::int64_t max_gap_s = std::max<std::int64_t>(kMaxRowGapS, std::llround(step_s));
+  if (rows.size() < min_rows || on_hours.size() < kMinHourRows || on_hours.size() == rows.size()) {
     return rule;
   }
   std::vector<double> all_on_flow;
@@ -105,7 +113,7 @@ PumpRule LearnPumpRule(const Plant& plant, const Series& history) {
   std::size_t best = 0;
   for (double on = 0.0; on <= kGridMaxWM2; on += kGridStepWM2) {
     for (double off = 0.0; off <= on; off += kGridStepWM2) {
-      const std::size_t right = Matches(inside, on, off);
+      const std::size_t right = Matches(inside, on, off, max_gap_s);
       if (right > best) {
         best = right;
         rule.g_on_w_m2 = on;

@@ -126,9 +126,9 @@ int ImportIntervals(Store& store, Series series, const std::string& csv) {
   std::cerr << "imported " << series.size() << " rows of " << step_min
             << "-min data into measurement_interval of " << store.path()
             << ", at their own step: 1-min rows made from them would invent the values inside "
-               "each interval, so measurement_1min is left as it was. The daemon's calibration "
-               "and daily checks and diagnose --db read these rows at their step where a window "
-               "has no 1-min rows; export --table interval gives them back.\n";
+               "each interval, so measurement_1min is left as it was. The daemon's calibration, "
+               "daily checks and forecast and diagnose --db read these rows at their step where "
+               "a window has no 1-min rows; export --table interval gives them back.\n";
   return kExitOk;
 }
 

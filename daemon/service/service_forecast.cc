@@ -1,6 +1,9 @@
 // The forecast job of the Service (service_internal.h): a banded forecast
 // issued every [forecast] refresh_min and after each accepted calibration,
-// with what the window teaches replayed once per day and calibration.
+// with what the window teaches replayed once per day and calibration. Its
+// history is the window's 1-min rows, else its interval rows at their own
+// step (window_data.h, as the calibration reads it): the forecast then runs
+// at that step on their grid.
 #include <cmath>
 #include <initializer_list>
 #include <utility>
@@ -40,26 +43,53 @@ std::string InputsInBrief(const ForecastInputUse& use) {
                {"learned", use.operation_learned}});
 }
 
-// The request of an issue now: whole minutes, the configured horizon.
-ForecastRequest RequestAt(double now_s, double horizon_h) {
+// The request of an issue now on the history's grid: whole minutes for
+// 1-min rows; interval rows (window_data.h) at their own step and phase (a
+// 10-min logger's rows at :05, :15, … give issues at :05, :15, …), so that
+// every forecast row, its persisted inputs and its replayed errors fall on
+// measured rows. The horizon is the configured one.
+ForecastRequest RequestAt(double now_s, double horizon_h, const cli::WindowData& history) {
   ForecastRequest request;
-  request.issued_at_s = static_cast<std::int64_t>(std::floor(now_s / 60.0)) * 60;
+  const std::int64_t minute = static_cast<std::int64_t>(std::floor(now_s / 60.0)) * 60;
+  request.issued_at_s = minute;
   request.horizon_s = horizon_h * 3600.0;
+  if (history.source != cli::WindowSource::kIntervals) return request;
+  const std::int64_t step = std::llround(history.rows.step_s);
+  if (step <= 60) return request;
+  const std::int64_t phase = ((history.rows.time_s.back() % step) + step) % step;
+  request.step_s = static_cast<double>(step);
+  request.issued_at_s = minute - (((minute - phase) % step) + step) % step;
   return request;
+}
+
+// The forecast's `inputs` part naming its history (doc/contracts.md).
+std::string HistoryPart(const cli::WindowData& history) {
+  if (history.source == cli::WindowSource::kNone) return "history: none";
+  return "history: " + history.Describe() +
+         (history.source == cli::WindowSource::kMinutes ? " of measurement_1min" : "");
 }
 
 }  // namespace
 
-bool Service::ReadForecastInputs(const ForecastRequest& request, std::int64_t history_s,
-                                 Series* history, Series* weather, Series* plan) {
-  const std::int64_t horizon_end =
-      request.issued_at_s + static_cast<std::int64_t>(request.horizon_s);
+bool Service::ReadForecastInputs(double now_s, std::int64_t history_s, ForecastRequest* request,
+                                 cli::WindowData* history, Series* weather, Series* plan) {
+  const std::int64_t minute = static_cast<std::int64_t>(std::floor(now_s / 60.0)) * 60;
   std::string error;
+  if (!cli::ReadWindowData(*store_, minute - history_s, minute, history, &error)) {
+    LogToStderr(kErr, "forecast inputs could not be read: " + error);
+    return false;
+  }
+  *request = RequestAt(now_s, config_.forecast.horizon_h, *history);
+  // An interval row starting at the issue (set back onto the rows' grid)
+  // is the forecast's first row, not its history.
+  Series& rows = history->rows;
+  rows = rows.Slice(0, rows.RowAtOrAfter(request->issued_at_s));
+  const std::int64_t horizon_end =
+      request->issued_at_s + static_cast<std::int64_t>(request->horizon_s);
   Store::TextCells weather_text, plan_text;
-  if (!store_->ReadMinutes(request.issued_at_s - history_s, request.issued_at_s, history, &error) ||
-      !store_->ReadWeatherForecast(request.issued_at_s, horizon_end, weather, &error,
+  if (!store_->ReadWeatherForecast(request->issued_at_s, horizon_end, weather, &error,
                                    &weather_text) ||
-      !store_->ReadOperationPlan(request.issued_at_s, horizon_end, plan, &error, &plan_text)) {
+      !store_->ReadOperationPlan(request->issued_at_s, horizon_end, plan, &error, &plan_text)) {
     LogToStderr(kErr, "forecast inputs could not be read: " + error);
     return false;
   }
@@ -82,12 +112,14 @@ void Service::IssueForecast() {
   }
   const double now = Now();
   next_forecast_s_ = now + config_.forecast.refresh_min * 60.0;
-  const ForecastRequest request = RequestAt(now, config_.forecast.horizon_h);
-  Series history, weather, plan;
-  if (!ReadForecastInputs(request, config_.calibration.window_days * kDayS, &history, &weather,
-                          &plan)) {
+  ForecastRequest request;
+  cli::WindowData measured;
+  Series weather, plan;
+  if (!ReadForecastInputs(now, config_.calibration.window_days * kDayS, &request, &measured,
+                          &weather, &plan)) {
     return;
   }
+  const Series& history = measured.rows;
   UpdateForecastStats(history, request);
   BandedForecast banded;
   std::string error;
@@ -103,8 +135,9 @@ void Service::IssueForecast() {
                                                         &forecast.inputs.weather_sources, &error)) {
     LogToStderr(kWarning, "the weather_forecast sources could not be read: " + error);
   }
-  WriteForecast(request, ForecastBasis::kCalibrated, banded, banded.Inputs(),
-                InputsInBrief(forecast.inputs));
+  WriteForecast(request, ForecastBasis::kCalibrated, banded,
+                banded.Inputs() + "; " + HistoryPart(measured),
+                InputsInBrief(forecast.inputs) + "; " + HistoryPart(measured));
 }
 
 // No calibration yet: the start values, retried soon while the model cannot
@@ -113,15 +146,16 @@ void Service::IssueForecast() {
 void Service::IssueStartValueForecast() {
   if (child_.running()) return;
   const double now = Now();
-  const ForecastRequest request = RequestAt(now, config_.forecast.horizon_h);
-  Series history, weather, plan;
-  if (!ReadForecastInputs(request, kDayS, &history, &weather, &plan)) {
+  ForecastRequest request;
+  cli::WindowData measured;
+  Series weather, plan;
+  if (!ReadForecastInputs(now, kDayS, &request, &measured, &weather, &plan)) {
     next_forecast_s_ = now + kStartValueRetryS;
     return;
   }
   StartValueForecast start;
   std::string error;
-  if (!MakeStartValueForecast(config_.plant, spec_, history, weather, plan, request,
+  if (!MakeStartValueForecast(config_.plant, spec_, measured.rows, weather, plan, request,
                               StartValueOptions{}, &start, &error)) {
     next_forecast_s_ = now + kStartValueRetryS;
     if (error != start_value_error_) {
@@ -133,8 +167,10 @@ void Service::IssueStartValueForecast() {
   }
   start_value_error_.clear();
   next_forecast_s_ = now + config_.forecast.refresh_min * 60.0;
-  WriteForecast(request, ForecastBasis::kStartValues, start.banded, start.inputs,
-                "start values, clear-sky index " + Format("%.2f", start.clear_sky_index));
+  WriteForecast(request, ForecastBasis::kStartValues, start.banded,
+                start.inputs + "; " + HistoryPart(measured),
+                "start values, clear-sky index " + Format("%.2f", start.clear_sky_index) + "; " +
+                    HistoryPart(measured));
 }
 
 bool Service::WriteForecast(const ForecastRequest& request, ForecastBasis basis,

@@ -34,6 +34,7 @@
 #include "daemon/service/service.h"
 #include "daemon/service/upload_worker.h"
 #include "daemon/service/weather_worker.h"
+#include "daemon/service/window_data.h"
 #include "io/modbus/modbus_poller.h"
 #include "io/platform/child_process.h"
 #include "io/store/store.h"
@@ -125,10 +126,12 @@ class Service {
   void IssueForecast();
   // Before the first accepted calibration (core/forecast/start_value_forecast.h).
   void IssueStartValueForecast();
-  // The history of the last history_s, the weather forecast and the plan
-  // over the horizon of `request`; false after logging.
-  bool ReadForecastInputs(const ForecastRequest& request, std::int64_t history_s, Series* history,
-                          Series* weather, Series* plan);
+  // The measured history of the history_s before now (the 1-min rows, else
+  // without one the interval rows at their own step: window_data.h), the
+  // request of an issue now at that history's step and on its grid, and the
+  // weather forecast and the plan over its horizon; false after logging.
+  bool ReadForecastInputs(double now_s, std::int64_t history_s, ForecastRequest* request,
+                          cli::WindowData* history, Series* weather, Series* plan);
   // Stores one issue and logs it (brief: the inputs in a few words); false
   // after logging.
   bool WriteForecast(const ForecastRequest& request, ForecastBasis basis,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/data/resample.h"
 #include "core/forecast/forecast.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
@@ -113,6 +114,40 @@ TEST(Forecast, WithoutPlanRunsTheMedianDayOfTheWindow) {
   EXPECT_EQ(f.inputs.operation_plan, 0u);
   EXPECT_EQ(f.inputs.operation_typical, 1440u);
   for (double v : f.inputs_used[Channel::kTInC]) ASSERT_EQ(v, 30.0);
+}
+
+// A history of 15-min interval rows (a coarser logger's, issue 53) is
+// forecast at 15 min: each row's weather from the weather_forecast table is
+// the mean of the table's minutes over the row's interval, as the measured
+// rows are means, not the table's value at the interval's start; the rows
+// then carry the energy of the minutes.
+TEST(Forecast, AtAFifteenMinuteStepTheWeatherForecastIsAveragedOverEachRow) {
+  const Case c;
+  Series history;
+  std::string error;
+  ASSERT_TRUE(Resample(c.Before(c.t_forecast), 900.0, &history, &error)) << error;
+  const Series minutes = c.From(c.t_forecast);
+  ForecastRequest request;
+  request.issued_at_s = c.t_forecast;
+  request.step_s = 900.0;
+  Forecast f;
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, history, minutes, Series{}, request, &f,
+                           &error))
+      << error;
+  ASSERT_EQ(f.rows.size(), 96u);
+  EXPECT_EQ(f.inputs.weather_forecast, 96u);
+  double energy_rows_wh = 0.0, energy_minutes_wh = 0.0, largest_start_gap_w_m2 = 0.0;
+  for (std::size_t k = 0; k < f.rows.size(); ++k) {
+    double sum = 0.0;
+    for (std::size_t m = 0; m < 15; ++m) sum += minutes[Channel::kGPoaWM2][15 * k + m];
+    ASSERT_NEAR(f.inputs_used[Channel::kGPoaWM2][k], sum / 15.0, 1e-9) << k;
+    largest_start_gap_w_m2 = std::max(
+        largest_start_gap_w_m2, std::fabs(sum / 15.0 - minutes[Channel::kGPoaWM2][15 * k]));
+    energy_rows_wh += f.inputs_used[Channel::kGPoaWM2][k] * 0.25;
+  }
+  for (std::size_t m = 0; m < 1440; ++m) energy_minutes_wh += minutes[Channel::kGPoaWM2][m] / 60.0;
+  EXPECT_GT(largest_start_gap_w_m2, 10.0);  // the start of an interval is not its mean
+  EXPECT_NEAR(energy_rows_wh, energy_minutes_wh, 1e-6 * energy_minutes_wh);
 }
 
 // The inputs column says, per channel, where the values came from, and names

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 
+#include "core/data/resample.h"
 #include "core/forecast/forecast.h"
 #include "core/forecast/forecast_bands.h"
 #include "core/forecast/operation_forecast.h"
@@ -191,6 +192,22 @@ TEST(PumpRule, StandsForADifferentialThermostat) {
   ASSERT_TRUE(ChooseOperation(m.plant, m.spec, m.truth, m.data, request, &choice, &error));
   EXPECT_EQ(choice.chosen, OperationForecast::kLearned) << choice.Describe();
   EXPECT_LT(choice.mae_q_th_learned_w, choice.mae_q_th_typical_w);
+}
+
+// Ten days of a 15-min logger (960 rows, fewer than a day of minutes) hold
+// the rule as well: a day of rows is counted at their step, and consecutive
+// 15-min rows are no gap that would restart the hysteresis at each row.
+TEST(PumpRule, IsLearnedFromFifteenMinuteRows) {
+  const Month m(10, 3);
+  Series rows;
+  std::string error;
+  ASSERT_TRUE(Resample(m.data, 900.0, &rows, &error)) << error;
+  const PumpRule rule = LearnPumpRule(m.plant, rows);
+  ASSERT_TRUE(rule.valid) << rule.Describe();
+  // A 15-min mean blurs the switch: within two steps of the grid.
+  EXPECT_NEAR(rule.g_on_w_m2, m.weather.pump_on_w_m2, 50.0) << rule.Describe();
+  EXPECT_NEAR(rule.g_off_w_m2, m.weather.pump_off_w_m2, 50.0) << rule.Describe();
+  EXPECT_GT(rule.accuracy, 0.9) << rule.Describe();
 }
 
 // Without enough data there is no rule, and the forecast keeps the typical day.

@@ -6,11 +6,14 @@
 // goes to measurement_interval at its own step: 1-min rows made from it
 // would invent what happened inside each interval. All are upserts, so
 // importing the same or overlapping data again leaves one row per time.
+// Then the closed days of forecast_skill whose minutes changed are
+// materialised again (Store::RefreshForecastSkill).
 #include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <optional>
 
+#include "core/common/clock.h"
 #include "daemon/commands/commands.h"
 #include "daemon/commands/inputs.h"
 #include "daemon/service/store_cli.h"
@@ -132,6 +135,19 @@ int ImportIntervals(Store& store, Series series, const std::string& csv) {
   return kExitOk;
 }
 
+// forecast_skill materialised again for the closed days the import changed
+// (their rows marked them dirty), so that its readers do not compute them
+// until the daemon's next daily checks.
+int RefreshSkill(Store& store) {
+  std::string error;
+  if (!store.RefreshForecastSkill(static_cast<std::int64_t>(WallNowS()), nullptr, &error)) {
+    std::cerr << "import: the rows are stored, but forecast_skill_day was not refreshed: " << error
+              << "\n";
+    return kExitRuntime;
+  }
+  return kExitOk;
+}
+
 enum class ImportKind { kSamples, kMinutes, kIntervals };
 
 // Where rows of this step go; nullopt (and the message) when nowhere.
@@ -177,15 +193,19 @@ int RunImport(const ImportArgs& a) {
   if (!OpenStoreOrReport(a.db.empty() ? config.storage.path : a.db, options, &store)) {
     return kExitRuntime;
   }
+  int code = kExitRuntime;
   switch (*kind) {
     case ImportKind::kSamples:
-      return ImportSamples(*store, series, a.csv);
+      code = ImportSamples(*store, series, a.csv);
+      break;
     case ImportKind::kMinutes:
-      return ImportMinutes(*store, series, a.csv);
+      code = ImportMinutes(*store, series, a.csv);
+      break;
     case ImportKind::kIntervals:
-      return ImportIntervals(*store, series, a.csv);
+      code = ImportIntervals(*store, series, a.csv);
+      break;
   }
-  return kExitRuntime;
+  return code == kExitOk ? RefreshSkill(*store) : code;
 }
 
 }  // namespace

@@ -218,10 +218,25 @@ void CheckDatasheetPower(Store& store, const DailyCheckInputs& in, const Series&
   }
 }
 
+// forecast_skill materialised for the days that ended since the last run
+// and those whose measurements or scored forecasts changed (an import, a
+// late forecast), so that a dashboard's reads compute only today.
+void RefreshSkill(Store& store, const DailyCheckInputs& in, LogLines* log) {
+  int days = 0;
+  std::string error;
+  if (!store.RefreshForecastSkill(in.now_s, &days, &error)) {
+    log->push_back({kErr, "daily checks: " + error});
+  } else if (days > 0) {
+    log->push_back({kInfo, "forecast_skill materialised for " + std::to_string(days) +
+                               (days == 1 ? " day" : " days")});
+  }
+}
+
 }  // namespace
 
 std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const DailyCheckInputs& in) {
   LogLines log;
+  RefreshSkill(store, in, &log);
   // One read for every check: from the first day of the calibration window
   // up to now, its 1-min rows or without them its interval rows at their
   // step (window_data.h).

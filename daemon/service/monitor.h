@@ -1,11 +1,11 @@
 // The daemon's daily checks (core/monitoring.h), run after each nightly
-// calibration: the performance index of every day of the window not yet
+// calibration: forecast_skill materialised for the days that ended or
+// changed, the performance index of every day of the window not yet
 // scored, sensor faults of the last two days, the drift of the accepted
 // parameters and the performance alarm, on the window's 1-min rows or,
 // without them, its measurement_interval rows at their step (window_data.h).
-// Results go to the store
-// (performance_daily, qc_event, monitor_event); what an operator must see is
-// also returned as log lines.
+// Results go to the store (forecast_skill_day, performance_daily, qc_event,
+// monitor_event); what an operator must see is also returned as log lines.
 #pragma once
 
 #include <cstdint>

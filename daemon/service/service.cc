@@ -232,6 +232,11 @@ int Service::Run() {
       if (!store_->ApplyRetention(static_cast<std::int64_t>(Now()),
                                   config_.storage.raw_retention_days, &error))
         LogToStderr(kWarning, "retention failed (retried in an hour): " + error);
+      // The daily checks materialise forecast_skill after the night's
+      // calibration; this covers the nights without one (a skipped or
+      // failed calibration) and costs nothing when there is nothing to do.
+      if (!store_->RefreshForecastSkill(static_cast<std::int64_t>(Now()), nullptr, &error))
+        LogToStderr(kWarning, "forecast_skill refresh failed (retried in an hour): " + error);
     }
     if (watchdog_s > 0 && WallNowS() >= next_watchdog_wall_s_) {
       NotifyWatchdog();

@@ -180,6 +180,22 @@
 //       the daemon marks that wait with one monitor_event of kind
 //       calibration_waiting, severity info.
 //
+// Version 11 adds (forecast_skill materialised per day; doc/sql.md):
+//   forecast_skill_day(day INTEGER PRIMARY KEY, <the columns of
+//                      forecast_skill after day>)
+//       forecast_skill's rows of closed UTC days, written by
+//       RefreshForecastSkill (store_skill.cc) and by the migration for the
+//       days before the current one.
+//   forecast_skill_dirty(day INTEGER PRIMARY KEY)
+//       materialised days changed since: triggers on measurement_1min
+//       (insert, update, delete) and on forecast (an issue the day scores,
+//       or scored, inserted, updated or deleted) mark them.
+//   forecast_skill_state(id = 1, done_before INTEGER)
+//       the 00:00 UTC of the first day not materialised.
+//   view forecast_skill keeps its columns and values: the materialised rows
+//       of clean days, and computed from the measurements only the days from
+//       done_before on and the dirty ones.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -211,7 +227,10 @@
 // forecast_skill, and the newest issue before the local day began, scored
 // by forecast_skill_local): hourly 24 h forecasts would otherwise add 1440
 // rows per hour (about 3 MiB a day, pvtwin-bench store), and the views
-// return the same rows before and after pruning.
+// return the same rows before and after pruning. The issues forecast_skill
+// scores stay after their day is materialised (a late import makes the day
+// dirty, and it is scored again from them); pruning an issue no day scores
+// marks nothing dirty.
 //
 // Threads: one Store is one connection, guarded by a mutex; another thread
 // (the calibration worker) may share it or, better for long reads, open its
@@ -233,7 +252,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 10;
+inline constexpr int kStoreSchemaVersion = 11;
 // NULL in a row struct.
 inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
@@ -459,6 +478,15 @@ class Store {
   // forecast_skill rows with from_day <= day < to_day (unix s of 00:00 UTC).
   bool ReadForecastSkill(std::int64_t from_day, std::int64_t to_day, std::vector<SkillRow>* out,
                          std::string* error);
+
+  // Materialises forecast_skill (schema version 11) in forecast_skill_day
+  // for every UTC day before the one of now_ts that is not materialised yet
+  // or is dirty (its measurements or scored forecasts changed since), in one
+  // transaction; *days_written (may be null) gets the rows written. The view
+  // is right without it: it computes the days not materialised from the
+  // measurements, which is what this spares its readers (meant to run
+  // daily, and after an import).
+  bool RefreshForecastSkill(std::int64_t now_ts, int* days_written, std::string* error);
 
   // Cells of weather_forecast or operation_plan that hold text (or a blob)
   // where a number belongs: what `sqlite3 .import` writes for an empty CSV

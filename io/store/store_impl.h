@@ -4,7 +4,8 @@
 // its migrations, store_samples.cc the measurements and forecast inputs,
 // store_forecast.cc calibrations, forecasts and their scores,
 // store_monitoring.cc events, sensor faults and diagnoses, store_local_day.cc
-// the local days of the configured zone. Not included
+// the local days of the configured zone, store_skill.cc the materialised
+// forecast_skill. Not included
 // outside io/store.
 #ifndef PVTWIN_IO_STORE_STORE_IMPL_H_
 #define PVTWIN_IO_STORE_STORE_IMPL_H_
@@ -84,6 +85,14 @@ inline std::string ColumnDefs(std::span<const Channel> channels) {
   for (const Channel c : channels) s += ", " + std::string(ChannelName(c)) + " REAL";
   return s;
 }
+
+// forecast_skill's SQL of schema version 11 (store_schema.cc), shared with
+// the refresh of forecast_skill_day (store_skill.cc): the day-ahead pairs
+// (columns day, err_p, meas_p, ...) of the measurement_1min rows m of the
+// FROM list `from` where `where`, and the view's columns per day from a CTE
+// `pairs` of them ("SELECT day, ... FROM pairs GROUP BY day").
+std::string SkillPairsV11(const std::string& from, const std::string& where);
+std::string SkillAggregatesV11();
 
 // The outcome of one database step: an SQLite result code and what was done.
 struct DbStatus {
@@ -340,6 +349,10 @@ struct Store::Impl {
   template <typename Row, typename FromStatement>
   bool ReadRows(const std::string& sql, const std::string& what, std::int64_t from, std::int64_t to,
                 FromStatement from_statement, std::vector<Row>* out, std::string* error);
+  // Materialises forecast_skill for the closed UTC days before now_ts's day
+  // that are dirty or not yet materialised (store_skill.cc; inside a
+  // transaction); *days_written += the rows written.
+  DbStatus RefreshForecastSkill(std::int64_t now_ts, int* days_written);
   // Deletes the forecast rows in [from_ts, to_ts) that no view uses.
   DbStatus PruneForecasts(std::int64_t from_ts, std::int64_t to_ts);
   bool ReadInputTable(const std::string& table, std::span<const Channel> channels,

@@ -389,13 +389,121 @@ std::vector<std::string> SchemaV10() {
   };
 }
 
+}  // namespace
+
+// Day-ahead pairs of version 11 (those of version 8) of the measurements
+// `from` (an SQL FROM list naming the measurement_1min row m) where `where`.
+std::string store_detail::SkillPairsV11(const std::string& from, const std::string& where) {
+  return " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day," + std::string(kSkillPairColumns) +
+         " FROM " + from +
+         " CROSS JOIN forecast f ON f.ts = m.ts"
+         "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+         "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
+         " WHERE (m.valid IS NULL OR m.valid != 0) AND " +
+         where;
+}
+
+std::string store_detail::SkillAggregatesV11() { return SkillAggregatesV8(); }
+
+namespace {
+
+// The first UTC day forecast_skill_day does not hold (version 11): closed
+// days before it are materialised unless forecast_skill_dirty names them.
+// Without a state row (a damaged store), none is.
+constexpr const char* kSkillDoneBefore =
+    "COALESCE((SELECT done_before FROM forecast_skill_state WHERE id = 1), "
+    "-9223372036854775807 - 1)";
+
+// The UTC day (00:00, unix s) of the SQL time expression t.
+std::string UtcDayOf(const std::string& t) {
+  return "(" + t + " - ((" + t + " % 86400) + 86400) % 86400)";
+}
+
+// Marks the UTC day of time `ts` (an OLD or NEW column) dirty when it is
+// materialised (before done_before) and `also` holds.
+std::string MarkDirty(const std::string& ts, const std::string& also) {
+  return " INSERT OR IGNORE INTO forecast_skill_dirty(day) SELECT " + UtcDayOf(ts) + " WHERE " +
+         ts + " < " + kSkillDoneBefore + " AND " + also + ";";
+}
+
+// Whether the forecast row `row` (OLD or NEW) is, or was, the issue
+// forecast_skill scores at its ts: issued at or before its UTC day began,
+// and no later such issue of that ts exists. A prune that deletes only
+// superseded issues marks nothing.
+std::string IsScoredIssue(const std::string& row) {
+  const std::string day = UtcDayOf(row + ".ts");
+  return row + ".issued_at <= " + day + " AND NOT EXISTS (SELECT 1 FROM forecast g WHERE g.ts = " +
+         row + ".ts AND g.issued_at > " + row + ".issued_at AND g.issued_at <= " + day + ")";
+}
+
+// forecast_skill of version 11: the materialised rows of clean closed days,
+// and the live computation (as version 8) of the rest only: the minutes
+// from done_before on and those of the dirty days.
+std::string ForecastSkillViewV11() {
+  const std::string done = kSkillDoneBefore;
+  return std::string("CREATE VIEW forecast_skill") + kSkillColumnsV8 +
+         " AS SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
+         "coverage_p10_p90, minutes, coverage_p_el, coverage_q_th FROM forecast_skill_day"
+         " WHERE day < " +
+         done +
+         " AND day NOT IN (SELECT day FROM forecast_skill_dirty)"
+         " UNION ALL SELECT * FROM (WITH pairs AS (" +
+         store_detail::SkillPairsV11("measurement_1min m", "m.ts >= " + done) + " UNION ALL" +
+         store_detail::SkillPairsV11(
+             "forecast_skill_dirty x CROSS JOIN measurement_1min m ON m.ts >= x.day AND m.ts < "
+             "x.day + 86400",
+             "x.day < " + done) +
+         ")" + SkillAggregatesV8() + ")";
+}
+
+// Version 11 (forecast_skill materialised per UTC day): forecast_skill_day
+// holds the rows of closed days (filled by Store::RefreshForecastSkill,
+// store_skill.cc), forecast_skill_dirty the materialised days whose
+// measurements or scored forecasts changed since (marked by triggers), and
+// forecast_skill_state the first day not yet materialised. The migration
+// materialises the days before the current UTC day (before the day after
+// the newest measurement, when that is earlier).
+std::vector<std::string> SchemaV11() {
+  std::vector<std::string> s = {
+      "CREATE TABLE forecast_skill_day(day INTEGER PRIMARY KEY, mae_p_el_w REAL, mae_q_th_w REAL, "
+      "nmae_p_el REAL, nmae_q_th REAL, skill_p_el REAL, skill_q_th REAL, coverage_p10_p90 REAL, "
+      "minutes INTEGER, coverage_p_el REAL, coverage_q_th REAL)",
+      "CREATE TABLE forecast_skill_dirty(day INTEGER PRIMARY KEY)",
+      "CREATE TABLE forecast_skill_state(id INTEGER PRIMARY KEY CHECK(id = 1), done_before "
+      "INTEGER NOT NULL)",
+      "INSERT INTO forecast_skill_state(id, done_before) SELECT 1, MIN(" +
+          UtcDayOf("CAST(strftime('%s', 'now') AS INTEGER)") + ", COALESCE(" +
+          UtcDayOf("MAX(ts)") + " + 86400, 0)) FROM measurement_1min",
+      "WITH pairs AS (" +
+          store_detail::SkillPairsV11("measurement_1min m", std::string("m.ts < ") + kSkillDoneBefore) +
+          ") INSERT INTO forecast_skill_day" + SkillAggregatesV8(),
+      "DROP VIEW forecast_skill",
+      ForecastSkillViewV11(),
+  };
+  const std::string any = "1";
+  s.push_back("CREATE TRIGGER forecast_skill_measurement_insert AFTER INSERT ON measurement_1min "
+              "BEGIN" + MarkDirty("NEW.ts", any) + " END");
+  s.push_back("CREATE TRIGGER forecast_skill_measurement_update AFTER UPDATE ON measurement_1min "
+              "BEGIN" + MarkDirty("OLD.ts", any) + MarkDirty("NEW.ts", any) + " END");
+  s.push_back("CREATE TRIGGER forecast_skill_measurement_delete AFTER DELETE ON measurement_1min "
+              "BEGIN" + MarkDirty("OLD.ts", any) + " END");
+  s.push_back("CREATE TRIGGER forecast_skill_forecast_insert AFTER INSERT ON forecast BEGIN" +
+              MarkDirty("NEW.ts", IsScoredIssue("NEW")) + " END");
+  s.push_back("CREATE TRIGGER forecast_skill_forecast_update AFTER UPDATE ON forecast BEGIN" +
+              MarkDirty("OLD.ts", "OLD.issued_at <= " + UtcDayOf("OLD.ts")) +
+              MarkDirty("NEW.ts", "NEW.issued_at <= " + UtcDayOf("NEW.ts")) + " END");
+  s.push_back("CREATE TRIGGER forecast_skill_forecast_delete AFTER DELETE ON forecast BEGIN" +
+              MarkDirty("OLD.ts", IsScoredIssue("OLD")) + " END");
+  return s;
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
 const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2},  {3, &SchemaV3}, {4, &SchemaV4},
                                  {5, &SchemaV5}, {6, &SchemaV6},  {7, &SchemaV7}, {8, &SchemaV8},
-                                 {9, &SchemaV9}, {10, &SchemaV10}};
+                                 {9, &SchemaV9}, {10, &SchemaV10}, {11, &SchemaV11}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 

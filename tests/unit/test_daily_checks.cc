@@ -8,6 +8,7 @@
 // all, newest first.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/synth/synthetic_plant.h"
@@ -84,6 +85,29 @@ class DailyChecks : public ::testing::Test {
   Config config_;
   std::unique_ptr<Store> store_;
 };
+
+// The daily checks materialise forecast_skill for the days that ended
+// (store schema 11): the view's rows of the scored days, now in
+// forecast_skill_day, and the view computes nothing before today.
+TEST_F(DailyChecks, ForecastSkillIsMaterialisedForTheDaysThatEnded) {
+  std::vector<Store::ForecastRow> rows;
+  for (std::int64_t t = kJune1; t < kJune1 + 2 * kDayS; t += 60) rows.push_back({t, 50.0, 300.0});
+  std::string error;
+  ASSERT_TRUE(store_->InsertForecast(kJune1 - 3600, 0, "test", rows, &error)) << error;
+  testing::RawDb db(dir_ / "pvtwin.db");
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 0.0);
+  const auto skill = db.Rows("SELECT * FROM forecast_skill ORDER BY day");
+  ASSERT_EQ(skill.size(), 2u) << "the issue before day 1 is the newest before day 2 too";
+  const auto log = RunDailyChecks(*store_, Inputs(false));
+  EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
+            static_cast<double>(kJune1 + kDays * kDayS));
+  EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill_day ORDER BY day"), skill);
+  EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill ORDER BY day"), skill);
+  const auto line = std::find_if(log.begin(), log.end(), [](const auto& l) {
+    return l.second == "forecast_skill materialised for 2 days";
+  });
+  EXPECT_NE(line, log.end());
+}
 
 TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
   const auto log = RunDailyChecks(*store_, Inputs(false));

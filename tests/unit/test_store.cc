@@ -12,6 +12,7 @@
 #include "core/common/units.h"
 #include "io/store/store.h"
 #include "tests/support/sqlite_db.h"
+#include "tests/support/store_schema_v10.h"
 
 namespace pvtwin {
 namespace {
@@ -154,9 +155,10 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   {
     RawDb db(DbPath());
     ASSERT_EQ(db.Exec("INSERT INTO forecast(issued_at, ts, p_el_w) VALUES(0, 60, 1)"), SQLITE_OK);
-    // Back to what version 1 wrote: without the tables and views of 2 to 10
+    // Back to what version 1 wrote: without the tables and views of 2 to 11
     // (version 1's two forecast views stand in as views of those names,
     // which version 6 replaces).
+    std::vector<std::string> downgrade = testing::DropSchemaV11();  // version 11
     for (const char* sql : {"DROP VIEW performance_daily_local",
                             "DROP VIEW forecast_skill_local",
                             "DROP TABLE local_day_zone",
@@ -187,8 +189,9 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
                             "DROP TABLE plant_config",
                             "DROP TABLE store_identity",
                             "PRAGMA user_version = 1"}) {
-      ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
+      downgrade.push_back(sql);
     }
+    for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
   }
   auto store = OpenStore();
   ASSERT_NE(store, nullptr);

@@ -143,6 +143,35 @@ TEST_F(StoreCli, ExportToAFullDiskLeavesNoPartialFile) {
   EXPECT_FALSE(std::filesystem::exists(dir_ / "e.csv.partial"));
 }
 
+// After its rows are stored, import materialises forecast_skill again for
+// the closed days they changed (store schema 11): here the day a forecast
+// written by another program had made dirty.
+TEST_F(StoreCli, ImportMaterialisesTheForecastSkillOfTheDaysItChanged) {
+  WriteRows("m.csv", Rows(kMinute0, 360, 60.0));  // 12:00 to 18:00 of 2024-06-01
+  ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
+  RawDb db(dir_ / "t.db");
+  const std::int64_t day = kMinute0 - 12 * 3600;
+  EXPECT_GT(db.Number("SELECT done_before FROM forecast_skill_state"), static_cast<double>(day))
+      << "the day is over, and materialised (without a score: no forecast yet)";
+  ASSERT_EQ(db.Exec("WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kMinute0) +
+                    " UNION ALL SELECT ts + 60 FROM t WHERE ts + 60 < " +
+                    std::to_string(kMinute0 + 360 * 60) +
+                    ") INSERT INTO forecast(issued_at, ts, p_el_w) SELECT " +
+                    std::to_string(day - 3600) + ", ts, 150 FROM t"),
+            SQLITE_OK);
+  EXPECT_EQ(db.Rows("SELECT day FROM forecast_skill_dirty"),
+            (std::vector<std::vector<std::string>>{{std::to_string(day)}}));
+  EXPECT_EQ(db.Number("SELECT minutes FROM forecast_skill"), 360.0) << "computed live";
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 0.0);
+  ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0);
+  EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill_day"), db.Rows("SELECT * FROM forecast_skill"));
+  // p_el_w = 100 … 459 W against 150 W: MAE = mean |150 − p|.
+  double mae_w = 0.0;
+  for (int i = 0; i < 360; ++i) mae_w += std::abs(150.0 - (100.0 + i)) / 360.0;
+  EXPECT_NEAR(db.Number("SELECT mae_p_el_w FROM forecast_skill_day"), mae_w, 1e-9);
+}
+
 TEST_F(StoreCli, FiveSecondTableExportsTheRawSamples) {
   WriteRows("a.csv", Rows(kMinute0, 24, 5.0));
   ASSERT_EQ(Pvtwin("import --csv a.csv --db t.db").exit_code, 0);

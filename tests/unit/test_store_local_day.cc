@@ -21,6 +21,7 @@
 #include "io/store/store.h"
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"
+#include "tests/support/store_schema_v10.h"
 
 namespace pvtwin {
 namespace {
@@ -463,15 +464,20 @@ TEST_F(StoreLocalDayTest, LocalDaysFollowTheZoneAndAreMadeAtMigration) {
     // Back to version 8: version 10's forecast.basis (its forecast_latest
     // stands in as a view of that name, which version 10 replaces), then
     // version 9's local days.
-    static_assert(kStoreSchemaVersion == 10, "take the new version's objects back here too");
+    static_assert(kStoreSchemaVersion == 11, "take the new version's objects back here too");
+    std::vector<std::string> downgrade = testing::DropSchemaV11();  // and its view:
+    downgrade.push_back("DROP VIEW forecast_skill");
+    downgrade.push_back(std::string("CREATE VIEW forecast_skill") + testing::kForecastSkillColumns +
+                        " AS " + testing::kForecastSkillV10);
     for (const char* sql :
          {"DROP VIEW forecast_latest", "DROP VIEW forecast_skill_local",
           "ALTER TABLE forecast DROP COLUMN basis",
           "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
           "DROP VIEW performance_daily_local", "DROP TABLE local_day_zone", "DROP TABLE local_day",
           "PRAGMA user_version = 8"}) {
-      ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
+      downgrade.push_back(sql);
     }
+    for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
   }
   ASSERT_NE(OpenIn("Europe/Vienna"), nullptr);
   RawDb db(DbPath());

@@ -12,6 +12,7 @@
 #include "io/store/store.h"
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"
+#include "tests/support/store_schema_v10.h"
 
 namespace pvtwin {
 namespace {
@@ -59,8 +60,9 @@ class StoreMigrationTest : public testing::TempDirTest {
     RawDb db(DbPath());
     // Each later version's objects go first (a new version adds its own
     // here), then version 8's.
-    static_assert(kStoreSchemaVersion == 10, "take the new version's objects back here too");
-    std::vector<std::string> downgrade = {
+    static_assert(kStoreSchemaVersion == 11, "take the new version's objects back here too");
+    std::vector<std::string> downgrade = testing::DropSchemaV11();
+    downgrade.insert(downgrade.end(), {
         "DROP VIEW performance_daily_local",
         "DROP VIEW forecast_skill_local",
         "DROP TABLE local_day_zone",
@@ -71,7 +73,7 @@ class StoreMigrationTest : public testing::TempDirTest {
         "ALTER TABLE forecast DROP COLUMN p_el_w_p50",
         "ALTER TABLE forecast DROP COLUMN q_th_w_p50",
         "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
-        "CREATE VIEW forecast_skill(day) AS SELECT ts FROM measurement_1min"};
+        "CREATE VIEW forecast_skill(day) AS SELECT ts FROM measurement_1min"});
     downgrade.push_back("PRAGMA user_version = 7");
     for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
   }

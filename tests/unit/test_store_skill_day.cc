@@ -1,0 +1,313 @@
+// forecast_skill materialised per UTC day (store schema version 11): the
+// view returns what version 10's query computes from the same rows, before
+// the refresh, after it and after a late import and a late forecast change
+// closed days; a prune marks nothing; after the refresh a year of 1-min
+// rows costs the view only today's minutes (counted in SQLite's virtual
+// machine steps and full-scan steps, and read in its query plan); the
+// migration from version 10 keeps the values. Real store files.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "io/store/store.h"
+#include "tests/support/sqlite_db.h"
+#include "tests/support/store_schema_v10.h"
+
+namespace pvtwin {
+namespace {
+
+using testing::RawDb;
+
+constexpr std::int64_t kDay = 86400;
+constexpr std::int64_t kDay0 = 1717200000;  // 2024-06-01T00:00:00Z
+
+// SQLite's counters of one query run to its end on its own connection.
+struct QueryCost {
+  long vm_steps = 0;        // SQLITE_STMTSTATUS_VM_STEP
+  long fullscan_steps = 0;  // SQLITE_STMTSTATUS_FULLSCAN_STEP
+  long rows = 0;
+};
+
+QueryCost CostOf(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  QueryCost cost;
+  EXPECT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr), SQLITE_OK)
+      << sql << ": " << sqlite3_errmsg(db);
+  while (stmt != nullptr && sqlite3_step(stmt) == SQLITE_ROW) ++cost.rows;
+  cost.vm_steps = sqlite3_stmt_status(stmt, SQLITE_STMTSTATUS_VM_STEP, 0);
+  cost.fullscan_steps = sqlite3_stmt_status(stmt, SQLITE_STMTSTATUS_FULLSCAN_STEP, 0);
+  sqlite3_finalize(stmt);
+  sqlite3_close_v2(db);
+  return cost;
+}
+
+// Rows of two queries are equal: the same days and NULLs, integers exactly,
+// reals to 1e-12 relative (a sum's order may differ between whole-table and
+// per-day aggregation).
+void ExpectSameRows(const std::vector<std::vector<std::string>>& actual,
+                    const std::vector<std::vector<std::string>>& expected, const std::string& what) {
+  ASSERT_EQ(actual.size(), expected.size()) << what;
+  for (std::size_t r = 0; r < actual.size(); ++r) {
+    ASSERT_EQ(actual[r].size(), expected[r].size()) << what;
+    for (std::size_t c = 0; c < actual[r].size(); ++c) {
+      const std::string& a = actual[r][c];
+      const std::string& e = expected[r][c];
+      if (a == e) continue;
+      ASSERT_NE(a, "NULL") << what << " row " << r << " column " << c << ": expected " << e;
+      ASSERT_NE(e, "NULL") << what << " row " << r << " column " << c << ": got " << a;
+      const double x = std::strtod(a.c_str(), nullptr), y = std::strtod(e.c_str(), nullptr);
+      EXPECT_LE(std::abs(x - y), 1e-12 * std::max(1.0, std::abs(y)))
+          << what << " day " << actual[r][0] << " column " << c << ": " << a << " vs " << e;
+    }
+  }
+}
+
+const std::string kViewRows = "SELECT * FROM forecast_skill ORDER BY day";
+const std::string kVersion10Rows = std::string(testing::kForecastSkillV10) + " ORDER BY day";
+
+class SkillDayTest : public testing::TempDirTest {
+ protected:
+  std::string DbPath() const { return (dir_ / "pvtwin.db").string(); }
+  std::unique_ptr<Store> Open() {
+    StoreOptions options;
+    options.log = nullptr;
+    std::string error;
+    std::unique_ptr<Store> store = Store::Open(DbPath(), options, &error);
+    EXPECT_NE(store, nullptr) << error;
+    return store;
+  }
+
+  // Measured minutes of [from, to): power that follows the sun's hours with
+  // a wobble, every 97th minute invalid.
+  static Series Minutes(std::int64_t from, std::int64_t to, double offset_w) {
+    Series s;
+    s.step_s = 60;
+    std::vector<double> p_el_w, q_th_w, valid;
+    for (std::int64_t t = from; t < to; t += 60) {
+      const double h = static_cast<double>(t % kDay) / 3600.0;
+      const double sun = std::max(0.0, std::sin((h - 6.0) / 12.0 * M_PI));
+      const auto x = static_cast<double>(t);
+      s.time_s.push_back(t);
+      p_el_w.push_back(offset_w + 400.0 * sun + 30.0 * std::sin(x / 700.0));
+      q_th_w.push_back(offset_w + 1200.0 * sun - 80.0 + 50.0 * std::cos(x / 900.0));
+      valid.push_back((t / 60) % 97 == 0 ? 0.0 : 1.0);
+    }
+    s[Channel::kPElW] = p_el_w;
+    s[Channel::kQThW] = q_th_w;
+    s[Channel::kValid] = valid;
+    return s;
+  }
+
+  // One issue at issued_at for [issued_at, issued_at + horizon_s), with
+  // bands, medians and the reference; `bias` shifts its values.
+  static std::vector<Store::ForecastRow> Issue(std::int64_t issued_at, std::int64_t horizon_s,
+                                               double bias) {
+    std::vector<Store::ForecastRow> rows;
+    for (std::int64_t t = issued_at; t < issued_at + horizon_s; t += 60) {
+      const double h = static_cast<double>(t % kDay) / 3600.0;
+      const double sun = std::max(0.0, std::sin((h - 6.0) / 12.0 * M_PI));
+      Store::ForecastRow r;
+      r.ts = t;
+      r.p_el_w = 390.0 * sun + bias;
+      r.q_th_w = 1150.0 * sun - 70.0 + 0.5 * bias;
+      r.p_el_w_p10 = r.p_el_w - 25.0;
+      r.p_el_w_p90 = r.p_el_w + 20.0;
+      r.q_th_w_p10 = r.q_th_w - 60.0;
+      r.q_th_w_p90 = r.q_th_w + 40.0;
+      r.p_el_w_p50 = r.p_el_w;
+      r.q_th_w_p50 = r.q_th_w;
+      r.p_el_w_ref = 350.0 * sun;
+      r.q_th_w_ref = 1000.0 * sun;
+      rows.push_back(r);
+    }
+    return rows;
+  }
+
+  // Measurements from day 0 to noon of day 3, and hourly issues 26 h
+  // ahead from 12 h before day 0.
+  void FillFourDays(Store* store) {
+    std::string error;
+    ASSERT_TRUE(store->WriteMinutes(Minutes(kDay0, kDay0 + 3 * kDay + kDay / 2, 0.0), &error))
+        << error;
+    for (std::int64_t issued = kDay0 - kDay / 2; issued < kDay0 + 3 * kDay + kDay / 2;
+         issued += 3600) {
+      const double bias = 10.0 * std::sin(static_cast<double>(issued) / 5000.0);
+      ASSERT_TRUE(store->InsertForecast(issued, 0, "test", Issue(issued, 26 * 3600, bias), &error))
+          << error;
+    }
+  }
+};
+
+// The view's rows equal version 10's query on the same rows at each stage;
+// a changed closed day is computed live until the refresh materialises it
+// again. Without the dirty marks the view would show the stale
+// materialised rows of days 1 and 2, which this test tells apart.
+TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAndALateImport) {
+  auto store = Open();
+  ASSERT_NE(store, nullptr);
+  ASSERT_NO_FATAL_FAILURE(FillFourDays(store.get()));
+  RawDb db(DbPath());
+  const auto v10_before = db.Rows(kVersion10Rows);
+  ASSERT_EQ(v10_before.size(), 4u) << "days 0 to 3 are scored";
+  ExpectSameRows(db.Rows(kViewRows), v10_before, "before the refresh");
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 0.0);
+
+  const std::int64_t now = kDay0 + 3 * kDay + kDay / 2;  // noon of day 3
+  int written = 0;
+  std::string error;
+  ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
+  EXPECT_EQ(written, 3) << "the closed days 0, 1 and 2";
+  EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
+            static_cast<double>(kDay0 + 3 * kDay));
+  ExpectSameRows(db.Rows(kViewRows), db.Rows(kVersion10Rows), "after the refresh");
+  ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
+  EXPECT_EQ(written, 0) << "nothing more to do: no day written again";
+
+  // A late import of day 1's morning and a late forecast issued at 00:00 of
+  // day 2 (the newest at or before the day began) change two closed days.
+  const std::int64_t day1 = kDay0 + kDay, day2 = kDay0 + 2 * kDay;
+  ASSERT_TRUE(store->WriteMinutes(Minutes(day1 + 6 * 3600, day1 + 9 * 3600, 60.0), &error))
+      << error;
+  ASSERT_TRUE(store->InsertForecast(day2, 0, "late", Issue(day2, kDay, -40.0), &error)) << error;
+  EXPECT_EQ(db.Rows("SELECT day FROM forecast_skill_dirty ORDER BY day"),
+            (std::vector<std::vector<std::string>>{{std::to_string(day1)},
+                                                   {std::to_string(day2)}}));
+  const auto v10_late = db.Rows(kVersion10Rows);
+  ExpectSameRows(db.Rows(kViewRows), v10_late, "after the late import");
+  for (const std::int64_t day : {day1, day2}) {
+    const std::string where = " WHERE day = " + std::to_string(day);
+    EXPECT_NE(db.Text("SELECT mae_p_el_w FROM forecast_skill_day" + where),
+              db.Text("SELECT mae_p_el_w FROM forecast_skill" + where))
+        << "the materialised row of day " << day << " is stale until the refresh";
+  }
+  written = 0;
+  ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
+  EXPECT_EQ(written, 2);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0);
+  ExpectSameRows(db.Rows(kViewRows), v10_late, "after the second refresh");
+
+  // Pruning superseded issues changes no score, so it marks no day dirty.
+  const double rows_before = db.Number("SELECT COUNT(*) FROM forecast");
+  ASSERT_TRUE(store->PruneForecasts(kDay0 - kDay, now + 2 * kDay, &error)) << error;
+  EXPECT_LT(db.Number("SELECT COUNT(*) FROM forecast"), rows_before / 2);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0);
+  ExpectSameRows(db.Rows(kViewRows), v10_late, "after the prune");
+  ExpectSameRows(db.Rows(kVersion10Rows), v10_late, "version 10's query after the prune");
+
+  // Deleting a scored forecast row of a closed day does change its score.
+  ASSERT_EQ(db.Exec("DELETE FROM forecast WHERE issued_at = " + std::to_string(day2) +
+                    " AND ts = " + std::to_string(day2 + 12 * 3600)),
+            SQLITE_OK);
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 1.0);
+  ExpectSameRows(db.Rows(kViewRows), db.Rows(kVersion10Rows), "after deleting a scored row");
+}
+
+// A year of 1-min rows and one issue a day, made by SQL in one statement
+// each. After the refresh the view computes today's minutes only: its
+// virtual machine steps stay below those of one more whole day computed
+// live, a small fraction of version 10's query over the year, and it scans
+// no table of minutes in full.
+TEST_F(SkillDayTest, AfterTheRefreshAYearCostsTheViewOnlyTodaysMinutes) {
+  const std::int64_t today = kDay0 + 365 * kDay;
+  const std::int64_t now = today + kDay / 2;
+  {
+    auto store = Open();
+    ASSERT_NE(store, nullptr);
+  }
+  RawDb db(DbPath());
+  const std::string minutes =
+      "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kDay0) + " UNION ALL SELECT ts + 60 " +
+      "FROM t WHERE ts + 60 < " + std::to_string(now) + ") ";
+  ASSERT_EQ(db.Exec(minutes +
+                    "INSERT INTO measurement_1min(ts, p_el_w, q_th_w, valid) SELECT ts, "
+                    "100 + (ts / 60 * 7919) % 250, 400 + (ts / 60 * 104729) % 450, 1 FROM t"),
+            SQLITE_OK);
+  ASSERT_EQ(db.Exec(minutes +
+                    "INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w, p_el_w_p10, p_el_w_p90, "
+                    "q_th_w_p10, q_th_w_p90, p_el_w_ref, q_th_w_ref) SELECT ts - ts % 86400 - "
+                    "3600, ts, 210, 590, 150, 260, 400, 800, 200, 600 FROM t"),
+            SQLITE_OK);
+  {
+    auto store = Open();
+    int written = 0;
+    std::string error;
+    ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
+    EXPECT_EQ(written, 365);
+  }
+  const std::string view = "SELECT * FROM forecast_skill";
+  const QueryCost cost = CostOf(DbPath(), view);
+  EXPECT_EQ(cost.rows, 366) << "365 materialised days and today";
+  const QueryCost year = CostOf(DbPath(), testing::kForecastSkillV10);
+  EXPECT_EQ(year.rows, 366);
+  // Yesterday made dirty: the view computes one more whole day live.
+  ASSERT_EQ(db.Exec("UPDATE measurement_1min SET p_el_w = p_el_w + 1 WHERE ts = " +
+                    std::to_string(today - 3600)),
+            SQLITE_OK);
+  const QueryCost with_yesterday = CostOf(DbPath(), view);
+  EXPECT_EQ(with_yesterday.rows, 366);
+  const long one_day = with_yesterday.vm_steps - cost.vm_steps;
+  EXPECT_LT(cost.vm_steps, one_day) << "today's half day costs less than one whole day";
+  EXPECT_LT(100 * cost.vm_steps, year.vm_steps) << "version 10's query computes 365.5 days";
+  EXPECT_LT(cost.fullscan_steps, 1440) << "no table of minutes is scanned in full";
+  EXPECT_GT(year.fullscan_steps, 365 * 1440);
+  std::printf("forecast_skill over a year: view %ld VM steps (%ld full-scan), with yesterday "
+              "dirty %ld, version 10's query %ld (%ld full-scan)\n",
+              cost.vm_steps, cost.fullscan_steps, with_yesterday.vm_steps, year.vm_steps,
+              year.fullscan_steps);
+  // The query plan reaches measurement_1min by its key only.
+  const auto plan = db.Rows("EXPLAIN QUERY PLAN " + view);
+  int searches = 0;
+  for (const auto& row : plan) {
+    const std::string detail = row.back() + " ";  // the view names measurement_1min m
+    EXPECT_NE(detail.rfind("SCAN m ", 0), 0u) << detail;
+    searches += detail.rfind("SEARCH m USING INTEGER PRIMARY KEY", 0) == 0;
+  }
+  EXPECT_EQ(searches, 2) << "the minutes from done_before on, and those of the dirty days";
+}
+
+// A version 10 store is migrated with its closed days materialised, and the
+// view returns what version 10's did.
+TEST_F(SkillDayTest, MigratingFromVersionTenMaterialisesTheDaysAndKeepsTheValues) {
+  {
+    auto store = Open();
+    ASSERT_NE(store, nullptr);
+    ASSERT_NO_FATAL_FAILURE(FillFourDays(store.get()));
+  }
+  std::vector<std::vector<std::string>> v10;
+  {
+    RawDb db(DbPath());
+    std::vector<std::string> downgrade = testing::DropSchemaV11();
+    downgrade.push_back("DROP VIEW forecast_skill");
+    downgrade.push_back(std::string("CREATE VIEW forecast_skill") + testing::kForecastSkillColumns +
+                        " AS " + testing::kForecastSkillV10);
+    downgrade.push_back("PRAGMA user_version = 10");
+    for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
+    v10 = db.Rows(kViewRows);
+    ASSERT_EQ(v10.size(), 4u);
+  }
+  auto store = Open();
+  ASSERT_NE(store, nullptr);
+  EXPECT_EQ(store->upgrade().from_version, 10);
+  EXPECT_EQ(store->upgrade().to_version, 11);
+  RawDb db(DbPath());
+  // The stored days end on day 3, long over: all four are materialised.
+  EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 4.0);
+  EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
+            static_cast<double>(kDay0 + 4 * kDay));
+  ExpectSameRows(db.Rows(kViewRows), v10, "after the migration");
+  ExpectSameRows(db.Rows("SELECT * FROM forecast_skill_day ORDER BY day"), v10,
+                 "the materialised rows");
+  RawDb copy(store->upgrade().backup_path);
+  EXPECT_EQ(copy.Number("PRAGMA user_version"), 10.0);
+}
+
+}  // namespace
+}  // namespace pvtwin

@@ -1,7 +1,9 @@
-// The diagnosis names a sensor fault that is plausible on every row: the
-// inlet temperature reading high by a constant from one day on (the heat
-// meter then reads ṁ·c_p·ΔT low), with its channel, onset and size, and
-// names none on the same plant without it.
+// The diagnosis names sensor faults that are plausible on every row, with
+// channel, kind, onset and size, and names none on the same plant without
+// them: the inlet temperature reading high by a constant from one day on
+// (the heat meter then reads ṁ·c_p·ΔT low: offset_step); the logged outlet
+// reading low from one day on, seen with the pump on at night (pair_offset);
+// the flow meter reading 10 % high from one day on (scale).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -15,21 +17,40 @@
 namespace pvtwin {
 namespace {
 
-Series Plant21Days(const Plant& plant, double offset_k, std::int64_t* onset_s) {
+// 21 days of 1N1Cwr data with `kind` of `severity` from the third held-out
+// day (severity 0: none); with night_pumping the pump runs day and night
+// while the absorber is warmer than the brine (a heat pump's source field).
+Series Plant21Days(const Plant& plant, DisturbanceKind kind, double severity,
+                   std::int64_t* onset_s, bool night_pumping = false) {
   SyntheticOptions synth;
   std::string error;
   EXPECT_TRUE(DefaultSyntheticOptions(plant, "1N1Cwr", 21, 3, &synth, &error)) << error;
+  if (night_pumping) {
+    synth.weather.pump_control = PumpControl::kHeatPumpSource;
+    synth.weather.heat_pump_from_h = 0.0;
+    synth.weather.heat_pump_to_h = 24.0;
+  }
   const std::int64_t offset_s = SolarDayOffsetS(plant);
   const std::int64_t first = SolarDayStartS(synth.weather.start_time_s, offset_s) + kSecondsPerDay;
   synth.weather.start_time_s = first;
   *onset_s = first + 16 * kSecondsPerDay;  // the third held-out day
-  if (offset_k != 0.0) {
-    synth.disturbances.push_back(
-        {DisturbanceKind::kInletSensorOffset, *onset_s, first + 30 * kSecondsPerDay, offset_k});
+  if (severity != 0.0) {
+    synth.disturbances.push_back({kind, *onset_s, first + 30 * kSecondsPerDay, severity});
   }
   Series s = MakeSyntheticPlantData(plant, synth);
   ApplyPaperCorrections(&s);
   return s;
+}
+
+Series Plant21Days(const Plant& plant, double offset_k, std::int64_t* onset_s) {
+  return Plant21Days(plant, DisturbanceKind::kInletSensorOffset, offset_k, onset_s);
+}
+
+const SensorFinding* FindKind(const DiagnosisResult& r, const std::string& kind) {
+  for (const SensorFinding& f : r.sensors) {
+    if (f.kind == kind) return &f;
+  }
+  return nullptr;
 }
 
 DiagnosisResult DiagnoseSoilingOnly(const Series& s, const Plant& plant) {
@@ -57,6 +78,7 @@ TEST(DiagnosisSensors, InletOffsetFromOneDayOnIsNamedWithChannelOnsetAndSize) {
   EXPECT_GT(step->size, 0.75);  // the model's own response to the high inlet absorbs a part
   EXPECT_LT(step->size, 1.8);
   EXPECT_NE(r.verdict_sentence.find("t_in_c offset_step from"), std::string::npos);
+  EXPECT_EQ(FindKind(r, "scale"), nullptr) << "an offset is not a flow meter scale";
 }
 
 TEST(DiagnosisSensors, NoOffsetStepOnTheSamePlantWithoutIt) {
@@ -64,6 +86,53 @@ TEST(DiagnosisSensors, NoOffsetStepOnTheSamePlantWithoutIt) {
   std::int64_t onset_s = 0;
   const DiagnosisResult r = DiagnoseSoilingOnly(Plant21Days(plant, 0.0, &onset_s), plant);
   for (const SensorFinding& f : r.sensors) EXPECT_NE(f.kind, "offset_step") << f.detail;
+}
+
+TEST(DiagnosisSensors, OutletOffsetWithThePumpOnAtNightIsNamedAsThePair) {
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  const DiagnosisResult r = DiagnoseSoilingOnly(
+      Plant21Days(plant, DisturbanceKind::kOutletSensorOffset, -0.8, &onset_s, true), plant);
+  const SensorFinding* pair = FindKind(r, "pair_offset");
+  ASSERT_NE(pair, nullptr) << r.verdict_sentence;
+  EXPECT_EQ(pair->channel, "t_in_c,t_out_c");
+  EXPECT_EQ(pair->from, SolarDate(onset_s, SolarDayOffsetS(plant)));
+  EXPECT_NEAR(pair->size, -0.8, 0.2);  // an outlet offset shows in full
+  // The heat meter has its own pair: Q_u is right, no other fault is named.
+  EXPECT_EQ(FindKind(r, "offset_step"), nullptr);
+  EXPECT_EQ(FindKind(r, "scale"), nullptr);
+  // As qc_event rows: from the onset to the end given.
+  const std::vector<SensorFault> rows = DiagnosedSensorFaults(r, onset_s + 10 * kSecondsPerDay);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].channel, "t_in_c,t_out_c");
+  EXPECT_EQ(rows[0].kind, "pair_offset");
+  EXPECT_EQ(rows[0].start_s, onset_s);
+}
+
+TEST(DiagnosisSensors, FlowMeterScaleFromOneDayOnIsNamedWithItsRatio) {
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  const DiagnosisResult r = DiagnoseSoilingOnly(
+      Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 1.1, &onset_s, true), plant);
+  const SensorFinding* scale = FindKind(r, "scale");
+  ASSERT_NE(scale, nullptr) << r.verdict_sentence;
+  EXPECT_EQ(scale->channel, "flow_kg_s");
+  EXPECT_EQ(scale->from, SolarDate(onset_s, SolarDayOffsetS(plant)));
+  EXPECT_GT(scale->size, 1.06);
+  EXPECT_LT(scale->size, 1.14);
+  EXPECT_EQ(FindKind(r, "offset_step"), nullptr) << "a scale is not an inlet offset";
+  EXPECT_NE(r.verdict_sentence.find("flow_kg_s scale from"), std::string::npos);
+}
+
+TEST(DiagnosisSensors, NoResidualSensorFaultOnAPlantPumpingAtNightWithoutOne) {
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  const DiagnosisResult r = DiagnoseSoilingOnly(
+      Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 0.0, &onset_s, true), plant);
+  for (const SensorFinding& f : r.sensors) {
+    EXPECT_TRUE(f.kind != "offset_step" && f.kind != "pair_offset" && f.kind != "scale")
+        << f.channel << " " << f.kind << ": " << f.detail;
+  }
 }
 
 }  // namespace

@@ -84,7 +84,14 @@ std::vector<SelftestCase> SelftestCases(const Plant& plant) {
   cases.push_back({"stuck_flow_reading", "unknown", plain, plain, truth,
                    DisturbanceKind::kStuckFlowReading, 0.0});
   cases.push_back({"snow_cover", "unknown", plain, plain, truth, DisturbanceKind::kSnowCover, 0.0});
-  // Sensor faults from the third held-out day on. The logged outlet reads
+  // Sensor faults from the third held-out day on. The inlet reads 1.5 K high
+  // and the heat meter, which uses the logged pair, reads ṁ·c_p·1.5 K low.
+  SelftestCase inlet{"tin_offset", "unknown", plain, plain, truth,
+                     DisturbanceKind::kInletSensorOffset, 1.5};
+  inlet.sensor_channel = "t_in_c";
+  inlet.sensor_kind = "offset_step";
+  cases.push_back(inlet);
+  // The logged outlet reads
   // 0.8 K low on a field that pumps at night (the heat meter's own pair is
   // right: the model sees no gap, only the pair at night disagrees).
   SelftestCase pair{"tout_offset_night", "none", plain, plain, truth,
@@ -99,6 +106,10 @@ std::vector<SelftestCase> SelftestCases(const Plant& plant) {
   scale.sensor_channel = "flow_kg_s";
   scale.sensor_kind = "scale";
   cases.push_back(scale);
+  // No fault on a field that pumps at night: the pair check's null case.
+  SelftestCase night{"null_night_pumping", "none", plain, plain, truth, std::nullopt, 0.0};
+  night.night_pumping = true;
+  cases.push_back(night);
   return cases;
 }
 
@@ -108,7 +119,8 @@ std::vector<SelftestCase> OtherFormSelftestCases(const Plant& plant) {
     c.form = TruthForm::kOtherForm;
     const EffectModule* effect = FindEffect(c.expected);
     if (effect != nullptr && effect->other_truth == nullptr) continue;
-    if (!c.sensor_kind.empty()) continue;  // the same data as its same-form case
+    // Sensor cases and their null case: the same data as in the same-form battery.
+    if (!c.sensor_kind.empty() || c.night_pumping) continue;
     cases.push_back(c);
   }
   // The same effects and the null case in autumn: 2024-10-01 00:00 UTC.

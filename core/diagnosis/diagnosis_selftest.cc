@@ -186,8 +186,12 @@ Series SelftestData(const Plant& plant, const SelftestCase& c, std::uint64_t see
   }
   std::vector<std::int64_t> days;
   if (c.disturbance && !c.sensor_kind.empty()) {
-    const std::int64_t onset =
-        first + static_cast<std::int64_t>(options.train_days + 2) * kSecondsPerDay;
+    // The third held-out day, or earlier so that 5 days follow it: the day-step
+    // test's smallest p with m of n days after the onset is 2·m!(n−m)!/n!
+    // times the n − 3 splits it tries, above alpha with 3 of 15 days.
+    const int onset_day =
+        std::min(options.train_days + 2, options.train_days + options.heldout_days - 5);
+    const std::int64_t onset = first + static_cast<std::int64_t>(onset_day) * kSecondsPerDay;
     const std::int64_t end =
         first + static_cast<std::int64_t>(options.train_days + options.heldout_days + 1) *
                     kSecondsPerDay;

@@ -58,7 +58,8 @@ struct SelftestCase {
   // midnight); 0 = the generator's default, 1 June.
   std::int64_t start_time_s = 0;
   // A sensor fault case: the disturbance (a reading, the physics untouched)
-  // acts from the third held-out day to the end of the data, and the case is
+  // acts from the third held-out day (earlier when fewer than 5 days would
+  // follow it) to the end of the data, and the case is
   // correct only when `sensors` names it with this channel and kind from
   // that day (the verdict as `expected`).
   std::string sensor_channel{}, sensor_kind{};

@@ -6,12 +6,20 @@
 // the flow meter reading 10 % high from one day on (scale).
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
 
 #include "core/common/calendar.h"
 #include "core/data/qc.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/synth/synthetic_plant.h"
+#include "io/platform/time_format.h"
+#include "io/store/store.h"
+#include "tests/support/run_pvtwin.h"
+#include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
@@ -133,6 +141,58 @@ TEST(DiagnosisSensors, NoResidualSensorFaultOnAPlantPumpingAtNightWithoutOne) {
     EXPECT_TRUE(f.kind != "offset_step" && f.kind != "pair_offset" && f.kind != "scale")
         << f.channel << " " << f.kind << ": " << f.detail;
   }
+}
+
+// The daemon's nightly diagnosis (`pvtwin diagnose --db … --record`) puts a
+// fault found in the residuals into qc_event with its onset, as report.json's
+// `sensors` names it; without --record nothing is written.
+TEST(DiagnosisSensors, RecordPutsTheFlowMeterScaleIntoQcEventFromItsOnset) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("pvtwin_sensors_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  Series s = Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 1.1, &onset_s);
+  // The store keeps minute starts: every row later by under a minute, each
+  // in the solar day it was in.
+  const std::int64_t late_s = (60 - s.time_s.front() % 60) % 60;
+  for (std::int64_t& t : s.time_s) t += late_s;
+  std::string error;
+  {
+    std::unique_ptr<Store> store = Store::Open((dir / "t.db").string(), &error);
+    ASSERT_TRUE(store) << error;
+    ASSERT_TRUE(store->WriteMinutes(s, &error)) << error;
+  }
+  const std::string config =
+      "'" + (fs::path(PVTWIN_GOLDEN_DIR) / ".." / ".." / "config" / "examples" / "plant.toml")
+                .string() + "'";
+  const std::string args = "diagnose --config " + config + " --db t.db --variant 1N1Cwr" +
+                           " --train-days 14 --heldout-days 7 --effects soiling --from " +
+                           FormatIsoUtc(s.time_s.front()) + " --to " +
+                           FormatIsoUtc(s.time_s.back() + 60) + " --report out";
+  const testing::ProcessResult read_only = testing::RunPvtwin(dir, args);
+  ASSERT_EQ(read_only.exit_code, 0) << read_only.err;
+  {
+    testing::RawDb db(dir / "t.db");
+    EXPECT_EQ(db.Number("SELECT COUNT(*) FROM qc_event"), 0.0);
+  }
+  const testing::ProcessResult run = testing::RunPvtwin(dir, args + " --record");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(testing::ReadFile(dir / "out" / "report.json"));
+  bool in_report = false;
+  for (const auto& f : j.at("sensors")) {
+    in_report = in_report || (f.at("channel") == "flow_kg_s" && f.at("kind") == "scale" &&
+                              f.at("from") == SolarDate(onset_s, SolarDayOffsetS(plant)));
+  }
+  EXPECT_TRUE(in_report) << j.at("sensors").dump();
+  testing::RawDb db(dir / "t.db");
+  const auto rows = db.Rows(
+      "SELECT channel, start_ts FROM qc_event WHERE kind = 'scale' ORDER BY start_ts");
+  ASSERT_EQ(rows.size(), 1u) << run.err;
+  EXPECT_EQ(rows[0][0], "flow_kg_s");
+  EXPECT_EQ(rows[0][1], std::to_string(onset_s));
+  fs::remove_all(dir);
 }
 
 }  // namespace

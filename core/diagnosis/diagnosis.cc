@@ -54,6 +54,12 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
   if (!(min_temperature_offset_k >= 0.0)) {
     out << "min_temperature_offset_k = " << min_temperature_offset_k << ": must be ≥ 0; ";
   }
+  if (!(sensor_night_g_w_m2 >= 0.0)) {
+    out << "sensor_night_g_w_m2 = " << sensor_night_g_w_m2 << ": must be ≥ 0; ";
+  }
+  if (!(min_flow_scale_error >= 0.0 && min_flow_scale_error < 1.0)) {
+    out << "min_flow_scale_error = " << min_flow_scale_error << ": must be in [0, 1); ";
+  }
   if (max_ladder_steps < 1) out << "max_ladder_steps = " << max_ladder_steps << ": must be ≥ 1; ";
   if (!(unknown_noise_ratio > 1.0)) {
     out << "unknown_noise_ratio = " << unknown_noise_ratio << ": must be > 1; ";
@@ -134,14 +140,14 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   trials.progress = progress;
   trials.extrapolation = &r.extrapolation;
   const st::LadderModel final_model = st::RunLadder(trials, base, &r);
-  // The offset step is looked for in the residuals of the final model: a
+  // The residual sensor checks read the residuals of the final model: a
   // base model that lacks a large effect leaves day-to-day structure that a
   // step can fit (final-check seed 31, other-form wind in October: a false
   // t_out_c step with the base 1N1Cr fitted on all days).
-  if (std::optional<SensorFinding> step = st::FindInletOffsetStep(
-          data, split, plant, final_model.spec, final_model.params, options, progress)) {
-    r.sensors.insert(r.sensors.begin(), std::move(*step));
-  }
+  std::vector<SensorFinding> steps = st::FindResidualSensorFaults(
+      data, split, plant, final_model.spec, final_model.params, options, progress);
+  r.sensors.insert(r.sensors.begin(), std::make_move_iterator(steps.begin()),
+                   std::make_move_iterator(steps.end()));
   ++r.identifications;
 
   if (!st::EstimateNoiseFloor(split, plant, final_model, &r, error)) return false;

@@ -54,6 +54,7 @@
 #include "core/diagnosis/gap_localisation.h"
 #include "core/fit/identification.h"
 #include "core/model/variant.h"
+#include "core/monitor/monitoring.h"
 
 namespace pvtwin {
 
@@ -122,6 +123,17 @@ struct DiagnosisOptions {
   // Smallest step that is a sensor fault, K: twice the tolerance of a
   // class-A Pt100 at 25 °C (IEC 60751: ±(0.15 + 0.002·|T|) K).
   double min_temperature_offset_k = 0.4;
+  // The pair check at night (sensor_pair_night.cc) reads rows with flow and
+  // in-plane irradiance at most this, W/m²: 5 W/m² absorbed at η0 ≈ 0.5
+  // warms the fluid by under 0.1 K even at 30 % of a nominal 0.02 kg/(s·m²),
+  // a quarter of min_temperature_offset_k, and the model's optics (whose
+  // errors dominate daytime residuals) are out of the residual.
+  double sensor_night_g_w_m2 = 5.0;
+  // Smallest step of measured / modelled Q_u, |k − 1|, that is a flow meter
+  // scale error (sensor_flow_scale.cc): the maximum permissible error of an
+  // EN 1434 class-2 heat meter near its nominal flow (flow sensor 2–4 %,
+  // temperature pair and calculator ≈ 1 %) is under 5 %.
+  double min_flow_scale_error = 0.05;
   // A free parameter that ends a fit (the base model's, a candidate's) at a
   // bound of Table 3's range is re-fitted within the hull of that range and
   // its physical range (core/common/physical_ranges.h), from the first fit;
@@ -145,15 +157,22 @@ struct DiagnosisOptions {
 // monitoring.h, FindSensorFaults, over all days), one per channel and kind.
 struct SensorFinding {
   std::string channel;         // canonical name, "time" for a clock shift
-  std::string kind;            // sky_warmer_than_air, frozen, missing, above_clear_sky, …
+  std::string kind;  // sky_warmer_than_air, frozen, missing, above_clear_sky, offset_step,
+                     // pair_offset (channel "t_in_c,t_out_c"), scale (flow_kg_s), …
   std::size_t rows = 0;        // rows in the flagged intervals
   double share = 0.0;          // of all rows
   double size = std::nan("");  // sky_warmer_than_air: median sky − air on those rows, K;
-                               // offset_step: the step, K
-  std::string from;            // offset_step: the solar day it starts (YYYY-MM-DD), else ""
-  std::int64_t from_s = 0;     // … its start, unix s
+                               // offset_step: the step, K; pair_offset: the step of
+                               // (T_out − T_in) logged − model at night, K, signed;
+                               // scale: measured / true flow (measured / modelled Q_u)
+  std::string size_unit = "K";  // of size: "K", or "" for a ratio (scale)
+  std::string from;  // offset_step, pair_offset, scale: the solar day it starts (YYYY-MM-DD)
+  std::int64_t from_s = 0;  // … its start, unix s (0: no onset)
   std::string detail;          // the first interval's sentence, and how many there are
 };
+
+// The finding's size with its unit: "1.4 K", "× 1.100" (sensors.cc).
+std::string SensorSizeText(const SensorFinding& f);
 
 // A driver of the model whose held-out values lie outside what the training
 // days showed (share_outside of the held-out objective rows beyond the
@@ -340,6 +359,11 @@ struct GapBias {
   double share_p_el = 0.0, share_q_th = 0.0;
 };
 GapBias BaseModelBias(const DiagnosisResult& result);
+
+// The findings of the residual sensor checks (those with an onset) as
+// qc_event rows from their onset to end_s (sensors.cc); the monitor's own
+// checks are recorded by the daemon's daily run.
+std::vector<SensorFault> DiagnosedSensorFaults(const DiagnosisResult& result, std::int64_t end_s);
 
 // Runs the diagnosis of `base` on `data`. Returns false with *error when it
 // cannot run: invalid options, a step the data cannot be averaged to, missing

@@ -84,6 +84,32 @@ std::vector<SelftestCase> SelftestCases(const Plant& plant) {
   cases.push_back({"stuck_flow_reading", "unknown", plain, plain, truth,
                    DisturbanceKind::kStuckFlowReading, 0.0});
   cases.push_back({"snow_cover", "unknown", plain, plain, truth, DisturbanceKind::kSnowCover, 0.0});
+  // Sensor faults from the third held-out day on. The inlet reads 1.5 K high
+  // and the heat meter, which uses the logged pair, reads ṁ·c_p·1.5 K low.
+  SelftestCase inlet{"tin_offset", "unknown", plain, plain, truth,
+                     DisturbanceKind::kInletSensorOffset, 1.5};
+  inlet.sensor_channel = "t_in_c";
+  inlet.sensor_kind = "offset_step";
+  cases.push_back(inlet);
+  // The logged outlet reads
+  // 0.8 K low on a field that pumps at night (the heat meter's own pair is
+  // right: the model sees no gap, only the pair at night disagrees).
+  SelftestCase pair{"tout_offset_night", "none", plain, plain, truth,
+                    DisturbanceKind::kOutletSensorOffset, -0.8};
+  pair.sensor_channel = "t_in_c,t_out_c";
+  pair.sensor_kind = "pair_offset";
+  pair.night_pumping = true;
+  cases.push_back(pair);
+  // The flow meter reads 10 % high (and the heat meter with it).
+  SelftestCase scale{"flow_scale", "unknown", plain, plain, truth,
+                     DisturbanceKind::kFlowMeterScale, 1.1};
+  scale.sensor_channel = "flow_kg_s";
+  scale.sensor_kind = "scale";
+  cases.push_back(scale);
+  // No fault on a field that pumps at night: the pair check's null case.
+  SelftestCase night{"null_night_pumping", "none", plain, plain, truth, std::nullopt, 0.0};
+  night.night_pumping = true;
+  cases.push_back(night);
   return cases;
 }
 
@@ -93,6 +119,8 @@ std::vector<SelftestCase> OtherFormSelftestCases(const Plant& plant) {
     c.form = TruthForm::kOtherForm;
     const EffectModule* effect = FindEffect(c.expected);
     if (effect != nullptr && effect->other_truth == nullptr) continue;
+    // Sensor cases and their null case: the same data as in the same-form battery.
+    if (!c.sensor_kind.empty() || c.night_pumping) continue;
     cases.push_back(c);
   }
   // The same effects and the null case in autumn: 2024-10-01 00:00 UTC.
@@ -151,8 +179,25 @@ Series SelftestData(const Plant& plant, const SelftestCase& c, std::uint64_t see
   const std::int64_t offset_s = SolarDayOffsetS(plant);
   const std::int64_t first = SolarDayStartS(synth.weather.start_time_s, offset_s) + kSecondsPerDay;
   synth.weather.start_time_s = first;
+  if (c.night_pumping) {
+    synth.weather.pump_control = PumpControl::kHeatPumpSource;
+    synth.weather.heat_pump_from_h = 0.0;
+    synth.weather.heat_pump_to_h = 24.0;
+  }
   std::vector<std::int64_t> days;
-  if (c.disturbance) {
+  if (c.disturbance && !c.sensor_kind.empty()) {
+    // The third held-out day, or earlier so that 5 days follow it: the day-step
+    // test's smallest p with m of n days after the onset is 2·m!(n−m)!/n!
+    // times the n − 3 splits it tries, above alpha with 3 of 15 days.
+    const int onset_day =
+        std::min(options.train_days + 2, options.train_days + options.heldout_days - 5);
+    const std::int64_t onset = first + static_cast<std::int64_t>(onset_day) * kSecondsPerDay;
+    const std::int64_t end =
+        first + static_cast<std::int64_t>(options.train_days + options.heldout_days + 1) *
+                    kSecondsPerDay;
+    days.push_back(onset);
+    synth.disturbances.push_back({*c.disturbance, onset, end, c.severity});
+  } else if (c.disturbance) {
     for (int k : {1, 4}) {
       if (k >= options.heldout_days) continue;
       const std::int64_t day =
@@ -166,6 +211,33 @@ Series SelftestData(const Plant& plant, const SelftestCase& c, std::uint64_t see
   ApplyPaperCorrections(&s);
   return s;
 }
+
+namespace {
+
+// A sensor fault case: its finding, with channel, kind and onset; every case:
+// any other finding with an onset is false.
+void SensorOutcome(const Plant& plant, const SelftestCase& c,
+                   const std::vector<std::int64_t>& disturbed_days, SelftestOutcome* o,
+                   std::ostringstream* why) {
+  const std::string onset =
+      c.sensor_kind.empty() || disturbed_days.empty()
+          ? std::string()
+          : SolarDate(disturbed_days.front(), SolarDayOffsetS(plant));
+  bool named = false;
+  for (const SensorFinding& f : o->result.sensors) {
+    if (f.from_s <= 0) continue;  // the monitor's row checks
+    const bool own = !c.sensor_kind.empty() && f.channel == c.sensor_channel &&
+                     f.kind == c.sensor_kind && f.from == onset;
+    named = named || own;
+    if (!own) o->false_sensor = true;
+  }
+  if (!c.sensor_kind.empty() && !named) {
+    *why << "sensors do not name " << c.sensor_channel << " " << c.sensor_kind << " from "
+         << onset << "; ";
+  }
+}
+
+}  // namespace
 
 SelftestOutcome RunSelftestCase(const Plant& plant, const SelftestCase& c, std::uint64_t seed,
                                 const SelftestOptions& options,
@@ -215,7 +287,8 @@ SelftestOutcome RunSelftestCase(const Plant& plant, const SelftestCase& c, std::
           << "; ";
     }
   }
-  if (c.expected == "unknown") {
+  SensorOutcome(plant, c, disturbed_days, &o, &why);
+  if (c.expected == "unknown" && c.sensor_kind.empty()) {
     const GapRegion* day_region = nullptr;
     for (const GapRegion& w : r.where) {
       if (w.driver == "day") {
@@ -251,6 +324,10 @@ std::string FormatSelftestReport(const std::vector<SelftestOutcome>& outcomes) {
                   o.correct ? "yes" : "NO");
     out << line;
     if (!o.correct) out << "  (" << o.why << ")";
+    for (const SensorFinding& f : o.result.sensors) {
+      if (f.from_s > 0) out << "  [sensor " << f.channel << " " << f.kind << " from " << f.from
+                            << ", size " << SensorSizeText(f) << "]";
+    }
     out << "\n";
   }
   // Confusion table: rows expected, columns verdict.
@@ -284,17 +361,19 @@ std::string FormatSelftestReport(const std::vector<SelftestOutcome>& outcomes) {
     }
     out << "\n";
   }
-  int correct = 0, false_significant = 0, null_cases = 0;
+  int correct = 0, false_significant = 0, null_cases = 0, false_sensor = 0;
   for (const SelftestOutcome& o : outcomes) {
     correct += o.correct;
     false_significant += o.false_significant;
+    false_sensor += o.false_sensor;
     null_cases += o.expected == "none";
   }
   out << "\nhit rate: " << correct << " / " << outcomes.size() << " = "
       << FixedDecimals(
              outcomes.empty() ? 0.0 : 100.0 * correct / static_cast<double>(outcomes.size()), 1)
       << " %; false significant effects on null cases: " << false_significant << " of "
-      << null_cases << "\n";
+      << null_cases << "; cases with a false sensor finding with an onset: " << false_sensor
+      << "\n";
   return out.str();
 }
 

@@ -57,6 +57,15 @@ struct SelftestCase {
   // First day of the data (unix s UTC; moved to the next local solar
   // midnight); 0 = the generator's default, 1 June.
   std::int64_t start_time_s = 0;
+  // A sensor fault case: the disturbance (a reading, the physics untouched)
+  // acts from the third held-out day (earlier when fewer than 5 days would
+  // follow it) to the end of the data, and the case is
+  // correct only when `sensors` names it with this channel and kind from
+  // that day (the verdict as `expected`).
+  std::string sensor_channel{}, sensor_kind{};
+  // The pump runs day and night while the absorber is warmer than the brine
+  // (PumpControl::kHeatPumpSource around the clock): rows with flow and no sun.
+  bool night_pumping = false;
 };
 
 struct SelftestOptions {
@@ -82,6 +91,9 @@ struct SelftestOutcome {
   std::string first_step;  // effect of the ladder's first step, "" if none
   bool correct = false;
   bool false_significant = false;    // null case with a significant effect
+  // A sensor finding with an onset (a residual sensor check's) other than
+  // the case's own sensor fault.
+  bool false_sensor = false;
   double heldout_before_w_m2 = 0.0;  // base model's held-out objective
   double heldout_after_w_m2 = 0.0;   // after the ladder
   double heldout_truth_w_m2 = 0.0;   // truth model with truth parameters
@@ -91,7 +103,9 @@ struct SelftestOutcome {
 };
 
 // The cases: one per effect the catalogue can add to a base it chooses, a
-// null case, and the two disturbances.
+// null case, the uncatalogued disturbances and the sensor faults that only
+// the residual sensor checks name (same-form battery only: their truth has
+// no effect, an other-form battery would repeat their data).
 std::vector<SelftestCase> SelftestCases(const Plant& plant);
 
 // The other-form battery: one case per effect that has an other-form truth

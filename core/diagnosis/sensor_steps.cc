@@ -1,10 +1,13 @@
-// A sensor fault that the sensor checks of the monitor cannot see because it
-// is plausible on every row: the inlet temperature reading high (or the
-// outlet low) by a constant from one day on. The heat meter multiplies flow
-// by the logged T_out − T_in, so from that day the measured Q_u is low by
-// ṁ·c_p·ΔT while the pump runs, and a model fitted on all the days leaves a
-// step in its Q_u residual per unit of capacity flow, (Q_pred − Q_meas) /
-// (ṁ·c_p) in K, that stays from that day on.
+// The residual sensor checks' common part (sensor_residuals.h): the final
+// model fitted on all the days, the day series, the step test, the registry,
+// and the first check, offset_step.
+//
+// offset_step: the inlet temperature reading high (or the outlet low) by a
+// constant from one day on. The heat meter multiplies flow by the logged
+// T_out − T_in, so from that day the measured Q_u is low by ṁ·c_p·ΔT while
+// the pump runs, and a model fitted on all the days leaves a step in its Q_u
+// residual per unit of capacity flow, (Q_pred − Q_meas) / (ṁ·c_p) in K, that
+// stays from that day on.
 //
 // The test, over the days (DiagnosisOptions, sensor_step_*):
 //  * per day the median of that residual over the rows with flow;
@@ -20,9 +23,18 @@
 #include <map>
 
 #include "core/common/calendar.h"
-#include "core/diagnosis/stages.h"
+#include "core/diagnosis/sensor_residuals.h"
 
 namespace pvtwin::diagnosis_stages {
+
+const std::vector<ResidualSensorCheck>& ResidualSensorChecks() {
+  static const std::vector<ResidualSensorCheck> checks = {
+      CheckOffsetStep,       // t_in_c / t_out_c offset_step (this file)
+      CheckNightPairOffset,  // t_in_c,t_out_c pair_offset (sensor_pair_night.cc)
+      CheckFlowScale,        // flow_kg_s scale (sensor_flow_scale.cc)
+  };
+  return checks;
+}
 
 namespace {
 
@@ -67,13 +79,11 @@ double SeparationP(std::size_t n1, std::size_t n2) {
   return std::min(1.0, 2.0 * std::exp(log_p));
 }
 
-}  // namespace
-
-std::optional<SensorFinding> FindInletOffsetStep(const Series& data, const Split& split,
-                                                 const Plant& plant, const ModelSpec& base,
-                                                 const ParamVector& start,
-                                                 const DiagnosisOptions& options,
-                                                 const Progress& progress) {
+// The final model on all the days, per row (nullopt when it cannot be fitted).
+std::optional<SensorResiduals> FitAllDays(const Series& data, const Split& split,
+                                          const Plant& plant, const ModelSpec& base,
+                                          const ParamVector& start,
+                                          const DiagnosisOptions& options) {
   Part all;
   std::string why;
   if (!PreparePart(data, plant, base, split.data_start_s, split.cleanings, &all, &why)) {
@@ -86,71 +96,168 @@ std::optional<SensorFinding> FindInletOffsetStep(const Series& data, const Split
   if (!fit.ok) return std::nullopt;
   SimOutputs sim;
   Simulate(all.drivers, fit.params, &sim);
-  std::map<std::int64_t, std::vector<double>> by_day;
-  for (std::uint32_t i : all.meas.rows) {
-    const double w = all.drivers.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
-    const double r = sim.q_th_w[i] - all.meas.q_th_w[i];
-    if (!(w > 0.0) || !std::isfinite(r)) continue;
-    by_day[SolarDayStartS(all.drivers.time_s[i], split.offset_s)].push_back(r / w);
+  SensorResiduals r;
+  r.data = &data;
+  r.plant = &plant;
+  r.options = &options;
+  r.offset_s = split.offset_s;
+  r.rows = all.meas.rows;
+  const std::size_t n = data.size();
+  r.day_s.resize(n);
+  for (std::size_t i = 0; i < n; ++i) r.day_s[i] = SolarDayStartS(data.time_s[i], split.offset_s);
+  r.capacity_flow_w_k.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    r.capacity_flow_w_k[i] = all.drivers.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
   }
-  std::vector<std::int64_t> days;
-  std::vector<double> y;
-  for (auto& [day, x] : by_day) {
-    if (x.size() < static_cast<std::size_t>(options.sensor_step_min_rows)) continue;
-    days.push_back(day);
-    y.push_back(Median(std::move(x)));
-  }
+  r.g_poa_w_m2 = all.drivers.g_poa_w_m2;
+  r.q_meas_w = all.meas.q_th_w;
+  r.q_model_w = std::move(sim.q_th_w);
+  r.t_in_c = all.drivers.t_in_c;
+  r.t_out_meas_c = data.Has(Channel::kTOutC) ? data[Channel::kTOutC]
+                                             : std::vector<double>(n, std::nan(""));
+  r.t_out_model_c = std::move(sim.t_out_c);
+  return r;
+}
+
+}  // namespace
+
+std::optional<DayStep> TestDayStep(const DaySeries& s, double alpha) {
+  const std::vector<double>& y = s.y;
   const std::size_t n = y.size();
   const std::size_t min_side = 2;
   if (n < 2 * min_side + 1) return std::nullopt;
-  std::size_t best = 0;
+  DayStep d;
   double best_sse = 0.0;
-  for (std::size_t s = min_side; s + min_side <= n; ++s) {
-    const double m1 = Mean(y, 0, s), m2 = Mean(y, s, n);
+  for (std::size_t k = min_side; k + min_side <= n; ++k) {
+    const double m1 = Mean(y, 0, k), m2 = Mean(y, k, n);
     double sse = 0.0;
-    for (std::size_t k = 0; k < n; ++k) sse += std::pow(y[k] - (k < s ? m1 : m2), 2);
-    if (best == 0 || sse < best_sse) {
-      best = s;
+    for (std::size_t j = 0; j < n; ++j) sse += std::pow(y[j] - (j < k ? m1 : m2), 2);
+    if (d.split == 0 || sse < best_sse) {
+      d.split = k;
       best_sse = sse;
     }
   }
   const std::size_t splits = n - 2 * min_side + 1;
-  const double m1 = Mean(y, 0, best), m2 = Mean(y, best, n);
-  const double lo1 = *std::min_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(best));
-  const double hi1 = *std::max_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(best));
-  const double lo2 = *std::min_element(y.begin() + static_cast<std::ptrdiff_t>(best), y.end());
-  const double hi2 = *std::max_element(y.begin() + static_cast<std::ptrdiff_t>(best), y.end());
-  const bool separated = m2 > m1 ? lo2 > hi1 : hi2 < lo1;
-  const double p = std::min(1.0, SeparationP(best, n - best) * static_cast<double>(splits));
-  const double step_k = m2 - m1;
-  const bool step_beats_line = best_sse < LineSse(y);
-  progress("sensor step test: Q_u residual per capacity flow steps by " + FixedDecimals(step_k, 2) +
-           " K on " + SolarDate(days[best], split.offset_s) +
-           (separated ? " (days separated" : " (days not separated") + ", p = " + PValue(p) +
-           (step_beats_line ? ", better than a drift)" : ", a drift fits as well)"));
-  if (!separated || !step_beats_line || p > options.alpha ||
-      std::fabs(step_k) < options.min_temperature_offset_k) {
-    return std::nullopt;
+  const auto mid = y.begin() + static_cast<std::ptrdiff_t>(d.split);
+  d.before = Mean(y, 0, d.split);
+  d.after = Mean(y, d.split, n);
+  const double lo1 = *std::min_element(y.begin(), mid), hi1 = *std::max_element(y.begin(), mid);
+  const double lo2 = *std::min_element(mid, y.end()), hi2 = *std::max_element(mid, y.end());
+  d.separated = d.after > d.before ? lo2 > hi1 : hi2 < lo1;
+  d.p = std::min(1.0, SeparationP(d.split, n - d.split) * static_cast<double>(splits));
+  d.beats_line = best_sse < LineSse(y);
+  d.found = d.separated && d.beats_line && d.p <= alpha;
+  return d;
+}
+
+DaySeries DailyMedians(const SensorResiduals& r, const std::function<bool(std::uint32_t)>& keep,
+                       const std::function<double(std::uint32_t)>& x, int min_rows) {
+  std::map<std::int64_t, std::vector<double>> by_day;
+  for (std::uint32_t i : r.rows) {
+    if (!keep(i)) continue;
+    const double v = x(i);
+    if (std::isfinite(v)) by_day[r.day_s[i]].push_back(v);
   }
-  SensorFinding f;
+  DaySeries s;
+  for (auto& [day, v] : by_day) {
+    if (v.size() < static_cast<std::size_t>(min_rows)) continue;
+    s.days.push_back(day);
+    s.y.push_back(Median(std::move(v)));
+  }
+  return s;
+}
+
+double FaultMse(const SensorResiduals& r, std::int64_t from_s,
+                const std::function<double(std::uint32_t)>& e) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::uint32_t i : r.rows) {
+    if (!(r.capacity_flow_w_k[i] > 0.0) || r.day_s[i] < from_s) continue;
+    const double v = e(i);
+    if (!std::isfinite(v)) continue;
+    sum += v * v;
+    ++n;
+  }
+  return n > 0 ? sum / static_cast<double>(n) : std::nan("");
+}
+
+void CountRowsFrom(const Series& data, std::int64_t from_s, SensorFinding* f) {
+  f->rows = 0;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    if (data.time_s[i] >= from_s) ++f->rows;
+  }
+  f->share =
+      data.size() > 0 ? static_cast<double>(f->rows) / static_cast<double>(data.size()) : 0.0;
+}
+
+std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r,
+                                               const Progress& progress) {
+  const DiagnosisOptions& o = *r.options;
+  auto with_flow = [&r](std::uint32_t i) { return r.capacity_flow_w_k[i] > 0.0; };
+  auto per_flow = [&r](std::uint32_t i) {
+    return (r.q_model_w[i] - r.q_meas_w[i]) / r.capacity_flow_w_k[i];
+  };
+  const DaySeries s = DailyMedians(r, with_flow, per_flow, o.sensor_step_min_rows);
+  const std::optional<DayStep> d = TestDayStep(s, o.alpha);
+  if (!d) return std::nullopt;
+  const double step_k = d->after - d->before;
+  const std::string from = SolarDate(s.days[d->split], r.offset_s);
+  progress("sensor step test: Q_u residual per capacity flow steps by " + FixedDecimals(step_k, 2) +
+           " K on " + from + (d->separated ? " (days separated" : " (days not separated") +
+           ", p = " + PValue(d->p) +
+           (d->beats_line ? ", better than a drift)" : ", a drift fits as well)"));
+  if (!d->found || std::fabs(step_k) < o.min_temperature_offset_k) return std::nullopt;
+  ResidualFinding out;
+  SensorFinding& f = out.finding;
   f.channel = step_k > 0.0 ? "t_in_c" : "t_out_c";
   f.kind = "offset_step";
-  f.from_s = days[best];
-  f.from = SolarDate(days[best], split.offset_s);
+  f.from_s = s.days[d->split];
+  f.from = from;
   f.size = std::fabs(step_k);
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    if (data.time_s[i] >= days[best]) ++f.rows;
-  }
-  f.share = data.size() > 0 ? static_cast<double>(f.rows) / static_cast<double>(data.size()) : 0.0;
+  CountRowsFrom(*r.data, f.from_s, &f);
   f.detail =
       "from " + f.from + " on the measured Q_u is " + FixedDecimals(std::fabs(step_k), 2) +
       " K × ṁ·c_p " + (step_k > 0.0 ? "below" : "above") +
       " what the model fitted on all days predicts, on every day after and on none before (p = " +
-      PValue(p) + " over " + std::to_string(n) + " days): the " +
+      PValue(d->p) + " over " + std::to_string(s.y.size()) + " days): the " +
       (step_k > 0.0 ? "inlet temperature reads high (or the outlet low)"
                     : "outlet temperature reads high (or the inlet low)") +
       " by about that much";
-  return f;
+  // Its fault model from the onset: Q_meas = Q_model − ṁ·c_p·(level after).
+  out.explains = "q_th_w";
+  out.fault_mse = FaultMse(r, f.from_s, [&r, &d](std::uint32_t i) {
+    return r.q_model_w[i] - r.q_meas_w[i] - r.capacity_flow_w_k[i] * d->after;
+  });
+  return out;
+}
+
+std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Split& split,
+                                                    const Plant& plant, const ModelSpec& base,
+                                                    const ParamVector& start,
+                                                    const DiagnosisOptions& options,
+                                                    const Progress& progress) {
+  const std::optional<SensorResiduals> r = FitAllDays(data, split, plant, base, start, options);
+  if (!r) return {};
+  std::vector<ResidualFinding> found;
+  for (const ResidualSensorCheck& check : ResidualSensorChecks()) {
+    if (std::optional<ResidualFinding> f = check(*r, progress)) found.push_back(std::move(*f));
+  }
+  // Of the findings that explain the same residual, the best fault model stays.
+  std::vector<SensorFinding> out;
+  for (const ResidualFinding& f : found) {
+    bool beaten = false;
+    for (const ResidualFinding& g : found) {
+      beaten = beaten || (&g != &f && !f.explains.empty() && g.explains == f.explains &&
+                          g.fault_mse < f.fault_mse);
+    }
+    if (beaten) {
+      progress("sensor checks: " + f.finding.channel + " " + f.finding.kind +
+               " dropped, another fault explains the " + f.explains + " residual better");
+    } else {
+      out.push_back(f.finding);
+    }
+  }
+  return out;
 }
 
 }  // namespace pvtwin::diagnosis_stages

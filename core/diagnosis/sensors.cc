@@ -53,3 +53,21 @@ std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant) 
 }
 
 }  // namespace pvtwin::diagnosis_stages
+
+namespace pvtwin {
+
+std::string SensorSizeText(const SensorFinding& f) {
+  if (f.size_unit.empty()) return "× " + FixedDecimals(f.size, 3);
+  return FixedDecimals(f.size, 1) + " " + f.size_unit;
+}
+
+std::vector<SensorFault> DiagnosedSensorFaults(const DiagnosisResult& result, std::int64_t end_s) {
+  std::vector<SensorFault> out;
+  for (const SensorFinding& f : result.sensors) {
+    if (f.from_s <= 0 || f.from_s >= end_s) continue;
+    out.push_back({f.channel, f.from_s, end_s, f.kind, f.detail});
+  }
+  return out;
+}
+
+}  // namespace pvtwin

@@ -158,15 +158,15 @@ std::vector<std::uint8_t> RowsInsideTrainingRange(const Drivers& d,
 // one finding per channel and kind, most rows first (sensors.cc).
 std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant);
 
-// A constant offset of the inlet (or outlet) temperature from one day on, in
-// the Q_u residual of `base` (the ladder's final model) fitted on all the
-// data from `start`
-// (sensor_steps.cc); nullopt when there is none.
-std::optional<SensorFinding> FindInletOffsetStep(const Series& data, const Split& split,
-                                                 const Plant& plant, const ModelSpec& base,
-                                                 const ParamVector& start,
-                                                 const DiagnosisOptions& options,
-                                                 const Progress& progress);
+// The residual sensor checks (sensor_residuals.h: an inlet / outlet offset
+// step, the pair at night, a flow meter scale) in the residuals of `base`
+// (the ladder's final model) fitted on all the data from `start`; one
+// finding per fault found, none when the model cannot be fitted.
+std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Split& split,
+                                                    const Plant& plant, const ModelSpec& base,
+                                                    const ParamVector& start,
+                                                    const DiagnosisOptions& options,
+                                                    const Progress& progress);
 
 // --- 4. Candidate trials ---
 // Controls of the evidence regression, per held-out row: in-plane

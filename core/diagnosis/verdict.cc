@@ -127,9 +127,8 @@ void DecideVerdict(const DiagnosisOptions& options, DiagnosisResult* result) {
         " Sensor check: " + f.channel + " " + f.kind +
         (f.from.empty() ? std::string() : " from " + f.from) + " on " + std::to_string(f.rows) +
         " rows (" + FixedDecimals(100.0 * f.share, 1) + " % of the data" +
-        (std::isfinite(f.size)
-             ? (f.from.empty() ? ", median " : ", size ") + FixedDecimals(f.size, 1) + " K"
-             : std::string()) +
+        (std::isfinite(f.size) ? (f.from.empty() ? ", median " : ", size ") + SensorSizeText(f)
+                               : std::string()) +
         ").";
   }
 }

@@ -98,6 +98,10 @@ std::string_view DisturbanceName(DisturbanceKind kind) {
       return "snow_cover";
     case DisturbanceKind::kInletSensorOffset:
       return "inlet_sensor_offset";
+    case DisturbanceKind::kOutletSensorOffset:
+      return "outlet_sensor_offset";
+    case DisturbanceKind::kFlowMeterScale:
+      return "flow_meter_scale";
   }
   return "?";
 }
@@ -197,26 +201,37 @@ Series DisturbedPhysics(const Series& s, const SyntheticOptions& options) {
           }
           break;
         case DisturbanceKind::kInletSensorOffset:
-          break;  // a sensor fault: the physics is untouched (InletSensorOffsets)
+        case DisturbanceKind::kOutletSensorOffset:
+        case DisturbanceKind::kFlowMeterScale:
+          break;  // a sensor fault: the physics is untouched (SensorDisturbances)
       }
     }
   }
   return physics;
 }
 
-// The logged inlet temperature of an inlet sensor offset, and the heat
-// meter's reading computed from it (flow × c_p × (T_out − T_in) as logged).
-void InletSensorOffsets(const Plant& plant, const std::vector<Disturbance>& disturbances,
+// The readings of the sensor disturbances: a logged inlet offset and the
+// heat meter's reading computed from it (flow × c_p × (T_out − T_in) as
+// logged); a logged outlet offset (the heat meter's own pair reads right); a
+// flow meter scale and the heat meter's reading from that flow.
+void SensorDisturbances(const Plant& plant, const std::vector<Disturbance>& disturbances,
                         Series* s) {
+  auto& t_in = (*s)[Channel::kTInC];
+  auto& t_out = (*s)[Channel::kTOutC];
+  auto& q_th = (*s)[Channel::kQThW];
+  auto& flow = (*s)[Channel::kMdotKgS];
   for (const Disturbance& d : disturbances) {
-    if (d.kind != DisturbanceKind::kInletSensorOffset) continue;
-    auto& t_in = (*s)[Channel::kTInC];
-    auto& q_th = (*s)[Channel::kQThW];
-    const auto& flow = (*s)[Channel::kMdotKgS];
     for (std::size_t i = 0; i < s->size(); ++i) {
       if (!InWindow(d, s->time_s[i])) continue;
-      t_in[i] += d.severity;
-      if (flow[i] > 0.0) q_th[i] -= flow[i] * plant.fluid_cp_j_kgk * d.severity;
+      if (d.kind == DisturbanceKind::kInletSensorOffset) {
+        t_in[i] += d.severity;
+        if (flow[i] > 0.0) q_th[i] -= flow[i] * plant.fluid_cp_j_kgk * d.severity;
+      } else if (d.kind == DisturbanceKind::kOutletSensorOffset) {
+        t_out[i] += d.severity;
+      } else if (d.kind == DisturbanceKind::kFlowMeterScale) {
+        flow[i] *= d.severity;
+        q_th[i] *= d.severity;
+      }
     }
   }
 }
@@ -344,7 +359,7 @@ Series MakeSyntheticPlantData(const Plant& plant, const SyntheticOptions& option
   SimOutputs out;
   RunTruth(other, ctx, options.truth, &drivers, &out);
   WriteMeasuredOutputs(plant, options.noise, drivers, out, &s);
-  InletSensorOffsets(plant, options.disturbances, &s);
+  SensorDisturbances(plant, options.disturbances, &s);
   for (const EffectModule* m : EffectRegistry()) {
     const bool other_form = std::find(other.begin(), other.end(), m) != other.end();
     if (other_form && m->other_truth->measured != nullptr) {

@@ -82,6 +82,15 @@ enum class DisturbanceKind {
   // high and the heat meter, which multiplies flow by the logged
   // T_out − T_in, reads ṁ·c_p·severity less while the pump runs.
   kInletSensorOffset,
+  // The logged outlet temperature reads `severity` K high (negative: low)
+  // on the rows of the window; the heat meter has its own sensor pair and
+  // reads right. The physics is untouched.
+  kOutletSensorOffset,
+  // The flow meter reads `severity` × the true flow (a clogged or re-mounted
+  // meter, a wrong pulse value); the heat meter multiplies that reading by
+  // the (right) temperature rise, so q_th_w reads `severity` × the truth.
+  // The physics is untouched.
+  kFlowMeterScale,
 };
 
 std::string_view DisturbanceName(DisturbanceKind kind);
@@ -90,7 +99,8 @@ struct Disturbance {
   DisturbanceKind kind = DisturbanceKind::kFailingPump;
   std::int64_t start_s = 0;  // unix s UTC
   std::int64_t end_s = 0;
-  double severity = 0.0;  // kFailingPump: real/read flow; kSnowCover: transmitted fraction
+  double severity = 0.0;  // kFailingPump: real/read flow; kSnowCover: transmitted fraction;
+                          // sensor offsets: K; kFlowMeterScale: read/real flow
 };
 
 // The paper's data defects (Tables 1 and 2, core/data/qc.h), injected so that the

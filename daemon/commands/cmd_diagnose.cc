@@ -95,7 +95,7 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
     std::printf(
         "sensor: %s %s on %zu rows (%.1f %%)%s: %s\n", f.channel.c_str(), f.kind.c_str(), f.rows,
         100 * f.share,
-        std::isfinite(f.size) ? (", median " + FixedDecimals(f.size, 1) + " K").c_str() : "",
+        std::isfinite(f.size) ? (", size " + SensorSizeText(f)).c_str() : "",
         f.detail.c_str());
   }
   for (const Extrapolation& x : result.extrapolation) {
@@ -286,6 +286,17 @@ int RunDiagnose(const DiagnoseArgs& a) {
   DiagnosisResult result;
   const int rc = DiagnoseSeries(series, config.plant, spec, options, source, a.report, &result);
   if (rc != kExitOk || !a.record) return rc;
+  // The residual sensor checks' faults (with their onset) go to qc_event
+  // beside the diagnosis row, seen until the end of the window.
+  const std::vector<SensorFault> diagnosed = DiagnosedSensorFaults(result, to_ts);
+  std::string qc_error;
+  if (!store->RecordSensorFaults(diagnosed, &qc_error)) {
+    std::cerr << qc_error << "\n";
+    return kExitRuntime;
+  }
+  if (!diagnosed.empty()) {
+    std::cerr << "recorded " << diagnosed.size() << " diagnosed sensor fault(s) in qc_event\n";
+  }
   return RecordDiagnosis(*store, result, from_ts, to_ts, a) ? kExitOk : kExitRuntime;
 }
 

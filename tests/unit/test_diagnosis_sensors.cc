@@ -1,35 +1,64 @@
-// The diagnosis names a sensor fault that is plausible on every row: the
-// inlet temperature reading high by a constant from one day on (the heat
-// meter then reads ṁ·c_p·ΔT low), with its channel, onset and size, and
-// names none on the same plant without it.
+// The diagnosis names sensor faults that are plausible on every row, with
+// channel, kind, onset and size, and names none on the same plant without
+// them: the inlet temperature reading high by a constant from one day on
+// (the heat meter then reads ṁ·c_p·ΔT low: offset_step); the logged outlet
+// reading low from one day on, seen with the pump on at night (pair_offset);
+// the flow meter reading 10 % high from one day on (scale).
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
 
 #include "core/common/calendar.h"
 #include "core/data/qc.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/synth/synthetic_plant.h"
+#include "io/platform/time_format.h"
+#include "io/store/store.h"
+#include "tests/support/run_pvtwin.h"
+#include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
 
-Series Plant21Days(const Plant& plant, double offset_k, std::int64_t* onset_s) {
+// 21 days of 1N1Cwr data with `kind` of `severity` from the third held-out
+// day (severity 0: none); with night_pumping the pump runs day and night
+// while the absorber is warmer than the brine (a heat pump's source field).
+Series Plant21Days(const Plant& plant, DisturbanceKind kind, double severity,
+                   std::int64_t* onset_s, bool night_pumping = false) {
   SyntheticOptions synth;
   std::string error;
   EXPECT_TRUE(DefaultSyntheticOptions(plant, "1N1Cwr", 21, 3, &synth, &error)) << error;
+  if (night_pumping) {
+    synth.weather.pump_control = PumpControl::kHeatPumpSource;
+    synth.weather.heat_pump_from_h = 0.0;
+    synth.weather.heat_pump_to_h = 24.0;
+  }
   const std::int64_t offset_s = SolarDayOffsetS(plant);
   const std::int64_t first = SolarDayStartS(synth.weather.start_time_s, offset_s) + kSecondsPerDay;
   synth.weather.start_time_s = first;
   *onset_s = first + 16 * kSecondsPerDay;  // the third held-out day
-  if (offset_k != 0.0) {
-    synth.disturbances.push_back(
-        {DisturbanceKind::kInletSensorOffset, *onset_s, first + 30 * kSecondsPerDay, offset_k});
+  if (severity != 0.0) {
+    synth.disturbances.push_back({kind, *onset_s, first + 30 * kSecondsPerDay, severity});
   }
   Series s = MakeSyntheticPlantData(plant, synth);
   ApplyPaperCorrections(&s);
   return s;
+}
+
+Series Plant21Days(const Plant& plant, double offset_k, std::int64_t* onset_s) {
+  return Plant21Days(plant, DisturbanceKind::kInletSensorOffset, offset_k, onset_s);
+}
+
+const SensorFinding* FindKind(const DiagnosisResult& r, const std::string& kind) {
+  for (const SensorFinding& f : r.sensors) {
+    if (f.kind == kind) return &f;
+  }
+  return nullptr;
 }
 
 DiagnosisResult DiagnoseSoilingOnly(const Series& s, const Plant& plant) {
@@ -57,6 +86,7 @@ TEST(DiagnosisSensors, InletOffsetFromOneDayOnIsNamedWithChannelOnsetAndSize) {
   EXPECT_GT(step->size, 0.75);  // the model's own response to the high inlet absorbs a part
   EXPECT_LT(step->size, 1.8);
   EXPECT_NE(r.verdict_sentence.find("t_in_c offset_step from"), std::string::npos);
+  EXPECT_EQ(FindKind(r, "scale"), nullptr) << "an offset is not a flow meter scale";
 }
 
 TEST(DiagnosisSensors, NoOffsetStepOnTheSamePlantWithoutIt) {
@@ -64,6 +94,105 @@ TEST(DiagnosisSensors, NoOffsetStepOnTheSamePlantWithoutIt) {
   std::int64_t onset_s = 0;
   const DiagnosisResult r = DiagnoseSoilingOnly(Plant21Days(plant, 0.0, &onset_s), plant);
   for (const SensorFinding& f : r.sensors) EXPECT_NE(f.kind, "offset_step") << f.detail;
+}
+
+TEST(DiagnosisSensors, OutletOffsetWithThePumpOnAtNightIsNamedAsThePair) {
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  const DiagnosisResult r = DiagnoseSoilingOnly(
+      Plant21Days(plant, DisturbanceKind::kOutletSensorOffset, -0.8, &onset_s, true), plant);
+  const SensorFinding* pair = FindKind(r, "pair_offset");
+  ASSERT_NE(pair, nullptr) << r.verdict_sentence;
+  EXPECT_EQ(pair->channel, "t_in_c,t_out_c");
+  EXPECT_EQ(pair->from, SolarDate(onset_s, SolarDayOffsetS(plant)));
+  EXPECT_NEAR(pair->size, -0.8, 0.2);  // an outlet offset shows in full
+  // The heat meter has its own pair: Q_u is right, no other fault is named.
+  EXPECT_EQ(FindKind(r, "offset_step"), nullptr);
+  EXPECT_EQ(FindKind(r, "scale"), nullptr);
+  // As qc_event rows: from the onset to the end given.
+  const std::vector<SensorFault> rows = DiagnosedSensorFaults(r, onset_s + 10 * kSecondsPerDay);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].channel, "t_in_c,t_out_c");
+  EXPECT_EQ(rows[0].kind, "pair_offset");
+  EXPECT_EQ(rows[0].start_s, onset_s);
+}
+
+TEST(DiagnosisSensors, FlowMeterScaleFromOneDayOnIsNamedWithItsRatio) {
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  const DiagnosisResult r = DiagnoseSoilingOnly(
+      Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 1.1, &onset_s, true), plant);
+  const SensorFinding* scale = FindKind(r, "scale");
+  ASSERT_NE(scale, nullptr) << r.verdict_sentence;
+  EXPECT_EQ(scale->channel, "flow_kg_s");
+  EXPECT_EQ(scale->from, SolarDate(onset_s, SolarDayOffsetS(plant)));
+  EXPECT_GT(scale->size, 1.06);
+  EXPECT_LT(scale->size, 1.14);
+  EXPECT_EQ(FindKind(r, "offset_step"), nullptr) << "a scale is not an inlet offset";
+  EXPECT_NE(r.verdict_sentence.find("flow_kg_s scale from"), std::string::npos);
+}
+
+TEST(DiagnosisSensors, NoResidualSensorFaultOnAPlantPumpingAtNightWithoutOne) {
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  const DiagnosisResult r = DiagnoseSoilingOnly(
+      Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 0.0, &onset_s, true), plant);
+  for (const SensorFinding& f : r.sensors) {
+    EXPECT_TRUE(f.kind != "offset_step" && f.kind != "pair_offset" && f.kind != "scale")
+        << f.channel << " " << f.kind << ": " << f.detail;
+  }
+}
+
+// The daemon's nightly diagnosis (`pvtwin diagnose --db … --record`) puts a
+// fault found in the residuals into qc_event with its onset, as report.json's
+// `sensors` names it; without --record nothing is written.
+TEST(DiagnosisSensors, RecordPutsTheFlowMeterScaleIntoQcEventFromItsOnset) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("pvtwin_sensors_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  Series s = Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 1.1, &onset_s);
+  // The store keeps minute starts: every row later by under a minute, each
+  // in the solar day it was in.
+  const std::int64_t late_s = (60 - s.time_s.front() % 60) % 60;
+  for (std::int64_t& t : s.time_s) t += late_s;
+  std::string error;
+  {
+    std::unique_ptr<Store> store = Store::Open((dir / "t.db").string(), &error);
+    ASSERT_TRUE(store) << error;
+    ASSERT_TRUE(store->WriteMinutes(s, &error)) << error;
+  }
+  const std::string config =
+      "'" + (fs::path(PVTWIN_GOLDEN_DIR) / ".." / ".." / "config" / "examples" / "plant.toml")
+                .string() + "'";
+  const std::string args = "diagnose --config " + config + " --db t.db --variant 1N1Cwr" +
+                           " --train-days 14 --heldout-days 7 --effects soiling --from " +
+                           FormatIsoUtc(s.time_s.front()) + " --to " +
+                           FormatIsoUtc(s.time_s.back() + 60) + " --report out";
+  const testing::ProcessResult read_only = testing::RunPvtwin(dir, args);
+  ASSERT_EQ(read_only.exit_code, 0) << read_only.err;
+  {
+    testing::RawDb db(dir / "t.db");
+    EXPECT_EQ(db.Number("SELECT COUNT(*) FROM qc_event"), 0.0);
+  }
+  const testing::ProcessResult run = testing::RunPvtwin(dir, args + " --record");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(testing::ReadFile(dir / "out" / "report.json"));
+  bool in_report = false;
+  for (const auto& f : j.at("sensors")) {
+    in_report = in_report || (f.at("channel") == "flow_kg_s" && f.at("kind") == "scale" &&
+                              f.at("from") == SolarDate(onset_s, SolarDayOffsetS(plant)));
+  }
+  EXPECT_TRUE(in_report) << j.at("sensors").dump();
+  testing::RawDb db(dir / "t.db");
+  const auto rows = db.Rows(
+      "SELECT channel, start_ts FROM qc_event WHERE kind = 'scale' ORDER BY start_ts");
+  ASSERT_EQ(rows.size(), 1u) << run.err;
+  EXPECT_EQ(rows[0][0], "flow_kg_s");
+  EXPECT_EQ(rows[0][1], std::to_string(onset_s));
+  fs::remove_all(dir);
 }
 
 }  // namespace

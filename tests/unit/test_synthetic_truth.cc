@@ -145,7 +145,9 @@ TEST(SyntheticTruth, DisturbancesActOnTheirDaysOnly) {
         EXPECT_LT(q_ratio, 0.05) << name;
         break;
       case DisturbanceKind::kInletSensorOffset:
-        break;  // a sensor fault: its own test below
+      case DisturbanceKind::kOutletSensorOffset:
+      case DisturbanceKind::kFlowMeterScale:
+        break;  // sensor faults: their own tests below
     }
   }
 }
@@ -177,6 +179,32 @@ TEST(SyntheticTruth, InletSensorOffsetIsAReadingFromItsDayOn) {
     const double flow = s[Channel::kMdotKgS][i];
     if (flow > 0.0) ++flowing;
     ASSERT_NEAR(dq, flow > 0.0 ? -flow * plant.fluid_cp_j_kgk * 1.5 : 0.0, 1e-6);
+  }
+  EXPECT_GT(flowing, 100);
+}
+
+// A logged outlet offset moves t_out_c only (the heat meter has its own
+// pair); a flow meter scale moves the flow reading and the heat meter's
+// q_th_w by the factor. Both from their first day on; the physics is untouched.
+TEST(SyntheticTruth, OutletOffsetAndFlowScaleAreReadingsFromTheirDayOn) {
+  const Plant plant = DesignExamplePlant();
+  SyntheticOptions clean = Options("1N1Cwr", 4, 24);
+  clean.defects = DataDefects{};
+  const Series base = MakeSyntheticPlantData(plant, clean);
+  const std::int64_t day2 = base.time_s[0] + 2 * 86400;
+  SyntheticOptions o = clean;
+  o.disturbances = {{DisturbanceKind::kOutletSensorOffset, day2, base.time_s.back() + 1, -0.8},
+                    {DisturbanceKind::kFlowMeterScale, day2, base.time_s.back() + 1, 1.1}};
+  const Series s = MakeSyntheticPlantData(plant, o);
+  int flowing = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    ASSERT_EQ(s[Channel::kPElW][i], base[Channel::kPElW][i]);
+    ASSERT_EQ(s[Channel::kTInC][i], base[Channel::kTInC][i]);
+    const bool on = s.time_s[i] >= day2;
+    ASSERT_NEAR(s[Channel::kTOutC][i] - base[Channel::kTOutC][i], on ? -0.8 : 0.0, 1e-9);
+    ASSERT_NEAR(s[Channel::kMdotKgS][i], base[Channel::kMdotKgS][i] * (on ? 1.1 : 1.0), 1e-12);
+    ASSERT_NEAR(s[Channel::kQThW][i], base[Channel::kQThW][i] * (on ? 1.1 : 1.0), 1e-9);
+    flowing += on && base[Channel::kQThW][i] > 100.0;
   }
   EXPECT_GT(flowing, 100);
 }

@@ -1,0 +1,90 @@
+// scale: a flow meter whose reading is k × the true flow from one day on
+// (sensor_residuals.h). The heat meter multiplies that reading by the
+// (right) temperature difference, so Q_u,meas = k·Q_u,true while the pump
+// runs, and the model, driven by the same reading, predicts nearly the true
+// Q_u (at the collector's usual flows its heat removal factor barely moves
+// with flow). The measured-to-modelled ratio then steps to k and stays k at
+// every irradiance, temperature and flow, where a thermal-model gap moves
+// the ratio with irradiance (optics) or with T − T_amb (losses), and an
+// inlet offset moves Q_u by ṁ·c_p·δ, not in proportion.
+//
+// The test: per solar day the least-squares ratio Σ Q_meas·Q_model /
+// Σ Q_model² over the rows with flow (at least sensor_step_min_rows), its
+// logarithm as the day series, the day-step test (TestDayStep) with alpha,
+// and a ratio step exp(after − before) at least min_flow_scale_error from 1.
+// The finding competes with offset_step for the Q_u residual (both move it
+// from a day on): the fault model that fits the rows from its onset better
+// stays (FindResidualSensorFaults).
+#include <cmath>
+#include <map>
+
+#include "core/common/calendar.h"
+#include "core/diagnosis/sensor_residuals.h"
+
+namespace pvtwin::diagnosis_stages {
+
+namespace {
+
+// log(Σ Q_meas·Q_model / Σ Q_model²) per solar day with min_rows rows with flow.
+DaySeries DailyLogRatios(const SensorResiduals& r, int min_rows) {
+  struct Sums {
+    double mm = 0.0, pp = 0.0;
+    int n = 0;
+  };
+  std::map<std::int64_t, Sums> by_day;
+  for (std::uint32_t i : r.rows) {
+    if (!(r.capacity_flow_w_k[i] > 0.0)) continue;
+    const double m = r.q_meas_w[i], p = r.q_model_w[i];
+    if (!std::isfinite(m) || !std::isfinite(p)) continue;
+    Sums& s = by_day[r.day_s[i]];
+    s.mm += m * p;
+    s.pp += p * p;
+    ++s.n;
+  }
+  DaySeries out;
+  for (const auto& [day, s] : by_day) {
+    if (s.n < min_rows || !(s.pp > 0.0) || !(s.mm > 0.0)) continue;
+    out.days.push_back(day);
+    out.y.push_back(std::log(s.mm / s.pp));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Progress& progress) {
+  const DiagnosisOptions& o = *r.options;
+  const DaySeries s = DailyLogRatios(r, o.sensor_step_min_rows);
+  const std::optional<DayStep> d = TestDayStep(s, o.alpha);
+  if (!d) return std::nullopt;
+  const double k = std::exp(d->after - d->before);
+  const std::string from = SolarDate(s.days[d->split], r.offset_s);
+  progress("sensor scale test: measured / modelled Q_u steps by × " + FixedDecimals(k, 3) +
+           " on " + from + " (" + (d->separated ? "separated" : "not separated") +
+           ", p = " + PValue(d->p) + (d->beats_line ? ", better than a drift)" : ", a drift fits as well)"));
+  if (!d->found || std::fabs(k - 1.0) < o.min_flow_scale_error) return std::nullopt;
+  ResidualFinding out;
+  SensorFinding& f = out.finding;
+  f.channel = "flow_kg_s";
+  f.kind = "scale";
+  f.from_s = s.days[d->split];
+  f.from = from;
+  f.size = k;
+  f.size_unit = "";
+  CountRowsFrom(*r.data, f.from_s, &f);
+  f.detail = "from " + f.from + " on the measured Q_u is " + FixedDecimals(k, 3) +
+             " × what it was against the model before, on every day after and on none before "
+             "(p = " + PValue(d->p) + " over " + std::to_string(s.y.size()) +
+             " days), in proportion while the pump runs: the flow meter reads about " +
+             FixedDecimals(100.0 * (k - 1.0), 1) +
+             " % off (a clogged or re-mounted meter, a changed pulse value or glycol share)";
+  // Its fault model from the onset: Q_meas = exp(level after) · Q_model.
+  out.explains = "q_th_w";
+  const double after = std::exp(d->after);
+  out.fault_mse = FaultMse(r, f.from_s, [&r, after](std::uint32_t i) {
+    return after * r.q_model_w[i] - r.q_meas_w[i];
+  });
+  return out;
+}
+
+}  // namespace pvtwin::diagnosis_stages

@@ -1,0 +1,102 @@
+// The sensor checks that read the model's residuals (issue 52, item 5):
+// faults plausible on every row that the monitor's row checks cannot see, but
+// that the calibrated model shows from one day on. Each check is one module
+// (its own .cc) registered in one line of ResidualSensorChecks
+// (sensor_steps.cc); FindResidualSensorFaults fits the final model once on
+// all the days and asks every check.
+//
+//   offset_step  (sensor_steps.cc)      t_in_c / t_out_c: Q_u low by ṁ·c_p·δ
+//   pair_offset  (sensor_pair_night.cc) t_in_c,t_out_c: the logged pair
+//                disagrees with the model at night with the pump on
+//   scale        (sensor_flow_scale.cc) flow_kg_s: Q_u = k × the model's
+//                while the flow is on
+//
+// Every check reduces its rows to one number per solar day and asks the same
+// question of the day series (TestDayStep): is there a step that stays from
+// one day on? Day values are the units because residuals of a thermal model
+// carry the weather's hours-long memory: the minutes of one day are not
+// independent.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/diagnosis/stages.h"
+
+namespace pvtwin::diagnosis_stages {
+
+// What every residual check reads: the final model fitted on all the days
+// (no held-out split: a sensor fault is a property of the data), per row.
+struct SensorResiduals {
+  const Series* data = nullptr;  // the diagnosed rows (row i of every vector below)
+  const Plant* plant = nullptr;
+  const DiagnosisOptions* options = nullptr;
+  std::int64_t offset_s = 0;       // SolarDayOffsetS
+  std::vector<std::uint32_t> rows;  // objective rows of the fit
+  std::vector<std::int64_t> day_s;  // per row: its solar day's start
+  std::vector<double> capacity_flow_w_k;  // ṁ·c_p from the measured flow
+  std::vector<double> g_poa_w_m2;
+  std::vector<double> q_meas_w, q_model_w;      // heat meter, model
+  std::vector<double> t_in_c, t_out_meas_c, t_out_model_c;  // logged, logged, model
+};
+
+// The day series a check builds: one value per solar day with enough rows.
+struct DaySeries {
+  std::vector<std::int64_t> days;
+  std::vector<double> y;
+};
+
+// The step test over a day series (the test of sensor_steps.cc's comment):
+// the split day that fits best as two means; a step when the days on the two
+// sides separate perfectly (it stays), the step fits better than a straight
+// line (a drift is not a step) and 2·n1!·n2!/(n1+n2)! times the number of
+// split days tried is at most alpha (the probability of that separation in
+// a series without a step, whatever the days' distribution).
+struct DayStep {
+  bool found = false;  // separated, better than a line, p ≤ alpha (size not judged)
+  std::size_t split = 0;  // first day of the step (index into DaySeries)
+  double before = 0.0, after = 0.0;  // mean of the days before / from the split
+  double p = 1.0;
+  bool separated = false, beats_line = false;
+};
+std::optional<DayStep> TestDayStep(const DaySeries& s, double alpha);
+
+// Median of the values of `x` per solar day (rows where keep(i) and x finite),
+// days with at least min_rows values.
+DaySeries DailyMedians(const SensorResiduals& r, const std::function<bool(std::uint32_t)>& keep,
+                       const std::function<double(std::uint32_t)>& x, int min_rows);
+
+// A finding of a residual check. Checks that explain the same residual
+// (`explains`, e.g. "q_th_w") compete: of those found, the one whose fault
+// model leaves the smaller mean square on the rows from its onset
+// (`fault_mse`, in the residual's unit squared) is kept.
+struct ResidualFinding {
+  SensorFinding finding;
+  std::string explains;
+  double fault_mse = 0.0;
+};
+
+using ResidualSensorCheck = std::function<std::optional<ResidualFinding>(
+    const SensorResiduals&, const Progress&)>;
+
+// The checks (sensor_steps.cc), one line each.
+const std::vector<ResidualSensorCheck>& ResidualSensorChecks();
+
+// The checks' modules.
+std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r, const Progress& progress);
+std::optional<ResidualFinding> CheckNightPairOffset(const SensorResiduals& r,
+                                                    const Progress& progress);
+std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Progress& progress);
+
+// Mean of e(i)² over the rows with flow from the solar day from_s on (NaN
+// without any): a fault model's fit to its rows.
+double FaultMse(const SensorResiduals& r, std::int64_t from_s,
+                const std::function<double(std::uint32_t)>& e);
+
+// Rows from the solar day `from_s` on, and their share of the data, into f.
+void CountRowsFrom(const Series& data, std::int64_t from_s, SensorFinding* f);
+
+}  // namespace pvtwin::diagnosis_stages

@@ -65,13 +65,8 @@ std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Pr
   if (!d->found || std::fabs(k - 1.0) < o.min_flow_scale_error) return std::nullopt;
   ResidualFinding out;
   SensorFinding& f = out.finding;
-  f.channel = "flow_kg_s";
-  f.kind = "scale";
-  f.from_s = s.days[d->split];
-  f.from = from;
-  f.size = k;
-  f.size_unit = "";
-  CountRowsFrom(*r.data, f.from_s, &f);
+  f = FindingFrom(*r.data, "flow_kg_s", "scale", s.days[d->split], from, k);
+  f.size_unit = "";  // a ratio
   f.detail = "from " + f.from + " on the measured Q_u is " + FixedDecimals(k, 3) +
              " × what it was against the model before, on every day after and on none before "
              "(p = " + PValue(d->p) + " over " + std::to_string(s.y.size()) +

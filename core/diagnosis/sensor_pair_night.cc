@@ -44,12 +44,7 @@ std::optional<ResidualFinding> CheckNightPairOffset(const SensorResiduals& r,
   if (!d->found || std::fabs(step_k) < o.min_temperature_offset_k) return std::nullopt;
   ResidualFinding out;
   SensorFinding& f = out.finding;
-  f.channel = "t_in_c,t_out_c";
-  f.kind = "pair_offset";
-  f.from_s = s.days[d->split];
-  f.from = from;
-  f.size = step_k;
-  CountRowsFrom(*r.data, f.from_s, &f);
+  f = FindingFrom(*r.data, "t_in_c,t_out_c", "pair_offset", s.days[d->split], from, step_k);
   f.detail = "from " + f.from + " on, with the pump on and no sun, the logged T_out − T_in is " +
              FixedDecimals(std::fabs(step_k), 2) + " K " + (step_k > 0.0 ? "above" : "below") +
              " the model's (which at night is only the small exchange with air and sky), on "

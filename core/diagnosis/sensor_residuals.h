@@ -96,7 +96,10 @@ std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Pr
 double FaultMse(const SensorResiduals& r, std::int64_t from_s,
                 const std::function<double(std::uint32_t)>& e);
 
-// Rows from the solar day `from_s` on, and their share of the data, into f.
-void CountRowsFrom(const Series& data, std::int64_t from_s, SensorFinding* f);
+// A finding of `channel` and `kind` from the solar day `from_s` (written
+// `from`) on, of `size` in K, with the rows from that day on and their share
+// of the data.
+SensorFinding FindingFrom(const Series& data, std::string channel, std::string kind,
+                          std::int64_t from_s, std::string from, double size);
 
 }  // namespace pvtwin::diagnosis_stages

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include "core/common/calendar.h"
 #include "core/diagnosis/sensor_residuals.h"
@@ -181,13 +182,19 @@ double FaultMse(const SensorResiduals& r, std::int64_t from_s,
   return n > 0 ? sum / static_cast<double>(n) : std::nan("");
 }
 
-void CountRowsFrom(const Series& data, std::int64_t from_s, SensorFinding* f) {
-  f->rows = 0;
+SensorFinding FindingFrom(const Series& data, std::string channel, std::string kind,
+                          std::int64_t from_s, std::string from, double size) {
+  SensorFinding f;
+  f.channel = std::move(channel);
+  f.kind = std::move(kind);
+  f.from_s = from_s;
+  f.from = std::move(from);
+  f.size = size;
   for (std::size_t i = 0; i < data.size(); ++i) {
-    if (data.time_s[i] >= from_s) ++f->rows;
+    if (data.time_s[i] >= from_s) ++f.rows;
   }
-  f->share =
-      data.size() > 0 ? static_cast<double>(f->rows) / static_cast<double>(data.size()) : 0.0;
+  f.share = data.size() > 0 ? static_cast<double>(f.rows) / static_cast<double>(data.size()) : 0.0;
+  return f;
 }
 
 std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r,
@@ -209,12 +216,8 @@ std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r,
   if (!d->found || std::fabs(step_k) < o.min_temperature_offset_k) return std::nullopt;
   ResidualFinding out;
   SensorFinding& f = out.finding;
-  f.channel = step_k > 0.0 ? "t_in_c" : "t_out_c";
-  f.kind = "offset_step";
-  f.from_s = s.days[d->split];
-  f.from = from;
-  f.size = std::fabs(step_k);
-  CountRowsFrom(*r.data, f.from_s, &f);
+  f = FindingFrom(*r.data, step_k > 0.0 ? "t_in_c" : "t_out_c", "offset_step", s.days[d->split],
+                  from, std::fabs(step_k));
   f.detail =
       "from " + f.from + " on the measured Q_u is " + FixedDecimals(std::fabs(step_k), 2) +
       " K × ṁ·c_p " + (step_k > 0.0 ? "below" : "above") +

@@ -196,6 +196,19 @@
 //       of clean days, and computed from the measurements only the days from
 //       done_before on and the dirty ones.
 //
+// Version 12 adds (issue 53 item 5: forecasts from interval history scored;
+// doc/sql.md):
+//   view forecast_skill and forecast_skill_local score a day that has no
+//       measurement_1min row (valid or not) from its measurement_interval
+//       rows, each weighted by its step (step_s / 60 minutes) in MAE, nMAE,
+//       skill and coverage, so that minutes stays minutes (an integer where
+//       the steps sum to whole minutes); a day with 1-min rows keeps the
+//       values of version 11. The columns are those of version 8.
+//   triggers forecast_skill_interval_{insert,update,delete} on
+//       measurement_interval mark a materialised day without 1-min rows
+//       dirty. The migration materialises the closed days only interval
+//       rows score.
+//
 // Units and time: every time is unix seconds UTC (INTEGER) and marks the
 // start of the row's interval (5 s, 1 min); powers in W, temperatures in °C,
 // irradiance in W/m², flow in kg/s, wind in m/s. The column aoi_deg holds
@@ -252,7 +265,7 @@
 
 namespace pvtwin {
 
-inline constexpr int kStoreSchemaVersion = 11;
+inline constexpr int kStoreSchemaVersion = 12;
 // NULL in a row struct.
 inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 

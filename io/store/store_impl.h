@@ -93,6 +93,12 @@ inline std::string ColumnDefs(std::span<const Channel> channels) {
 // `pairs` of them ("SELECT day, ... FROM pairs GROUP BY day").
 std::string SkillPairsV11(const std::string& from, const std::string& where);
 std::string SkillAggregatesV11();
+// Those of version 12: the pairs also of the measurement_interval rows of
+// UTC days without 1-min rows, each with its step_s; `from` writes the
+// measurement table {m} (filled in once with each table), and the columns
+// weight each pair by its minutes.
+std::string SkillPairsV12(const std::string& from, const std::string& where);
+std::string SkillAggregatesV12();
 
 // The outcome of one database step: an SQLite result code and what was done.
 struct DbStatus {

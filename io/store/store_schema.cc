@@ -497,13 +497,164 @@ std::vector<std::string> SchemaV11() {
   return s;
 }
 
+// The rows m of measurement_interval (version 12) a day-ahead score reads:
+// those of UTC days (or of the local day `d`) without any measurement_1min
+// row. A day with 1-min rows is scored from them alone, as before.
+std::string NoMinuteRowsIn(const std::string& start, const std::string& end) {
+  return "NOT EXISTS (SELECT 1 FROM measurement_1min o WHERE o.ts >= " + start + " AND o.ts < " +
+         end + ")";
+}
+
+std::string ReplaceAll(std::string text, const std::string& token, const std::string& by) {
+  for (std::size_t at = text.find(token); at != std::string::npos;
+       at = text.find(token, at + by.size())) {
+    text.replace(at, token.size(), by);
+  }
+  return text;
+}
+
+}  // namespace
+
+// Day-ahead pairs of version 12: those of version 11 from measurement_1min,
+// and those of the measurement_interval rows of UTC days without 1-min
+// rows, each pair with the seconds it stands for (step_s: 60 for a
+// minute, the row's step_s for an interval row). `from` names the
+// measurement row m and writes its table {m}.
+std::string store_detail::SkillPairsV12(const std::string& from, const std::string& where) {
+  const std::string day = UtcDayOf("m.ts");
+  const auto pairs = [&](const char* table, const char* step_s, const std::string& also) {
+    return " SELECT " + day + " AS day, " + step_s + " AS step_s," + kSkillPairColumns + " FROM " +
+           ReplaceAll(from, "{m}", table) +
+           " CROSS JOIN forecast f ON f.ts = m.ts"
+           "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+           "   AND g.issued_at <= " +
+           day + ") WHERE (m.valid IS NULL OR m.valid != 0) AND " + where + also;
+  };
+  return pairs("measurement_1min", "60", "") + " UNION ALL" +
+         pairs("measurement_interval", "m.step_s",
+               " AND " + NoMinuteRowsIn(day, day + " + 86400"));
+}
+
+// forecast_skill's columns (version 12) from its CTE `pairs` (with
+// step_s), per day: each pair weighted by its minutes w = step_s / 60, so
+// that a 10-min row counts as ten minutes in every mean and in `minutes`.
+// For 1-min pairs (w = 1.0) every sum and quotient is the one of version 8
+// (SUM(1.0 * x) / SUM(1.0) is AVG(x) in SQLite's arithmetic), and minutes
+// stays COUNT(*), an integer.
+std::string store_detail::SkillAggregatesV12() {
+  const std::string w = "(step_s / 60.0)";
+  const auto weight_of = [&](const std::string& x) {
+    return "SUM(CASE WHEN " + x + " IS NOT NULL THEN " + w + " END)";
+  };
+  const auto mean_abs = [&](const std::string& x, const std::string& over) {
+    return "(SUM(CASE WHEN " + over + " IS NOT NULL THEN " + w + " * ABS(" + x + ") END) / " +
+           weight_of(over) + ")";
+  };
+  const auto skill = [&](const char* err, const char* ref) {
+    return " 1.0 - SUM(CASE WHEN " + std::string(ref) + " IS NOT NULL THEN " + w + " * ABS(" +
+           err + ") END) / NULLIF(SUM(CASE WHEN " + err + " IS NOT NULL THEN " + w + " * ABS(" +
+           ref + ") END), 0) END,";
+  };
+  const auto inside = [&](const char* in) { return "TOTAL(" + w + " * " + in + ")"; };
+  const auto banded = [&](const char* in) {
+    return "TOTAL(CASE WHEN " + std::string(in) + " IS NOT NULL THEN " + w + " END)";
+  };
+  const std::string enough =
+      " CASE WHEN SUM(step_s) >= " + std::to_string(kMinScoredMinutes * 60) + " THEN";
+  return " SELECT day, " + mean_abs("err_p", "err_p") + ", " + mean_abs("err_q", "err_q") + ", " +
+         mean_abs("err_p", "err_p") + " / " + mean_abs("meas_p", "err_p") + ", " +
+         mean_abs("err_q", "err_q") + " / " + mean_abs("meas_q", "err_q") + "," + enough +
+         skill("err_p", "ref_p") + enough + skill("err_q", "ref_q") + enough + " (" +
+         inside("in_p") + " + " + inside("in_q") + ") / NULLIF(" + banded("in_p") + " + " +
+         banded("in_q") +
+         ", 0) END,"
+         " CASE WHEN SUM(step_s) % 60 = 0 THEN SUM(step_s) / 60 ELSE SUM(step_s) / 60.0 END," +
+         enough + " " + inside("in_p") + " / NULLIF(" + banded("in_p") + ", 0) END," + enough +
+         " " + inside("in_q") + " / NULLIF(" + banded("in_q") + ", 0) END FROM pairs GROUP BY day";
+}
+
+namespace {
+
+// forecast_skill of version 12: as version 11's, with the pairs of
+// version 12 (interval rows of days without 1-min rows) in the live part.
+std::string ForecastSkillViewV12() {
+  const std::string done = kSkillDoneBefore;
+  return std::string("CREATE VIEW forecast_skill") + kSkillColumnsV8 +
+         " AS SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
+         "coverage_p10_p90, minutes, coverage_p_el, coverage_q_th FROM forecast_skill_day"
+         " WHERE day < " +
+         done +
+         " AND day NOT IN (SELECT day FROM forecast_skill_dirty)"
+         " UNION ALL SELECT * FROM (WITH pairs AS (" +
+         store_detail::SkillPairsV12("{m} m", "m.ts >= " + done) + " UNION ALL" +
+         store_detail::SkillPairsV12(
+             "forecast_skill_dirty x CROSS JOIN {m} m ON m.ts >= x.day AND m.ts < x.day + 86400",
+             "x.day < " + done) +
+         ")" + store_detail::SkillAggregatesV12() + ")";
+}
+
+// forecast_skill_local of version 12: version 9's pairs per local day, and
+// those of the interval rows of local days without 1-min rows.
+std::string ForecastSkillLocalViewV12() {
+  const auto pairs = [](const char* table, const char* step_s, const std::string& also) {
+    return std::string(" SELECT d.day AS day, ") + step_s + " AS step_s," + kSkillPairColumns +
+           " FROM local_day d CROSS JOIN " + table +
+           " m ON m.ts >= d.start_ts AND m.ts < d.end_ts"
+           " CROSS JOIN forecast f ON f.ts = m.ts"
+           "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
+           "   AND g.issued_at <= d.start_ts)"
+           " WHERE (m.valid IS NULL OR m.valid != 0)" +
+           also;
+  };
+  return std::string("CREATE VIEW forecast_skill_local") + kSkillColumnsV8 + " AS WITH pairs AS (" +
+         pairs("measurement_1min", "60", "") + " UNION ALL" +
+         pairs("measurement_interval", "m.step_s",
+               " AND " + NoMinuteRowsIn("d.start_ts", "d.end_ts")) +
+         ")" + store_detail::SkillAggregatesV12();
+}
+
+// Version 12 (issue 53 item 5: skill of forecasts from interval history):
+// forecast_skill and forecast_skill_local score the measurement_interval
+// rows of days without 1-min rows, each weighted by its step; triggers on
+// measurement_interval mark such days dirty. The migration materialises
+// the closed days that only interval rows score (version 11 has no row for
+// them) and leaves every other row as it was.
+std::vector<std::string> SchemaV12() {
+  const std::string done = kSkillDoneBefore;
+  std::vector<std::string> s = {
+      "DROP VIEW forecast_skill",
+      ForecastSkillViewV12(),
+      "DROP VIEW forecast_skill_local",
+      ForecastSkillLocalViewV12(),
+      "WITH pairs AS (" +
+          store_detail::SkillPairsV12(
+              "{m} m", "m.ts < " + done +
+                           " AND m.ts - ((m.ts % 86400) + 86400) % 86400 NOT IN (SELECT day FROM "
+                           "forecast_skill_dirty)") +
+          ") INSERT OR IGNORE INTO forecast_skill_day" + store_detail::SkillAggregatesV12(),
+  };
+  // A change of an interval row matters only to a day without 1-min rows.
+  const auto unscored = [](const std::string& ts) {
+    return NoMinuteRowsIn(UtcDayOf(ts), UtcDayOf(ts) + " + 86400");
+  };
+  s.push_back("CREATE TRIGGER forecast_skill_interval_insert AFTER INSERT ON measurement_interval "
+              "BEGIN" + MarkDirty("NEW.ts", unscored("NEW.ts")) + " END");
+  s.push_back("CREATE TRIGGER forecast_skill_interval_update AFTER UPDATE ON measurement_interval "
+              "BEGIN" + MarkDirty("OLD.ts", unscored("OLD.ts")) +
+              MarkDirty("NEW.ts", unscored("NEW.ts")) + " END");
+  s.push_back("CREATE TRIGGER forecast_skill_interval_delete AFTER DELETE ON measurement_interval "
+              "BEGIN" + MarkDirty("OLD.ts", unscored("OLD.ts")) + " END");
+  return s;
+}
+
 struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
 const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2},  {3, &SchemaV3}, {4, &SchemaV4},
                                  {5, &SchemaV5}, {6, &SchemaV6},  {7, &SchemaV7}, {8, &SchemaV8},
-                                 {9, &SchemaV9}, {10, &SchemaV10}, {11, &SchemaV11}};
+                                 {9, &SchemaV9}, {10, &SchemaV10}, {11, &SchemaV11},
+                                 {12, &SchemaV12}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 

@@ -1,9 +1,10 @@
-// forecast_skill materialised per UTC day (schema version 11,
+// forecast_skill materialised per UTC day (schema versions 11 and 12,
 // io/store/store.h): Store::RefreshForecastSkill writes forecast_skill_day
 // for the closed days not yet materialised and for the dirty ones (the
 // triggers of store_schema.cc mark a materialised day dirty when its
 // measurements or its scored forecasts change), so that the view computes
-// only the rest (normally today) from measurement_1min.
+// only the rest (normally today) from measurement_1min and, for days
+// without 1-min rows, measurement_interval.
 #include <sqlite3.h>
 
 #include <string>
@@ -62,10 +63,10 @@ DbStatus Store::Impl::RefreshForecastSkill(std::int64_t now_ts, int* days_writte
   s = StepDone(stmt, "delete the forecast_skill_day rows to refresh");
   if (!s.ok()) return s;
   s = Prepare("WITH pairs AS (" +
-                  SkillPairsV11("forecast_skill_dirty x CROSS JOIN measurement_1min m ON m.ts >= "
+                  SkillPairsV12("forecast_skill_dirty x CROSS JOIN {m} m ON m.ts >= "
                                 "x.day AND m.ts < x.day + 86400",
                                 "x.day < ?1 AND x.day < ?2") +
-                  ")" + kInsertSkillDays + SkillAggregatesV11(),
+                  ")" + kInsertSkillDays + SkillAggregatesV12(),
               &stmt);
   if (!s.ok()) return s;
   sqlite3_bind_int64(stmt, 1, today);
@@ -74,8 +75,8 @@ DbStatus Store::Impl::RefreshForecastSkill(std::int64_t now_ts, int* days_writte
   if (!s.ok()) return s;
   *days_written += sqlite3_changes(db);
   if (today > done) {
-    s = Prepare("WITH pairs AS (" + SkillPairsV11("measurement_1min m", "m.ts >= ?1 AND m.ts < ?2") +
-                    ")" + kInsertSkillDays + SkillAggregatesV11(),
+    s = Prepare("WITH pairs AS (" + SkillPairsV12("{m} m", "m.ts >= ?1 AND m.ts < ?2") +
+                    ")" + kInsertSkillDays + SkillAggregatesV12(),
                 &stmt);
     if (!s.ok()) return s;
     sqlite3_bind_int64(stmt, 1, done);

@@ -8,9 +8,11 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,7 @@
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
 #include "tests/support/files.h"
+#include "tests/support/forecast_skill_check.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/wait.h"
@@ -37,6 +40,8 @@ constexpr std::int64_t kDay = 86400;
 constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01 00:00 UTC
 // 2017-08-07 18:36 UTC: one row (2 min) after the last of htw saar day 1.
 constexpr std::int64_t kAfterHtwDay1 = 1502064000 + 18 * 3600 + 36 * 60;
+constexpr std::int64_t kHtwDay1 = 1502064000;  // 2017-08-07 00:00 UTC
+constexpr std::int64_t kHtwDay3 = 1500940800;  // 2017-07-25 00:00 UTC
 
 std::string Format(double unix_s) { return std::to_string(std::llround(unix_s)); }
 
@@ -63,6 +68,43 @@ class IntervalForecast : public testing::TempDirTest {
     ASSERT_EQ(run.exit_code, 0) << run.err;
     run = RunPvtwin(dir_, "import --config sim.toml --csv history.csv --db " + DbPath());
     ASSERT_EQ(run.exit_code, 0) << run.err;
+  }
+  // The htw saar day `file` (starting at `day`) as its own forecast's
+  // inputs: its measured weather imported by `pvtwin import-weather` (time
+  // stamps set to their minute) and its measured operation written into
+  // operation_plan, as another program would, for both minutes of each row.
+  void MeasuredDayAsForecastInputs(const std::string& file, std::int64_t day) {
+    std::ifstream in(kData / file);
+    std::string line;
+    std::getline(in, line);
+    std::vector<std::string> header;
+    for (std::stringstream cells(line); std::getline(cells, line, ',');) header.push_back(line);
+    const std::vector<std::string> keep = {"g_poa_w_m2", "g_poa_diffuse_w_m2", "t_amb_c",
+                                           "wind_m_s", "lw_down_w_m2"};
+    std::ofstream out(dir_ / "weather.csv");
+    out << "time";
+    for (const std::string& name : keep) out << "," << name;
+    out << "\n";
+    while (std::getline(in, line)) {
+      std::vector<std::string> cells;
+      for (std::stringstream row(line); std::getline(row, line, ',');) cells.push_back(line);
+      out << cells[0].substr(0, 17) << "00Z";
+      for (const std::string& name : keep) {
+        out << "," << cells[std::find(header.begin(), header.end(), name) - header.begin()];
+      }
+      out << "\n";
+    }
+    out.close();
+    const auto run = RunPvtwin(dir_, "import-weather --config '" + (kData / "plant.toml").string() +
+                                         "' --db " + DbPath() + " weather.csv");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const std::string of_day = " FROM measurement_interval WHERE ts >= " + Format(day) +
+                               " AND ts < " + Format(day + kDay);
+    Db db(DbPath());
+    ASSERT_EQ(db.Exec("INSERT INTO operation_plan(ts, t_in_c, flow_kg_s) SELECT ts, t_in_c, "
+                      "flow_kg_s" + of_day + " UNION ALL SELECT ts + 60, t_in_c, flow_kg_s" +
+                      of_day),
+              SQLITE_OK);
   }
   // A config without devices around `plant` (a [plant] table).
   void WriteConfig(const std::string& plant) {
@@ -184,6 +226,52 @@ TEST_F(IntervalForecast, TenMinuteHistoryIsForecastEveryTenMinutesWithBands) {
   EXPECT_EQ(db.Number("SELECT COUNT(*)" + of_issue +
                       " AND (q_th_w < q_th_w_p10 - 1e-6 OR q_th_w > q_th_w_p90 + 1e-6)"),
             0.0);
+}
+
+// Done when of issue 53 item 5 (skill): the htw saar days, 2-min rows only,
+// each forecast by `pvtwin run` from 10 min before it began, are scored in
+// forecast_skill from their 2-min rows, each weighted by 2 minutes, and
+// the rows equal the test's own computation over the stored rows (before
+// schema version 12: no row, forecast_skill read measurement_1min only).
+// The days lie 13 days apart, so no calibration and no history precede
+// them: the forecasts are the start values' (history: none), run on the
+// day's measured weather imported as its weather forecast and its measured
+// operation as its plan.
+TEST_F(IntervalForecast, TheHtwSaarDaysAreScoredFromTheirTwoMinuteRows) {
+  ImportHtwDays();
+  WriteConfig(ReadFile(kData / "plant.toml"));
+  Db db(DbPath());
+  const std::vector<std::pair<const char*, std::int64_t>> days = {
+      {"day3_clear_medium_dT.csv", kHtwDay3}, {"day1_clear_low_dT.csv", kHtwDay1}};
+  for (const auto& [file, day] : days) {
+    ASSERT_NO_FATAL_FAILURE(MeasuredDayAsForecastInputs(file, day));
+    if (day != days.front().second) {
+      ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();  // the first run's daemon
+    }
+    StartDaemon(day - 600, 1.0);
+    const std::string issued = "SELECT COUNT(p_el_w) FROM forecast WHERE issued_at = " +
+                               Format(day - 600);
+    ASSERT_TRUE(WaitFor(60, [&] { return db.Number(issued) > 0; })) << Log();
+  }
+  ASSERT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 0.0);
+  testing::Rows by_hand;
+  for (const auto& [file, day] : days) {
+    const auto score = testing::ScoreDayByHand(db, "measurement_interval", day, day + kDay, day);
+    EXPECT_GE(score.minutes, 360.0) << file << ": the day's valid rows with a forecast";
+    EXPECT_EQ(score.minutes, 2.0 * score.pairs);
+    EXPECT_FALSE(std::isnan(score.mae_p_el_w));
+    EXPECT_FALSE(std::isnan(score.coverage_p10_p90)) << "more than 360 minutes, with bands";
+    by_hand.push_back(score.Cells(Format(day)));
+  }
+  testing::ExpectSameRows(db.Rows("SELECT * FROM forecast_skill WHERE day IN (" +
+                                  Format(kHtwDay3) + ", " + Format(kHtwDay1) + ") ORDER BY day"),
+                          by_hand, "the htw saar days against the test's computation", 1e-9);
+  std::printf("htw saar days scored from 2-min rows: %s\n",
+              db.Rows("SELECT group_concat(date(day, 'unixepoch') || ' MAE P_el ' || "
+                      "round(mae_p_el_w, 1) || ' W, Q_u ' || round(mae_q_th_w, 1) || ' W, "
+                      "coverage ' || round(coverage_p10_p90, 2) || ', ' || minutes || ' min', "
+                      "'; ') FROM forecast_skill")[0][0]
+                  .c_str());
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "io/store/store.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
+#include "tests/support/store_schema_v11.h"
 
 namespace pvtwin {
 namespace {
@@ -158,7 +159,8 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
     // Back to what version 1 wrote: without the tables and views of 2 to 11
     // (version 1's two forecast views stand in as views of those names,
     // which version 6 replaces).
-    std::vector<std::string> downgrade = testing::DropSchemaV11();  // version 11
+    std::vector<std::string> downgrade = testing::DropSchemaV12();  // version 12
+    for (const std::string& sql : testing::DropSchemaV11()) downgrade.push_back(sql);
     for (const char* sql : {"DROP VIEW performance_daily_local",
                             "DROP VIEW forecast_skill_local",
                             "DROP TABLE local_day_zone",

@@ -22,6 +22,7 @@
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
+#include "tests/support/store_schema_v11.h"
 
 namespace pvtwin {
 namespace {
@@ -464,8 +465,9 @@ TEST_F(StoreLocalDayTest, LocalDaysFollowTheZoneAndAreMadeAtMigration) {
     // Back to version 8: version 10's forecast.basis (its forecast_latest
     // stands in as a view of that name, which version 10 replaces), then
     // version 9's local days.
-    static_assert(kStoreSchemaVersion == 11, "take the new version's objects back here too");
-    std::vector<std::string> downgrade = testing::DropSchemaV11();  // and its view:
+    static_assert(kStoreSchemaVersion == 12, "take the new version's objects back here too");
+    std::vector<std::string> downgrade = testing::DropSchemaV12();
+    for (const std::string& sql : testing::DropSchemaV11()) downgrade.push_back(sql);  // and its view:
     downgrade.push_back("DROP VIEW forecast_skill");
     downgrade.push_back(std::string("CREATE VIEW forecast_skill") + testing::kForecastSkillColumns +
                         " AS " + testing::kForecastSkillV10);

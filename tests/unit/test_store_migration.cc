@@ -13,6 +13,7 @@
 #include "tests/support/files.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
+#include "tests/support/store_schema_v11.h"
 
 namespace pvtwin {
 namespace {
@@ -60,8 +61,9 @@ class StoreMigrationTest : public testing::TempDirTest {
     RawDb db(DbPath());
     // Each later version's objects go first (a new version adds its own
     // here), then version 8's.
-    static_assert(kStoreSchemaVersion == 11, "take the new version's objects back here too");
-    std::vector<std::string> downgrade = testing::DropSchemaV11();
+    static_assert(kStoreSchemaVersion == 12, "take the new version's objects back here too");
+    std::vector<std::string> downgrade = testing::DropSchemaV12();
+    for (const std::string& sql : testing::DropSchemaV11()) downgrade.push_back(sql);
     downgrade.insert(downgrade.end(), {
         "DROP VIEW performance_daily_local",
         "DROP VIEW forecast_skill_local",

@@ -87,7 +87,10 @@ double WobbleVariancePerDay(const std::vector<ParameterPoint>& known, int* steps
   for (const auto& [step, lag] : step_lag) sum_step += step, sum_lag += lag;
   const double rate = sum_step / sum_lag;  // the mean change per day (a steady drift)
   double sum_sq = 0.0;
-  for (const auto& [step, lag] : step_lag) sum_sq += (step - rate * lag) * (step - rate * lag) / lag;
+  for (const auto& [step, lag] : step_lag) {
+    const double off = step - rate * lag;  // the step beside the mean rate
+    sum_sq += off * off / lag;
+  }
   return sum_sq / static_cast<double>(step_lag.size() - 1);
 }
 

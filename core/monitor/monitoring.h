@@ -111,8 +111,8 @@ struct ParameterPoint {
 inline constexpr double kDriftSigmas = 3.0;
 
 struct ParameterDrift {
-  bool judged = false;  // two fits whose windows do not overlap, and two steps
-  bool drift = false;   // judged and |change| > kDriftSigmas · scale
+  bool judged = false;             // two fits whose windows do not overlap, and two steps
+  bool drift = false;              // judged and |change| > kDriftSigmas · scale
   double first = 0.0, last = 0.0;  // the oldest fit of a window apart, and the newest
   std::int64_t first_window_end_s = 0, last_window_start_s = 0;
   double change = 0.0;       // last − first

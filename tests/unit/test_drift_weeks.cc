@@ -97,12 +97,12 @@ Series PlantData(std::uint64_t seed, int days, bool drift) {
   if (!drift) return healthy;
   ParamVector wet = truth;
   wet[static_cast<std::size_t>(Drifting())] *= 1.0 + kDriftFraction;
-  const Series risen =
-      MakeSyntheticPlantData(plant, weather, testing::SpecOf(kTruth), wet, RealisticSensorNoise(seed));
+  const Series risen = MakeSyntheticPlantData(plant, weather, testing::SpecOf(kTruth), wet,
+                                              RealisticSensorNoise(seed));
   const double start_s = static_cast<double>(kJune1 + kDriftStart * kDayS);
   for (std::size_t i = 0; i < healthy.size(); ++i) {
-    const double f =
-        std::clamp((static_cast<double>(healthy.time_s[i]) - start_s) / (kDriftDays * kDayS), 0.0, 1.0);
+    const double f = std::clamp(
+        (static_cast<double>(healthy.time_s[i]) - start_s) / (kDriftDays * kDayS), 0.0, 1.0);
     if (f == 0.0) continue;
     for (std::size_t c = 0; c < kNumChannels; ++c) {
       if (healthy.columns[c].empty()) continue;
@@ -164,13 +164,16 @@ std::vector<std::string> DriftWarnings(const Series& data, int nights) {
   }
   // The last night's figures of the rule for the drifting parameter.
   std::map<std::string, std::vector<ParameterPoint>> history;
-  EXPECT_TRUE(store->ReadAcceptedParameters(
-      in.now_s - config.monitor.drift_days * kDayS, &history, &error)) << error;
+  EXPECT_TRUE(
+      store->ReadAcceptedParameters(in.now_s - config.monitor.drift_days * kDayS, &history, &error))
+      << error;
   const std::string name(Info(Drifting()).name);
   const ParameterDrift u = DetectDrift(history[name]);
-  std::printf("  last night, %s: %.3f -> %.3f (%+.3f), fits' error %.3f, wobble %.3f "
-              "from %d steps, judged %d, drift %d\n",
-              name.c_str(), u.first, u.last, u.change, u.combined_se, u.wobble_sd, u.steps, u.judged, u.drift);
+  std::printf(
+      "  last night, %s: %.3f -> %.3f (%+.3f), fits' error %.3f, wobble %.3f "
+      "from %d steps, judged %d, drift %d\n",
+      name.c_str(), u.first, u.last, u.change, u.combined_se, u.wobble_sd, u.steps, u.judged,
+      u.drift);
   testing::RawDb db(dir.path() / "pvtwin.db");
   std::vector<std::string> messages;
   for (const auto& r : db.Rows("SELECT message FROM monitor_event WHERE kind = 'parameter_drift' "
@@ -196,10 +199,11 @@ TEST(DriftWeeks, AHealthyPlantRaisesNoDriftAndARisingBackLossDoes) {
     const std::string name(Info(Drifting()).name);
     int named = 0;
     for (const std::string& m : drifted) named += m.rfind(name, 0) == 0;
-    std::printf("seed %llu, %d nights, %s +30 %% over 6 weeks from day %d: %zu warning(s), "
-                "%d on it\n",
-                static_cast<unsigned long long>(seed), nights, name.c_str(), kDriftStart,
-                drifted.size(), named);
+    std::printf(
+        "seed %llu, %d nights, %s +30 %% over 6 weeks from day %d: %zu warning(s), "
+        "%d on it\n",
+        static_cast<unsigned long long>(seed), nights, name.c_str(), kDriftStart, drifted.size(),
+        named);
     for (const std::string& m : drifted) std::printf("  %s\n", m.c_str());
   }
 }

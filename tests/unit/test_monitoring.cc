@@ -168,8 +168,7 @@ TEST(Drift, ALossCoefficientRisingThirtyPercentInSixWeeksIsADrift) {
   EXPECT_GT(std::fabs(d.change), kDriftSigmas * d.scale);
   // The steady rise does not widen its own yardstick: the scale is the
   // healthy wobble's.
-  EXPECT_NEAR(d.wobble_sd, DetectDrift(Nightly(28, 56, 0.1, Wobble)).wobble_sd,
-              0.05 * d.wobble_sd);
+  EXPECT_NEAR(d.wobble_sd, DetectDrift(Nightly(28, 56, 0.1, Wobble)).wobble_sd, 0.05 * d.wobble_sd);
 }
 
 // Without a wobble the fits' errors are the scale: a change beyond three

@@ -167,33 +167,32 @@ void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::Calibrati
     const ParameterDrift drift = DetectDrift(points);
     judged += drift.judged;
     if (!drift.drift) continue;
-    const std::string message =
-        name + " drifted from " + Fixed(drift.first, 4) + " to " + Fixed(drift.last, 4) + " (" +
-        (drift.change > 0 ? "+" : "") + Fixed(drift.change, 4) + ", more than " +
-        Fixed(kDriftSigmas, 0) + " times its standard error " + Fixed(drift.scale, 4) +
-        ": the larger of the fits' " + Fixed(drift.combined_se, 4) + " and the wobble of fits " +
-        "a window apart " + Fixed(drift.wobble_sd, 4) + " from " + std::to_string(drift.steps) +
-        " nightly steps; windows ending " + Day(drift.first_window_end_s) + " and from " +
-        Day(drift.last_window_start_s) + ") over " + std::to_string(drift.calibrations) +
-        " accepted calibrations since " + Day(since) + " (last: calibration " +
-        std::to_string(cal.id) + ")";
+    const std::string head = name + " drifted from " + Fixed(drift.first, 4) + " to " +
+                             Fixed(drift.last, 4) + " (" + (drift.change > 0 ? "+" : "") +
+                             Fixed(drift.change, 4) + ", more than " + Fixed(kDriftSigmas, 0) +
+                             " times its standard error " + Fixed(drift.scale, 4);
+    const std::string tail = ") over " + std::to_string(drift.calibrations) +
+                             " accepted calibrations since " + Day(since) + " (last: calibration " +
+                             std::to_string(cal.id) + ")";
+    const std::string message = head + ": the larger of the fits' " + Fixed(drift.combined_se, 4) +
+                                " and the wobble of fits a window apart " +
+                                Fixed(drift.wobble_sd, 4) + " from " + std::to_string(drift.steps) +
+                                " nightly steps; windows ending " + Day(drift.first_window_end_s) +
+                                " and from " + Day(drift.last_window_start_s) + tail;
     if (!store.InsertMonitorEvent(in.now_s, "parameter_drift", "warning", message, &error)) {
       log->push_back({kErr, "daily checks: " + error});
     }
-    log->push_back({kWarning, message});
+    log->push_back({kWarning, head + tail});  // the event has the scale's parts
   }
   if (judged > 0 || history.empty()) return;
   const bool too_short = drift_days < window_days + 2;
-  log->push_back(
-      {too_short ? kWarning : kInfo,
-       "parameter drift not judged: the accepted calibrations since " + Day(since) +
-           " ([monitor] drift_days = " + std::to_string(drift_days) +
-           ") hold no fit whose window ended before the newest window's start with two nightly "
-           "steps beside it; that needs nightly fits over window_days + 2 = " +
-           std::to_string(window_days + 2) + " days" +
-           (too_short ? ", more than drift_days holds: set drift_days >= 2 x window_days = " +
-                            std::to_string(2 * window_days)
-                      : " (the daemon's history is shorter)")});
+  log->push_back({too_short ? kWarning : kInfo,
+                  "parameter drift not judged: no two accepted fits of drift_days = " +
+                      std::to_string(drift_days) + " lie a window apart (needs window_days + 2 = " +
+                      std::to_string(window_days + 2) + " days of nightly fits" +
+                      (too_short ? ": set drift_days >= 2 x window_days = " +
+                                       std::to_string(2 * window_days) + ")"
+                                 : "; the daemon's history is shorter)")});
 }
 
 // The datasheet's power check over the calibration window; an event when

@@ -169,8 +169,15 @@ TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
   const ParamVector truth = ReferenceTruthParams(config_.plant);
   Accept(kJune1 + 7 * kDayS, truth, 0.3);
   Accept(kJune1 + 14 * kDayS, truth, 0.6);
-  RunDailyChecks(*store_, Inputs(true));
+  const auto log = RunDailyChecks(*store_, Inputs(true));
   testing::RawDb db(dir_ / "pvtwin.db");
+  // The log's line is the event's without the scale's parts (log lines stay
+  // within 200 characters).
+  const auto line = std::find_if(log.begin(), log.end(), [](const auto& l) {
+    return l.first == kWarning && l.second.find("u_front_w_m2k drifted from") == 0;
+  });
+  ASSERT_NE(line, log.end());
+  EXPECT_LE(line->second.size(), 200u) << line->second;
   const auto drift = db.Rows("SELECT message FROM monitor_event WHERE kind = 'parameter_drift'");
   ASSERT_EQ(drift.size(), 1u);
   EXPECT_NE(drift[0][0].find("u_front_w_m2k drifted"), std::string::npos) << drift[0][0];
@@ -180,6 +187,10 @@ TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
   EXPECT_NE(drift[0][0].find("windows ending 2024-06-01 and from 2024-06-01"), std::string::npos)
       << drift[0][0];
   EXPECT_NE(drift[0][0].find("over 3 accepted calibrations"), std::string::npos) << drift[0][0];
+  EXPECT_NE(drift[0][0].find("the wobble of fits a window apart 0.0000 from 2 nightly steps"),
+            std::string::npos)
+      << drift[0][0];
+  EXPECT_EQ(line->second.find("wobble"), std::string::npos) << line->second;
   // Without a new calibration the drift is not raised again.
   RunDailyChecks(*store_, Inputs(false));
   EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'parameter_drift'"), 1);

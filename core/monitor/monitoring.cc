@@ -67,28 +67,62 @@ bool ScoreDay(const Series& minutes, std::int64_t day_start_s, const Plant& plan
   return true;
 }
 
-std::optional<ParameterDrift> DetectDrift(std::span<const ParameterPoint> points) {
+namespace {
+
+// The steps' variance per day of window shift (DetectDrift's v̂) over the
+// consecutive fits whose windows overlap; *steps how many there were.
+double WobbleVariancePerDay(const std::vector<ParameterPoint>& known, int* steps) {
+  std::vector<std::pair<double, double>> step_lag;  // (step, lag in days)
+  for (std::size_t k = 1; k < known.size(); ++k) {
+    const double lag_d =
+        static_cast<double>(known[k].window_end_s - known[k - 1].window_end_s) / kDayS;
+    const double window_d =
+        static_cast<double>(known[k].window_end_s - known[k].window_start_s) / kDayS;
+    if (!(lag_d > 0.0) || lag_d >= window_d) continue;  // same window, or no overlap
+    step_lag.emplace_back(known[k].value - known[k - 1].value, lag_d);
+  }
+  *steps = static_cast<int>(step_lag.size());
+  if (step_lag.size() < 2) return kNaN;
+  double sum_step = 0.0, sum_lag = 0.0;
+  for (const auto& [step, lag] : step_lag) sum_step += step, sum_lag += lag;
+  const double rate = sum_step / sum_lag;  // the mean change per day (a steady drift)
+  double sum_sq = 0.0;
+  for (const auto& [step, lag] : step_lag) {
+    const double off = step - rate * lag;  // the step beside the mean rate
+    sum_sq += off * off / lag;
+  }
+  return sum_sq / static_cast<double>(step_lag.size() - 1);
+}
+
+}  // namespace
+
+ParameterDrift DetectDrift(std::span<const ParameterPoint> points) {
   std::vector<ParameterPoint> known;
   for (const ParameterPoint& p : points) {
-    if (std::isfinite(p.value) && std::isfinite(p.std_error) && p.std_error >= 0.0) {
+    if (std::isfinite(p.value) && std::isfinite(p.std_error) && p.std_error >= 0.0 &&
+        p.window_end_s > p.window_start_s) {
       known.push_back(p);
     }
   }
-  if (known.size() < 3) return std::nullopt;
-  int ups = 0, downs = 0;
-  for (std::size_t k = 1; k < known.size(); ++k) {
-    const double step = known[k].value - known[k - 1].value;
-    ups += step > 0.0;
-    downs += step < 0.0;
-  }
-  if (ups > 0 && downs > 0) return std::nullopt;  // not one direction
   ParameterDrift d;
-  d.first = known.front().value;
-  d.last = known.back().value;
-  d.change = d.last - d.first;
-  d.combined_se = std::hypot(known.front().std_error, known.back().std_error);
   d.calibrations = static_cast<int>(known.size());
-  if (!(std::fabs(d.change) > 2.0 * d.combined_se)) return std::nullopt;
+  if (known.empty()) return d;
+  const ParameterPoint& last = known.back();
+  const auto first = std::find_if(known.begin(), known.end(), [&last](const ParameterPoint& p) {
+    return p.window_end_s <= last.window_start_s;
+  });
+  const double v = WobbleVariancePerDay(known, &d.steps);
+  if (first == known.end() || !std::isfinite(v)) return d;  // not judged
+  d.judged = true;
+  d.first = first->value;
+  d.last = last.value;
+  d.first_window_end_s = first->window_end_s;
+  d.last_window_start_s = last.window_start_s;
+  d.change = d.last - d.first;
+  d.combined_se = std::hypot(first->std_error, last.std_error);
+  d.wobble_sd = std::sqrt(v * static_cast<double>(last.window_end_s - last.window_start_s) / kDayS);
+  d.scale = std::max(d.combined_se, d.wobble_sd);
+  d.drift = std::fabs(d.change) > kDriftSigmas * d.scale;
   return d;
 }
 

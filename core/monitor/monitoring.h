@@ -60,25 +60,71 @@ bool ScoreDay(const Series& minutes, std::int64_t day_start_s, const Plant& plan
 
 // ---------------------------------------------------------------------------
 // Drift of an identified parameter across accepted calibrations.
+//
+// Nightly fits of a window of W days share W − 1 of their days, so their
+// estimates are strongly correlated: a monotone run over three or four fits
+// is common by chance, and a fit's Hessian standard error leaves out the
+// structural gap between model and plant (which days the window holds moves
+// a parameter more than its standard error says). The rule therefore
+// compares two fits whose windows do not overlap, and reads the scale of
+// their difference from the plant's own history of the parameter.
+//
+// Model of a healthy plant: a fit over days [n − W, n) is μ + (1/W)·Σ u_d,
+// the mean of the days' own preferences u_d (independent, variance σ_u²).
+// Two fits whose windows are L days apart then differ with variance
+//   Var(x_{n+L} − x_n) = 2σ_u²·min(L, W)/W² = v·min(L, W),  v = 2σ_u²/W²,
+// a random walk for L < W that saturates at v·W once the windows no longer
+// overlap. v comes from the steps between consecutive fits (L < W):
+//   v̂ = Σ (step − m·L)²/L / (steps − 1),   m = Σ step / Σ L,
+// the steps' spread around their mean rate m, so that a steady drift does
+// not inflate its own yardstick. The scale of a change between windows that
+// do not overlap is the larger of sqrt(v̂·W) (the wobble of the plant's
+// own fits) and sqrt(se_first² + se_last²) (the fits' errors).
+//
+// The rule: the newest fit (last) against the oldest fit of the history
+// whose window ended at or before the newest window's start (first): the
+// longest span of independent windows in drift_days, where a steady drift
+// has moved furthest. A drift when |last − first| > kDriftSigmas·scale,
+// kDriftSigmas = 3 (Shewhart's control limit, fixed before any seed was
+// run). False-alarm rate it implies for a Gaussian wobble of known scale:
+// 0.27 % of independent comparisons of a parameter; nightly comparisons
+// share their windows, so about one independent comparison per W days:
+// with the six identified parameters of 2N1Ccolwr and W = 14, about 0.4
+// false warnings a year (with the scale estimated from ~27 steps, Student's
+// t with ~26 degrees of freedom, about 0.6 % and 0.9 a year).
+//
+// Not judged (judged false, no drift) when the history holds no fit whose
+// window ended before the newest one's start, or fewer than two steps
+// between overlapping windows: drift_days shorter than W + 2 days of
+// accepted nightly fits, or a daemon younger than that.
 
 struct ParameterPoint {
   std::int64_t run_at_s = 0;
   double value = 0.0;
   double std_error = 0.0;  // NaN when unknown
+  // The fit's window [window_start_s, window_end_s); a point without one
+  // (end not after start) does not count.
+  std::int64_t window_start_s = 0, window_end_s = 0;
 };
+
+// Shewhart's control limit, in units of the scale.
+inline constexpr double kDriftSigmas = 3.0;
 
 struct ParameterDrift {
-  double first = 0.0, last = 0.0;  // values at the window's first and last calibration
-  double change = 0.0;             // last − first
-  double combined_se = 0.0;        // sqrt(se_first² + se_last²)
-  int calibrations = 0;
+  bool judged = false;             // two fits whose windows do not overlap, and two steps
+  bool drift = false;              // judged and |change| > kDriftSigmas · scale
+  double first = 0.0, last = 0.0;  // the oldest fit of a window apart, and the newest
+  std::int64_t first_window_end_s = 0, last_window_start_s = 0;
+  double change = 0.0;       // last − first
+  double combined_se = 0.0;  // sqrt(se_first² + se_last²)
+  double wobble_sd = 0.0;    // sqrt(v̂·W): the plant's own fits, windows apart
+  double scale = 0.0;        // max(combined_se, wobble_sd)
+  int calibrations = 0;      // points with a value, standard error and window
+  int steps = 0;             // steps between overlapping consecutive fits
 };
 
-// A drift when at least three calibrations with standard errors move the
-// value in one direction (every step the same sign or zero, not all zero) and
-// the whole change exceeds twice its combined standard error. points in time
-// order.
-std::optional<ParameterDrift> DetectDrift(std::span<const ParameterPoint> points);
+// points in time order (of their windows).
+ParameterDrift DetectDrift(std::span<const ParameterPoint> points);
 
 // ---------------------------------------------------------------------------
 // Power check of the thermal output against the collector's datasheet, in

@@ -146,30 +146,53 @@ void CheckSensors(Store& store, const DailyCheckInputs& in, const Series& window
   }
 }
 
-// Drift of each parameter over the accepted calibrations of drift_days.
+// Drift of each parameter over the accepted calibrations of drift_days
+// (DetectDrift: the newest fit against the oldest a window apart, on the
+// scale of the plant's own wobble). When no parameter can be judged the log
+// says why: a daemon younger than a window and two nights, or drift_days
+// too short to hold fits a window apart (a warning: it never will).
 void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::CalibrationRow& cal,
                 LogLines* log) {
   std::map<std::string, std::vector<ParameterPoint>> history;
   std::string error;
-  const std::int64_t since = in.now_s - in.config->monitor.drift_days * kDayS;
+  const int drift_days = in.config->monitor.drift_days;
+  const int window_days = in.config->calibration.window_days;
+  const std::int64_t since = in.now_s - drift_days * kDayS;
   if (!store.ReadAcceptedParameters(since, &history, &error)) {
     log->push_back({kErr, "daily checks: " + error});
     return;
   }
+  int judged = 0;
   for (const auto& [name, points] : history) {
-    const std::optional<ParameterDrift> drift = DetectDrift(points);
-    if (!drift) continue;
-    const std::string message =
-        name + " drifted from " + Fixed(drift->first, 4) + " to " + Fixed(drift->last, 4) + " (" +
-        (drift->change > 0 ? "+" : "") + Fixed(drift->change, 4) + ", more than twice its " +
-        "standard error " + Fixed(drift->combined_se, 4) + ") over " +
-        std::to_string(drift->calibrations) + " accepted calibrations since " + Day(since) +
-        " (last: calibration " + std::to_string(cal.id) + ")";
+    const ParameterDrift drift = DetectDrift(points);
+    judged += drift.judged;
+    if (!drift.drift) continue;
+    const std::string head = name + " drifted from " + Fixed(drift.first, 4) + " to " +
+                             Fixed(drift.last, 4) + " (" + (drift.change > 0 ? "+" : "") +
+                             Fixed(drift.change, 4) + ", more than " + Fixed(kDriftSigmas, 0) +
+                             " times its standard error " + Fixed(drift.scale, 4);
+    const std::string tail = ") over " + std::to_string(drift.calibrations) +
+                             " accepted calibrations since " + Day(since) + " (last: calibration " +
+                             std::to_string(cal.id) + ")";
+    const std::string message = head + ": the larger of the fits' " + Fixed(drift.combined_se, 4) +
+                                " and the wobble of fits a window apart " +
+                                Fixed(drift.wobble_sd, 4) + " from " + std::to_string(drift.steps) +
+                                " nightly steps; windows ending " + Day(drift.first_window_end_s) +
+                                " and from " + Day(drift.last_window_start_s) + tail;
     if (!store.InsertMonitorEvent(in.now_s, "parameter_drift", "warning", message, &error)) {
       log->push_back({kErr, "daily checks: " + error});
     }
-    log->push_back({kWarning, message});
+    log->push_back({kWarning, head + tail});  // the event has the scale's parts
   }
+  if (judged > 0 || history.empty()) return;
+  const bool too_short = drift_days < window_days + 2;
+  log->push_back({too_short ? kWarning : kInfo,
+                  "parameter drift not judged: no two accepted fits of drift_days = " +
+                      std::to_string(drift_days) + " lie a window apart (needs window_days + 2 = " +
+                      std::to_string(window_days + 2) + " days of nightly fits" +
+                      (too_short ? ": set drift_days >= 2 x window_days = " +
+                                       std::to_string(2 * window_days) + ")"
+                                 : "; the daemon's history is shorter)")});
 }
 
 // The datasheet's power check over the calibration window; an event when

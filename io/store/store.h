@@ -434,7 +434,7 @@ class Store {
   bool LatestMonitorEventSeverity(const std::string& kind, std::string* severity, bool* found,
                                   std::string* error);
   // Parameters of the accepted calibrations with run_at >= since_ts, per
-  // name, in time order.
+  // name, in time order, with their calibration's window (0, 0 when NULL).
   bool ReadAcceptedParameters(std::int64_t since_ts,
                               std::map<std::string, std::vector<ParameterPoint>>* out,
                               std::string* error);

@@ -89,12 +89,14 @@ bool Store::ReadAcceptedParameters(std::int64_t since_ts,
       [&]() -> DbStatus {
         points.clear();
         return db.SelectRange(
-            "SELECT name, run_at, value, std_error FROM parameter_history WHERE accepted = 1 AND "
-            "run_at >= ? AND run_at < ? ORDER BY run_at",
+            "SELECT h.name, h.run_at, h.value, h.std_error, c.window_start, c.window_end "
+            "FROM parameter_history h JOIN calibration c ON c.id = h.calibration_id "
+            "WHERE h.accepted = 1 AND h.run_at >= ? AND h.run_at < ? ORDER BY h.run_at",
             since_ts, std::numeric_limits<std::int64_t>::max(),
             [&points](sqlite3_stmt* stmt) {
               points[ColumnText(stmt, 0)].push_back(
-                  {sqlite3_column_int64(stmt, 1), ColumnReal(stmt, 2), ColumnReal(stmt, 3)});
+                  {sqlite3_column_int64(stmt, 1), ColumnReal(stmt, 2), ColumnReal(stmt, 3),
+                   sqlite3_column_int64(stmt, 4), sqlite3_column_int64(stmt, 5)});
             },
             "read parameter_history");
       },

@@ -4,7 +4,7 @@
 // calibration. The daily checks score every day, band each from the days
 // before, raise the performance alarm for electricity only (on the third
 // low day: the evidence of three days together), record the frozen sensor,
-// and find a drift across accepted calibrations; the event view lists it
+// and find a drift across accepted calibrations whose windows lie apart; the event view lists it
 // all, newest first.
 #include <gtest/gtest.h>
 
@@ -61,6 +61,8 @@ class DailyChecks : public ::testing::Test {
     u_front += du;
     Store::CalibrationRow row;
     row.run_at = run_at;
+    row.window_start = run_at - kDays * kDayS;  // the 14 days before it
+    row.window_end = run_at;
     row.variant = "2N1Ccolwr";
     row.status = "accepted";
     row.accepted = true;
@@ -160,19 +162,57 @@ TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
   EXPECT_EQ(events[2][0], "calibration_accepted");
 }
 
+// Fits a week apart rising 0.3 each (a steady rise: no wobble, the fits'
+// errors 0.1 the scale): the newest against the first, whose window ended
+// where the newest's began, moved 0.6 > 3·0.141.
 TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
   const ParamVector truth = ReferenceTruthParams(config_.plant);
-  Accept(kJune1 + 2 * kDayS, truth, 0.3);
-  Accept(kJune1 + 4 * kDayS, truth, 0.6);
-  RunDailyChecks(*store_, Inputs(true));
+  Accept(kJune1 + 7 * kDayS, truth, 0.3);
+  Accept(kJune1 + 14 * kDayS, truth, 0.6);
+  const auto log = RunDailyChecks(*store_, Inputs(true));
   testing::RawDb db(dir_ / "pvtwin.db");
+  // The log's line is the event's without the scale's parts (log lines stay
+  // within 200 characters).
+  const auto line = std::find_if(log.begin(), log.end(), [](const auto& l) {
+    return l.first == kWarning && l.second.find("u_front_w_m2k drifted from") == 0;
+  });
+  ASSERT_NE(line, log.end());
+  EXPECT_LE(line->second.size(), 200u) << line->second;
   const auto drift = db.Rows("SELECT message FROM monitor_event WHERE kind = 'parameter_drift'");
   ASSERT_EQ(drift.size(), 1u);
   EXPECT_NE(drift[0][0].find("u_front_w_m2k drifted"), std::string::npos) << drift[0][0];
+  EXPECT_NE(drift[0][0].find("(+0.6000, more than 3 times its standard error 0.1414"),
+            std::string::npos)
+      << drift[0][0];
+  EXPECT_NE(drift[0][0].find("windows ending 2024-06-01 and from 2024-06-01"), std::string::npos)
+      << drift[0][0];
   EXPECT_NE(drift[0][0].find("over 3 accepted calibrations"), std::string::npos) << drift[0][0];
+  EXPECT_NE(drift[0][0].find("the wobble of fits a window apart 0.0000 from 2 nightly steps"),
+            std::string::npos)
+      << drift[0][0];
+  EXPECT_EQ(line->second.find("wobble"), std::string::npos) << line->second;
   // Without a new calibration the drift is not raised again.
   RunDailyChecks(*store_, Inputs(false));
   EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'parameter_drift'"), 1);
+}
+
+// drift_days shorter than a window and two nights never holds fits a
+// window apart: no event, and a warning in the log that says so (never a
+// silent no-op).
+TEST_F(DailyChecks, DriftDaysShorterThanTwoWindowsIsSaidInTheLog) {
+  config_.monitor.drift_days = 10;
+  const ParamVector truth = ReferenceTruthParams(config_.plant);
+  Accept(kJune1 + 7 * kDayS, truth, 0.3);
+  Accept(kJune1 + 14 * kDayS, truth, 0.6);
+  const auto log = RunDailyChecks(*store_, Inputs(true));
+  testing::RawDb db(dir_ / "pvtwin.db");
+  EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'parameter_drift'"), 0);
+  const auto line = std::find_if(log.begin(), log.end(), [](const auto& l) {
+    return l.first == kWarning && l.second.find("parameter drift not judged") == 0 &&
+           l.second.find("drift_days = 10") != std::string::npos &&
+           l.second.find("set drift_days >= 2 x window_days = 28") != std::string::npos;
+  });
+  EXPECT_NE(line, log.end());
 }
 
 // The datasheet power check: a datasheet that promises far more heat than

@@ -1,7 +1,8 @@
 // core/monitoring.h: the performance index of a day on synthetic data with a
 // known answer (the truth model scores 1; a module that lost 15 % of its
-// output scores 0.85), the drift rule on analytic
-// cases, and the sensor faults found where they were planted.
+// output scores 0.85), the drift rule on analytic nightly fits (a healthy
+// wobble, a loss coefficient rising 30 % in six weeks), and the sensor
+// faults found where they were planted.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -100,24 +101,97 @@ TEST(Performance, RowsOfACoarserLoggerCountTheMinutesTheyCover) {
   EXPECT_NEAR(p.pi_el, 1.0, 0.01);
 }
 
-TEST(Drift, OneDirectionBeyondTwiceTheCombinedErrorIsADrift) {
-  const ParameterPoint rising[] = {{0, 10.0, 0.2}, {86400, 10.4, 0.2}, {2 * 86400, 10.9, 0.2}};
-  const std::optional<ParameterDrift> d = DetectDrift(rising);
-  ASSERT_TRUE(d);
-  EXPECT_DOUBLE_EQ(d->change, 0.9);
-  EXPECT_DOUBLE_EQ(d->combined_se, std::hypot(0.2, 0.2));  // 0.283: 0.9 > 0.566
-  EXPECT_EQ(d->calibrations, 3);
-  // Within twice the error: no drift.
-  const ParameterPoint small[] = {{0, 10.0, 0.2}, {1, 10.2, 0.2}, {2, 10.5, 0.2}};
-  EXPECT_FALSE(DetectDrift(small));
-  // Back and forth: no direction.
-  const ParameterPoint zigzag[] = {{0, 10.0, 0.1}, {1, 11.0, 0.1}, {2, 10.5, 0.1}, {3, 12.0, 0.1}};
-  EXPECT_FALSE(DetectDrift(zigzag));
-  // Two calibrations are not a trend; unknown errors do not count.
-  const ParameterPoint two[] = {{0, 10.0, 0.1}, {1, 12.0, 0.1}};
-  EXPECT_FALSE(DetectDrift(two));
-  const ParameterPoint unknown[] = {{0, 10.0, NAN}, {1, 11.0, 0.1}, {2, 12.0, 0.1}};
-  EXPECT_FALSE(DetectDrift(unknown));
+// Nightly fits of 14-day windows: fit n runs at night n over [n − 14, n).
+// value(n) gives the estimate, se its standard error.
+template <typename F>
+std::vector<ParameterPoint> Nightly(int from, int to, double se, F value) {
+  std::vector<ParameterPoint> points;
+  for (int n = from; n <= to; ++n) {
+    const std::int64_t t = n * kDayS;
+    points.push_back({t, value(n), se, t - 14 * kDayS, t});
+  }
+  return points;
+}
+
+// A healthy wobble: the fits follow the weather's passing fronts, ±0.2 over
+// 9 nights around 10 (2 %), twice the fits' standard error 0.1.
+double Wobble(int n) { return 10.0 + 0.2 * std::sin(2.0 * kPi * n / 9.0); }
+
+// A young daemon's four fits, rising with the wobble by 0.35 (more than
+// twice their combined error 0.14): three steps one way, which the rule
+// before issue 53's fix called a drift. No two of their windows are apart:
+// not judged.
+TEST(Drift, AYoungDaemonsOverlappingFitsAreNotJudged) {
+  const std::vector<ParameterPoint> young = Nightly(16, 19, 0.1, Wobble);
+  for (std::size_t k = 1; k < young.size(); ++k) ASSERT_GT(young[k].value, young[k - 1].value);
+  ASSERT_GT(young.back().value - young.front().value, 2 * std::hypot(0.1, 0.1));
+  const ParameterDrift d = DetectDrift(young);
+  EXPECT_FALSE(d.judged);
+  EXPECT_FALSE(d.drift);
+  EXPECT_EQ(d.calibrations, 4);
+}
+
+// Four weeks of the healthy wobble: the newest fit against the oldest whose
+// window ended before the newest's began (28 nights apart). The scale is
+// the wobble's, sqrt(v·W) from the steps, larger than the fits' errors:
+// no drift.
+TEST(Drift, AHealthyWobbleOfFourWeeksIsNoDrift) {
+  const std::vector<ParameterPoint> month = Nightly(14, 42, 0.1, Wobble);
+  const ParameterDrift d = DetectDrift(month);
+  ASSERT_TRUE(d.judged);
+  EXPECT_FALSE(d.drift);
+  EXPECT_DOUBLE_EQ(d.first, Wobble(14));
+  EXPECT_DOUBLE_EQ(d.last, Wobble(42));
+  EXPECT_EQ(d.steps, 28);
+  EXPECT_GT(d.wobble_sd, d.combined_se);
+  EXPECT_DOUBLE_EQ(d.scale, d.wobble_sd);
+  // The steps of a sine of amplitude a and period 9 have the mean square
+  // 2a²·sin²(π/9) (about 0.0094 here); the scale is about sqrt(14·that).
+  const double mean_sq = 2.0 * 0.04 * std::pow(std::sin(kPi / 9.0), 2);
+  EXPECT_NEAR(d.wobble_sd, std::sqrt(14.0 * mean_sq), 0.05 * std::sqrt(14.0 * mean_sq));
+}
+
+// A loss coefficient rising 30 % over six weeks (soiling, fouling, wet
+// insulation) under the same wobble: after six weeks of nightly fits, the
+// newest against the fit 28 nights before has moved 0.3·10·28/42 = 2.0,
+// more than three times the wobble's scale. The rule before (every step
+// one way) saw none: the wobble turns the steps back and forth.
+TEST(Drift, ALossCoefficientRisingThirtyPercentInSixWeeksIsADrift) {
+  auto soiled = [](int n) { return Wobble(n) + 10.0 * 0.3 * (n - 14) / 42.0; };
+  const std::vector<ParameterPoint> all = Nightly(14, 56, 0.1, soiled);
+  // drift_days = 28: the accepted calibrations of the last 28 days.
+  const std::vector<ParameterPoint> recent(all.end() - 29, all.end());
+  const ParameterDrift d = DetectDrift(recent);
+  ASSERT_TRUE(d.judged);
+  EXPECT_TRUE(d.drift);
+  EXPECT_NEAR(d.change, 2.0 + Wobble(56) - Wobble(28), 1e-9);
+  EXPECT_GT(std::fabs(d.change), kDriftSigmas * d.scale);
+  // The steady rise does not widen its own yardstick: the scale is the
+  // healthy wobble's.
+  EXPECT_NEAR(d.wobble_sd, DetectDrift(Nightly(28, 56, 0.1, Wobble)).wobble_sd, 0.05 * d.wobble_sd);
+}
+
+// Without a wobble the fits' errors are the scale: a change beyond three
+// times their combined error is a drift, within it none; unknown errors
+// and windows do not count.
+TEST(Drift, WithoutAWobbleTheFitsErrorsAreTheScale) {
+  const std::vector<ParameterPoint> steady = Nightly(14, 42, 0.1, [](int n) {
+    return 10.0 + 0.02 * (n - 14);  // 0.56 over 28 nights: 4 times 0.141
+  });
+  const ParameterDrift d = DetectDrift(steady);
+  ASSERT_TRUE(d.judged);
+  EXPECT_NEAR(d.wobble_sd, 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(d.combined_se, std::hypot(0.1, 0.1));
+  EXPECT_TRUE(d.drift);
+  std::vector<ParameterPoint> noisy = steady;
+  for (ParameterPoint& p : noisy) p.std_error = 0.2;  // 0.56 < 3·0.283
+  EXPECT_FALSE(DetectDrift(noisy).drift);
+  std::vector<ParameterPoint> unknown = steady;
+  unknown.front().std_error = NAN;
+  unknown[1].window_end_s = unknown[1].window_start_s;  // no window
+  const ParameterDrift u = DetectDrift(unknown);
+  EXPECT_EQ(u.calibrations, static_cast<int>(steady.size()) - 2);
+  EXPECT_DOUBLE_EQ(u.first, steady[2].value);
 }
 
 TEST(SensorFaults, FoundWherePlanted) {

@@ -187,13 +187,16 @@ double Persisted(const Track& measured, std::int64_t t, std::int64_t history_spa
 // The weather channels: warm-up measured; horizon from the weather forecast
 // table where it has the channel (when use_table), else persisted. Counts the
 // sources into *use and flags the rows whose irradiance all came from the
-// table (and no weather channel is missing).
+// table (and no weather channel is missing), and those with a persisted
+// irradiance channel (*irradiance_persisted).
 void FillWeather(const Series& history, const Series& weather_forecast,
                  const ForecastRequest& request, std::size_t n_warm, bool use_table, Series* in,
-                 ForecastInputUse* use, std::vector<std::uint8_t>* from_table) {
+                 ForecastInputUse* use, std::vector<std::uint8_t>* from_table,
+                 std::vector<std::uint8_t>* irradiance_persisted) {
   const std::size_t n_horizon = in->size() - n_warm;
   const std::int64_t history_span_s = history.time_s.back() - history.time_s.front();
   from_table->assign(n_horizon, use_table ? 1 : 0);
+  irradiance_persisted->assign(n_horizon, 0);
   std::vector<std::uint8_t> persisted(n_horizon, 0), missing(n_horizon, 0);
   // A forecast's irradiance is one set: where the table has irradiance, an
   // irradiance channel it lacks (the in-plane diffuse of a GTI-only
@@ -220,6 +223,7 @@ void FillWeather(const Series& history, const Series& weather_forecast,
       if (IsIrradiance(c)) (*from_table)[h] = 0;
       v = Persisted(measured, t, history_span_s, nullptr);
       (std::isnan(v) ? missing : persisted)[h] = 1;
+      if (IsIrradiance(c) && !std::isnan(v)) (*irradiance_persisted)[h] = 1;
       ++(std::isnan(v) ? channel_use.missing : channel_use.fallback);
       return v;
     });
@@ -309,8 +313,8 @@ void FillOperation(const Plant& plant, const Series& history, const Series& oper
   }
 }
 
-// Smart persistence of the irradiance channels (the reference forecast, see
-// the header): the horizon value at t is k·clear(t), k the clear-sky index
+// Smart persistence of the irradiance channels on the horizon rows h with
+// rows[h] set (see the header): the horizon value at t is k·clear(t), k the clear-sky index
 // of the measured hour around t − back (the persistence day) against the
 // clear sky of the channel's kind (in-plane or horizontal), 0 ≤ k ≤
 // kMaxClearSkyIndex. Near the horizon (clear-sky mean of that hour below
@@ -320,7 +324,7 @@ constexpr double kMinClearSkyWM2 = 5.0;
 constexpr double kLinkeTurbidity = 3.0;
 
 void SmartPersistIrradiance(const Plant& plant, const Series& history, std::size_t n_warm,
-                            Series* in) {
+                            const std::vector<std::uint8_t>& rows, Series* in) {
   constexpr Channel kIrradiance[] = {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2,
                                      Channel::kGPoaDiffuseWM2};
   if (in->size() <= n_warm) return;
@@ -342,6 +346,7 @@ void SmartPersistIrradiance(const Plant& plant, const Series& history, std::size
     const Track measured(history, c);
     std::vector<double>& col = (*in)[c];
     for (std::size_t k = n_warm; k < in->size(); ++k) {
+      if (!rows[k - n_warm]) continue;
       const std::int64_t t = in->time_s[k];
       std::int64_t back = 0;
       if (std::isnan(Persisted(measured, t, history_span_s, &back)) || back > 2 * 86400) continue;
@@ -430,8 +435,10 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
   ForecastInputUse use;
   use.rows = n - n_warm;
   Series averaged;
+  std::vector<std::uint8_t> persisted;
   FillWeather(history, WeatherAtStep(weather_forecast, request, &averaged), request, n_warm, true,
-              &in, &use, &out->weather_from_forecast);
+              &in, &use, &out->weather_from_forecast, &persisted);
+  SmartPersistIrradiance(plant, history, n_warm, persisted, &in);
   PumpRule rule;
   if (request.operation == OperationForecast::kLearned) {
     rule = LearnPumpRule(plant, request.operation_history ? *request.operation_history : history);
@@ -447,8 +454,10 @@ bool MakeForecast(const Plant& plant, const ModelSpec& spec, const ParamVector& 
   Series ref = MakeFrame(request, n_warm, n);
   ForecastInputUse ref_use;
   std::vector<std::uint8_t> ref_from_table;
-  FillWeather(history, Series{}, request, n_warm, false, &ref, &ref_use, &ref_from_table);
-  SmartPersistIrradiance(plant, history, n_warm, &ref);
+  std::vector<std::uint8_t> ref_persisted;
+  FillWeather(history, Series{}, request, n_warm, false, &ref, &ref_use, &ref_from_table,
+              &ref_persisted);
+  SmartPersistIrradiance(plant, history, n_warm, ref_persisted, &ref);
   FillOperation(plant, history, Series{}, request, n_warm, false, nullptr, &ref, &ref_use);
   return RunHorizon(plant, spec, params, ref, n_warm, false, &out->reference, error);
 }

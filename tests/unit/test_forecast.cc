@@ -74,23 +74,51 @@ TEST(Forecast, PerfectInputsReproduceTheTruthModel) {
 TEST(Forecast, WithoutWeatherForecastPersistsTheLastDay) {
   const Case c;
   const Series plan = c.From(c.t_forecast);
+  // Broken clouds on the last day: every other 5 minutes at 30 % of the sun.
+  Series history = c.Before(c.t_forecast);
+  const std::size_t yesterday = history.RowAtOrAfter(c.t_forecast - kDay);
+  for (Channel ch : {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2,
+                     Channel::kGPoaDiffuseWM2}) {
+    if (!history.Has(ch)) continue;
+    for (std::size_t i = yesterday; i < history.size(); ++i) {
+      if ((i - yesterday) / 5 % 2 == 1) history[ch][i] *= 0.3;
+    }
+  }
   ForecastRequest request;
   request.issued_at_s = c.t_forecast;
   Forecast f;
   std::string error;
-  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, c.Before(c.t_forecast), Series{}, plan,
-                           request, &f, &error))
+  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, history, Series{}, plan, request, &f, &error))
       << error;
   EXPECT_EQ(f.inputs.weather_forecast, 0u);
   EXPECT_EQ(f.inputs.weather_persistence, 1440u);
   EXPECT_EQ(f.inputs.weather_missing, 0u);
-  const std::size_t yesterday = c.RowOf(c.t_forecast - kDay);
-  for (Channel ch : {Channel::kGPoaWM2, Channel::kTAmbC, Channel::kWindMS}) {
-    if (!c.data.Has(ch)) continue;
+  ASSERT_EQ(history.size() - yesterday, 1440u);
+  for (Channel ch : {Channel::kTAmbC, Channel::kWindMS}) {
+    if (!history.Has(ch)) continue;
     for (std::size_t i = 0; i < 1440; i += 97) {
-      EXPECT_EQ(f.inputs_used[ch][i], c.data[ch][yesterday + i]) << ChannelName(ch) << " row " << i;
+      EXPECT_EQ(f.inputs_used[ch][i], history[ch][yesterday + i]) << ChannelName(ch) << " row " << i;
     }
   }
+  // The irradiance is the last day's as smart persistence (forecast.h): its
+  // clear-sky index over the hour, so the day keeps its energy (the sun's
+  // path differs by a day's declination only), nights stay dark, and the
+  // clouds that passed minute by minute are averaged, not replayed.
+  const std::vector<double>& g = f.inputs_used[Channel::kGPoaWM2];
+  const std::vector<double>& measured = history[Channel::kGPoaWM2];
+  double energy = 0.0, energy_yesterday = 0.0, variation = 0.0, variation_yesterday = 0.0;
+  for (std::size_t i = 0; i < 1440; ++i) {
+    energy += g[i];
+    energy_yesterday += measured[yesterday + i];
+    if (measured[yesterday + i] == 0.0) {
+      EXPECT_EQ(g[i], 0.0) << "row " << i;
+    }
+    if (i == 0) continue;
+    variation += std::fabs(g[i] - g[i - 1]);
+    variation_yesterday += std::fabs(measured[yesterday + i] - measured[yesterday + i - 1]);
+  }
+  EXPECT_NEAR(energy / energy_yesterday, 1.0, 0.02);
+  EXPECT_LT(variation, 0.1 * variation_yesterday);
   EXPECT_NE(f.inputs.Describe().find("persistence 1440/1440"), std::string::npos);
 }
 

@@ -110,19 +110,16 @@ std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool the
     }
     Follow(ReferenceOf(out, day, bands), bands, cusum, &s, &run, &day);
     out.push_back(day);
-    if (!day.banded) continue;
-    // The open excursion's days (this one included) are suspect; when S is
-    // back at 0 they were noise. An earlier excursion ended at a day with S
-    // at 0 or at an alarm, whose days stay out.
-    const bool open = run > 0;
+    if (!day.alarm) continue;
+    // The alarm judges its excursion's days (this one back to the day after
+    // S was last 0) a fault: they leave the reference of every later day.
+    // While the excursion is open they stay in it (index_band.h).
     for (auto it = out.rbegin(); it != out.rend(); ++it) {
       if (it != out.rbegin() && it->banded && (it->run_days == 0 || it->alarm)) break;
-      if (it->banded) it->suspect = open;
+      if (it->banded) it->suspect = true;
     }
-    if (day.alarm) {
-      s = 0.0;
-      run = 0;
-    }
+    s = 0.0;
+    run = 0;
   }
   return out;
 }

@@ -2,7 +2,8 @@
 // split-conformal 10–90 % band of the reference days' errors (type-7
 // quantiles by hand), holds 1 on 80 % of exchangeable days, and the CUSUM
 // alarms on several moderately low days together, never on one day's band
-// edge; days of an alarm stay out of later references.
+// edge; days of an alarm stay out of later references, the days of an open
+// excursion stay in.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -141,11 +142,14 @@ TEST(IndexBand, ADayIsJudgedAgainstTheDaysMostLikeItInExpectedEnergy) {
 }
 
 TEST(IndexCusum, ThreeDaysTwoSigmaLowAlarmOneBandEdgeDoesNot) {
-  // Reference: 20 days alternating ∓σ·z90, so that every band's 10 and 90 %
-  // quantiles are −a and a, and its σ is known.
+  // Reference: 30 days alternating ∓σ·z90, so that every band's 10 and 90 %
+  // quantiles are −a and a, and its σ is known. 30, not 20: an open
+  // excursion's days stay in the reference, so the third low day's holds
+  // the first two; with n = 30 the low rank is ⌊3.1⌋ = 3 and two low days
+  // do not reach it (with 20 days, rank 2, they would widen the band).
   const double sigma = 0.03, a = sigma * kZ90;
   std::vector<double> errors;
-  for (int d = 0; d < 20; ++d) errors.push_back(d % 2 == 0 ? -a : a);
+  for (int d = 0; d < 30; ++d) errors.push_back(d % 2 == 0 ? -a : a);
   // One day at its band's lower edge (z = −z90), then two normal days, then
   // three days 2.1σ low.
   errors.push_back(-a);
@@ -153,26 +157,27 @@ TEST(IndexCusum, ThreeDaysTwoSigmaLowAlarmOneBandEdgeDoesNot) {
   errors.push_back(0.0);
   for (int d = 0; d < 3; ++d) errors.push_back(-2.1 * sigma);
   IndexBandOptions bands;
-  bands.reference_days = 20;  // exactly the alternating days at day 20
-  bands.neighbours = 20;
+  bands.reference_days = 30;  // exactly the alternating days at day 30
+  bands.neighbours = 30;
   const std::vector<DayPerformance> days = Banded(errors, bands);
   const std::vector<IndexDay> run = FollowIndex(days, false, bands, IndexCusumOptions{});
   ASSERT_EQ(run.size(), errors.size());
   EXPECT_FALSE(run[8].banded);  // eight reference days: no band, no part in the CUSUM
   EXPECT_TRUE(run[9].banded);
-  // Day 20: the band edge, z = −z90, S = z90 − 1 = 0.28: no alarm.
-  const IndexDay& edge = run[20];
-  EXPECT_EQ(edge.day_start_s, kJune1 + 20 * kDayS);
+  // Day 30: the band edge, z = −z90, S = z90 − 1 = 0.28: no alarm.
+  const IndexDay& edge = run[30];
+  EXPECT_EQ(edge.day_start_s, kJune1 + 30 * kDayS);
   EXPECT_NEAR(edge.z, -kZ90, 1e-9);
   EXPECT_NEAR(edge.s, kZ90 - 1.0, 1e-9);
   EXPECT_FALSE(edge.alarm);
-  EXPECT_NEAR(days[20].pi_el_high, 1.0, 1e-12);  // the top of its band touches 1
-  // Days 23–25, 2.1σ low each: S = 1.1, 2.2, 3.3 σ; the alarm on the third.
-  for (int d = 23; d <= 25; ++d) {
+  EXPECT_NEAR(days[30].pi_el_high, 1.0, 1e-12);  // the top of its band touches 1
+  // Days 33–35, 2.1σ low each: S = 1.1, 2.2, 3.3 σ; the alarm on the third.
+  for (int d = 33; d <= 35; ++d) {
     const IndexDay& c = run[static_cast<std::size_t>(d)];
     ASSERT_EQ(c.day_start_s, kJune1 + d * kDayS);
-    EXPECT_EQ(c.alarm, d == 25) << d;
-    EXPECT_EQ(c.run_days, d - 22) << d;
+    EXPECT_NEAR(c.z, -2.1, 1e-9) << d;
+    EXPECT_EQ(c.alarm, d == 35) << d;
+    EXPECT_EQ(c.run_days, d - 32) << d;
   }
   int alarms = 0;
   for (const IndexDay& c : run) alarms += c.alarm;
@@ -254,6 +259,46 @@ TEST(IndexBand, ADayOutsideItsReferencesRegimeIsNotJudgedAndAHealthyPlantDoesNot
   }
   EXPECT_GE(first_alarm, 32);
   EXPECT_LE(first_alarm, 34);
+}
+
+TEST(IndexCusum, AnOpenExcursionsDaysStayInTheReferenceSoANewHealthyRegimeIsLearned) {
+  // A mixed reference (issue 53): 20 days alternating overcast (500–540 Wh
+  // expected, the model right) and broken (1500–1580 Wh, the model 0.5 %
+  // high), then clear days (2000–2080 Wh, within the regime test's range,
+  // the model 1.2 % high: healthy, a regime error of its structure), each
+  // with ±0.2 % noise; from day 32 a fault, 5 % less. The first clear days
+  // read low against the broken ones and open an excursion. Were its days
+  // left out while it is open, every clear day would be judged against the
+  // broken days alone (z about −2 to −3 each) and alarm on the third (day
+  // 22), again and again; kept in, the next clear day has them among its
+  // nearest days, S stays below h, and the only alarms are the fault's.
+  std::vector<DayPerformance> days;
+  const IndexBandOptions bands;
+  const IndexCusumOptions cusum;
+  for (int d = 0; d < 40; ++d) {
+    const double noise = 0.002 * (d % 3 - 1);
+    double error = d >= 20 ? -0.012 : (d % 2 == 0 ? 0.0 : -0.005);
+    if (d >= 32) error -= 0.05;
+    DayPerformance p = DayWithError(d, error + noise);
+    p.e_el_model_wh = d >= 20 ? 2000.0 + 20.0 * (d % 5)
+                              : (d % 2 == 0 ? 500.0 + 10.0 * (d % 5) : 1500.0 + 20.0 * (d % 5));
+    SetIndexBands(days, bands, cusum, &p);
+    days.push_back(p);
+  }
+  const std::vector<IndexDay> run = FollowIndex(days, false, bands, cusum);
+  ASSERT_EQ(run.size(), 40u);
+  EXPECT_FALSE(run[20].withheld);  // the clear days lie within the references' regime range
+  EXPECT_LT(run[20].z, -1.0);      // the first clear day reads low: an excursion opens
+  EXPECT_GT(run[21].run_days, 0);
+  int first_alarm = -1;
+  for (int d = 0; d < 40 && first_alarm < 0; ++d) {
+    if (run[static_cast<std::size_t>(d)].alarm) first_alarm = d;
+  }
+  EXPECT_GE(first_alarm, 32);
+  EXPECT_LE(first_alarm, 34);
+  // The alarm's days leave the reference; the open excursion's before it
+  // had not.
+  EXPECT_TRUE(run[static_cast<std::size_t>(first_alarm)].suspect);
 }
 
 }  // namespace

@@ -19,7 +19,14 @@
 // week, 43 and 54 with 10 or 11 overcast days; 7 opens with 11 clear days;
 // 4 mixed; each with clear days after kSwitchDay) and checked once on
 // final seeds 23, 29, 37, 61, 65, 71, chosen the same way before the rule
-// was changed (doc/validation.md has the figures).
+// was changed (doc/validation.md has the figures). The reference's
+// composition (an open excursion's days stay in the reference, an alarm's
+// leave it) was designed on fresh development seeds 103, 112, 120, 134,
+// 148, 164 (with the old ones) and checked once on fresh final seeds 105,
+// 123, 137, 143, 173, 188, both sets fixed before the rule changed and
+// chosen by DayTypesFor alone: months that mix the regimes (overcast or
+// broken stretches between clear ones; 112, 164 and 143 open overcast or
+// broken with few clear days), each with clear days after kSwitchDay.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -189,6 +196,14 @@ void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
 
 TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeClearDays) {
   CheckSeeds(Seeds(), true);
+}
+
+// Seeds 30, 37 and 61 (37 and 61 the regime test's spent final seeds) had
+// 1, 4 and 5 false electricity alarms from a mixed reference: clear days
+// 2–4 σ low against broken and overcast ones, left out of the reference
+// while their excursion was open; none with its days kept in.
+TEST(PerformanceWeeks, AMixedReferenceRaisesNoFalseAlarmOnTheClearDays) {
+  CheckSeeds({30, 37, 61}, false);
 }
 
 // Development seeds 43 and 54 open with 11 and 10 overcast days: the model,

@@ -373,8 +373,7 @@ void SmartPersistIrradiance(const Plant& plant, const Series& history, std::size
 // over [t, t + step_s), the grid at issued_at's phase; the model's inputs
 // are interval means, as the measured rows it was calibrated on, not the
 // table's value at the interval's start. Else the table itself.
-const Series& WeatherAtStep(const Series& table, const ForecastRequest& request,
-                            Series* averaged) {
+const Series& WeatherAtStep(const Series& table, const ForecastRequest& request, Series* averaged) {
   if (table.size() == 0 || !(table.step_s > 0.0) || request.step_s <= table.step_s) return table;
   const std::int64_t step = std::llround(request.step_s);
   const std::int64_t phase = ((request.issued_at_s % step) + step) % step;

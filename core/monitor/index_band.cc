@@ -34,7 +34,7 @@ ConformalQuantiles QuantilesOf(std::vector<double> errors) {
 // window that are not suspect, the `neighbours` nearest in ln expected
 // energy (ties: the more recent); their errors ln pi and their regimes.
 struct Reference {
-  std::vector<double> errors;      // ln pi
+  std::vector<double> errors;       // ln pi
   std::vector<double> log_e_model;  // ln expected energy (Wh)
 };
 Reference ReferenceOf(const std::vector<IndexDay>& before, const IndexDay& today,

@@ -130,10 +130,10 @@ struct IndexDay {
   // regime they do not hold); no band (NaN), no part in the CUSUM, still a
   // reference for later days.
   bool withheld = false;
-  double z = 0.0;                // standardised error of the day (σ); 0 without a band
-  double s = 0.0;                // S after the day (σ); after an alarm the next starts from 0
-  int run_days = 0;              // days of the excursion up to this day (0: S is 0)
-  bool alarm = false;            // S reached h with run_days >= min_days on this day
+  double z = 0.0;      // standardised error of the day (σ); 0 without a band
+  double s = 0.0;      // S after the day (σ); after an alarm the next starts from 0
+  int run_days = 0;    // days of the excursion up to this day (0: S is 0)
+  bool alarm = false;  // S reached h with run_days >= min_days on this day
   // Left out of later days' reference: part of an excursion that ended in
   // an alarm (the days of an open excursion stay in it).
   bool suspect = false;

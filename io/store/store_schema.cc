@@ -394,8 +394,8 @@ std::vector<std::string> SchemaV10() {
 // Day-ahead pairs of version 11 (those of version 8) of the measurements
 // `from` (an SQL FROM list naming the measurement_1min row m) where `where`.
 std::string store_detail::SkillPairsV11(const std::string& from, const std::string& where) {
-  return " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day," + std::string(kSkillPairColumns) +
-         " FROM " + from +
+  return " SELECT m.ts - ((m.ts % 86400) + 86400) % 86400 AS day," +
+         std::string(kSkillPairColumns) + " FROM " + from +
          " CROSS JOIN forecast f ON f.ts = m.ts"
          "  AND f.issued_at = (SELECT MAX(g.issued_at) FROM forecast g WHERE g.ts = m.ts"
          "   AND g.issued_at <= m.ts - ((m.ts % 86400) + 86400) % 86400)"
@@ -432,28 +432,35 @@ std::string MarkDirty(const std::string& ts, const std::string& also) {
 // superseded issues marks nothing.
 std::string IsScoredIssue(const std::string& row) {
   const std::string day = UtcDayOf(row + ".ts");
-  return row + ".issued_at <= " + day + " AND NOT EXISTS (SELECT 1 FROM forecast g WHERE g.ts = " +
-         row + ".ts AND g.issued_at > " + row + ".issued_at AND g.issued_at <= " + day + ")";
+  return row + ".issued_at <= " + day +
+         " AND NOT EXISTS (SELECT 1 FROM forecast g WHERE g.ts = " + row +
+         ".ts AND g.issued_at > " + row + ".issued_at AND g.issued_at <= " + day + ")";
 }
 
-// forecast_skill of version 11: the materialised rows of clean closed days,
-// and the live computation (as version 8) of the rest only: the minutes
-// from done_before on and those of the dirty days.
-std::string ForecastSkillViewV11() {
-  const std::string done = kSkillDoneBefore;
+// forecast_skill over forecast_skill_day (versions 11 on): the materialised
+// rows of clean closed days, and the aggregates of live_pairs (the pairs of
+// the minutes from done_before on and of the dirty days) for the rest.
+std::string MaterialisedSkillView(const std::string& live_pairs, const std::string& aggregates) {
   return std::string("CREATE VIEW forecast_skill") + kSkillColumnsV8 +
          " AS SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
          "coverage_p10_p90, minutes, coverage_p_el, coverage_q_th FROM forecast_skill_day"
          " WHERE day < " +
-         done +
+         kSkillDoneBefore +
          " AND day NOT IN (SELECT day FROM forecast_skill_dirty)"
          " UNION ALL SELECT * FROM (WITH pairs AS (" +
-         store_detail::SkillPairsV11("measurement_1min m", "m.ts >= " + done) + " UNION ALL" +
-         store_detail::SkillPairsV11(
-             "forecast_skill_dirty x CROSS JOIN measurement_1min m ON m.ts >= x.day AND m.ts < "
-             "x.day + 86400",
-             "x.day < " + done) +
-         ")" + SkillAggregatesV8() + ")";
+         live_pairs + ")" + aggregates + ")";
+}
+
+// forecast_skill of version 11: the live computation as version 8's.
+std::string ForecastSkillViewV11() {
+  const std::string done = kSkillDoneBefore;
+  return MaterialisedSkillView(
+      store_detail::SkillPairsV11("measurement_1min m", "m.ts >= " + done) + " UNION ALL" +
+          store_detail::SkillPairsV11(
+              "forecast_skill_dirty x CROSS JOIN measurement_1min m ON m.ts >= x.day AND m.ts < "
+              "x.day + 86400",
+              "x.day < " + done),
+      SkillAggregatesV8());
 }
 
 // Version 11 (forecast_skill materialised per UTC day): forecast_skill_day
@@ -472,21 +479,28 @@ std::vector<std::string> SchemaV11() {
       "CREATE TABLE forecast_skill_state(id INTEGER PRIMARY KEY CHECK(id = 1), done_before "
       "INTEGER NOT NULL)",
       "INSERT INTO forecast_skill_state(id, done_before) SELECT 1, MIN(" +
-          UtcDayOf("CAST(strftime('%s', 'now') AS INTEGER)") + ", COALESCE(" +
-          UtcDayOf("MAX(ts)") + " + 86400, 0)) FROM measurement_1min",
+          UtcDayOf("CAST(strftime('%s', 'now') AS INTEGER)") + ", COALESCE(" + UtcDayOf("MAX(ts)") +
+          " + 86400, 0)) FROM measurement_1min",
       "WITH pairs AS (" +
-          store_detail::SkillPairsV11("measurement_1min m", std::string("m.ts < ") + kSkillDoneBefore) +
+          store_detail::SkillPairsV11("measurement_1min m",
+                                      std::string("m.ts < ") + kSkillDoneBefore) +
           ") INSERT INTO forecast_skill_day" + SkillAggregatesV8(),
       "DROP VIEW forecast_skill",
       ForecastSkillViewV11(),
   };
   const std::string any = "1";
-  s.push_back("CREATE TRIGGER forecast_skill_measurement_insert AFTER INSERT ON measurement_1min "
-              "BEGIN" + MarkDirty("NEW.ts", any) + " END");
-  s.push_back("CREATE TRIGGER forecast_skill_measurement_update AFTER UPDATE ON measurement_1min "
-              "BEGIN" + MarkDirty("OLD.ts", any) + MarkDirty("NEW.ts", any) + " END");
-  s.push_back("CREATE TRIGGER forecast_skill_measurement_delete AFTER DELETE ON measurement_1min "
-              "BEGIN" + MarkDirty("OLD.ts", any) + " END");
+  s.push_back(
+      "CREATE TRIGGER forecast_skill_measurement_insert AFTER INSERT ON measurement_1min "
+      "BEGIN" +
+      MarkDirty("NEW.ts", any) + " END");
+  s.push_back(
+      "CREATE TRIGGER forecast_skill_measurement_update AFTER UPDATE ON measurement_1min "
+      "BEGIN" +
+      MarkDirty("OLD.ts", any) + MarkDirty("NEW.ts", any) + " END");
+  s.push_back(
+      "CREATE TRIGGER forecast_skill_measurement_delete AFTER DELETE ON measurement_1min "
+      "BEGIN" +
+      MarkDirty("OLD.ts", any) + " END");
   s.push_back("CREATE TRIGGER forecast_skill_forecast_insert AFTER INSERT ON forecast BEGIN" +
               MarkDirty("NEW.ts", IsScoredIssue("NEW")) + " END");
   s.push_back("CREATE TRIGGER forecast_skill_forecast_update AFTER UPDATE ON forecast BEGIN" +
@@ -531,8 +545,7 @@ std::string store_detail::SkillPairsV12(const std::string& from, const std::stri
            day + ") WHERE (m.valid IS NULL OR m.valid != 0) AND " + where + also;
   };
   return pairs("measurement_1min", "60", "") + " UNION ALL" +
-         pairs("measurement_interval", "m.step_s",
-               " AND " + NoMinuteRowsIn(day, day + " + 86400"));
+         pairs("measurement_interval", "m.step_s", " AND " + NoMinuteRowsIn(day, day + " + 86400"));
 }
 
 // forecast_skill's columns (version 12) from its CTE `pairs` (with
@@ -551,9 +564,9 @@ std::string store_detail::SkillAggregatesV12() {
            weight_of(over) + ")";
   };
   const auto skill = [&](const char* err, const char* ref) {
-    return " 1.0 - SUM(CASE WHEN " + std::string(ref) + " IS NOT NULL THEN " + w + " * ABS(" +
-           err + ") END) / NULLIF(SUM(CASE WHEN " + err + " IS NOT NULL THEN " + w + " * ABS(" +
-           ref + ") END), 0) END,";
+    return " 1.0 - SUM(CASE WHEN " + std::string(ref) + " IS NOT NULL THEN " + w + " * ABS(" + err +
+           ") END) / NULLIF(SUM(CASE WHEN " + err + " IS NOT NULL THEN " + w + " * ABS(" + ref +
+           ") END), 0) END,";
   };
   const auto inside = [&](const char* in) { return "TOTAL(" + w + " * " + in + ")"; };
   const auto banded = [&](const char* in) {
@@ -579,18 +592,12 @@ namespace {
 // version 12 (interval rows of days without 1-min rows) in the live part.
 std::string ForecastSkillViewV12() {
   const std::string done = kSkillDoneBefore;
-  return std::string("CREATE VIEW forecast_skill") + kSkillColumnsV8 +
-         " AS SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th, skill_p_el, skill_q_th, "
-         "coverage_p10_p90, minutes, coverage_p_el, coverage_q_th FROM forecast_skill_day"
-         " WHERE day < " +
-         done +
-         " AND day NOT IN (SELECT day FROM forecast_skill_dirty)"
-         " UNION ALL SELECT * FROM (WITH pairs AS (" +
-         store_detail::SkillPairsV12("{m} m", "m.ts >= " + done) + " UNION ALL" +
-         store_detail::SkillPairsV12(
-             "forecast_skill_dirty x CROSS JOIN {m} m ON m.ts >= x.day AND m.ts < x.day + 86400",
-             "x.day < " + done) +
-         ")" + store_detail::SkillAggregatesV12() + ")";
+  return MaterialisedSkillView(
+      store_detail::SkillPairsV12("{m} m", "m.ts >= " + done) + " UNION ALL" +
+          store_detail::SkillPairsV12(
+              "forecast_skill_dirty x CROSS JOIN {m} m ON m.ts >= x.day AND m.ts < x.day + 86400",
+              "x.day < " + done),
+      store_detail::SkillAggregatesV12());
 }
 
 // forecast_skill_local of version 12: version 9's pairs per local day, and
@@ -637,13 +644,18 @@ std::vector<std::string> SchemaV12() {
   const auto unscored = [](const std::string& ts) {
     return NoMinuteRowsIn(UtcDayOf(ts), UtcDayOf(ts) + " + 86400");
   };
-  s.push_back("CREATE TRIGGER forecast_skill_interval_insert AFTER INSERT ON measurement_interval "
-              "BEGIN" + MarkDirty("NEW.ts", unscored("NEW.ts")) + " END");
-  s.push_back("CREATE TRIGGER forecast_skill_interval_update AFTER UPDATE ON measurement_interval "
-              "BEGIN" + MarkDirty("OLD.ts", unscored("OLD.ts")) +
-              MarkDirty("NEW.ts", unscored("NEW.ts")) + " END");
-  s.push_back("CREATE TRIGGER forecast_skill_interval_delete AFTER DELETE ON measurement_interval "
-              "BEGIN" + MarkDirty("OLD.ts", unscored("OLD.ts")) + " END");
+  s.push_back(
+      "CREATE TRIGGER forecast_skill_interval_insert AFTER INSERT ON measurement_interval "
+      "BEGIN" +
+      MarkDirty("NEW.ts", unscored("NEW.ts")) + " END");
+  s.push_back(
+      "CREATE TRIGGER forecast_skill_interval_update AFTER UPDATE ON measurement_interval "
+      "BEGIN" +
+      MarkDirty("OLD.ts", unscored("OLD.ts")) + MarkDirty("NEW.ts", unscored("NEW.ts")) + " END");
+  s.push_back(
+      "CREATE TRIGGER forecast_skill_interval_delete AFTER DELETE ON measurement_interval "
+      "BEGIN" +
+      MarkDirty("OLD.ts", unscored("OLD.ts")) + " END");
   return s;
 }
 
@@ -651,10 +663,10 @@ struct Migration {
   int to_version;
   std::vector<std::string> (*statements)();
 };
-const Migration kMigrations[] = {{1, &SchemaV1}, {2, &SchemaV2},  {3, &SchemaV3}, {4, &SchemaV4},
-                                 {5, &SchemaV5}, {6, &SchemaV6},  {7, &SchemaV7}, {8, &SchemaV8},
-                                 {9, &SchemaV9}, {10, &SchemaV10}, {11, &SchemaV11},
-                                 {12, &SchemaV12}};
+const Migration kMigrations[] = {{1, &SchemaV1},   {2, &SchemaV2},   {3, &SchemaV3},
+                                 {4, &SchemaV4},   {5, &SchemaV5},   {6, &SchemaV6},
+                                 {7, &SchemaV7},   {8, &SchemaV8},   {9, &SchemaV9},
+                                 {10, &SchemaV10}, {11, &SchemaV11}, {12, &SchemaV12}};
 static_assert(sizeof(kMigrations) / sizeof(kMigrations[0]) == kStoreSchemaVersion,
               "one migration per schema version");
 

@@ -75,8 +75,8 @@ DbStatus Store::Impl::RefreshForecastSkill(std::int64_t now_ts, int* days_writte
   if (!s.ok()) return s;
   *days_written += sqlite3_changes(db);
   if (today > done) {
-    s = Prepare("WITH pairs AS (" + SkillPairsV12("{m} m", "m.ts >= ?1 AND m.ts < ?2") +
-                    ")" + kInsertSkillDays + SkillAggregatesV12(),
+    s = Prepare("WITH pairs AS (" + SkillPairsV12("{m} m", "m.ts >= ?1 AND m.ts < ?2") + ")" +
+                    kInsertSkillDays + SkillAggregatesV12(),
                 &stmt);
     if (!s.ok()) return s;
     sqlite3_bind_int64(stmt, 1, done);

@@ -16,9 +16,37 @@
 #include <string>
 #include <vector>
 
+#include "io/store/store.h"
 #include "tests/support/sqlite_db.h"
 
 namespace pvtwin::testing {
+
+// One issue at issued_at for [issued_at, issued_at + horizon_s) at 1 min,
+// with bands, medians and the reference, on a half-sine day; `bias` shifts
+// its values.
+inline std::vector<Store::ForecastRow> Issue(std::int64_t issued_at, std::int64_t horizon_s,
+                                             double bias) {
+  constexpr std::int64_t kDayS = 86400;
+  std::vector<Store::ForecastRow> rows;
+  for (std::int64_t t = issued_at; t < issued_at + horizon_s; t += 60) {
+    const double h = static_cast<double>(t % kDayS) / 3600.0;
+    const double sun = std::max(0.0, std::sin((h - 6.0) / 12.0 * M_PI));
+    Store::ForecastRow r;
+    r.ts = t;
+    r.p_el_w = 390.0 * sun + bias;
+    r.q_th_w = 1150.0 * sun - 70.0 + 0.5 * bias;
+    r.p_el_w_p10 = r.p_el_w - 25.0;
+    r.p_el_w_p90 = r.p_el_w + 20.0;
+    r.q_th_w_p10 = r.q_th_w - 60.0;
+    r.q_th_w_p90 = r.q_th_w + 40.0;
+    r.p_el_w_p50 = r.p_el_w;
+    r.q_th_w_p50 = r.q_th_w;
+    r.p_el_w_ref = 350.0 * sun;
+    r.q_th_w_ref = 1000.0 * sun;
+    rows.push_back(r);
+  }
+  return rows;
+}
 
 // SQLite's counters of one query run to its end on its own connection.
 struct QueryCost {
@@ -91,9 +119,9 @@ inline double Cell(const std::string& text) {
 }
 // Sums of one output over a day's pairs, each weighted by its minutes w.
 struct Sums {
-  double err = 0, err_w = 0, meas = 0;       // w|f - m|, w, w|m| where both are known
-  double err_with_ref = 0, ref = 0;          // w|f - m|, w|ref - m| where all three are
-  double inside = 0, banded = 0;             // w where m lies in a band of width, w banded
+  double err = 0, err_w = 0, meas = 0;  // w|f - m|, w, w|m| where both are known
+  double err_with_ref = 0, ref = 0;     // w|f - m|, w|ref - m| where all three are
+  double inside = 0, banded = 0;        // w where m lies in a band of width, w banded
   bool with_ref = false;
   void Add(double w, double m, double f, double ref_f, double p10, double p90) {
     if (!std::isnan(f) && !std::isnan(m)) {
@@ -121,8 +149,8 @@ struct Sums {
 inline SkillByHand ScoreDayByHand(RawDb& db, const std::string& table, std::int64_t start,
                                   std::int64_t end, std::int64_t cutoff) {
   using skill_detail::Cell;
-  const std::string range = " WHERE ts >= " + std::to_string(start) +
-                            " AND ts < " + std::to_string(end);
+  const std::string range =
+      " WHERE ts >= " + std::to_string(start) + " AND ts < " + std::to_string(end);
   // ts -> (issued_at, columns) of the newest qualifying issue.
   std::map<std::int64_t, std::pair<std::int64_t, std::vector<std::string>>> forecast;
   for (const auto& row : db.Rows("SELECT ts, issued_at, p_el_w, q_th_w, p_el_w_p10, p_el_w_p90, "
@@ -136,8 +164,8 @@ inline SkillByHand ScoreDayByHand(RawDb& db, const std::string& table, std::int6
   const std::string step = table == "measurement_1min" ? "60" : "step_s";
   skill_detail::Sums p, q;
   SkillByHand day;
-  for (const auto& m : db.Rows("SELECT ts, " + step + ", p_el_w, q_th_w, valid FROM " + table +
-                               range)) {
+  for (const auto& m :
+       db.Rows("SELECT ts, " + step + ", p_el_w, q_th_w, valid FROM " + table + range)) {
     if (m[4] != "NULL" && Cell(m[4]) == 0.0) continue;
     const auto it = forecast.find(std::stoll(m[0]));
     if (it == forecast.end()) continue;
@@ -162,7 +190,9 @@ inline SkillByHand ScoreDayByHand(RawDb& db, const std::string& table, std::int6
     };
     day.skill_p_el = skill(p);
     day.skill_q_th = skill(q);
-    const auto share = [](double inside, double banded) { return banded > 0 ? inside / banded : NAN; };
+    const auto share = [](double inside, double banded) {
+      return banded > 0 ? inside / banded : NAN;
+    };
     day.coverage_p10_p90 = share(p.inside + q.inside, p.banded + q.banded);
     day.coverage_p_el = share(p.inside, p.banded);
     day.coverage_q_th = share(q.inside, q.banded);

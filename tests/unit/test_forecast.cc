@@ -77,8 +77,8 @@ TEST(Forecast, WithoutWeatherForecastPersistsTheLastDay) {
   // Broken clouds on the last day: every other 5 minutes at 30 % of the sun.
   Series history = c.Before(c.t_forecast);
   const std::size_t yesterday = history.RowAtOrAfter(c.t_forecast - kDay);
-  for (Channel ch : {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2,
-                     Channel::kGPoaDiffuseWM2}) {
+  for (Channel ch :
+       {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2}) {
     if (!history.Has(ch)) continue;
     for (std::size_t i = yesterday; i < history.size(); ++i) {
       if ((i - yesterday) / 5 % 2 == 1) history[ch][i] *= 0.3;
@@ -97,7 +97,8 @@ TEST(Forecast, WithoutWeatherForecastPersistsTheLastDay) {
   for (Channel ch : {Channel::kTAmbC, Channel::kWindMS}) {
     if (!history.Has(ch)) continue;
     for (std::size_t i = 0; i < 1440; i += 97) {
-      EXPECT_EQ(f.inputs_used[ch][i], history[ch][yesterday + i]) << ChannelName(ch) << " row " << i;
+      EXPECT_EQ(f.inputs_used[ch][i], history[ch][yesterday + i])
+          << ChannelName(ch) << " row " << i;
     }
   }
   // The irradiance is the last day's as smart persistence (forecast.h): its
@@ -159,8 +160,8 @@ TEST(Forecast, AtAFifteenMinuteStepTheWeatherForecastIsAveragedOverEachRow) {
   request.issued_at_s = c.t_forecast;
   request.step_s = 900.0;
   Forecast f;
-  ASSERT_TRUE(MakeForecast(c.plant, c.spec, c.truth, history, minutes, Series{}, request, &f,
-                           &error))
+  ASSERT_TRUE(
+      MakeForecast(c.plant, c.spec, c.truth, history, minutes, Series{}, request, &f, &error))
       << error;
   ASSERT_EQ(f.rows.size(), 96u);
   EXPECT_EQ(f.inputs.weather_forecast, 96u);
@@ -169,8 +170,8 @@ TEST(Forecast, AtAFifteenMinuteStepTheWeatherForecastIsAveragedOverEachRow) {
     double sum = 0.0;
     for (std::size_t m = 0; m < 15; ++m) sum += minutes[Channel::kGPoaWM2][15 * k + m];
     ASSERT_NEAR(f.inputs_used[Channel::kGPoaWM2][k], sum / 15.0, 1e-9) << k;
-    largest_start_gap_w_m2 = std::max(
-        largest_start_gap_w_m2, std::fabs(sum / 15.0 - minutes[Channel::kGPoaWM2][15 * k]));
+    largest_start_gap_w_m2 = std::max(largest_start_gap_w_m2,
+                                      std::fabs(sum / 15.0 - minutes[Channel::kGPoaWM2][15 * k]));
     energy_rows_wh += f.inputs_used[Channel::kGPoaWM2][k] * 0.25;
   }
   for (std::size_t m = 0; m < 1440; ++m) energy_minutes_wh += minutes[Channel::kGPoaWM2][m] / 60.0;

@@ -52,9 +52,9 @@ class IntervalForecast : public testing::TempDirTest {
 
   void ImportHtwDays() {
     for (const char* day : {"day3_clear_medium_dT.csv", "day1_clear_low_dT.csv"}) {
-      const auto run = RunPvtwin(dir_, "import --config '" + (kData / "plant.toml").string() +
-                                           "' --csv '" + (kData / day).string() + "' --db " +
-                                           DbPath());
+      const auto run =
+          RunPvtwin(dir_, "import --config '" + (kData / "plant.toml").string() + "' --csv '" +
+                              (kData / day).string() + "' --db " + DbPath());
       ASSERT_EQ(run.exit_code, 0) << run.err;
     }
   }
@@ -98,12 +98,12 @@ class IntervalForecast : public testing::TempDirTest {
     const auto run = RunPvtwin(dir_, "import-weather --config '" + (kData / "plant.toml").string() +
                                          "' --db " + DbPath() + " weather.csv");
     ASSERT_EQ(run.exit_code, 0) << run.err;
-    const std::string of_day = " FROM measurement_interval WHERE ts >= " + Format(day) +
-                               " AND ts < " + Format(day + kDay);
+    const std::string of_day =
+        " FROM measurement_interval WHERE ts >= " + Format(day) + " AND ts < " + Format(day + kDay);
     Db db(DbPath());
     ASSERT_EQ(db.Exec("INSERT INTO operation_plan(ts, t_in_c, flow_kg_s) SELECT ts, t_in_c, "
-                      "flow_kg_s" + of_day + " UNION ALL SELECT ts + 60, t_in_c, flow_kg_s" +
-                      of_day),
+                      "flow_kg_s" +
+                      of_day + " UNION ALL SELECT ts + 60, t_in_c, flow_kg_s" + of_day),
               SQLITE_OK);
   }
   // A config without devices around `plant` (a [plant] table).
@@ -120,10 +120,11 @@ class IntervalForecast : public testing::TempDirTest {
            "azimuth_deg = 180\narea_m2 = 1.8\n";
   }
   void StartDaemon(std::int64_t sim_start, double speed) {
-    const std::vector<std::string> argv = {
-        PVTWIN_BINARY, "run",          "--config",           (dir_ / "pvtwin.toml").string(),
-        "--speed",     std::to_string(speed), "--sim-start", std::to_string(sim_start),
-        "--wall-anchor", std::to_string(WallNowS())};
+    const std::vector<std::string> argv = {PVTWIN_BINARY,   "run",
+                                           "--config",      (dir_ / "pvtwin.toml").string(),
+                                           "--speed",       std::to_string(speed),
+                                           "--sim-start",   std::to_string(sim_start),
+                                           "--wall-anchor", std::to_string(WallNowS())};
     std::string error;
     ASSERT_TRUE(daemon_.Start(argv, (dir_ / "daemon.log").string(), &error)) << error;
     ASSERT_TRUE(WaitFor(20, [&] { return Log().find("info: ready: ") != std::string::npos; }))
@@ -131,8 +132,7 @@ class IntervalForecast : public testing::TempDirTest {
   }
   // Waits for the first calibrated forecast; its issued_at (NaN: none).
   double WaitForCalibratedForecast(Db& db, double timeout_s) {
-    const std::string sql =
-        "SELECT MIN(issued_at) FROM forecast WHERE basis = 'calibrated'";
+    const std::string sql = "SELECT MIN(issued_at) FROM forecast WHERE basis = 'calibrated'";
     WaitFor(timeout_s, [&] { return !std::isnan(db.Number(sql)); });
     return db.Number(sql);
   }
@@ -168,8 +168,7 @@ TEST_F(IntervalForecast, TheHtwSaarDaysAreForecastAtTheirOwnStepFromTheirLastRow
   EXPECT_NE(db.Text("SELECT inputs" + of_issue + " LIMIT 1")
                 .find("; history: 2-min rows of measurement_interval"),
             std::string::npos);
-  EXPECT_NE(Log().find("history: 2-min rows of measurement_interval"), std::string::npos)
-      << Log();
+  EXPECT_NE(Log().find("history: 2-min rows of measurement_interval"), std::string::npos) << Log();
   // The start state: the forecast's first row follows day 1's last measured
   // row (18:34) directly, so the warm-up ran up to the issue on measured
   // rows, without a missing row after which the model would restart at a
@@ -249,8 +248,8 @@ TEST_F(IntervalForecast, TheHtwSaarDaysAreScoredFromTheirTwoMinuteRows) {
       ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();  // the first run's daemon
     }
     StartDaemon(day - 600, 1.0);
-    const std::string issued = "SELECT COUNT(p_el_w) FROM forecast WHERE issued_at = " +
-                               Format(day - 600);
+    const std::string issued =
+        "SELECT COUNT(p_el_w) FROM forecast WHERE issued_at = " + Format(day - 600);
     ASSERT_TRUE(WaitFor(60, [&] { return db.Number(issued) > 0; })) << Log();
   }
   ASSERT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 0.0);
@@ -263,8 +262,8 @@ TEST_F(IntervalForecast, TheHtwSaarDaysAreScoredFromTheirTwoMinuteRows) {
     EXPECT_FALSE(std::isnan(score.coverage_p10_p90)) << "more than 360 minutes, with bands";
     by_hand.push_back(score.Cells(Format(day)));
   }
-  testing::ExpectSameRows(db.Rows("SELECT * FROM forecast_skill WHERE day IN (" +
-                                  Format(kHtwDay3) + ", " + Format(kHtwDay1) + ") ORDER BY day"),
+  testing::ExpectSameRows(db.Rows("SELECT * FROM forecast_skill WHERE day IN (" + Format(kHtwDay3) +
+                                  ", " + Format(kHtwDay1) + ") ORDER BY day"),
                           by_hand, "the htw saar days against the test's computation", 1e-9);
   std::printf("htw saar days scored from 2-min rows: %s\n",
               db.Rows("SELECT group_concat(date(day, 'unixepoch') || ' MAE P_el ' || "

@@ -37,12 +37,12 @@ const SelftestCase& CaseNamed(const std::vector<SelftestCase>& cases, const std:
 // Footprint energy (Wh, P_el + Q_th) of one case and seed, split.
 struct Footprint {
   double total_wh = 0.0;
-  double afternoon_wh = 0.0;      // local solar time ≥ 12 h
-  double aoi_over_60_wh = 0.0;    // beam angle of incidence ≥ 60°
-  double diffuse_rows_wh = 0.0;   // rows with beam < half of the plane's light
-  double obstacle_day_wh = 0.0;   // UTC days the other-form obstacle stands on
-  double p_el_wh = 0.0;           // the electrical part of total_wh
-  double output_wh = 0.0;         // the null case's P_el + Q_th, for scale
+  double afternoon_wh = 0.0;     // local solar time ≥ 12 h
+  double aoi_over_60_wh = 0.0;   // beam angle of incidence ≥ 60°
+  double diffuse_rows_wh = 0.0;  // rows with beam < half of the plane's light
+  double obstacle_day_wh = 0.0;  // UTC days the other-form obstacle stands on
+  double p_el_wh = 0.0;          // the electrical part of total_wh
+  double output_wh = 0.0;        // the null case's P_el + Q_th, for scale
 };
 
 Footprint Measure(const Plant& plant, const SelftestCase& effect, const SelftestCase& null_case,
@@ -116,7 +116,8 @@ TEST(OctoberSeparation, ObstacleIsOneSidedInJuneAndLargelyDiffuseInOctoberTheIam
     for (int k = 0; k < 2; ++k) {
       const std::string season = k == 0 ? "" : "_october";
       const SelftestCase& null_case = CaseNamed(cases, "null" + season);
-      const Footprint shading = Measure(plant, CaseNamed(cases, "shading" + season), null_case, seed);
+      const Footprint shading =
+          Measure(plant, CaseNamed(cases, "shading" + season), null_case, seed);
       const Footprint iam = Measure(plant, CaseNamed(cases, "iam" + season), null_case, seed);
       const Footprint sky =
           Measure(plant, CaseNamed(cases, "sky_radiation" + season), null_case, seed);

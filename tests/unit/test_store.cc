@@ -545,7 +545,8 @@ TEST_F(StoreTest, StartValueForecastsAreFlaggedAndTheFirstWaitIsNoWarningInEvent
       << error;
   RawDb db(DbPath());
   const std::string ts = std::to_string(t);
-  EXPECT_EQ(db.Rows("SELECT ts - " + ts + ", basis, calibration_id FROM forecast ORDER BY "
+  EXPECT_EQ(db.Rows("SELECT ts - " + ts +
+                    ", basis, calibration_id FROM forecast ORDER BY "
                     "issued_at, ts"),
             (std::vector<std::vector<std::string>>{{"0", "start_values", "NULL"},
                                                    {"60", "start_values", "NULL"},

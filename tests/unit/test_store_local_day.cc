@@ -467,16 +467,16 @@ TEST_F(StoreLocalDayTest, LocalDaysFollowTheZoneAndAreMadeAtMigration) {
     // version 9's local days.
     static_assert(kStoreSchemaVersion == 12, "take the new version's objects back here too");
     std::vector<std::string> downgrade = testing::DropSchemaV12();
-    for (const std::string& sql : testing::DropSchemaV11()) downgrade.push_back(sql);  // and its view:
+    for (const std::string& sql : testing::DropSchemaV11())
+      downgrade.push_back(sql);  // and its view:
     downgrade.push_back("DROP VIEW forecast_skill");
     downgrade.push_back(std::string("CREATE VIEW forecast_skill") + testing::kForecastSkillColumns +
                         " AS " + testing::kForecastSkillV10);
-    for (const char* sql :
-         {"DROP VIEW forecast_latest", "DROP VIEW forecast_skill_local",
-          "ALTER TABLE forecast DROP COLUMN basis",
-          "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
-          "DROP VIEW performance_daily_local", "DROP TABLE local_day_zone", "DROP TABLE local_day",
-          "PRAGMA user_version = 8"}) {
+    for (const char* sql : {"DROP VIEW forecast_latest", "DROP VIEW forecast_skill_local",
+                            "ALTER TABLE forecast DROP COLUMN basis",
+                            "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
+                            "DROP VIEW performance_daily_local", "DROP TABLE local_day_zone",
+                            "DROP TABLE local_day", "PRAGMA user_version = 8"}) {
       downgrade.push_back(sql);
     }
     for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;

@@ -64,18 +64,15 @@ class StoreMigrationTest : public testing::TempDirTest {
     static_assert(kStoreSchemaVersion == 12, "take the new version's objects back here too");
     std::vector<std::string> downgrade = testing::DropSchemaV12();
     for (const std::string& sql : testing::DropSchemaV11()) downgrade.push_back(sql);
-    downgrade.insert(downgrade.end(), {
-        "DROP VIEW performance_daily_local",
-        "DROP VIEW forecast_skill_local",
-        "DROP TABLE local_day_zone",
-        "DROP TABLE local_day",
-        "DROP VIEW forecast_latest",
-        "DROP VIEW forecast_skill",
-        "ALTER TABLE forecast DROP COLUMN basis",  // version 10
-        "ALTER TABLE forecast DROP COLUMN p_el_w_p50",
-        "ALTER TABLE forecast DROP COLUMN q_th_w_p50",
-        "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
-        "CREATE VIEW forecast_skill(day) AS SELECT ts FROM measurement_1min"});
+    downgrade.insert(downgrade.end(),
+                     {"DROP VIEW performance_daily_local", "DROP VIEW forecast_skill_local",
+                      "DROP TABLE local_day_zone", "DROP TABLE local_day",
+                      "DROP VIEW forecast_latest", "DROP VIEW forecast_skill",
+                      "ALTER TABLE forecast DROP COLUMN basis",  // version 10
+                      "ALTER TABLE forecast DROP COLUMN p_el_w_p50",
+                      "ALTER TABLE forecast DROP COLUMN q_th_w_p50",
+                      "CREATE VIEW forecast_latest(ts) AS SELECT ts FROM forecast",
+                      "CREATE VIEW forecast_skill(day) AS SELECT ts FROM measurement_1min"});
     downgrade.push_back("PRAGMA user_version = 7");
     for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
   }

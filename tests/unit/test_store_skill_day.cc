@@ -31,6 +31,7 @@ constexpr std::int64_t kDay0 = 1717200000;  // 2024-06-01T00:00:00Z
 
 using testing::CostOf;
 using testing::ExpectSameRows;
+using testing::Issue;
 using testing::QueryCost;
 
 const std::string kViewRows = "SELECT * FROM forecast_skill ORDER BY day";
@@ -67,31 +68,6 @@ class SkillDayTest : public testing::TempDirTest {
     s[Channel::kQThW] = q_th_w;
     s[Channel::kValid] = valid;
     return s;
-  }
-
-  // One issue at issued_at for [issued_at, issued_at + horizon_s), with
-  // bands, medians and the reference; `bias` shifts its values.
-  static std::vector<Store::ForecastRow> Issue(std::int64_t issued_at, std::int64_t horizon_s,
-                                               double bias) {
-    std::vector<Store::ForecastRow> rows;
-    for (std::int64_t t = issued_at; t < issued_at + horizon_s; t += 60) {
-      const double h = static_cast<double>(t % kDay) / 3600.0;
-      const double sun = std::max(0.0, std::sin((h - 6.0) / 12.0 * M_PI));
-      Store::ForecastRow r;
-      r.ts = t;
-      r.p_el_w = 390.0 * sun + bias;
-      r.q_th_w = 1150.0 * sun - 70.0 + 0.5 * bias;
-      r.p_el_w_p10 = r.p_el_w - 25.0;
-      r.p_el_w_p90 = r.p_el_w + 20.0;
-      r.q_th_w_p10 = r.q_th_w - 60.0;
-      r.q_th_w_p90 = r.q_th_w + 40.0;
-      r.p_el_w_p50 = r.p_el_w;
-      r.q_th_w_p50 = r.q_th_w;
-      r.p_el_w_ref = 350.0 * sun;
-      r.q_th_w_ref = 1000.0 * sun;
-      rows.push_back(r);
-    }
-    return rows;
   }
 
   // Measurements from day 0 to noon of day 3, and hourly issues 26 h
@@ -140,9 +116,9 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
   ASSERT_TRUE(store->WriteMinutes(Minutes(day1 + 6 * 3600, day1 + 9 * 3600, 60.0), &error))
       << error;
   ASSERT_TRUE(store->InsertForecast(day2, 0, "late", Issue(day2, kDay, -40.0), &error)) << error;
-  EXPECT_EQ(db.Rows("SELECT day FROM forecast_skill_dirty ORDER BY day"),
-            (std::vector<std::vector<std::string>>{{std::to_string(day1)},
-                                                   {std::to_string(day2)}}));
+  EXPECT_EQ(
+      db.Rows("SELECT day FROM forecast_skill_dirty ORDER BY day"),
+      (std::vector<std::vector<std::string>>{{std::to_string(day1)}, {std::to_string(day2)}}));
   const auto v10_late = db.Rows(kVersion10Rows);
   ExpectSameRows(db.Rows(kViewRows), v10_late, "after the late import");
   for (const std::int64_t day : {day1, day2}) {
@@ -186,13 +162,13 @@ TEST_F(SkillDayTest, AfterTheRefreshAYearCostsTheViewOnlyTodaysMinutes) {
     ASSERT_NE(store, nullptr);
   }
   RawDb db(DbPath());
-  const std::string minutes =
-      "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kDay0) + " UNION ALL SELECT ts + 60 " +
-      "FROM t WHERE ts + 60 < " + std::to_string(now) + ") ";
-  ASSERT_EQ(db.Exec(minutes +
-                    "INSERT INTO measurement_1min(ts, p_el_w, q_th_w, valid) SELECT ts, "
-                    "100 + (ts / 60 * 7919) % 250, 400 + (ts / 60 * 104729) % 450, 1 FROM t"),
-            SQLITE_OK);
+  const std::string minutes = "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kDay0) +
+                              " UNION ALL SELECT ts + 60 " + "FROM t WHERE ts + 60 < " +
+                              std::to_string(now) + ") ";
+  ASSERT_EQ(
+      db.Exec(minutes + "INSERT INTO measurement_1min(ts, p_el_w, q_th_w, valid) SELECT ts, "
+                        "100 + (ts / 60 * 7919) % 250, 400 + (ts / 60 * 104729) % 450, 1 FROM t"),
+      SQLITE_OK);
   ASSERT_EQ(db.Exec(minutes +
                     "INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w, p_el_w_p10, p_el_w_p90, "
                     "q_th_w_p10, q_th_w_p90, p_el_w_ref, q_th_w_ref) SELECT ts - ts % 86400 - "
@@ -221,10 +197,11 @@ TEST_F(SkillDayTest, AfterTheRefreshAYearCostsTheViewOnlyTodaysMinutes) {
   EXPECT_LT(100 * cost.vm_steps, year.vm_steps) << "version 10's query computes 365.5 days";
   EXPECT_LT(cost.fullscan_steps, 1440) << "no table of minutes is scanned in full";
   EXPECT_GT(year.fullscan_steps, 365 * 1440);
-  std::printf("forecast_skill over a year: view %ld VM steps (%ld full-scan), with yesterday "
-              "dirty %ld, version 10's query %ld (%ld full-scan)\n",
-              cost.vm_steps, cost.fullscan_steps, with_yesterday.vm_steps, year.vm_steps,
-              year.fullscan_steps);
+  std::printf(
+      "forecast_skill over a year: view %ld VM steps (%ld full-scan), with yesterday "
+      "dirty %ld, version 10's query %ld (%ld full-scan)\n",
+      cost.vm_steps, cost.fullscan_steps, with_yesterday.vm_steps, year.vm_steps,
+      year.fullscan_steps);
   // The query plan reaches measurement_1min by its key only.
   const auto plan = db.Rows("EXPLAIN QUERY PLAN " + view);
   int searches = 0;

@@ -26,6 +26,7 @@ namespace pvtwin {
 namespace {
 
 using testing::ExpectSameRows;
+using testing::Issue;
 using testing::RawDb;
 using testing::Rows;
 using testing::ScoreDayByHand;
@@ -54,31 +55,6 @@ Series Measured(std::int64_t from, std::int64_t to, int step_s, double offset_w)
   s[Channel::kQThW] = q_th_w;
   s[Channel::kValid] = valid;
   return s;
-}
-
-// One issue at issued_at for [issued_at, issued_at + horizon_s) at 1 min,
-// with bands, medians and the reference; `bias` shifts its values.
-std::vector<Store::ForecastRow> Issue(std::int64_t issued_at, std::int64_t horizon_s,
-                                      double bias) {
-  std::vector<Store::ForecastRow> rows;
-  for (std::int64_t t = issued_at; t < issued_at + horizon_s; t += 60) {
-    const double h = static_cast<double>(t % kDay) / 3600.0;
-    const double sun = std::max(0.0, std::sin((h - 6.0) / 12.0 * M_PI));
-    Store::ForecastRow r;
-    r.ts = t;
-    r.p_el_w = 390.0 * sun + bias;
-    r.q_th_w = 1150.0 * sun - 70.0 + 0.5 * bias;
-    r.p_el_w_p10 = r.p_el_w - 25.0;
-    r.p_el_w_p90 = r.p_el_w + 20.0;
-    r.q_th_w_p10 = r.q_th_w - 60.0;
-    r.q_th_w_p90 = r.q_th_w + 40.0;
-    r.p_el_w_p50 = r.p_el_w;
-    r.q_th_w_p50 = r.q_th_w;
-    r.p_el_w_ref = 350.0 * sun;
-    r.q_th_w_ref = 1000.0 * sun;
-    rows.push_back(r);
-  }
-  return rows;
 }
 
 // The view's rows of the given days.
@@ -111,8 +87,8 @@ class SkillIntervalTest : public testing::TempDirTest {
   static void FillDays(Store* store) {
     std::string error;
     ASSERT_TRUE(store->WriteMinutes(Measured(kDay0, kDay0 + 2 * kDay, 60, 0.0), &error)) << error;
-    ASSERT_TRUE(store->WriteIntervalRows(Measured(kDay0 + kDay, kDay0 + 3 * kDay, 600, 25.0),
-                                         &error))
+    ASSERT_TRUE(
+        store->WriteIntervalRows(Measured(kDay0 + kDay, kDay0 + 3 * kDay, 600, 25.0), &error))
         << error;
     ASSERT_TRUE(store->WriteIntervalRows(
         Measured(kDay0 + 3 * kDay, kDay0 + 3 * kDay + kDay / 2, 900, -15.0), &error))
@@ -130,8 +106,8 @@ class SkillIntervalTest : public testing::TempDirTest {
   static Rows IntervalDaysByHand(RawDb& db, const std::vector<std::int64_t>& days) {
     Rows rows;
     for (const std::int64_t day : days) {
-      rows.push_back(
-          ScoreDayByHand(db, "measurement_interval", day, day + kDay, day).Cells(std::to_string(day)));
+      rows.push_back(ScoreDayByHand(db, "measurement_interval", day, day + kDay, day)
+                         .Cells(std::to_string(day)));
     }
     return rows;
   }
@@ -158,11 +134,11 @@ TEST_F(SkillIntervalTest, IntervalDaysAreScoredByTheirStepAndMinuteDaysKeepTheir
   EXPECT_GT(by_hand.pairs, 100);
   EXPECT_EQ(db.Text("SELECT minutes FROM forecast_skill WHERE day = " + std::to_string(day2)),
             std::to_string(10 * by_hand.pairs));
-  EXPECT_EQ(db.Text("SELECT typeof(minutes) FROM forecast_skill WHERE day = " +
-                    std::to_string(day3)),
-            "integer");
-  EXPECT_FALSE(std::isnan(db.Number("SELECT skill_p_el FROM forecast_skill WHERE day = " +
-                                    std::to_string(day3))))
+  EXPECT_EQ(
+      db.Text("SELECT typeof(minutes) FROM forecast_skill WHERE day = " + std::to_string(day3)),
+      "integer");
+  EXPECT_FALSE(std::isnan(
+      db.Number("SELECT skill_p_el FROM forecast_skill WHERE day = " + std::to_string(day3))))
       << "half a day of 15-min rows is 360 minutes or more";
 
   int written = 0;
@@ -188,8 +164,8 @@ TEST_F(SkillIntervalTest, IntervalTriggersMarkOnlyDaysScoredFromIntervalRows) {
   const std::string of_day2 = " WHERE day = " + std::to_string(day2);
   const std::string materialised = db.Text("SELECT mae_p_el_w FROM forecast_skill_day" + of_day2);
 
-  ASSERT_TRUE(store->WriteIntervalRows(Measured(kDay0 + 6 * 3600, kDay0 + 9 * 3600, 600, 80.0),
-                                       &error))
+  ASSERT_TRUE(
+      store->WriteIntervalRows(Measured(kDay0 + 6 * 3600, kDay0 + 9 * 3600, 600, 80.0), &error))
       << error;
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0)
       << "day 0 is scored from its 1-min rows: its interval rows change nothing";
@@ -207,15 +183,14 @@ TEST_F(SkillIntervalTest, IntervalTriggersMarkOnlyDaysScoredFromIntervalRows) {
                  IntervalDaysByHand(db, {day2}), "day 2 materialised again", 1e-9);
 
   // One 1-min row in day 2: the day is scored from it alone, as version 10.
-  ASSERT_TRUE(store->WriteMinutes(Measured(day2 + 12 * 3600, day2 + 12 * 3600 + 60, 60, 0.0),
-                                  &error))
+  ASSERT_TRUE(
+      store->WriteMinutes(Measured(day2 + 12 * 3600, day2 + 12 * 3600 + 60, 60, 0.0), &error))
       << error;
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill" + of_day2),
             RowsOfDays(db.Rows(kVersion10Rows), {day2}));
   EXPECT_EQ(db.Number("SELECT minutes FROM forecast_skill" + of_day2), 1.0);
   ASSERT_TRUE(store->RefreshForecastSkill(now, nullptr, &error)) << error;
-  ASSERT_EQ(db.Exec("DELETE FROM measurement_1min WHERE ts >= " + std::to_string(day2)),
-            SQLITE_OK);
+  ASSERT_EQ(db.Exec("DELETE FROM measurement_1min WHERE ts >= " + std::to_string(day2)), SQLITE_OK);
   ExpectSameRows(db.Rows("SELECT * FROM forecast_skill" + of_day2), IntervalDaysByHand(db, {day2}),
                  "day 2 back on its interval rows", 1e-9);
 }
@@ -231,19 +206,20 @@ TEST_F(SkillIntervalTest, LocalDaysWithoutMinuteRowsAreScoredFromIntervalRows) {
   ASSERT_NO_FATAL_FAILURE(FillDays(store.get()));
   RawDb db(DbPath());
   const Rows local = db.Rows("SELECT * FROM forecast_skill_local ORDER BY day");
-  const Rows v11 =
-      db.Rows(std::string(testing::kForecastSkillLocalV11) + " ORDER BY day");
+  const Rows v11 = db.Rows(std::string(testing::kForecastSkillLocalV11) + " ORDER BY day");
   ASSERT_EQ(v11.size(), 3u) << "2024-06-01 to 2024-06-03 hold 1-min rows";
   ASSERT_EQ(local.size(), 4u) << "and 2024-06-04 interval rows only";
   EXPECT_EQ(Rows(local.begin(), local.begin() + 3), v11);
   EXPECT_LE(std::stod(local[2][8]), 120.0) << "2024-06-03: its 2 h of 1-min rows at most";
   Rows by_hand;
   for (const auto& row : local) {
-    const auto bounds = db.Rows("SELECT start_ts, end_ts FROM local_day WHERE day = '" + row[0] + "'");
+    const auto bounds =
+        db.Rows("SELECT start_ts, end_ts FROM local_day WHERE day = '" + row[0] + "'");
     ASSERT_EQ(bounds.size(), 1u);
     const std::int64_t start = std::stoll(bounds[0][0]), end = std::stoll(bounds[0][1]);
-    const bool minutes = db.Number("SELECT COUNT(*) FROM measurement_1min WHERE ts >= " +
-                                   bounds[0][0] + " AND ts < " + bounds[0][1]) > 0;
+    const bool minutes =
+        db.Number("SELECT COUNT(*) FROM measurement_1min WHERE ts >= " + bounds[0][0] +
+                  " AND ts < " + bounds[0][1]) > 0;
     by_hand.push_back(
         ScoreDayByHand(db, minutes ? "measurement_1min" : "measurement_interval", start, end, start)
             .Cells(row[0]));
@@ -268,16 +244,16 @@ TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyTod
   const std::string rows = "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kDay0) +
                            " UNION ALL SELECT ts + 600 FROM t WHERE ts + 600 < " +
                            std::to_string(now) + ") ";
-  ASSERT_EQ(db.Exec(rows +
-                    "INSERT INTO measurement_interval(ts, step_s, p_el_w, q_th_w, valid) SELECT "
-                    "ts, 600, 100 + (ts / 600 * 7919) % 250, 400 + (ts / 600 * 104729) % 450, 1 "
-                    "FROM t"),
-            SQLITE_OK);
-  ASSERT_EQ(db.Exec(rows +
-                    "INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w, p_el_w_p10, p_el_w_p90, "
-                    "q_th_w_p10, q_th_w_p90, p_el_w_ref, q_th_w_ref) SELECT ts - ts % 86400 - "
-                    "3600, ts, 210, 590, 150, 260, 400, 800, 200, 600 FROM t"),
-            SQLITE_OK);
+  ASSERT_EQ(
+      db.Exec(rows + "INSERT INTO measurement_interval(ts, step_s, p_el_w, q_th_w, valid) SELECT "
+                     "ts, 600, 100 + (ts / 600 * 7919) % 250, 400 + (ts / 600 * 104729) % 450, 1 "
+                     "FROM t"),
+      SQLITE_OK);
+  ASSERT_EQ(
+      db.Exec(rows + "INSERT INTO forecast(issued_at, ts, p_el_w, q_th_w, p_el_w_p10, p_el_w_p90, "
+                     "q_th_w_p10, q_th_w_p90, p_el_w_ref, q_th_w_ref) SELECT ts - ts % 86400 - "
+                     "3600, ts, 210, 590, 150, 260, 400, 800, 200, 600 FROM t"),
+      SQLITE_OK);
   const std::string view = "SELECT * FROM forecast_skill";
   const testing::QueryCost live = testing::CostOf(DbPath(), view);
   EXPECT_EQ(live.rows, 366) << "every day computed live";
@@ -304,10 +280,11 @@ TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyTod
   EXPECT_LT(50 * cost.vm_steps, live.vm_steps) << "the live view computes 365.5 days";
   EXPECT_LT(cost.fullscan_steps, 144) << "no table of rows is scanned in full";
   EXPECT_GT(live.vm_steps, 365 * one_day / 2);
-  std::printf("forecast_skill over a year of 10-min rows: view %ld VM steps (%ld full-scan), with "
-              "yesterday dirty %ld, every day live %ld (%ld full-scan)\n",
-              cost.vm_steps, cost.fullscan_steps, with_yesterday.vm_steps, live.vm_steps,
-              live.fullscan_steps);
+  std::printf(
+      "forecast_skill over a year of 10-min rows: view %ld VM steps (%ld full-scan), with "
+      "yesterday dirty %ld, every day live %ld (%ld full-scan)\n",
+      cost.vm_steps, cost.fullscan_steps, with_yesterday.vm_steps, live.vm_steps,
+      live.fullscan_steps);
   int searches = 0;
   for (const auto& row : db.Rows("EXPLAIN QUERY PLAN " + view)) {
     const std::string detail = row.back() + " ";

@@ -35,6 +35,7 @@
 #include "daemon/service/monitor.h"
 #include "io/files/params_json.h"
 #include "tests/support/files.h"
+#include "tests/support/seeds.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
 
@@ -51,14 +52,7 @@ constexpr double kDriftFraction = 0.30;
 constexpr const char* kTruth = "2N2CrI+wind+transport_delay";
 constexpr const char* kModel = "2N1Ccolwr";
 
-std::vector<std::uint64_t> Seeds() {
-  const char* env = std::getenv("PVTWIN_DRIFT_SEEDS");
-  std::vector<std::uint64_t> seeds;
-  std::stringstream list(env != nullptr ? env : "1");
-  std::string item;
-  while (std::getline(list, item, ',')) seeds.push_back(std::stoull(item));
-  return seeds;
-}
+std::vector<std::uint64_t> Seeds() { return testing::SeedsFromEnv("PVTWIN_DRIFT_SEEDS", "1"); }
 
 // The truth's parameter that rises: PVTWIN_DRIFT_PARAM, u_back_w_m2k by
 // default (the back loss coefficient; fouling: r0_fluid_m2k_w).

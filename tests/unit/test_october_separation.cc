@@ -22,6 +22,7 @@
 #include "core/diagnosis/diagnosis_selftest.h"
 #include "core/effects/shading.h"
 #include "core/synth/synthetic_plant.h"
+#include "tests/support/seeds.h"
 
 namespace pvtwin {
 namespace {
@@ -77,17 +78,7 @@ Footprint Measure(const Plant& plant, const SelftestCase& effect, const Selftest
 }
 
 std::vector<std::uint64_t> DevelopmentSeeds() {
-  if (const char* env = std::getenv("PVTWIN_OCTOBER_SEEDS")) {
-    std::vector<std::uint64_t> seeds;
-    std::string list = env;
-    for (std::size_t at = 0; at < list.size();) {
-      const std::size_t comma = std::min(list.find(',', at), list.size());
-      seeds.push_back(std::stoull(list.substr(at, comma - at)));
-      at = comma + 1;
-    }
-    return seeds;
-  }
-  return {1, 2, 3};
+  return testing::SeedsFromEnv("PVTWIN_OCTOBER_SEEDS", "1,2,3");
 }
 
 void Print(const char* name, std::uint64_t seed, const Footprint& f) {

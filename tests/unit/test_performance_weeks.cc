@@ -40,6 +40,7 @@
 #include "io/files/params_json.h"
 #include "tests/support/effect_named.h"
 #include "tests/support/files.h"
+#include "tests/support/seeds.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
 
@@ -54,14 +55,7 @@ constexpr int kSwitchDay = 18;  // pv_clipping from this day on
 constexpr const char* kTruth = "2N2CrI+wind+transport_delay";
 constexpr const char* kModel = "2N1Ccolwr";
 
-std::vector<std::uint64_t> Seeds() {
-  const char* env = std::getenv("PVTWIN_PI_SEEDS");
-  std::vector<std::uint64_t> seeds;
-  std::stringstream list(env != nullptr ? env : "1,2,3");
-  std::string item;
-  while (std::getline(list, item, ',')) seeds.push_back(std::stoull(item));
-  return seeds;
-}
+std::vector<std::uint64_t> Seeds() { return testing::SeedsFromEnv("PVTWIN_PI_SEEDS", "1,2,3"); }
 
 WeatherOptions WeatherOf(std::uint64_t seed) {
   WeatherOptions w;

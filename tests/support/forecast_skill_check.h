@@ -16,10 +16,33 @@
 #include <string>
 #include <vector>
 
+#include "core/common/series.h"
 #include "io/store/store.h"
 #include "tests/support/sqlite_db.h"
 
 namespace pvtwin::testing {
+
+// Measured rows of [from, to) at step_s: power that follows the sun's hours
+// with a wobble, every 7th row (every 97th at 1 min) invalid.
+inline Series Measured(std::int64_t from, std::int64_t to, int step_s, double offset_w) {
+  constexpr std::int64_t kDayS = 86400;
+  Series s;
+  s.step_s = step_s;
+  std::vector<double> p_el_w, q_th_w, valid;
+  for (std::int64_t t = from; t < to; t += step_s) {
+    const double h = static_cast<double>(t % kDayS) / 3600.0;
+    const double sun = std::max(0.0, std::sin((h - 6.0) / 12.0 * M_PI));
+    const auto x = static_cast<double>(t);
+    s.time_s.push_back(t);
+    p_el_w.push_back(offset_w + 400.0 * sun + 30.0 * std::sin(x / 700.0));
+    q_th_w.push_back(offset_w + 1200.0 * sun - 80.0 + 50.0 * std::cos(x / 900.0));
+    valid.push_back((t / step_s) % (step_s == 60 ? 97 : 7) == 0 ? 0.0 : 1.0);
+  }
+  s[Channel::kPElW] = p_el_w;
+  s[Channel::kQThW] = q_th_w;
+  s[Channel::kValid] = valid;
+  return s;
+}
 
 // One issue at issued_at for [issued_at, issued_at + horizon_s) at 1 min,
 // with bands, medians and the reference, on a half-sine day; `bias` shifts

@@ -49,25 +49,8 @@ class SkillDayTest : public testing::TempDirTest {
     return store;
   }
 
-  // Measured minutes of [from, to): power that follows the sun's hours with
-  // a wobble, every 97th minute invalid.
   static Series Minutes(std::int64_t from, std::int64_t to, double offset_w) {
-    Series s;
-    s.step_s = 60;
-    std::vector<double> p_el_w, q_th_w, valid;
-    for (std::int64_t t = from; t < to; t += 60) {
-      const double h = static_cast<double>(t % kDay) / 3600.0;
-      const double sun = std::max(0.0, std::sin((h - 6.0) / 12.0 * M_PI));
-      const auto x = static_cast<double>(t);
-      s.time_s.push_back(t);
-      p_el_w.push_back(offset_w + 400.0 * sun + 30.0 * std::sin(x / 700.0));
-      q_th_w.push_back(offset_w + 1200.0 * sun - 80.0 + 50.0 * std::cos(x / 900.0));
-      valid.push_back((t / 60) % 97 == 0 ? 0.0 : 1.0);
-    }
-    s[Channel::kPElW] = p_el_w;
-    s[Channel::kQThW] = q_th_w;
-    s[Channel::kValid] = valid;
-    return s;
+    return testing::Measured(from, to, 60, offset_w);
   }
 
   // Measurements from day 0 to noon of day 3, and hourly issues 26 h

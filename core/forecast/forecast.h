@@ -17,7 +17,7 @@
 //                  clouds passing minute by minute would be counted twice
 //                  against any day but yesterday (once where they were, once
 //                  where they are not); the hour's index keeps the day's
-//                  energy and weather class and costs 4–8 % less MAE of P_el
+//                  energy and weather class and costs 2–8 % less MAE of P_el
 //                  (doc/forecast.md);
 //   operation   1. the operation plan (table operation_plan: t_in_c, flow_kg_s);
 //   (t_in_c,    2. the typical day of the window: the median, over the window's

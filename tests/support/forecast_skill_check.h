@@ -223,4 +223,15 @@ inline SkillByHand ScoreDayByHand(RawDb& db, const std::string& table, std::int6
   return day;
 }
 
+// Hourly issues from `from` to `to` (exclusive), each 26 h ahead with a
+// bias that wanders with the issue time.
+inline void InsertHourlyIssues(Store* store, std::int64_t from, std::int64_t to) {
+  std::string error;
+  for (std::int64_t issued = from; issued < to; issued += 3600) {
+    const double bias = 10.0 * std::sin(static_cast<double>(issued) / 5000.0);
+    ASSERT_TRUE(store->InsertForecast(issued, 0, "test", Issue(issued, 26 * 3600, bias), &error))
+        << error;
+  }
+}
+
 }  // namespace pvtwin::testing

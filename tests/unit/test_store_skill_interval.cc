@@ -73,12 +73,7 @@ class SkillIntervalTest : public testing::TempDirTest {
     ASSERT_TRUE(store->WriteIntervalRows(
         Measured(kDay0 + 3 * kDay, kDay0 + 3 * kDay + kDay / 2, 900, -15.0), &error))
         << error;
-    for (std::int64_t issued = kDay0 - kDay / 2; issued < kDay0 + 3 * kDay + kDay / 2;
-         issued += 3600) {
-      const double bias = 10.0 * std::sin(static_cast<double>(issued) / 5000.0);
-      ASSERT_TRUE(store->InsertForecast(issued, 0, "test", Issue(issued, 26 * 3600, bias), &error))
-          << error;
-    }
+    testing::InsertHourlyIssues(store, kDay0 - kDay / 2, kDay0 + 3 * kDay + kDay / 2);
   }
 
   // The rows forecast_skill should have for the interval days `days`,

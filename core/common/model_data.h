@@ -62,6 +62,9 @@ struct Drivers {
   // shading: the measured P_el per I_gt relative to its solar day's upper
   // quartile (ShadingRelativeYield), NaN where undefined or without +shading.
   std::vector<double> relative_yield;
+  // shading: the measured P_el per I_gt on its solar day's diffuse-lit rows
+  // (ShadingDiffuseYield), NaN where undefined or without +shading.
+  std::vector<double> diffuse_yield;
   // irradiance_bias: the pyranometer scale error k estimated from the two
   // sources (EstimateIrradianceBias); g_poa_w_m2, g_abs_w_m2 and a beam from
   // the plane-of-array sensors are already multiplied by (1 + k). 0 without

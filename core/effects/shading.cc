@@ -22,6 +22,12 @@ double ShadedFraction(double sun_azimuth_rad, double sun_elevation_rad, double c
          logistic((edge_elevation_rad - sun_elevation_rad) / kEdgeRad);
 }
 
+double BoxDiffuseShare(double width_rad, double edge_elevation_rad) {
+  const double width = std::clamp(width_rad, 0.0, 2.0 * kPi);
+  const double edge = std::clamp(edge_elevation_rad, 0.0, 0.5 * kPi);
+  return width / (2.0 * kPi) * std::sin(edge) * std::sin(edge);
+}
+
 double HorizonElevationRad(const HorizonProfile& p, double azimuth_rad) {
   const std::vector<double>& az = p.azimuth_rad;
   const std::vector<double>& el = p.elevation_rad;
@@ -96,6 +102,38 @@ std::vector<double> ShadingRelativeYield(const std::vector<std::int64_t>& time_s
   return out;
 }
 
+std::vector<double> ShadingDiffuseYield(const std::vector<std::int64_t>& time_s,
+                                        const std::vector<double>& p_el_w,
+                                        const std::vector<double>& g_poa_w_m2,
+                                        const std::vector<double>& beam_w_m2,
+                                        const std::vector<double>& sun_elevation_rad,
+                                        std::int64_t solar_offset_s) {
+  const std::size_t n = time_s.size();
+  std::vector<double> out(n, std::nan(""));
+  for (std::size_t lo = 0; lo < n;) {
+    const std::int64_t day = SolarDayStartS(time_s[lo], solar_offset_s);
+    double p_sum = 0.0, g_sum = 0.0;
+    int rows = 0;
+    std::size_t hi = lo;
+    for (; hi < n && SolarDayStartS(time_s[hi], solar_offset_s) == day; ++hi) {
+      const double g = g_poa_w_m2[hi];
+      const double beam = std::isfinite(beam_w_m2[hi]) ? beam_w_m2[hi] : 0.0;
+      if (g >= 100.0 && beam < 0.5 * g && sun_elevation_rad[hi] > 0.0 &&
+          std::isfinite(p_el_w[hi])) {
+        p_sum += p_el_w[hi];
+        g_sum += g;
+        ++rows;
+      }
+    }
+    if (rows >= 10) {
+      std::fill(out.begin() + static_cast<std::ptrdiff_t>(lo),
+                out.begin() + static_cast<std::ptrdiff_t>(hi), p_sum / g_sum);
+    }
+    lo = hi;
+  }
+  return out;
+}
+
 void ObstacleDayEvidence::Add(double relative_yield, double shaded_fraction, double beam_share,
                               double mismatch) {
   if (!(shaded_fraction >= 0.5) || !std::isfinite(relative_yield) || !std::isfinite(beam_share)) {
@@ -107,8 +145,40 @@ void ObstacleDayEvidence::Add(double relative_yield, double shaded_fraction, dou
   ++rows;
 }
 
-bool ObstacleDayEvidence::Present() const {
-  return rows < 3 || measured_deficit >= 0.5 * modelled_deficit;
+int ObstacleDayEvidence::BeamVerdict() const {
+  if (rows < 3) return 0;
+  return measured_deficit >= 0.5 * modelled_deficit ? 1 : -1;
+}
+
+std::vector<std::uint8_t> ObstacleDays(const std::vector<ObstacleDayEvidence>& days,
+                                       double diffuse_share) {
+  int present = 0, absent = 0;
+  std::vector<double> free_yield;
+  for (const ObstacleDayEvidence& day : days) {
+    const int verdict = day.BeamVerdict();
+    present += verdict > 0 ? 1 : 0;
+    absent += verdict < 0 ? 1 : 0;
+    if (verdict < 0 && std::isfinite(day.diffuse_yield)) free_yield.push_back(day.diffuse_yield);
+  }
+  double y_free = std::nan("");
+  if (!free_yield.empty()) {
+    const auto mid = free_yield.begin() + static_cast<std::ptrdiff_t>(free_yield.size() / 2);
+    std::nth_element(free_yield.begin(), mid, free_yield.end());
+    y_free = *mid;
+  }
+  const std::uint8_t majority = present >= absent ? 1 : 0;
+  std::vector<std::uint8_t> out(days.size(), majority);
+  for (std::size_t k = 0; k < days.size(); ++k) {
+    const int verdict = days[k].BeamVerdict();
+    if (verdict != 0) {
+      out[k] = verdict > 0 ? 1 : 0;
+      continue;
+    }
+    const double deficit = 1.0 - days[k].diffuse_yield / y_free;
+    if (!(y_free > 0.0) || !std::isfinite(deficit) || deficit > 1.5 * diffuse_share) continue;
+    out[k] = deficit >= 0.5 * diffuse_share ? 1 : 0;
+  }
+  return out;
 }
 
 const HorizonObstacle& OtherTruthObstacle() {
@@ -168,57 +238,72 @@ const OtherFormTruth& OtherTruth() {
   return kTruth;
 }
 
-// I_at loses s·I_beam; P_el is multiplied by (1 − f_mismatch·s), the power
+// I_at loses s·I_beam and the share f_d (BoxDiffuseShare) of its diffuse
+// part, I_at − I_beam; P_el is multiplied by (1 − f_mismatch·s), the power
 // not converted staying as heat (RunInputs::electric_effects). On the solar
-// days whose measured yield does not show the obstacle (ObstacleDayEvidence)
-// it does not stand: s = 0 there.
+// days whose measured yield does not show the obstacle (ObstacleDays) it
+// does not stand: s = 0 and no diffuse loss there.
 void ShadeTheBeam(const Drivers& d, const ParamVector& p, RunInputs* run) {
   const double centre = ParamOf(p, Param::kShadeAzimuthRad);
   const double width = ParamOf(p, Param::kShadeWidthRad);
   const double edge = ParamOf(p, Param::kShadeElevationRad);
   const double mismatch = ParamOf(p, Param::kShadeMismatch);
+  const double diffuse_share = BoxDiffuseShare(width, edge);
   const std::int64_t solar_offset_s = SolarDayOffsetS(d.plant);
   const bool has_yield = d.relative_yield.size() == run->n;
+  const bool has_diffuse_yield = d.diffuse_yield.size() == run->n;
   double* g_abs = run->Own(&run->g_abs_w_m2);
   std::vector<double>& shaded = run->Scratch();
   shaded.resize(run->n);
   std::vector<double>& factor = run->Scratch();
   factor.resize(run->n);
+  std::vector<ObstacleDayEvidence> evidence;
+  std::vector<std::size_t> day_end;  // end row of each solar day
   for (std::size_t lo = 0; lo < run->n;) {
     const std::int64_t day = SolarDayStartS(d.time_s[lo], solar_offset_s);
-    ObstacleDayEvidence evidence;
+    ObstacleDayEvidence& e = evidence.emplace_back();
+    if (has_diffuse_yield) e.diffuse_yield = d.diffuse_yield[lo];
     std::size_t hi = lo;
     for (; hi < run->n && SolarDayStartS(d.time_s[hi], solar_offset_s) == day; ++hi) {
       shaded[hi] =
           ShadedFraction(d.sun_azimuth_rad[hi], d.sun_elevation_rad[hi], centre, width, edge);
       if (has_yield) {
-        evidence.Add(d.relative_yield[hi], shaded[hi], run->g_beam_w_m2[hi] / run->g_poa_w_m2[hi],
-                     mismatch);
+        e.Add(d.relative_yield[hi], shaded[hi], run->g_beam_w_m2[hi] / run->g_poa_w_m2[hi],
+              mismatch);
       }
     }
-    const bool present = evidence.Present();
-    for (std::size_t i = lo; i < hi; ++i) {
-      const double s = present ? shaded[i] : 0.0;
+    day_end.push_back(hi);
+    lo = hi;
+  }
+  const std::vector<std::uint8_t> stands = ObstacleDays(evidence, diffuse_share);
+  std::size_t i = 0;
+  for (std::size_t k = 0; k < day_end.size(); ++k) {
+    for (; i < day_end[k]; ++i) {
+      const double s = stands[k] != 0 ? shaded[i] : 0.0;
       const double beam = std::isfinite(run->g_beam_w_m2[i]) ? run->g_beam_w_m2[i] : 0.0;
-      g_abs[i] -= s * beam;
+      const double diffuse = stands[k] != 0 ? std::max(0.0, g_abs[i] - beam) : 0.0;
+      g_abs[i] -= s * beam + diffuse_share * diffuse;
       // Multiplies a factor set before (iam's "+iam_thermal").
       factor[i] = (run->pv_factor != nullptr ? run->pv_factor[i] : 1.0) * (1.0 - mismatch * s);
     }
-    lo = hi;
   }
   run->pv_factor = factor.data();
   run->electric_effects = true;
 }
 
-// The measured relative yield of every row (ShadingRelativeYield), for the
-// days on which the obstacle stands.
+// The measured relative yields of every row (ShadingRelativeYield,
+// ShadingDiffuseYield), for the days on which the obstacle stands.
 bool PrepareRelativeYield(const Series& s, Drivers* d, std::string*) {
   if (!s.Has(Channel::kPElW)) {
     d->relative_yield.clear();
+    d->diffuse_yield.clear();
     return true;
   }
   d->relative_yield = ShadingRelativeYield(d->time_s, s[Channel::kPElW], d->g_poa_w_m2,
                                            d->sun_elevation_rad, SolarDayOffsetS(d->plant));
+  d->diffuse_yield =
+      ShadingDiffuseYield(d->time_s, s[Channel::kPElW], d->g_poa_w_m2, d->g_beam_w_m2,
+                          d->sun_elevation_rad, SolarDayOffsetS(d->plant));
   return true;
 }
 
@@ -359,13 +444,18 @@ const EffectModule& ShadingEffect() {
         "An obstacle (building, tree, row in front) blocks the beam while the sun is "
         "inside an azimuth window γ_shade ± Δγ/2 below the obstacle's edge α_shade: "
         "s = σ((Δγ/2 − |γ_sun − γ_shade|)/e)·σ((α_shade − α_sun)/e), logistic edges "
-        "e = 2° so that the fit has a gradient. The absorbed irradiance loses s·I_beam, "
-        "and partial shade of a string makes the bypass diodes drop whole substrings: "
-        "P_el is further multiplied by (1 − f_mismatch·s), the power not converted "
-        "staying as heat. P_el therefore drops much more than Q_u. An obstacle may stand "
-        "on some days only (scaffolding, a vehicle, a crown in leaf): it is taken to stand "
-        "on a solar day when the measured yield P_el/I_gt on the rows it shades falls by "
-        "at least half of what it would remove (every day where P_el is not measured).";
+        "e = 2° so that the fit has a gradient. The absorbed irradiance loses s·I_beam "
+        "and, on every row, the share of the sky the obstacle hides from the diffuse "
+        "part, f_d = (Δγ/2π)·sin²α_shade (sky view factor from the horizon angle, "
+        "Dozier & Frew 1990); partial shade of a string makes the bypass diodes drop "
+        "whole substrings: P_el is further multiplied by (1 − f_mismatch·s), the power "
+        "not converted staying as heat. P_el therefore drops much more than Q_u. An "
+        "obstacle may stand on some days only (scaffolding, a vehicle, a crown in leaf): "
+        "it is taken to stand on a solar day when the measured yield P_el/I_gt on the "
+        "rows it shades falls by at least half of what it would remove; a day without "
+        "such rows is judged by the yield of its diffuse-lit rows against the days shown "
+        "free of it (a deficit within f_d ± f_d/2), else follows the majority of the "
+        "days judged (every day where P_el is not measured).";
     m.source =
         "Deline et al. 2013, A simplified model of uniform shading in large photovoltaic arrays, "
         "Solar Energy 96";

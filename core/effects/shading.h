@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/effects/effect_module.h"
@@ -19,6 +20,13 @@ namespace pvtwin {
 double ShadedFraction(double sun_azimuth_rad, double sun_elevation_rad, double centre_rad,
                       double width_rad, double edge_elevation_rad);
 
+// Share of the isotropic sky diffuse that the box of ShadedFraction hides: a
+// horizon at the constant angle α_shade over the azimuth width Δγ (Dozier &
+// Frew 1990, the sky view factor from the horizon angle, as in
+// HorizonDiffuseShare): f_d = (Δγ/2π)·sin²α_shade; Δγ clamped to [0, 2π],
+// α_shade to [0, π/2].
+double BoxDiffuseShare(double width_rad, double edge_elevation_rad);
+
 // An obstacle that stands on some days only (scaffolding, a parked vehicle,
 // a crown in leaf) shows in the measured yield y = P_el/I_gt, relative to the
 // upper quartile of y on the same solar day (rows with I_gt ≥ 200 W/m² and
@@ -30,18 +38,43 @@ std::vector<double> ShadingRelativeYield(const std::vector<std::int64_t>& time_s
                                          const std::vector<double>& sun_elevation_rad,
                                          std::int64_t solar_offset_s);
 
-// Whether the obstacle stands on a day: the measured relative-yield deficit
-// on the rows it shades is nearer the modelled one than none,
+// The obstacle hides a share of the sky on every row of its days, so a day
+// without beam on the obstacle shows it in the yield of its diffuse-lit
+// rows: per solar day, Y = Σ P_el / Σ I_gt over the rows with I_gt ≥ 100
+// W/m², the beam below half of I_gt and the sun up; NaN on days with fewer
+// than 10 such rows. Per row, in its order; b_i = beam_w_m2/g_poa_w_m2.
+std::vector<double> ShadingDiffuseYield(const std::vector<std::int64_t>& time_s,
+                                        const std::vector<double>& p_el_w,
+                                        const std::vector<double>& g_poa_w_m2,
+                                        const std::vector<double>& beam_w_m2,
+                                        const std::vector<double>& sun_elevation_rad,
+                                        std::int64_t solar_offset_s);
+
+// What one solar day shows of the obstacle. On the rows it shades the
+// measured relative-yield deficit is nearer the modelled one than none,
 //   Σ (1 − y_i) ≥ ½·Σ (1 − (1 − s_i·b_i)·(1 − f_mismatch·s_i)),
 // over the day's rows with s_i ≥ 0.5 and a relative yield y_i (b_i =
-// I_beam/I_gt). A day with fewer than 3 such rows keeps the obstacle.
+// I_beam/I_gt); fewer than 3 such rows give no verdict.
 struct ObstacleDayEvidence {
   double measured_deficit = 0.0;
   double modelled_deficit = 0.0;
   int rows = 0;
+  double diffuse_yield = std::numeric_limits<double>::quiet_NaN();  // Y, ShadingDiffuseYield
   void Add(double relative_yield, double shaded_fraction, double beam_share, double mismatch);
-  bool Present() const;
+  // +1 the obstacle stands, −1 it does not, 0 no verdict.
+  int BeamVerdict() const;
 };
+
+// Whether the obstacle stands on each day (1) or not (0). A day with a beam
+// verdict keeps it. A day without one is judged by its diffuse-lit yield
+// against the obstacle-free one, Y_free = the median Y of the days whose
+// beam shows no obstacle: it stands when its deficit D = 1 − Y/Y_free is
+// nearer the hidden sky share f_d (BoxDiffuseShare) than 0 and no further
+// above it than below, ½·f_d ≤ D ≤ 3/2·f_d (a larger loss is not the
+// obstacle's: snow, a fault). Every other day follows the beam verdicts'
+// majority (the obstacle stands on a tie, and when no day has one).
+std::vector<std::uint8_t> ObstacleDays(const std::vector<ObstacleDayEvidence>& days,
+                                       double diffuse_share);
 
 // --- Other-form truth: an obstacle's horizon profile, on some days ---
 

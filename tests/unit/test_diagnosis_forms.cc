@@ -218,15 +218,63 @@ TEST(DiagnosisForms, ObstacleDayFromTheMeasuredYieldDeficit) {
     shaded.Add(0.25, 1.0, 0.8, 0.0);  // measured deficit 0.75
     clear.Add(0.97, 1.0, 0.8, 0.0);   // 0.03: no obstacle that day
   }
-  EXPECT_TRUE(shaded.Present());
-  EXPECT_FALSE(clear.Present());
+  EXPECT_EQ(shaded.BeamVerdict(), 1);
+  EXPECT_EQ(clear.BeamVerdict(), -1);
   // Rows the fitted obstacle does not reach (s < 0.5) or without a yield do
-  // not count; fewer than 3 rows keep the obstacle.
+  // not count; fewer than 3 rows give no verdict.
   undecided.Add(0.97, 0.2, 0.8, 0.0);
   undecided.Add(std::nan(""), 1.0, 0.8, 0.0);
   undecided.Add(0.97, 1.0, 0.8, 0.0);
   EXPECT_EQ(undecided.rows, 1);
-  EXPECT_TRUE(undecided.Present());
+  EXPECT_EQ(undecided.BeamVerdict(), 0);
+}
+
+// A day without a beam verdict from its diffuse-lit yield Y against the
+// obstacle-free days' median: the obstacle hides f_d = 5 % of the sky.
+TEST(DiagnosisForms, ObstacleDayWithoutBeamFromItsDiffuseLitYield) {
+  constexpr double kShare = 0.05;
+  auto day = [](int verdict, double diffuse_yield) {
+    ObstacleDayEvidence e;
+    for (int i = 0; i < 10 && verdict != 0; ++i) e.Add(verdict > 0 ? 0.2 : 0.98, 1.0, 0.8, 0.0);
+    e.diffuse_yield = diffuse_yield;
+    return e;
+  };
+  const double nan = std::nan("");
+  // Free days at Y = 0.30, 0.31 and 0.29 (median 0.30), two shaded days.
+  std::vector<ObstacleDayEvidence> days = {day(-1, 0.30), day(-1, 0.31), day(-1, 0.29), day(1, nan),
+                                           day(1, nan)};
+  days.push_back(day(0, 0.30 * (1.0 - kShare)));        // D = f_d: stands
+  days.push_back(day(0, 0.30 * (1.0 - 0.4 * kShare)));  // nearer 0 than f_d: free
+  days.push_back(day(0, 0.30 * (1.0 - 0.6 * kShare)));  // nearer f_d: stands
+  days.push_back(day(0, 0.30 * (1.0 - 1.4 * kShare)));  // still the obstacle's
+  days.push_back(day(0, 0.02));  // snow: not the obstacle, the majority (3 free : 2)
+  days.push_back(day(0, nan));   // no yield: the majority
+  const std::vector<std::uint8_t> stands = ObstacleDays(days, kShare);
+  EXPECT_EQ(stands, (std::vector<std::uint8_t>{0, 0, 0, 1, 1, 1, 0, 1, 1, 0, 0}));
+  // An obstacle whose beam shows it on every day judged stands on every other
+  // day too, whatever the yield: there is no free day to compare with.
+  const std::vector<std::uint8_t> always =
+      ObstacleDays({day(1, 0.28), day(1, 0.27), day(0, 0.30), day(0, 0.10), day(0, nan)}, kShare);
+  EXPECT_EQ(always, (std::vector<std::uint8_t>{1, 1, 1, 1, 1}));
+}
+
+TEST(DiagnosisForms, DiffuseLitYieldIsTheDaysRatioOfSumsOnRowsWithoutMuchBeam) {
+  std::vector<std::int64_t> time_s;
+  std::vector<double> p_el, g_poa, beam, elevation;
+  for (int i = 0; i < 40; ++i) {
+    time_s.push_back(1'700'000'000 + 60 * i);
+    elevation.push_back(0.3);
+    g_poa.push_back(i < 20 ? 150.0 : 600.0);
+    beam.push_back(i < 20 ? 30.0 : 500.0);  // the last 20 rows are beam-lit
+    p_el.push_back(i < 20 ? 30.0 + (i % 2) * 6.0 : 100.0);
+  }
+  // Σ P_el / Σ I_gt over the 20 diffuse-lit rows: 660 / 3000.
+  const std::vector<double> y = ShadingDiffuseYield(time_s, p_el, g_poa, beam, elevation, 0);
+  EXPECT_NEAR(y[0], 0.22, 1e-12);
+  EXPECT_NEAR(y[39], 0.22, 1e-12);  // the day's value on every row
+  // Fewer than 10 diffuse-lit rows: none.
+  for (int i = 9; i < 20; ++i) beam[static_cast<std::size_t>(i)] = 100.0;
+  EXPECT_TRUE(std::isnan(ShadingDiffuseYield(time_s, p_el, g_poa, beam, elevation, 0)[0]));
 }
 
 TEST(DiagnosisForms, RelativeYieldIsOneForAConstantYieldAndDropsUnderTheObstacle) {

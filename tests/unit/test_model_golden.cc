@@ -70,7 +70,9 @@ TEST(ModelGolden, OutputsOfTable6VariantsAndEffectsAreBitIdentical) {
   // one-off comparison of the two builds); the two runs with both
   // capacitances re-recorded when their step's rotation moved from atan2,
   // cos and sin to half-angle formulas (DiagonaliseSymmetric; their outputs
-  // moved by at most 7.4e-13, 2.3e-14 relative, in the same comparison).
+  // moved by at most 7.4e-13, 2.3e-14 relative, in the same comparison);
+  // the three runs with shading re-recorded when its box began to hide its
+  // share of the sky diffuse (a change of the physics).
   const std::map<std::string, std::string> expected = {
 #include "tests/unit/model_golden_hashes.inc"
   };

@@ -83,6 +83,10 @@ TEST(OtherFormTruth, HorizonDiffuseShareByDozierFrew) {
   ramp.azimuth_rad = {DegToRad(200.0), DegToRad(230.0)};
   ramp.elevation_rad = {0.0, DegToRad(30.0)};
   EXPECT_NEAR(HorizonDiffuseShare(ramp), 0.0072086107, 1e-9);
+  // The candidate's box is that wall: the same share from its width and edge.
+  EXPECT_NEAR(BoxDiffuseShare(DegToRad(90.0), DegToRad(30.0)), HorizonDiffuseShare(wall), 1e-12);
+  EXPECT_EQ(BoxDiffuseShare(0.0, DegToRad(30.0)), 0.0);
+  EXPECT_NEAR(BoxDiffuseShare(DegToRad(400.0), DegToRad(120.0)), 1.0, 1e-12);  // clamped
 }
 
 TEST(OtherFormTruth, SaturatingSoilingBeforeAndAfterARainReset) {

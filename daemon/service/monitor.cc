@@ -148,9 +148,12 @@ void CheckSensors(Store& store, const DailyCheckInputs& in, const Series& window
 
 // Drift of each parameter over the accepted calibrations of drift_days
 // (DetectDrift: the newest fit against the oldest a window apart, on the
-// scale of the plant's own wobble). When no parameter can be judged the log
-// says why: a daemon younger than a window and two nights, or drift_days
-// too short to hold fits a window apart (a warning: it never will).
+// scale of the plant's own wobble). The log says each night what it finds;
+// monitor_event gets a parameter's drift once, when it begins (warning), and
+// once when a judged night no longer finds it (info), as the power check's
+// outcome. When no parameter can be judged the log says why: a daemon
+// younger than a window and two nights, or drift_days too short to hold
+// fits a window apart (a warning: it never will).
 void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::CalibrationRow& cal,
                 LogLines* log) {
   std::map<std::string, std::vector<ParameterPoint>> history;
@@ -166,7 +169,26 @@ void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::Calibrati
   for (const auto& [name, points] : history) {
     const ParameterDrift drift = DetectDrift(points);
     judged += drift.judged;
-    if (!drift.drift) continue;
+    if (!drift.judged) continue;
+    std::string last;
+    bool found = false;
+    if (!store.LatestMonitorEventSeverity("parameter_drift", name + " ", &last, &found, &error)) {
+      log->push_back({kErr, "daily checks: " + error});
+      continue;
+    }
+    const bool open = found && last == "warning";
+    if (!drift.drift) {
+      if (!open) continue;
+      const std::string message =
+          name + " no longer drifts: " + Fixed(drift.last, 4) + " against " +
+          Fixed(drift.first, 4) + " a window before, within " + Fixed(kDriftSigmas, 0) + " times " +
+          Fixed(drift.scale, 4) + " (calibration " + std::to_string(cal.id) + ")";
+      if (!store.InsertMonitorEvent(in.now_s, "parameter_drift", "info", message, &error)) {
+        log->push_back({kErr, "daily checks: " + error});
+      }
+      log->push_back({kInfo, message});
+      continue;
+    }
     const std::string head = name + " drifted from " + Fixed(drift.first, 4) + " to " +
                              Fixed(drift.last, 4) + " (" + (drift.change > 0 ? "+" : "") +
                              Fixed(drift.change, 4) + ", more than " + Fixed(kDriftSigmas, 0) +
@@ -179,10 +201,12 @@ void CheckDrift(Store& store, const DailyCheckInputs& in, const Store::Calibrati
                                 Fixed(drift.wobble_sd, 4) + " from " + std::to_string(drift.steps) +
                                 " nightly steps; windows ending " + Day(drift.first_window_end_s) +
                                 " and from " + Day(drift.last_window_start_s) + tail;
-    if (!store.InsertMonitorEvent(in.now_s, "parameter_drift", "warning", message, &error)) {
+    if (!open &&
+        !store.InsertMonitorEvent(in.now_s, "parameter_drift", "warning", message, &error)) {
       log->push_back({kErr, "daily checks: " + error});
     }
-    log->push_back({kWarning, head + tail});  // the event has the scale's parts
+    // The event has the scale's parts; the log says it again each night.
+    log->push_back({kWarning, head + tail + (open ? "; raised before, still open" : "")});
   }
   if (judged > 0 || history.empty()) return;
   const bool too_short = drift_days < window_days + 2;
@@ -231,7 +255,7 @@ void CheckDatasheetPower(Store& store, const DailyCheckInputs& in, const Series&
   log->push_back({r.pass ? kInfo : kWarning, message});
   std::string last;
   bool found = false;
-  if (!store.LatestMonitorEventSeverity("power_check", &last, &found, &error)) {
+  if (!store.LatestMonitorEventSeverity("power_check", "", &last, &found, &error)) {
     log->push_back({kErr, "daily checks: " + error});
     return;
   }

@@ -430,9 +430,10 @@ class Store {
   // warning or error).
   bool InsertMonitorEvent(std::int64_t ts, const std::string& kind, const std::string& severity,
                           const std::string& message, std::string* error);
-  // The newest monitor_event of kind: its severity; *found false when none.
-  bool LatestMonitorEventSeverity(const std::string& kind, std::string* severity, bool* found,
-                                  std::string* error);
+  // The newest monitor_event of kind whose message starts with
+  // message_prefix ("" for any): its severity; *found false when none.
+  bool LatestMonitorEventSeverity(const std::string& kind, const std::string& message_prefix,
+                                  std::string* severity, bool* found, std::string* error);
   // Parameters of the accepted calibrations with run_at >= since_ts, per
   // name, in time order, with their calibration's window (0, 0 when NULL).
   bool ReadAcceptedParameters(std::int64_t since_ts,

@@ -61,8 +61,8 @@ bool Store::InsertMonitorEvent(std::int64_t ts, const std::string& kind,
       error);
 }
 
-bool Store::LatestMonitorEventSeverity(const std::string& kind, std::string* severity, bool* found,
-                                       std::string* error) {
+bool Store::LatestMonitorEventSeverity(const std::string& kind, const std::string& message_prefix,
+                                       std::string* severity, bool* found, std::string* error) {
   Impl& db = *impl_;
   std::lock_guard lock(db.mutex);
   std::string result;
@@ -73,10 +73,14 @@ bool Store::LatestMonitorEventSeverity(const std::string& kind, std::string* sev
         any = false;
         sqlite3_stmt* stmt = nullptr;
         DbStatus s = db.Prepare(
-            "SELECT severity FROM monitor_event WHERE kind = ? ORDER BY ts DESC, id DESC LIMIT 1",
+            "SELECT severity FROM monitor_event WHERE kind = ? AND (? = '' OR instr(message, ?) = "
+            "1) "
+            "ORDER BY ts DESC, id DESC LIMIT 1",
             &stmt);
         if (!s.ok()) return s;
         sqlite3_bind_text(stmt, 1, kind.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(stmt, 2, message_prefix.c_str(), -1, SQLITE_TRANSIENT);
+        sqlite3_bind_text(stmt, 3, message_prefix.c_str(), -1, SQLITE_TRANSIENT);
         const int rc = sqlite3_step(stmt);
         if (rc == SQLITE_ROW) {
           any = true;

@@ -203,6 +203,45 @@ TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
   EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'parameter_drift'"), 1);
 }
 
+// A drift is one warning while it lasts and one info when a judged night
+// no longer finds it; the log says it each night.
+TEST_F(DailyChecks, ADriftIsOneEventUntilItEnds) {
+  const ParamVector truth = ReferenceTruthParams(config_.plant);
+  Accept(kJune1 + 7 * kDayS, truth, 0.3);
+  Accept(kJune1 + 14 * kDayS, truth, 0.6);
+  DailyCheckInputs night = Inputs(true);
+  RunDailyChecks(*store_, night);
+  testing::RawDb db(dir_ / "pvtwin.db");
+  const std::string events =
+      "SELECT severity, message FROM monitor_event WHERE kind = 'parameter_drift' ORDER BY id";
+  ASSERT_EQ(db.Rows(events).size(), 1u);
+  // The next night's fit drifted a little further: the log says so, no new
+  // event.
+  Accept(kJune1 + 15 * kDayS, truth, 0.65);
+  night.now_s += kDayS;
+  const auto log = RunDailyChecks(*store_, night);
+  EXPECT_EQ(db.Rows(events).size(), 1u);
+  EXPECT_NE(std::find_if(log.begin(), log.end(),
+                         [](const auto& l) {
+                           return l.first == kWarning &&
+                                  l.second.find("u_front_w_m2k drifted from") == 0 &&
+                                  l.second.find("still open") != std::string::npos;
+                         }),
+            log.end());
+  // Back where it was: the drift ends, once.
+  for (int k = 16; k <= 17; ++k) {
+    Accept(kJune1 + k * kDayS, truth, 0.0);
+    night.now_s += kDayS;
+    RunDailyChecks(*store_, night);
+  }
+  const auto rows = db.Rows(events);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0][0], "warning");
+  EXPECT_EQ(rows[1][0], "info");
+  EXPECT_EQ(rows[1][1].rfind("u_front_w_m2k no longer drifts: 14.0000 against 14.0000", 0), 0u)
+      << rows[1][1];
+}
+
 // drift_days shorter than a window and two nights never holds fits a
 // window apart: no event, and a warning in the log that says so (never a
 // silent no-op).

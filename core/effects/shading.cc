@@ -12,6 +12,23 @@
 
 namespace pvtwin {
 
+namespace {
+
+// Calls f(lo, hi) for each solar day's rows [lo, hi) of a time-ordered
+// series.
+template <class F>
+void ForEachSolarDay(const std::vector<std::int64_t>& time_s, std::int64_t solar_offset_s, F&& f) {
+  for (std::size_t lo = 0; lo < time_s.size();) {
+    const std::int64_t day = SolarDayStartS(time_s[lo], solar_offset_s);
+    std::size_t hi = lo + 1;
+    while (hi < time_s.size() && SolarDayStartS(time_s[hi], solar_offset_s) == day) ++hi;
+    f(lo, hi);
+    lo = hi;
+  }
+}
+
+}  // namespace
+
 double ShadedFraction(double sun_azimuth_rad, double sun_elevation_rad, double centre_rad,
                       double width_rad, double edge_elevation_rad) {
   if (!(sun_elevation_rad > 0.0)) return 0.0;
@@ -76,29 +93,25 @@ std::vector<double> ShadingRelativeYield(const std::vector<std::int64_t>& time_s
   const std::size_t n = time_s.size();
   std::vector<double> out(n, std::nan(""));
   std::vector<double> y;
-  for (std::size_t lo = 0; lo < n;) {
-    const std::int64_t day = SolarDayStartS(time_s[lo], solar_offset_s);
-    std::size_t hi = lo;
+  ForEachSolarDay(time_s, solar_offset_s, [&](std::size_t lo, std::size_t hi) {
     y.clear();
-    for (; hi < n && SolarDayStartS(time_s[hi], solar_offset_s) == day; ++hi) {
-      const double r = p_el_w[hi] / g_poa_w_m2[hi];
-      if (g_poa_w_m2[hi] >= 200.0 && sun_elevation_rad[hi] > 0.0 && std::isfinite(r)) {
+    for (std::size_t i = lo; i < hi; ++i) {
+      const double r = p_el_w[i] / g_poa_w_m2[i];
+      if (g_poa_w_m2[i] >= 200.0 && sun_elevation_rad[i] > 0.0 && std::isfinite(r)) {
         y.push_back(r);
       }
     }
-    if (y.size() >= 10) {
-      const auto q = y.begin() + static_cast<std::ptrdiff_t>(3 * y.size() / 4);
-      std::nth_element(y.begin(), q, y.end());
-      const double reference = *q;
-      for (std::size_t i = lo; reference > 0.0 && i < hi; ++i) {
-        const double r = p_el_w[i] / g_poa_w_m2[i];
-        if (g_poa_w_m2[i] >= 100.0 && sun_elevation_rad[i] > 0.0 && std::isfinite(r)) {
-          out[i] = r / reference;
-        }
+    if (y.size() < 10) return;
+    const auto q = y.begin() + static_cast<std::ptrdiff_t>(3 * y.size() / 4);
+    std::nth_element(y.begin(), q, y.end());
+    const double reference = *q;
+    for (std::size_t i = lo; reference > 0.0 && i < hi; ++i) {
+      const double r = p_el_w[i] / g_poa_w_m2[i];
+      if (g_poa_w_m2[i] >= 100.0 && sun_elevation_rad[i] > 0.0 && std::isfinite(r)) {
+        out[i] = r / reference;
       }
     }
-    lo = hi;
-  }
+  });
   return out;
 }
 
@@ -110,27 +123,22 @@ std::vector<double> ShadingDiffuseYield(const std::vector<std::int64_t>& time_s,
                                         std::int64_t solar_offset_s) {
   const std::size_t n = time_s.size();
   std::vector<double> out(n, std::nan(""));
-  for (std::size_t lo = 0; lo < n;) {
-    const std::int64_t day = SolarDayStartS(time_s[lo], solar_offset_s);
+  ForEachSolarDay(time_s, solar_offset_s, [&](std::size_t lo, std::size_t hi) {
     double p_sum = 0.0, g_sum = 0.0;
     int rows = 0;
-    std::size_t hi = lo;
-    for (; hi < n && SolarDayStartS(time_s[hi], solar_offset_s) == day; ++hi) {
-      const double g = g_poa_w_m2[hi];
-      const double beam = std::isfinite(beam_w_m2[hi]) ? beam_w_m2[hi] : 0.0;
-      if (g >= 100.0 && beam < 0.5 * g && sun_elevation_rad[hi] > 0.0 &&
-          std::isfinite(p_el_w[hi])) {
-        p_sum += p_el_w[hi];
+    for (std::size_t i = lo; i < hi; ++i) {
+      const double g = g_poa_w_m2[i];
+      const double beam = std::isfinite(beam_w_m2[i]) ? beam_w_m2[i] : 0.0;
+      if (g >= 100.0 && beam < 0.5 * g && sun_elevation_rad[i] > 0.0 && std::isfinite(p_el_w[i])) {
+        p_sum += p_el_w[i];
         g_sum += g;
         ++rows;
       }
     }
-    if (rows >= 10) {
-      std::fill(out.begin() + static_cast<std::ptrdiff_t>(lo),
-                out.begin() + static_cast<std::ptrdiff_t>(hi), p_sum / g_sum);
-    }
-    lo = hi;
-  }
+    if (rows < 10) return;
+    std::fill(out.begin() + static_cast<std::ptrdiff_t>(lo),
+              out.begin() + static_cast<std::ptrdiff_t>(hi), p_sum / g_sum);
+  });
   return out;
 }
 
@@ -259,22 +267,17 @@ void ShadeTheBeam(const Drivers& d, const ParamVector& p, RunInputs* run) {
   factor.resize(run->n);
   std::vector<ObstacleDayEvidence> evidence;
   std::vector<std::size_t> day_end;  // end row of each solar day
-  for (std::size_t lo = 0; lo < run->n;) {
-    const std::int64_t day = SolarDayStartS(d.time_s[lo], solar_offset_s);
+  ForEachSolarDay(d.time_s, solar_offset_s, [&](std::size_t lo, std::size_t hi) {
     ObstacleDayEvidence& e = evidence.emplace_back();
     if (has_diffuse_yield) e.diffuse_yield = d.diffuse_yield[lo];
-    std::size_t hi = lo;
-    for (; hi < run->n && SolarDayStartS(d.time_s[hi], solar_offset_s) == day; ++hi) {
-      shaded[hi] =
-          ShadedFraction(d.sun_azimuth_rad[hi], d.sun_elevation_rad[hi], centre, width, edge);
+    for (std::size_t i = lo; i < hi; ++i) {
+      shaded[i] = ShadedFraction(d.sun_azimuth_rad[i], d.sun_elevation_rad[i], centre, width, edge);
       if (has_yield) {
-        e.Add(d.relative_yield[hi], shaded[hi], run->g_beam_w_m2[hi] / run->g_poa_w_m2[hi],
-              mismatch);
+        e.Add(d.relative_yield[i], shaded[i], run->g_beam_w_m2[i] / run->g_poa_w_m2[i], mismatch);
       }
     }
     day_end.push_back(hi);
-    lo = hi;
-  }
+  });
   const std::vector<std::uint8_t> stands = ObstacleDays(evidence, diffuse_share);
   std::size_t i = 0;
   for (std::size_t k = 0; k < day_end.size(); ++k) {

@@ -78,9 +78,76 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
   return text.empty();
 }
 
+namespace {
+
+bool DiagnoseOnce(const Series& data_in, const Plant& plant, const ModelSpec& base,
+                  const DiagnosisOptions& options, bool recheck_after_sensor_onset,
+                  DiagnosisResult* result, std::string* error,
+                  const std::function<void(const std::string&)>& progress_in);
+
+// A named sensor fault that moves the measured Q_u from a held-out day on
+// (offset_step, scale) makes every model that predicts less heat look
+// better on the days after it. The effect the ladder accepted first must
+// then also be the first one chosen on the held-out days before that onset
+// (the same training days); otherwise its evidence lies on the faulty days
+// and it is not named. Returns the sentence for the report's notes when the
+// effect does not hold; "" when it does or nothing is to be checked.
+std::string EffectWithoutFaultyDays(const Series& data, const Plant& plant, const ModelSpec& base,
+                                    const DiagnosisOptions& options,
+                                    const diagnosis_stages::Split& split,
+                                    const std::vector<SensorFinding>& steps,
+                                    const DiagnosisResult& r) {
+  if (r.ladder.size() < 2) return "";
+  const std::int64_t heldout_start_s = split.day_starts[static_cast<std::size_t>(split.train_days)];
+  const SensorFinding* first = nullptr;
+  for (const SensorFinding& f : steps) {
+    if ((f.kind != "offset_step" && f.kind != "scale") || f.from_s <= heldout_start_s) continue;
+    if (first == nullptr || f.from_s < first->from_s) first = &f;
+  }
+  if (first == nullptr) return "";
+  int clean_days = 0;
+  for (std::int64_t d : split.day_starts) {
+    clean_days += d >= heldout_start_s && d < first->from_s ? 1 : 0;
+  }
+  const std::string effect = r.ladder[1].added;
+  std::string outcome = "no held-out day lies before it";
+  if (clean_days > 0) {
+    DiagnosisOptions before = options;
+    before.train_days = split.train_days;
+    before.heldout_days = clean_days;
+    DiagnosisResult clean;
+    std::string why;
+    if (!DiagnoseOnce(data.Slice(0, data.RowAtOrAfter(first->from_s)), plant, base, before, false,
+                      &clean, &why, nullptr)) {
+      outcome = "the days before it cannot be diagnosed (" + why + ")";
+    } else if (clean.ladder.size() > 1 && clean.ladder[1].added == effect) {
+      return "";
+    } else {
+      outcome = "on the " + std::to_string(clean_days) +
+                " held-out day(s) before it the verdict is " +
+                (clean.verdict.empty() ? "none" : clean.verdict);
+    }
+  }
+  return effect + " was chosen on held-out days that include those from " + first->from +
+         ", when the named " + first->channel + " " + first->kind +
+         " begins (it moves the measured Q_u); " + outcome +
+         ": its evidence lies on the faulty days, so it is not named";
+}
+
+}  // namespace
+
 bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
               const DiagnosisOptions& options, DiagnosisResult* result, std::string* error,
               const std::function<void(const std::string&)>& progress_in) {
+  return DiagnoseOnce(data_in, plant, base, options, true, result, error, progress_in);
+}
+
+namespace {
+
+bool DiagnoseOnce(const Series& data_in, const Plant& plant, const ModelSpec& base,
+                  const DiagnosisOptions& options, bool recheck_after_sensor_onset,
+                  DiagnosisResult* result, std::string* error,
+                  const std::function<void(const std::string&)>& progress_in) {
   namespace st = diagnosis_stages;
   const auto t0 = std::chrono::steady_clock::now();
   std::mutex progress_mutex;
@@ -139,16 +206,30 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   trials.test_unit = r.test_unit;
   trials.progress = progress;
   trials.extrapolation = &r.extrapolation;
-  const st::LadderModel final_model = st::RunLadder(trials, base, &r);
+  st::LadderModel final_model = st::RunLadder(trials, base, &r);
   // The residual sensor checks read the residuals of the final model: a
   // base model that lacks a large effect leaves day-to-day structure that a
   // step can fit (final-check seed 31, other-form wind in October: a false
   // t_out_c step with the base 1N1Cr fitted on all days).
   std::vector<SensorFinding> steps = st::FindResidualSensorFaults(
       data, split, plant, final_model.spec, final_model.params, options, progress);
+  ++r.identifications;
+  const std::string faulty =
+      recheck_after_sensor_onset
+          ? EffectWithoutFaultyDays(data, plant, base, options, split, steps, r)
+          : std::string();
+  if (!faulty.empty()) {
+    progress("sensor re-check: " + faulty);
+    r.notes.push_back(faulty);
+    r.ladder.resize(1);
+    r.candidates.clear();
+    r.separation.clear();
+    for (EffectTrial& t : r.effects) t.accepted_at_step = 0;
+    r.final_variant = base.Name();
+    final_model = st::LadderModel{base, base_fit.params, base_fit.score};
+  }
   r.sensors.insert(r.sensors.begin(), std::make_move_iterator(steps.begin()),
                    std::make_move_iterator(steps.end()));
-  ++r.identifications;
 
   if (!st::EstimateNoiseFloor(split, plant, final_model, &r, error)) return false;
   st::BuildReportModel(split, base_fit, residuals, final_model, plant.area_m2, &r);
@@ -157,6 +238,8 @@ bool Diagnose(const Series& data_in, const Plant& plant, const ModelSpec& base,
   *result = std::move(r);
   return true;
 }
+
+}  // namespace
 
 GapBias BaseModelBias(const DiagnosisResult& r) {
   const double nan = std::nan("");

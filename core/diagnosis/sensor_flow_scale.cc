@@ -59,9 +59,9 @@ std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Pr
   if (!d) return std::nullopt;
   const double k = std::exp(d->after - d->before);
   const std::string from = SolarDate(s.days[d->split], r.offset_s);
-  progress("sensor scale test: measured / modelled Q_u steps by × " + FixedDecimals(k, 3) +
-           " on " + from + " (" + (d->separated ? "separated" : "not separated") +
-           ", p = " + PValue(d->p) + (d->beats_line ? ", better than a drift)" : ", a drift fits as well)"));
+  progress("sensor scale test: measured / modelled Q_u steps by × " + FixedDecimals(k, 3) + " on " +
+           from + " (" + (d->separated ? "separated" : "not separated") + ", p = " + PValue(d->p) +
+           (d->beats_line ? ", better than a drift)" : ", a drift fits as well)"));
   if (!d->found || std::fabs(k - 1.0) < o.min_flow_scale_error) return std::nullopt;
   ResidualFinding out;
   SensorFinding& f = out.finding;
@@ -69,16 +69,16 @@ std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Pr
   f.size_unit = "";  // a ratio
   f.detail = "from " + f.from + " on the measured Q_u is " + FixedDecimals(k, 3) +
              " × what it was against the model before, on every day after and on none before "
-             "(p = " + PValue(d->p) + " over " + std::to_string(s.y.size()) +
+             "(p = " +
+             PValue(d->p) + " over " + std::to_string(s.y.size()) +
              " days), in proportion while the pump runs: the flow meter reads about " +
              FixedDecimals(100.0 * (k - 1.0), 1) +
              " % off (a clogged or re-mounted meter, a changed pulse value or glycol share)";
-  // Its fault model from the onset: Q_meas = exp(level after) · Q_model.
+  // Its fault model from the onset: Q_meas = k · Q_model.
   out.explains = "q_th_w";
-  const double after = std::exp(d->after);
-  out.fault_mse = FaultMse(r, f.from_s, [&r, after](std::uint32_t i) {
-    return after * r.q_model_w[i] - r.q_meas_w[i];
-  });
+  out.fault_mse = FaultMse(
+      r, f.from_s, [&r](std::uint32_t i) { return r.q_model_w[i]; },
+      [&r](std::uint32_t i) { return r.q_meas_w[i]; });
   return out;
 }
 

@@ -34,12 +34,12 @@ struct SensorResiduals {
   const Series* data = nullptr;  // the diagnosed rows (row i of every vector below)
   const Plant* plant = nullptr;
   const DiagnosisOptions* options = nullptr;
-  std::int64_t offset_s = 0;       // SolarDayOffsetS
-  std::vector<std::uint32_t> rows;  // objective rows of the fit
-  std::vector<std::int64_t> day_s;  // per row: its solar day's start
+  std::int64_t offset_s = 0;              // SolarDayOffsetS
+  std::vector<std::uint32_t> rows;        // objective rows of the fit
+  std::vector<std::int64_t> day_s;        // per row: its solar day's start
   std::vector<double> capacity_flow_w_k;  // ṁ·c_p from the measured flow
   std::vector<double> g_poa_w_m2;
-  std::vector<double> q_meas_w, q_model_w;      // heat meter, model
+  std::vector<double> q_meas_w, q_model_w;                  // heat meter, model
   std::vector<double> t_in_c, t_out_meas_c, t_out_model_c;  // logged, logged, model
 };
 
@@ -56,8 +56,8 @@ struct DaySeries {
 // split days tried is at most alpha (the probability of that separation in
 // a series without a step, whatever the days' distribution).
 struct DayStep {
-  bool found = false;  // separated, better than a line, p ≤ alpha (size not judged)
-  std::size_t split = 0;  // first day of the step (index into DaySeries)
+  bool found = false;                // separated, better than a line, p ≤ alpha (size not judged)
+  std::size_t split = 0;             // first day of the step (index into DaySeries)
   double before = 0.0, after = 0.0;  // mean of the days before / from the split
   double p = 1.0;
   bool separated = false, beats_line = false;
@@ -79,8 +79,8 @@ struct ResidualFinding {
   double fault_mse = 0.0;
 };
 
-using ResidualSensorCheck = std::function<std::optional<ResidualFinding>(
-    const SensorResiduals&, const Progress&)>;
+using ResidualSensorCheck =
+    std::function<std::optional<ResidualFinding>(const SensorResiduals&, const Progress&)>;
 
 // The checks (sensor_steps.cc), one line each.
 const std::vector<ResidualSensorCheck>& ResidualSensorChecks();
@@ -91,10 +91,13 @@ std::optional<ResidualFinding> CheckNightPairOffset(const SensorResiduals& r,
                                                     const Progress& progress);
 std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Progress& progress);
 
-// Mean of e(i)² over the rows with flow from the solar day from_s on (NaN
-// without any): a fault model's fit to its rows.
+// A fault model y(i) = g·x(i) fitted by least squares over the rows with
+// flow from the solar day from_s on, g = Σ x·y / Σ x²: the mean of
+// (y − g·x)² (NaN without any row). Every fault model is compared at its own
+// best size, so that the competition between two of them is fair.
 double FaultMse(const SensorResiduals& r, std::int64_t from_s,
-                const std::function<double(std::uint32_t)>& e);
+                const std::function<double(std::uint32_t)>& x,
+                const std::function<double(std::uint32_t)>& y);
 
 // A finding of `channel` and `kind` from the solar day `from_s` (written
 // `from`) on, of `size` in K, with the rows from that day on and their share

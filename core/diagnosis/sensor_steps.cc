@@ -114,8 +114,8 @@ std::optional<SensorResiduals> FitAllDays(const Series& data, const Split& split
   r.q_meas_w = all.meas.q_th_w;
   r.q_model_w = std::move(sim.q_th_w);
   r.t_in_c = all.drivers.t_in_c;
-  r.t_out_meas_c = data.Has(Channel::kTOutC) ? data[Channel::kTOutC]
-                                             : std::vector<double>(n, std::nan(""));
+  r.t_out_meas_c =
+      data.Has(Channel::kTOutC) ? data[Channel::kTOutC] : std::vector<double>(n, std::nan(""));
   r.t_out_model_c = std::move(sim.t_out_c);
   return r;
 }
@@ -169,17 +169,23 @@ DaySeries DailyMedians(const SensorResiduals& r, const std::function<bool(std::u
 }
 
 double FaultMse(const SensorResiduals& r, std::int64_t from_s,
-                const std::function<double(std::uint32_t)>& e) {
-  double sum = 0.0;
+                const std::function<double(std::uint32_t)>& x,
+                const std::function<double(std::uint32_t)>& y) {
+  double xx = 0.0, xy = 0.0, yy = 0.0;
   std::size_t n = 0;
   for (std::uint32_t i : r.rows) {
     if (!(r.capacity_flow_w_k[i] > 0.0) || r.day_s[i] < from_s) continue;
-    const double v = e(i);
-    if (!std::isfinite(v)) continue;
-    sum += v * v;
+    const double xi = x(i), yi = y(i);
+    if (!std::isfinite(xi) || !std::isfinite(yi)) continue;
+    xx += xi * xi;
+    xy += xi * yi;
+    yy += yi * yi;
     ++n;
   }
-  return n > 0 ? sum / static_cast<double>(n) : std::nan("");
+  if (n == 0) return std::nan("");
+  // Σ (y − g·x)² = Σy² − (Σxy)²/Σx² at g = Σxy/Σx².
+  const double sse = xx > 0.0 ? yy - xy * xy / xx : yy;
+  return std::max(0.0, sse) / static_cast<double>(n);
 }
 
 SensorFinding FindingFrom(const Series& data, std::string channel, std::string kind,
@@ -197,8 +203,7 @@ SensorFinding FindingFrom(const Series& data, std::string channel, std::string k
   return f;
 }
 
-std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r,
-                                               const Progress& progress) {
+std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r, const Progress& progress) {
   const DiagnosisOptions& o = *r.options;
   auto with_flow = [&r](std::uint32_t i) { return r.capacity_flow_w_k[i] > 0.0; };
   auto per_flow = [&r](std::uint32_t i) {
@@ -226,11 +231,11 @@ std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r,
       (step_k > 0.0 ? "inlet temperature reads high (or the outlet low)"
                     : "outlet temperature reads high (or the inlet low)") +
       " by about that much";
-  // Its fault model from the onset: Q_meas = Q_model − ṁ·c_p·(level after).
+  // Its fault model from the onset: Q_model − Q_meas = ṁ·c_p·δ.
   out.explains = "q_th_w";
-  out.fault_mse = FaultMse(r, f.from_s, [&r, &d](std::uint32_t i) {
-    return r.q_model_w[i] - r.q_meas_w[i] - r.capacity_flow_w_k[i] * d->after;
-  });
+  out.fault_mse = FaultMse(
+      r, f.from_s, [&r](std::uint32_t i) { return r.capacity_flow_w_k[i]; },
+      [&r](std::uint32_t i) { return r.q_model_w[i] - r.q_meas_w[i]; });
   return out;
 }
 

@@ -100,6 +100,7 @@ struct SelftestOutcome {
   std::string why;                   // what failed, when !correct
   double wall_time_s = 0.0;
   DiagnosisResult result;
+  std::string log;  // the diagnosis's progress lines, one per line (when asked for)
 };
 
 // The cases: one per effect the catalogue can add to a base it chooses, a

@@ -13,8 +13,8 @@
 // logarithm as the day series, the day-step test (TestDayStep) with alpha,
 // and a ratio step exp(after − before) at least min_flow_scale_error from 1.
 // The finding competes with offset_step for the Q_u residual (both move it
-// from a day on): the fault model that fits the rows from its onset better
-// stays (FindResidualSensorFaults).
+// from a day on): the fault model that fits the rows from its onset better,
+// on a model fitted before it, stays (FindResidualSensorFaults).
 #include <cmath>
 #include <map>
 
@@ -76,9 +76,8 @@ std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Pr
              " % off (a clogged or re-mounted meter, a changed pulse value or glycol share)";
   // Its fault model from the onset: Q_meas = k · Q_model.
   out.explains = "q_th_w";
-  out.fault_mse = FaultMse(
-      r, f.from_s, [&r](std::uint32_t i) { return r.q_model_w[i]; },
-      [&r](std::uint32_t i) { return r.q_meas_w[i]; });
+  out.fault_x = [](const SensorResiduals& m, std::uint32_t i) { return m.q_model_w[i]; };
+  out.fault_y = [](const SensorResiduals& m, std::uint32_t i) { return m.q_meas_w[i]; };
   return out;
 }
 

@@ -5,7 +5,8 @@
 // (sensor_steps.cc); FindResidualSensorFaults fits the final model once on
 // all the days and asks every check.
 //
-//   offset_step  (sensor_steps.cc)      t_in_c / t_out_c: Q_u low by ṁ·c_p·δ
+//   offset_step  (sensor_steps.cc)      t_in_c / t_out_c: Q_u low by ṁ·c_p·δ,
+//                                       less what the model loses from δ
 //   pair_offset  (sensor_pair_night.cc) t_in_c,t_out_c: the logged pair
 //                disagrees with the model at night with the pump on
 //   scale        (sensor_flow_scale.cc) flow_kg_s: Q_u = k × the model's
@@ -18,6 +19,7 @@
 // independent.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -38,6 +40,11 @@ struct SensorResiduals {
   std::vector<std::uint32_t> rows;        // objective rows of the fit
   std::vector<std::int64_t> day_s;        // per row: its solar day's start
   std::vector<double> capacity_flow_w_k;  // ṁ·c_p from the measured flow
+  // What the measured-minus-modelled Q_u changes per K of inlet offset,
+  // W/K: the heat meter's ṁ·c_p plus the model's own ∂Q_u/∂T_in (the model
+  // is driven by the same logged inlet and predicts more loss from it:
+  // re-run with T_in + 1 K, about −F_R·U_L·A).
+  std::vector<double> inlet_offset_w_k;
   std::vector<double> g_poa_w_m2;
   std::vector<double> q_meas_w, q_model_w;                  // heat meter, model
   std::vector<double> t_in_c, t_out_meas_c, t_out_model_c;  // logged, logged, model
@@ -69,14 +76,20 @@ std::optional<DayStep> TestDayStep(const DaySeries& s, double alpha);
 DaySeries DailyMedians(const SensorResiduals& r, const std::function<bool(std::uint32_t)>& keep,
                        const std::function<double(std::uint32_t)>& x, int min_rows);
 
-// A finding of a residual check. Checks that explain the same residual
-// (`explains`, e.g. "q_th_w") compete: of those found, the one whose fault
-// model leaves the smaller mean square on the rows from its onset
-// (`fault_mse`, in the residual's unit squared) is kept.
+// A fault model y(i) = g·x(i) over a residual set (FitFault).
+using RowValue = std::function<double(const SensorResiduals&, std::uint32_t)>;
+
+// A finding of a residual check. A finding with a fault model (fault_x,
+// fault_y) is sized on a model fitted on the days before its onset: its size
+// becomes |g| of that fit (a model fitted on the faulty days too has taken up
+// part of the fault). Checks that explain the same residual (`explains`,
+// e.g. "q_th_w") compete on the model fitted before the earliest of their
+// onsets: of those found, the one whose fault model leaves the smaller mean
+// square on the rows from its onset is kept (FindResidualSensorFaults).
 struct ResidualFinding {
   SensorFinding finding;
   std::string explains;
-  double fault_mse = 0.0;
+  RowValue fault_x, fault_y;
 };
 
 using ResidualSensorCheck =
@@ -92,12 +105,16 @@ std::optional<ResidualFinding> CheckNightPairOffset(const SensorResiduals& r,
 std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Progress& progress);
 
 // A fault model y(i) = g·x(i) fitted by least squares over the rows with
-// flow from the solar day from_s on, g = Σ x·y / Σ x²: the mean of
-// (y − g·x)² (NaN without any row). Every fault model is compared at its own
-// best size, so that the competition between two of them is fair.
-double FaultMse(const SensorResiduals& r, std::int64_t from_s,
-                const std::function<double(std::uint32_t)>& x,
-                const std::function<double(std::uint32_t)>& y);
+// flow from the solar day from_s on: g = Σ x·y / Σ x² and the mean of
+// (y − g·x)² (both NaN without any row). Every fault model is compared at
+// its own best size, so that the competition between two of them is fair.
+struct FaultFit {
+  double g = std::nan("");
+  double mse = std::nan("");
+};
+FaultFit FitFault(const SensorResiduals& r, std::int64_t from_s,
+                  const std::function<double(std::uint32_t)>& x,
+                  const std::function<double(std::uint32_t)>& y);
 
 // A finding of `channel` and `kind` from the solar day `from_s` (written
 // `from`) on, of `size` in K, with the rows from that day on and their share

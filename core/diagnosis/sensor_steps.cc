@@ -4,10 +4,15 @@
 //
 // offset_step: the inlet temperature reading high (or the outlet low) by a
 // constant from one day on. The heat meter multiplies flow by the logged
-// T_out − T_in, so from that day the measured Q_u is low by ṁ·c_p·ΔT while
-// the pump runs, and a model fitted on all the days leaves a step in its Q_u
-// residual per unit of capacity flow, (Q_pred − Q_meas) / (ṁ·c_p) in K, that
-// stays from that day on.
+// T_out − T_in, so from that day the measured Q_u is low by ṁ·c_p·δ while
+// the pump runs. The model is driven by the same logged inlet: from a δ
+// warmer inlet it predicts δ·∂Q_u/∂T_in less heat (more loss, about
+// −F_R·U_L·A·δ). A model fitted on all the days therefore leaves a Q_u
+// residual of δ·(ṁ·c_p + ∂Q_u/∂T_in) (SensorResiduals::inlet_offset_w_k),
+// and its residual per that sensitivity, (Q_pred − Q_meas) / (ṁ·c_p +
+// ∂Q_u/∂T_in) in K, steps by δ from that day on. Under a flow controller
+// that holds T_out − T_in, ṁ·c_p alone grows with Q_u and would make an
+// offset look like a flow meter scale at low flow.
 //
 // The test, over the days (DiagnosisOptions, sensor_step_*):
 //  * per day the median of that residual over the rows with flow;
@@ -20,6 +25,7 @@
 //    is at least min_temperature_offset_k.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -80,23 +86,31 @@ double SeparationP(std::size_t n1, std::size_t n2) {
   return std::min(1.0, 2.0 * std::exp(log_p));
 }
 
-// The final model on all the days, per row (nullopt when it cannot be fitted).
-std::optional<SensorResiduals> FitAllDays(const Series& data, const Split& split,
-                                          const Plant& plant, const ModelSpec& base,
-                                          const ParamVector& start,
-                                          const DiagnosisOptions& options) {
+// The final model per row of all the days, fitted on the rows before
+// fit_before_s (nullopt when it cannot be fitted).
+std::optional<SensorResiduals> FitAllDays(
+    const Series& data, const Split& split, const Plant& plant, const ModelSpec& base,
+    const ParamVector& start, const DiagnosisOptions& options,
+    std::int64_t fit_before_s = std::numeric_limits<std::int64_t>::max()) {
   Part all;
   std::string why;
   if (!PreparePart(data, plant, base, split.data_start_s, split.cleanings, &all, &why)) {
     return std::nullopt;
   }
+  Measurements fitted = all.meas;
+  std::erase_if(fitted.rows, [&](std::uint32_t i) { return data.time_s[i] >= fit_before_s; });
+  if (fitted.rows.empty()) return std::nullopt;
   // The final model's parameters as they are, in the ranges they were found in (no re-fit).
   DiagnosisOptions ranges = options;
   ranges.refit_in_physical_ranges = false;
-  const IdentSummary fit = IdentifyInRanges(all.drivers, all.meas, start, ranges).fit;
+  const IdentSummary fit = IdentifyInRanges(all.drivers, fitted, start, ranges).fit;
   if (!fit.ok) return std::nullopt;
   SimOutputs sim;
   Simulate(all.drivers, fit.params, &sim);
+  Drivers warmer_inlet = all.drivers;
+  for (double& t : warmer_inlet.t_in_c) t += 1.0;
+  SimOutputs warmer;
+  Simulate(warmer_inlet, fit.params, &warmer);
   SensorResiduals r;
   r.data = &data;
   r.plant = &plant;
@@ -109,6 +123,10 @@ std::optional<SensorResiduals> FitAllDays(const Series& data, const Split& split
   r.capacity_flow_w_k.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     r.capacity_flow_w_k[i] = all.drivers.mdot_kg_s[i] * plant.fluid_cp_j_kgk;
+  }
+  r.inlet_offset_w_k.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    r.inlet_offset_w_k[i] = r.capacity_flow_w_k[i] + (warmer.q_th_w[i] - sim.q_th_w[i]);
   }
   r.g_poa_w_m2 = all.drivers.g_poa_w_m2;
   r.q_meas_w = all.meas.q_th_w;
@@ -168,9 +186,9 @@ DaySeries DailyMedians(const SensorResiduals& r, const std::function<bool(std::u
   return s;
 }
 
-double FaultMse(const SensorResiduals& r, std::int64_t from_s,
-                const std::function<double(std::uint32_t)>& x,
-                const std::function<double(std::uint32_t)>& y) {
+FaultFit FitFault(const SensorResiduals& r, std::int64_t from_s,
+                  const std::function<double(std::uint32_t)>& x,
+                  const std::function<double(std::uint32_t)>& y) {
   double xx = 0.0, xy = 0.0, yy = 0.0;
   std::size_t n = 0;
   for (std::uint32_t i : r.rows) {
@@ -182,10 +200,13 @@ double FaultMse(const SensorResiduals& r, std::int64_t from_s,
     yy += yi * yi;
     ++n;
   }
-  if (n == 0) return std::nan("");
+  FaultFit fit;
+  if (n == 0) return fit;
   // Σ (y − g·x)² = Σy² − (Σxy)²/Σx² at g = Σxy/Σx².
+  fit.g = xx > 0.0 ? xy / xx : 0.0;
   const double sse = xx > 0.0 ? yy - xy * xy / xx : yy;
-  return std::max(0.0, sse) / static_cast<double>(n);
+  fit.mse = std::max(0.0, sse) / static_cast<double>(n);
+  return fit;
 }
 
 SensorFinding FindingFrom(const Series& data, std::string channel, std::string kind,
@@ -205,16 +226,20 @@ SensorFinding FindingFrom(const Series& data, std::string channel, std::string k
 
 std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r, const Progress& progress) {
   const DiagnosisOptions& o = *r.options;
-  auto with_flow = [&r](std::uint32_t i) { return r.capacity_flow_w_k[i] > 0.0; };
-  auto per_flow = [&r](std::uint32_t i) {
-    return (r.q_model_w[i] - r.q_meas_w[i]) / r.capacity_flow_w_k[i];
+  // Rows with flow whose sensitivity is positive (ṁ·c_p above the model's
+  // loss per K of inlet: every row but a trickle).
+  auto sensitive = [&r](std::uint32_t i) {
+    return r.capacity_flow_w_k[i] > 0.0 && r.inlet_offset_w_k[i] > 0.0;
   };
-  const DaySeries s = DailyMedians(r, with_flow, per_flow, o.sensor_step_min_rows);
+  auto per_kelvin = [&r](std::uint32_t i) {
+    return (r.q_model_w[i] - r.q_meas_w[i]) / r.inlet_offset_w_k[i];
+  };
+  const DaySeries s = DailyMedians(r, sensitive, per_kelvin, o.sensor_step_min_rows);
   const std::optional<DayStep> d = TestDayStep(s, o.alpha);
   if (!d) return std::nullopt;
   const double step_k = d->after - d->before;
   const std::string from = SolarDate(s.days[d->split], r.offset_s);
-  progress("sensor step test: Q_u residual per capacity flow steps by " + FixedDecimals(step_k, 2) +
+  progress("sensor step test: Q_u residual per K of inlet offset steps by " + FixedDecimals(step_k, 2) +
            " K on " + from + (d->separated ? " (days separated" : " (days not separated") +
            ", p = " + PValue(d->p) +
            (d->beats_line ? ", better than a drift)" : ", a drift fits as well)"));
@@ -225,17 +250,18 @@ std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r, const P
                   from, std::fabs(step_k));
   f.detail =
       "from " + f.from + " on the measured Q_u is " + FixedDecimals(std::fabs(step_k), 2) +
-      " K × ṁ·c_p " + (step_k > 0.0 ? "below" : "above") +
+      " K × (ṁ·c_p + ∂Q_u/∂T_in) " + (step_k > 0.0 ? "below" : "above") +
       " what the model fitted on all days predicts, on every day after and on none before (p = " +
       PValue(d->p) + " over " + std::to_string(s.y.size()) + " days): the " +
       (step_k > 0.0 ? "inlet temperature reads high (or the outlet low)"
                     : "outlet temperature reads high (or the inlet low)") +
       " by about that much";
-  // Its fault model from the onset: Q_model − Q_meas = ṁ·c_p·δ.
+  // Its fault model from the onset: Q_model − Q_meas = (ṁ·c_p + ∂Q_u/∂T_in)·δ.
   out.explains = "q_th_w";
-  out.fault_mse = FaultMse(
-      r, f.from_s, [&r](std::uint32_t i) { return r.capacity_flow_w_k[i]; },
-      [&r](std::uint32_t i) { return r.q_model_w[i] - r.q_meas_w[i]; });
+  out.fault_x = [](const SensorResiduals& m, std::uint32_t i) { return m.inlet_offset_w_k[i]; };
+  out.fault_y = [](const SensorResiduals& m, std::uint32_t i) {
+    return m.q_model_w[i] - m.q_meas_w[i];
+  };
   return out;
 }
 
@@ -250,17 +276,56 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
   for (const ResidualSensorCheck& check : ResidualSensorChecks()) {
     if (std::optional<ResidualFinding> f = check(*r, progress)) found.push_back(std::move(*f));
   }
-  // Of the findings that explain the same residual, the best fault model stays.
-  std::vector<SensorFinding> out;
-  for (const ResidualFinding& f : found) {
-    bool beaten = false;
-    for (const ResidualFinding& g : found) {
-      beaten = beaten || (&g != &f && !f.explains.empty() && g.explains == f.explains &&
-                          g.fault_mse < f.fault_mse);
+  // Each fault model fitted on the model of the days before the earliest
+  // onset of the findings that explain the same residual: its size, and the
+  // mean square by which they compete.
+  std::vector<double> mse(found.size(), std::nan(""));
+  std::vector<bool> sized(found.size(), false);
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    if (!found[k].fault_x || sized[k]) continue;
+    std::vector<std::size_t> group;
+    std::int64_t first_onset = found[k].finding.from_s;
+    for (std::size_t j = k; j < found.size(); ++j) {
+      if (!found[j].fault_x || found[j].explains != found[k].explains) continue;
+      group.push_back(j);
+      first_onset = std::min(first_onset, found[j].finding.from_s);
     }
-    if (beaten) {
-      progress("sensor checks: " + f.finding.channel + " " + f.finding.kind +
-               " dropped, another fault explains the " + f.explains + " residual better");
+    const std::optional<SensorResiduals> before =
+        FitAllDays(data, split, plant, base, start, options, first_onset);
+    const SensorResiduals& model = before ? *before : *r;
+    const std::string on = before ? "the model fitted before " + SolarDate(first_onset, r->offset_s)
+                                  : "the model fitted on all the days";
+    for (std::size_t j : group) {
+      ResidualFinding& f = found[j];
+      sized[j] = true;
+      const FaultFit fit = FitFault(
+          model, f.finding.from_s, [&](std::uint32_t i) { return f.fault_x(model, i); },
+          [&](std::uint32_t i) { return f.fault_y(model, i); });
+      mse[j] = fit.mse;
+      if (!std::isfinite(fit.g)) continue;
+      f.finding.size = std::fabs(fit.g);
+      f.finding.detail += "; its size against " + on + ": " + SensorSizeText(f.finding);
+      progress("sensor checks: " + f.finding.channel + " " + f.finding.kind + " against " + on +
+               ": size " + SensorSizeText(f.finding) + ", RMS " +
+               FixedDecimals(std::sqrt(fit.mse), 1) + " from its onset");
+    }
+  }
+  std::vector<SensorFinding> out;
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    const ResidualFinding& f = found[k];
+    std::size_t better = k;
+    for (std::size_t j = 0; j < found.size(); ++j) {
+      if (j != k && sized[k] && sized[j] && found[j].explains == f.explains &&
+          mse[j] < mse[k]) {
+        better = j;
+      }
+    }
+    if (better != k) {
+      progress("sensor checks: " + f.finding.channel + " " + f.finding.kind + " dropped, " +
+               found[better].finding.channel + " " + found[better].finding.kind +
+               " explains the " + f.explains + " residual better from its onset (RMS " +
+               FixedDecimals(std::sqrt(mse[better]), 1) + " against " +
+               FixedDecimals(std::sqrt(mse[k]), 1) + ")");
     } else {
       out.push_back(f.finding);
     }

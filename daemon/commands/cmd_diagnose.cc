@@ -22,6 +22,7 @@
 #include "daemon/commands/inputs.h"
 #include "daemon/service/store_cli.h"
 #include "daemon/service/window_data.h"
+#include "io/files/params_json.h"
 #include "io/report/diagnosis_report.h"
 #include "io/platform/quantity_text.h"
 #include "io/store/store.h"
@@ -415,7 +416,12 @@ int RunSelftest(const SelftestArgs& a) {
   auto worker = [&] {
     for (std::size_t k = next++; k < jobs.size(); k = next++) {
       if (jobs[k].twin >= 0) continue;
-      outcomes[k] = RunSelftestCase(plant, *jobs[k].c, jobs[k].seed, options);
+      std::string log;
+      auto keep_log = [&log](const std::string& line) { log += line + "\n"; };
+      outcomes[k] = a.report.empty()
+                        ? RunSelftestCase(plant, *jobs[k].c, jobs[k].seed, options)
+                        : RunSelftestCase(plant, *jobs[k].c, jobs[k].seed, options, keep_log);
+      outcomes[k].log = std::move(log);
       const SelftestOutcome& o = outcomes[k];
       std::lock_guard<std::mutex> lock(mutex);
       std::fprintf(stderr, "[%d/%zu] %s %s seed %llu: verdict %s (expected %s) %s %.1f s\n", ++done,
@@ -448,6 +454,10 @@ int RunSelftest(const SelftestArgs& a) {
                               (o.form == TruthForm::kOtherForm ? "other-form-" : "") + o.case_name +
                               "-seed" + std::to_string(o.seed);
       if (o.verdict != "error" && !WriteDiagnosisReport(dir, o.result, &error)) {
+        std::cerr << error << "\n";
+        return kExitRuntime;
+      }
+      if (o.verdict != "error" && !WriteTextFileAtomically(dir + "/diagnosis.log", o.log, &error)) {
         std::cerr << error << "\n";
         return kExitRuntime;
       }
@@ -553,8 +563,8 @@ void RegisterDiagnose(CLI::App& app) {
   self->add_option("--cases", st->cases, "comma-separated case names (default: all)")
       ->delimiter(',');
   self->add_option("--report", st->report,
-                   "write each case's report to DIR/<case>-seed<N>/ (other-form battery: "
-                   "DIR/other-form-<case>-seed<N>/)");
+                   "write each case's report and its diagnosis.log to DIR/<case>-seed<N>/ "
+                   "(other-form battery: DIR/other-form-<case>-seed<N>/)");
   self->add_option("--battery", st->battery,
                    "same: truth from the candidates' own equations; other: each effect in "
                    "another functional form than its candidate (a horizon profile on some "

@@ -90,7 +90,7 @@ struct SelftestOutcome {
   std::string verdict;
   std::string first_step;  // effect of the ladder's first step, "" if none
   bool correct = false;
-  bool false_significant = false;    // null case with a significant effect
+  bool false_significant = false;  // null case with a significant effect
   // A sensor finding with an onset (a residual sensor check's) other than
   // the case's own sensor fault.
   bool false_sensor = false;

@@ -3,7 +3,8 @@
 // that the calibrated model shows from one day on. Each check is one module
 // (its own .cc) registered in one line of ResidualSensorChecks
 // (sensor_steps.cc); FindResidualSensorFaults fits the final model once on
-// all the days and asks every check.
+// all the days and asks every check, then once more on the days before a
+// Q_u fault's onset to size it (ResidualFinding).
 //
 //   offset_step  (sensor_steps.cc)      t_in_c / t_out_c: Q_u low by ṁ·c_p·δ,
 //                                       less what the model loses from δ

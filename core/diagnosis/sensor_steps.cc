@@ -239,9 +239,9 @@ std::optional<ResidualFinding> CheckOffsetStep(const SensorResiduals& r, const P
   if (!d) return std::nullopt;
   const double step_k = d->after - d->before;
   const std::string from = SolarDate(s.days[d->split], r.offset_s);
-  progress("sensor step test: Q_u residual per K of inlet offset steps by " + FixedDecimals(step_k, 2) +
-           " K on " + from + (d->separated ? " (days separated" : " (days not separated") +
-           ", p = " + PValue(d->p) +
+  progress("sensor step test: Q_u residual per K of inlet offset steps by " +
+           FixedDecimals(step_k, 2) + " K on " + from +
+           (d->separated ? " (days separated" : " (days not separated") + ", p = " + PValue(d->p) +
            (d->beats_line ? ", better than a drift)" : ", a drift fits as well)"));
   if (!d->found || std::fabs(step_k) < o.min_temperature_offset_k) return std::nullopt;
   ResidualFinding out;
@@ -315,15 +315,14 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
     const ResidualFinding& f = found[k];
     std::size_t better = k;
     for (std::size_t j = 0; j < found.size(); ++j) {
-      if (j != k && sized[k] && sized[j] && found[j].explains == f.explains &&
-          mse[j] < mse[k]) {
+      if (j != k && sized[k] && sized[j] && found[j].explains == f.explains && mse[j] < mse[k]) {
         better = j;
       }
     }
     if (better != k) {
       progress("sensor checks: " + f.finding.channel + " " + f.finding.kind + " dropped, " +
-               found[better].finding.channel + " " + found[better].finding.kind +
-               " explains the " + f.explains + " residual better from its onset (RMS " +
+               found[better].finding.channel + " " + found[better].finding.kind + " explains the " +
+               f.explains + " residual better from its onset (RMS " +
                FixedDecimals(std::sqrt(mse[better]), 1) + " against " +
                FixedDecimals(std::sqrt(mse[k]), 1) + ")");
     } else {

@@ -23,10 +23,10 @@
 #include "daemon/service/store_cli.h"
 #include "daemon/service/window_data.h"
 #include "io/files/params_json.h"
-#include "io/report/diagnosis_report.h"
 #include "io/platform/quantity_text.h"
-#include "io/store/store.h"
 #include "io/platform/time_format.h"
+#include "io/report/diagnosis_report.h"
+#include "io/store/store.h"
 
 namespace pvtwin::cli {
 
@@ -93,11 +93,10 @@ int DiagnoseSeries(const Series& series, const Plant& plant, const ModelSpec& sp
                 t.rejected.empty() ? "" : ("; not accepted: " + t.rejected).c_str());
   }
   for (const SensorFinding& f : result.sensors) {
-    std::printf(
-        "sensor: %s %s on %zu rows (%.1f %%)%s: %s\n", f.channel.c_str(), f.kind.c_str(), f.rows,
-        100 * f.share,
-        std::isfinite(f.size) ? (", size " + SensorSizeText(f)).c_str() : "",
-        f.detail.c_str());
+    std::printf("sensor: %s %s on %zu rows (%.1f %%)%s: %s\n", f.channel.c_str(), f.kind.c_str(),
+                f.rows, 100 * f.share,
+                std::isfinite(f.size) ? (", size " + SensorSizeText(f)).c_str() : "",
+                f.detail.c_str());
   }
   for (const Extrapolation& x : result.extrapolation) {
     std::printf(

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/common/units.h"
+#include "core/data/qc.h"
 
 namespace pvtwin {
 
@@ -53,6 +54,11 @@ PhysicalLimit PhysicalLimitOf(Channel c, double area_m2) {
       break;
   }
   return {std::nan(""), std::nan("")};
+}
+
+bool PassesEdge(Channel c, double value, double area_m2) {
+  return PhysicalLimitOf(c, area_m2).Contains(value) ||
+         (IsShortWave(c) && IsIrradianceGlitch(value));
 }
 
 PhysicalLimit ProviderLimitOf(ProviderQuantity q) {

@@ -69,6 +69,13 @@ inline constexpr double kMaxAreaM2 = 1e6;
 // The limits of channel c for a field of area_m2 (≤ 0: unknown, kMaxAreaM2).
 PhysicalLimit PhysicalLimitOf(Channel c, double area_m2);
 
+// Whether a reading of channel c passes an edge (the Modbus poller, `pvtwin
+// poll --once`, the CSV reader): inside its limits, or a short-wave
+// irradiance that is the paper's night glitch (core/data/qc.h), which passes
+// as read so that ApplyPaperCorrections sets it to 0 after the edge on every
+// path alike (the CSV import, the 1-min aggregation of polled samples).
+bool PassesEdge(Channel c, double value, double area_m2);
+
 // A forecast provider's values before they are channels (read by
 // io/weather/weather_file.cc): hourly or 15-min values of the provider's own
 // variables, in pvtwin's units.

@@ -8,8 +8,7 @@ namespace pvtwin {
 QcCorrections ApplyPaperCorrections(Series* series) {
   assert(series != nullptr);
   QcCorrections counts;
-  for (const Channel c :
-       {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2}) {
+  for (const Channel c : kShortWaveChannels) {
     for (double& g_w_m2 : (*series)[c]) {
       if (IsIrradianceGlitch(g_w_m2)) {
         g_w_m2 = 0.0;

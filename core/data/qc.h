@@ -4,6 +4,8 @@
 // data is corrected the same way.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
 
 #include "core/common/series.h"
@@ -32,6 +34,14 @@ inline constexpr double kNegativeFlowToleranceKgS = 1e-3;
 // Whether a short-wave irradiance reading is the paper's night glitch.
 inline bool IsIrradianceGlitch(double g_w_m2) {
   return g_w_m2 > kIrradianceGlitchWM2 && g_w_m2 < kIrradianceGlitchMaxWM2;
+}
+
+// The short-wave irradiance channels the glitch correction applies to.
+inline constexpr std::array<Channel, 4> kShortWaveChannels = {
+    Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2};
+inline bool IsShortWave(Channel c) {
+  return std::find(kShortWaveChannels.begin(), kShortWaveChannels.end(), c) !=
+         kShortWaveChannels.end();
 }
 
 // How many cells ApplyPaperCorrections changed.

@@ -60,6 +60,7 @@ std::string PointLine(const ModbusConfig& map, const DeviceReading& device, cons
   } else {
     line += Number(r.wire_value) + " " + WireUnitName(p);
     if (p.wire_unit != WireUnit::kChannel) line += " = " + Number(r.value) + " kg/s";
+    if (!r.note.empty()) line += " (" + r.note + ")";
   }
   return line + "; raw " + Registers(r.words);
 }

@@ -250,8 +250,8 @@ void RegisterSim(CLI::App& app) {
       "Control lines on stdin: 'advance S' (with --stepped), 'fault SPEC', 'time', 'quit'.\n"
       "Faults: DEVICE:KIND:from=S:for=S[:ms=N], KIND drop | exception | delay | nan | range |\n"
       "freeze | stray (replies with a wrong transaction or unit id) | wrong_unit (replies\n"
-      "as unit id + 6), S simulated seconds after --start (delay: ms of wall time,\n"
-      "default 2000).\n"
+      "as unit id + 6) | glitch (6000 W/m² on the short-wave irradiance points), S\n"
+      "simulated seconds after --start (delay: ms of wall time, default 2000).\n"
       "With --export FILE it writes the same plant's history as canonical CSV and exits.");
   cmd->add_option("--config", args->config, "TOML config with [plant] and the register map")
       ->required();

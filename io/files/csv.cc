@@ -537,13 +537,11 @@ class CsvParser {
                 "; only small negative readings of a stopped pump are set to 0");
       return kMissing;
     }
-    if (!(column.channel == Channel::kGPoaWM2 || column.channel == Channel::kGhiWM2 ||
-          column.channel == Channel::kDhiWM2 || column.channel == Channel::kGPoaDiffuseWM2) ||
-        !IsIrradianceGlitch(value)) {
-      if (!column.limit.Contains(value)) {
-        NoteOutOfLimits(line_no, column, cell);
-        return kMissing;
-      }
+    // The paper's night glitch passes (core/data/physical_limits.h PassesEdge).
+    const bool glitch = column.channel && IsShortWave(*column.channel) && IsIrradianceGlitch(value);
+    if (!column.limit.Contains(value) && !glitch) {
+      NoteOutOfLimits(line_no, column, cell);
+      return kMissing;
     }
     return value;
   }

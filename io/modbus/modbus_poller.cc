@@ -226,8 +226,7 @@ void ModbusPoller::PollDevice(Device* device, std::int64_t period, Result* resul
       const auto c_index = static_cast<std::size_t>(p.channel);
       result->read_mask |= 1u << c_index;
       result->value[c_index] = PointToChannelUnit(p, v.value);
-      if (v.rejected ||
-          !PhysicalLimitOf(p.channel, options_.area_m2).Contains(result->value[c_index])) {
+      if (v.rejected || !PassesEdge(p.channel, result->value[c_index], options_.area_m2)) {
         result->rejected_mask |= 1u << c_index;
       }
     }

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/data/physical_limits.h"
+#include "core/data/qc.h"
 #include "io/modbus/modbus_link.h"
 #include "io/modbus/register_codec.h"
 
@@ -33,7 +34,7 @@ std::string Rejection(const ModbusPoint& p, std::span<const std::uint16_t> words
   }
   const PhysicalLimit limit = PhysicalLimitOf(p.channel, area_m2);
   const double channel_value = PointToChannelUnit(p, value);
-  if (!limit.Contains(channel_value)) {
+  if (!PassesEdge(p.channel, channel_value, area_m2)) {
     return Number(channel_value) + " outside the physical limits of " +
            std::string(ChannelName(p.channel)) + " [" + Number(limit.lo) + ", " + Number(limit.hi) +
            "]";
@@ -78,6 +79,11 @@ DeviceReading ReadDevice(const ModbusConfig& map, std::size_t d,
       r.wire_value = DecodeRaw(p.type, p.word_order, words) * p.scale + p.offset;
       r.rejection = Rejection(p, words, area_m2);
       r.value = r.rejection.empty() ? PointToChannelUnit(p, r.wire_value) : std::nan("");
+      if (r.rejection.empty() && IsShortWave(p.channel) && IsIrradianceGlitch(r.value)) {
+        r.note =
+            "the paper's night glitch (above 5000 W/m²): stored as read, 0 W/m² in the "
+            "1-min row";
+      }
       out.points.push_back(std::move(r));
     }
   }

@@ -23,6 +23,7 @@ struct PointReading {
   double value = 0.0;                // in the channel's unit (core's: aoi in rad); NaN rejected
   double wire_value = 0.0;           // raw · scale + offset, before any unit conversion
   std::string rejection;             // why the poller would reject it; "" when it would not
+  std::string note;                  // what becomes of a kept value ("" when nothing)
 };
 
 struct DeviceReading {

@@ -16,13 +16,14 @@
 #include <cstring>
 #include <limits>
 
+#include "core/data/qc.h"
 #include "io/modbus/register_codec.h"
 
 namespace pvtwin {
 
 namespace {
 
-constexpr std::array<std::pair<std::string_view, FaultKind>, 8> kFaultNames = {{
+constexpr std::array<std::pair<std::string_view, FaultKind>, 9> kFaultNames = {{
     {"drop", FaultKind::kDrop},
     {"exception", FaultKind::kException},
     {"delay", FaultKind::kDelay},
@@ -31,6 +32,7 @@ constexpr std::array<std::pair<std::string_view, FaultKind>, 8> kFaultNames = {{
     {"freeze", FaultKind::kFreeze},
     {"stray", FaultKind::kStray},
     {"wrong_unit", FaultKind::kWrongUnit},
+    {"glitch", FaultKind::kGlitch},
 }};
 
 bool ParseNumber(std::string_view text, double* out) {
@@ -72,7 +74,7 @@ double OutOfRangeValue(const ModbusPoint& p) {
 bool ParseFault(std::string_view text, Fault* fault, std::string* error) {
   const std::string rule =
       "expected DEVICE:KIND:from=S:for=S[:ms=N] with KIND one of drop, "
-      "exception, delay, nan, range, freeze, stray, wrong_unit";
+      "exception, delay, nan, range, freeze, stray, wrong_unit, glitch";
   const std::vector<std::string_view> parts = Split(text, ':');
   if (parts.size() < 4 || parts[0].empty()) {
     *error = "fault '" + std::string(text) + "': " + rule;
@@ -318,6 +320,8 @@ void ModbusSimServer::Serve(Device* device) {
         EncodeRaw(p.type, p.word_order, NanRaw(p), words);
       } else if (has(faults, FaultKind::kRange)) {
         EncodePoint(p, OutOfRangeValue(p), words);
+      } else if (has(faults, FaultKind::kGlitch) && IsShortWave(p.channel)) {
+        EncodePoint(p, ChannelToPointUnit(p, kGlitchWM2), words);
       } else {
         EncodePoint(p, ChannelToPointUnit(p, sample.Get(p.channel)), words);
       }

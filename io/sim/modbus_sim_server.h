@@ -20,6 +20,8 @@
 //              wrong transaction id; RTU: a wrong unit id)
 //   wrong_unit answer as another unit (unit id + 6): a gateway that mixes up
 //              its slaves (TCP: the MBAP unit id; RTU: the slave address)
+//   glitch     serve kGlitchWM2 on the short-wave irradiance points (the
+//              paper's night glitch, Table 2), the other points as they are
 // Text form (command line, control protocol):
 //   DEVICE:KIND:from=S:for=S[:ms=N]   S simulated seconds after the start
 #pragma once
@@ -39,7 +41,20 @@
 
 namespace pvtwin {
 
-enum class FaultKind { kDrop, kException, kDelay, kNan, kRange, kFreeze, kStray, kWrongUnit };
+enum class FaultKind {
+  kDrop,
+  kException,
+  kDelay,
+  kNan,
+  kRange,
+  kFreeze,
+  kStray,
+  kWrongUnit,
+  kGlitch
+};
+
+// The short-wave irradiance a "glitch" fault serves, W/m².
+inline constexpr double kGlitchWM2 = 6000.0;
 
 struct Fault {
   std::string device;

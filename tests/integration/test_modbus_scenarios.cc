@@ -10,7 +10,9 @@
 //   * inside a fault window, drop / exception / delay / stray / wrong_unit
 //     leave the device's channels missing (NaN, QC bit clear), nan / range /
 //     freeze (after frozen_after_polls identical polls) leave them rejected
-//     (QC bit set);
+//     (QC bit set), glitch leaves them present with the short-wave
+//     irradiance at the served glitch (the paper's night glitch passes the
+//     edge), and the 1-min aggregation of the samples sets it to 0;
 //   * from two periods after the window's end the device is back;
 //   * the period in which a window begins or ends may go either way (the
 //     request is sent a little after the period start);
@@ -46,11 +48,13 @@
 
 #include "config/plant_config.h"
 #include "core/common/clock.h"
+#include "core/data/aggregate.h"
+#include "core/data/qc.h"
 #include "io/modbus/modbus_poller.h"
-#include "io/sim/modbus_sim_server.h"
-#include "io/sim/plant_source.h"
 #include "io/modbus/register_codec.h"
 #include "io/platform/time_format.h"
+#include "io/sim/modbus_sim_server.h"
+#include "io/sim/plant_source.h"
 #include "tests/support/child_process.h"
 #include "tests/support/files.h"
 #include "tests/support/ports.h"
@@ -395,7 +399,9 @@ TEST_P(ModbusScenarioTest, Run) {
         if (f.device != name) continue;
         double begin_s = f.from_s;
         const double end_s = f.from_s + f.for_s;
-        if (f.kind == FaultKind::kNan || f.kind == FaultKind::kRange) {
+        if (f.kind == FaultKind::kGlitch) {
+          expected_inside = DeviceStatus::kPresent;
+        } else if (f.kind == FaultKind::kNan || f.kind == FaultKind::kRange) {
           expected_inside = DeviceStatus::kRejected;
         } else if (f.kind == FaultKind::kFreeze) {
           expected_inside = DeviceStatus::kRejected;
@@ -409,6 +415,14 @@ TEST_P(ModbusScenarioTest, Run) {
       if (inside) {
         ++checked_in_fault;
         EXPECT_EQ(status, expected_inside) << where;
+        for (const ModbusPoint& p : config.modbus.points) {
+          if (expected_inside != DeviceStatus::kPresent || p.device != d ||
+              !IsShortWave(p.channel)) {
+            continue;
+          }
+          EXPECT_EQ(s.Get(p.channel), ThroughRegisters(p, kGlitchWM2))
+              << where << ", " << ChannelName(p.channel);
+        }
       } else {
         EXPECT_EQ(status, DeviceStatus::kPresent) << where;
       }
@@ -416,6 +430,27 @@ TEST_P(ModbusScenarioTest, Run) {
   }
   if (!faults.empty()) {
     EXPECT_GT(checked_in_fault, 0) << "no period fell inside a fault window";
+  }
+  // The glitch becomes 0 W/m² in the 1-min rows, as in a CSV import: no
+  // minute loses its irradiance and none is flagged for rejected readings.
+  if (std::any_of(faults.begin(), faults.end(),
+                  [](const Fault& f) { return f.kind == FaultKind::kGlitch; })) {
+    MinuteRows minutes;
+    std::string error;
+    AggregateOptions aggregate;
+    aggregate.area_m2 = config.plant.area_m2;
+    ASSERT_TRUE(AggregateSamples(samples, aggregate, &minutes, &error)) << error;
+    int corrected = 0;
+    for (std::size_t m = 0; m < minutes.rows.size(); ++m) {
+      EXPECT_EQ(minutes.qc_flags[m] & kQcRejectedValues, 0u) << "minute " << m;
+      corrected += (minutes.qc_flags[m] & kQcIrradianceCorrected) != 0;
+      for (const Channel c : kShortWaveChannels) {
+        if (!minutes.rows.Has(c)) continue;
+        EXPECT_TRUE(std::isfinite(minutes.rows[c][m])) << ChannelName(c) << " minute " << m;
+        EXPECT_LT(minutes.rows[c][m], kIrradianceGlitchWM2) << ChannelName(c) << " minute " << m;
+      }
+    }
+    EXPECT_GT(corrected, 0) << "no minute held a corrected glitch";
   }
 
   // Values equal to the served ones, never older than the period.

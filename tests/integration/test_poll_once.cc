@@ -162,6 +162,24 @@ TEST_F(PollOnce, RejectedValuesCarryTheirReason) {
       << r.out;
 }
 
+// The paper's night glitch (6000 W/m²) is no rejection: the daemon keeps it
+// and its 1-min row carries 0 W/m² (paper Table 2), as a CSV import does.
+// The register map without valid ranges: only the physical limits judge.
+TEST_F(PollOnce, TheNightGlitchIsKeptAndSaysItBecomesZero) {
+  const fs::path map = fs::path(PVTWIN_SCENARIO_DIR) / "13-physical-limits/config.toml";
+  const std::map<std::string, int> ports = StartSim(map, {"weather:glitch:from=0:for=86400"});
+  ASSERT_EQ(ports.size(), 2u) << ReadFile(dir_ / "sim.err");
+  const fs::path config = WriteConfig(ReadFile(map), ports.at("collector"), ports.at("weather"));
+  const testing::ProcessResult r =
+      testing::RunPvtwin(dir_, "poll --once --config '" + config.string() + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("weather ghi_w_m2 (input 0 f32): 6000 W/m² (the paper's night glitch "
+                       "(above 5000 W/m²): stored as read, 0 W/m² in the 1-min row); raw "),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("rejected"), std::string::npos) << r.out;
+}
+
 TEST_F(PollOnce, AFailingDeviceIsNamedWithItsReadAndTheExitCodeIsOne) {
   const std::map<std::string, int> ports =
       StartSim(kSimPlant, {"weather:exception:from=0:for=86400"});

@@ -39,6 +39,8 @@ TEST(SimFault, ParsesTheTextForm) {
   EXPECT_EQ(f.kind, FaultKind::kFreeze);
   ASSERT_TRUE(ParseFault("weather:wrong_unit:from=0:for=5", &f, &error)) << error;
   EXPECT_EQ(f.kind, FaultKind::kWrongUnit);
+  ASSERT_TRUE(ParseFault("weather:glitch:from=0:for=5", &f, &error)) << error;
+  EXPECT_EQ(f.kind, FaultKind::kGlitch);
 }
 
 TEST(SimFault, RejectsBadText) {

@@ -12,6 +12,7 @@
 #include "core/common/units.h"
 #include "core/data/aggregate.h"
 #include "core/data/physical_limits.h"
+#include "core/data/qc.h"
 #include "io/files/csv.h"
 #include "io/store/store.h"
 #include "tests/support/files.h"
@@ -55,6 +56,22 @@ TEST(PhysicalLimits, TheTableHoldsThePublishedLimitsAndScalesWithTheArea) {
 // A provider's weather is read against the same table: its air temperature
 // against the channel's, the other variables against limits of their own
 // (the recorded gust, percentages, BSRN's GHI bound).
+// Paper Table 2's night glitch (above 5000 W/m²) passes every edge on the
+// short-wave channels, so that ApplyPaperCorrections makes it 0 on every
+// path; any other out-of-limit reading does not.
+TEST(PhysicalLimits, OnlyTheShortWaveNightGlitchPassesTheEdgeBeyondTheLimits) {
+  for (const Channel c : kShortWaveChannels) {
+    EXPECT_TRUE(PassesEdge(c, 6000.0, 2.0)) << ChannelName(c);
+    EXPECT_TRUE(PassesEdge(c, 800.0, 2.0)) << ChannelName(c);
+    EXPECT_FALSE(PassesEdge(c, 3000.0, 2.0)) << ChannelName(c) << ": above BSRN, no glitch";
+    EXPECT_FALSE(PassesEdge(c, 1e5, 2.0)) << ChannelName(c) << ": a broken register";
+    EXPECT_FALSE(PassesEdge(c, -31.0, 2.0)) << ChannelName(c);
+  }
+  EXPECT_FALSE(PassesEdge(Channel::kLwDownWM2, 6000.0, 2.0));
+  EXPECT_FALSE(PassesEdge(Channel::kTAmbC, 6000.0, 2.0));
+  EXPECT_FALSE(PassesEdge(Channel::kPElW, 6000.0, 2.0)) << "600 W/m² × 2 m² at most";
+}
+
 TEST(PhysicalLimits, ProviderWeatherLimitsLiveInTheTable) {
   const PhysicalLimit air = ProviderLimitOf(ProviderQuantity::kAirTemperatureC);
   EXPECT_EQ(air.lo, PhysicalLimitOf(Channel::kTAmbC, 0.0).lo);

@@ -396,6 +396,22 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesTheReports) {
   EXPECT_NE(html.find("<svg"), std::string::npos);
 }
 
+// `diagnose-selftest --report DIR` writes each case's reports and the
+// diagnosis's progress lines, the log to read why a case went as it did.
+TEST_F(DiagnoseCli, SelftestReportsCarryEachCasesLog) {
+  const testing::ProcessResult run = testing::RunPvtwin(
+      dir_,
+      "diagnose-selftest --battery same --cases null --seeds 1 --first-seed 3 --days 15 "
+      "--heldout-days 5 --step 300 --jobs 1 --report out");
+  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  const fs::path dir = dir_ / "out" / "null-seed3";
+  EXPECT_TRUE(fs::exists(dir / "report.json"));
+  const std::string log = testing::ReadFile(dir / "diagnosis.log");
+  EXPECT_NE(log.find("fitting the base model 1N1Cwr"), std::string::npos) << log;
+  EXPECT_NE(log.find("sensor step test: "), std::string::npos) << log;
+  EXPECT_EQ(log.back(), '\n');
+}
+
 TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
   const Plant plant = DesignExamplePlant();
   SyntheticOptions synth;

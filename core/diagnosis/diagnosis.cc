@@ -91,13 +91,13 @@ bool DiagnoseOnce(const Series& data_in, const Plant& plant, const ModelSpec& ba
 // then also be the first one chosen on the held-out days before that onset
 // (the same training days); otherwise its evidence lies on the faulty days
 // and it is not named. Returns the sentence for the report's notes when the
-// effect does not hold; "" when it does or nothing is to be checked.
+// effect does not hold; "" when it does or nothing is to be checked. The
+// second diagnosis's fits are added to r->identifications.
 std::string EffectWithoutFaultyDays(const Series& data, const Plant& plant, const ModelSpec& base,
                                     const DiagnosisOptions& options,
                                     const diagnosis_stages::Split& split,
-                                    const std::vector<SensorFinding>& steps,
-                                    const DiagnosisResult& r) {
-  if (r.ladder.size() < 2) return "";
+                                    const std::vector<SensorFinding>& steps, DiagnosisResult* r) {
+  if (r->ladder.size() < 2) return "";
   const std::int64_t heldout_start_s = split.day_starts[static_cast<std::size_t>(split.train_days)];
   const SensorFinding* first = nullptr;
   for (const SensorFinding& f : steps) {
@@ -109,7 +109,7 @@ std::string EffectWithoutFaultyDays(const Series& data, const Plant& plant, cons
   for (std::int64_t d : split.day_starts) {
     clean_days += d >= heldout_start_s && d < first->from_s ? 1 : 0;
   }
-  const std::string effect = r.ladder[1].added;
+  const std::string effect = r->ladder[1].added;
   std::string outcome = "no held-out day lies before it";
   if (clean_days > 0) {
     DiagnosisOptions before = options;
@@ -117,8 +117,10 @@ std::string EffectWithoutFaultyDays(const Series& data, const Plant& plant, cons
     before.heldout_days = clean_days;
     DiagnosisResult clean;
     std::string why;
-    if (!DiagnoseOnce(data.Slice(0, data.RowAtOrAfter(first->from_s)), plant, base, before, false,
-                      &clean, &why, nullptr)) {
+    const bool ok = DiagnoseOnce(data.Slice(0, data.RowAtOrAfter(first->from_s)), plant, base,
+                                 before, false, &clean, &why, nullptr);
+    r->identifications += clean.identifications;
+    if (!ok) {
       outcome = "the days before it cannot be diagnosed (" + why + ")";
     } else if (clean.ladder.size() > 1 && clean.ladder[1].added == effect) {
       return "";
@@ -211,12 +213,12 @@ bool DiagnoseOnce(const Series& data_in, const Plant& plant, const ModelSpec& ba
   // base model that lacks a large effect leaves day-to-day structure that a
   // step can fit (final-check seed 31, other-form wind in October: a false
   // t_out_c step with the base 1N1Cr fitted on all days).
-  std::vector<SensorFinding> steps = st::FindResidualSensorFaults(
-      data, split, plant, final_model.spec, final_model.params, options, progress);
-  ++r.identifications;
+  std::vector<SensorFinding> steps =
+      st::FindResidualSensorFaults(data, split, plant, final_model.spec, final_model.params,
+                                   options, progress, &r.identifications);
   const std::string faulty =
       recheck_after_sensor_onset
-          ? EffectWithoutFaultyDays(data, plant, base, options, split, steps, r)
+          ? EffectWithoutFaultyDays(data, plant, base, options, split, steps, &r)
           : std::string();
   if (!faulty.empty()) {
     progress("sensor re-check: " + faulty);

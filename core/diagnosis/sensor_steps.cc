@@ -269,7 +269,9 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
                                                     const Plant& plant, const ModelSpec& base,
                                                     const ParamVector& start,
                                                     const DiagnosisOptions& options,
-                                                    const Progress& progress) {
+                                                    const Progress& progress,
+                                                    int* identifications) {
+  ++*identifications;
   const std::optional<SensorResiduals> r = FitAllDays(data, split, plant, base, start, options);
   if (!r) return {};
   std::vector<ResidualFinding> found;
@@ -278,18 +280,16 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
   }
   // Each fault model fitted on the model of the days before the earliest
   // onset of the findings that explain the same residual: its size, and the
-  // mean square by which they compete.
-  std::vector<double> mse(found.size(), std::nan(""));
-  std::vector<bool> sized(found.size(), false);
+  // mean square by which they compete (NaN: no fault model).
+  std::map<std::string, std::vector<std::size_t>> groups;  // by the residual they explain
   for (std::size_t k = 0; k < found.size(); ++k) {
-    if (!found[k].fault_x || sized[k]) continue;
-    std::vector<std::size_t> group;
-    std::int64_t first_onset = found[k].finding.from_s;
-    for (std::size_t j = k; j < found.size(); ++j) {
-      if (!found[j].fault_x || found[j].explains != found[k].explains) continue;
-      group.push_back(j);
-      first_onset = std::min(first_onset, found[j].finding.from_s);
-    }
+    if (found[k].fault_x) groups[found[k].explains].push_back(k);
+  }
+  std::vector<double> mse(found.size(), std::nan(""));
+  for (const auto& [explains, group] : groups) {
+    std::int64_t first_onset = found[group.front()].finding.from_s;
+    for (std::size_t j : group) first_onset = std::min(first_onset, found[j].finding.from_s);
+    ++*identifications;
     const std::optional<SensorResiduals> before =
         FitAllDays(data, split, plant, base, start, options, first_onset);
     const SensorResiduals& model = before ? *before : *r;
@@ -297,7 +297,6 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
                                   : "the model fitted on all the days";
     for (std::size_t j : group) {
       ResidualFinding& f = found[j];
-      sized[j] = true;
       const FaultFit fit = FitFault(
           model, f.finding.from_s, [&](std::uint32_t i) { return f.fault_x(model, i); },
           [&](std::uint32_t i) { return f.fault_y(model, i); });
@@ -315,7 +314,8 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
     const ResidualFinding& f = found[k];
     std::size_t better = k;
     for (std::size_t j = 0; j < found.size(); ++j) {
-      if (j != k && sized[k] && sized[j] && found[j].explains == f.explains && mse[j] < mse[k]) {
+      // (A comparison with NaN, a finding without a fault model, is false.)
+      if (j != k && found[j].explains == f.explains && mse[j] < mse[k]) {
         better = j;
       }
     }

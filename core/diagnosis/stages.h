@@ -160,13 +160,15 @@ std::vector<SensorFinding> CheckSensors(const Series& data, const Plant& plant);
 
 // The residual sensor checks (sensor_residuals.h: an inlet / outlet offset
 // step, the pair at night, a flow meter scale) in the residuals of `base`
-// (the ladder's final model) fitted on all the data from `start`; one
-// finding per fault found, none when the model cannot be fitted.
+// (the ladder's final model) fitted on all the data from `start`, a Q_u
+// fault sized on `base` fitted on the days before its onset; one finding per
+// fault found, none when the model cannot be fitted. *identifications
+// counts the fits.
 std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Split& split,
                                                     const Plant& plant, const ModelSpec& base,
                                                     const ParamVector& start,
                                                     const DiagnosisOptions& options,
-                                                    const Progress& progress);
+                                                    const Progress& progress, int* identifications);
 
 // --- 4. Candidate trials ---
 // Controls of the evidence regression, per held-out row: in-plane

@@ -537,9 +537,11 @@ class CsvParser {
                 "; only small negative readings of a stopped pump are set to 0");
       return kMissing;
     }
-    // The paper's night glitch passes (core/data/physical_limits.h PassesEdge).
-    const bool glitch = column.channel && IsShortWave(*column.channel) && IsIrradianceGlitch(value);
-    if (!column.limit.Contains(value) && !glitch) {
+    // A channel's cell passes the edge rule of every reader (the paper's
+    // night glitch included); an air column's, its own limits.
+    const bool passes = column.channel ? PassesEdge(*column.channel, value, options_.area_m2)
+                                       : column.limit.Contains(value);
+    if (!passes) {
       NoteOutOfLimits(line_no, column, cell);
       return kMissing;
     }

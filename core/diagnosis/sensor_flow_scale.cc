@@ -16,45 +16,17 @@
 // from a day on): the fault model that fits the rows from its onset better,
 // on a model fitted before it, stays (FindResidualSensorFaults).
 #include <cmath>
-#include <map>
 
 #include "core/common/calendar.h"
 #include "core/diagnosis/sensor_residuals.h"
 
 namespace pvtwin::diagnosis_stages {
 
-namespace {
-
-// log(Σ Q_meas·Q_model / Σ Q_model²) per solar day with min_rows rows with flow.
-DaySeries DailyLogRatios(const SensorResiduals& r, int min_rows) {
-  struct Sums {
-    double mm = 0.0, pp = 0.0;
-    int n = 0;
-  };
-  std::map<std::int64_t, Sums> by_day;
-  for (std::uint32_t i : r.rows) {
-    if (!(r.capacity_flow_w_k[i] > 0.0)) continue;
-    const double m = r.q_meas_w[i], p = r.q_model_w[i];
-    if (!std::isfinite(m) || !std::isfinite(p)) continue;
-    Sums& s = by_day[r.day_s[i]];
-    s.mm += m * p;
-    s.pp += p * p;
-    ++s.n;
-  }
-  DaySeries out;
-  for (const auto& [day, s] : by_day) {
-    if (s.n < min_rows || !(s.pp > 0.0) || !(s.mm > 0.0)) continue;
-    out.days.push_back(day);
-    out.y.push_back(std::log(s.mm / s.pp));
-  }
-  return out;
-}
-
-}  // namespace
-
 std::optional<ResidualFinding> CheckFlowScale(const SensorResiduals& r, const Progress& progress) {
   const DiagnosisOptions& o = *r.options;
-  const DaySeries s = DailyLogRatios(r, o.sensor_step_min_rows);
+  const DaySeries s = DailyLogRatios(
+      r, r.q_meas_w, r.q_model_w, [&r](std::uint32_t i) { return r.capacity_flow_w_k[i] > 0.0; },
+      o.sensor_step_min_rows);
   const std::optional<DayStep> d = TestDayStep(s, o.alpha);
   if (!d) return std::nullopt;
   const double k = std::exp(d->after - d->before);

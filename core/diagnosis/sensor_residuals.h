@@ -18,6 +18,17 @@
 // one day on? Day values are the units because residuals of a thermal model
 // carry the weather's hours-long memory: the minutes of one day are not
 // independent.
+//
+// A fault of the heat meter's channels (a finding that explains "q_th_w")
+// leaves P_el alone: the inverter's reading does not change, and the model,
+// driven by the faulty reading, predicts a cell temperature off by a
+// fraction of a kelvin. A loss of light does not: soiling, snow or shading
+// lowers both outputs from the same day. So a Q_u finding is dropped when
+// P_el's measured-to-modelled ratio (DailyLogRatios) separates on the same
+// day in the same direction with a one-sided probability n1!·n2!/(n1+n2)! of
+// at most alpha (the chance of that separation when P_el does not step,
+// whatever its days' distribution): the step is in the light both outputs
+// share, not in the meter.
 #pragma once
 
 #include <cmath>
@@ -48,6 +59,7 @@ struct SensorResiduals {
   std::vector<double> inlet_offset_w_k;
   std::vector<double> g_poa_w_m2;
   std::vector<double> q_meas_w, q_model_w;                  // heat meter, model
+  std::vector<double> p_meas_w, p_model_w;                  // inverter, model
   std::vector<double> t_in_c, t_out_meas_c, t_out_model_c;  // logged, logged, model
 };
 
@@ -76,6 +88,13 @@ std::optional<DayStep> TestDayStep(const DaySeries& s, double alpha);
 // days with at least min_rows values.
 DaySeries DailyMedians(const SensorResiduals& r, const std::function<bool(std::uint32_t)>& keep,
                        const std::function<double(std::uint32_t)>& x, int min_rows);
+
+// log(Σ meas·model / Σ model²) per solar day over the rows where keep(i),
+// days with at least min_rows such rows and a positive ratio: the day's
+// least-squares ratio of the measured to the modelled output.
+DaySeries DailyLogRatios(const SensorResiduals& r, const std::vector<double>& meas,
+                         const std::vector<double>& model,
+                         const std::function<bool(std::uint32_t)>& keep, int min_rows);
 
 // A fault model y(i) = g·x(i) over a residual set (FitFault).
 using RowValue = std::function<double(const SensorResiduals&, std::uint32_t)>;

@@ -131,11 +131,64 @@ std::optional<SensorResiduals> FitAllDays(
   r.g_poa_w_m2 = all.drivers.g_poa_w_m2;
   r.q_meas_w = all.meas.q_th_w;
   r.q_model_w = std::move(sim.q_th_w);
+  r.p_meas_w = all.meas.p_el_w;
+  r.p_model_w = std::move(sim.p_el_w);
   r.t_in_c = all.drivers.t_in_c;
   r.t_out_meas_c =
       data.Has(Channel::kTOutC) ? data[Channel::kTOutC] : std::vector<double>(n, std::nan(""));
   r.t_out_model_c = std::move(sim.t_out_c);
   return r;
+}
+
+// Mean of the day values from from_s on minus the mean of those before
+// (NaN without a day on either side), and the one-sided probability that
+// the two sides separate in that direction when the series has no step.
+struct StepAt {
+  double step = std::nan("");
+  bool separated = false;
+  double p = 1.0;
+};
+StepAt StepAtDay(const DaySeries& s, std::int64_t from_s) {
+  std::vector<double> before, after;
+  for (std::size_t k = 0; k < s.days.size(); ++k) {
+    (s.days[k] < from_s ? before : after).push_back(s.y[k]);
+  }
+  StepAt out;
+  if (before.empty() || after.empty()) return out;
+  out.step = Mean(after, 0, after.size()) - Mean(before, 0, before.size());
+  const auto [lo1, hi1] = std::minmax_element(before.begin(), before.end());
+  const auto [lo2, hi2] = std::minmax_element(after.begin(), after.end());
+  out.separated = out.step > 0.0 ? *lo2 > *hi1 : *hi2 < *lo1;
+  out.p = SeparationP(before.size(), after.size()) / 2.0;
+  return out;
+}
+
+// True when P_el steps with a Q_u finding from its onset (sensor_residuals.h):
+// the loss is in the light both outputs share, not in the heat meter. *why
+// says what P_el did either way.
+bool LightStepsWithIt(const SensorResiduals& r, std::int64_t from_s, std::string* why) {
+  const int min_rows = r.options->sensor_step_min_rows;
+  const StepAt q = StepAtDay(
+      DailyLogRatios(
+          r, r.q_meas_w, r.q_model_w,
+          [&r](std::uint32_t i) { return r.capacity_flow_w_k[i] > 0.0; }, min_rows),
+      from_s);
+  const StepAt p = StepAtDay(
+      DailyLogRatios(
+          r, r.p_meas_w, r.p_model_w, [&r](std::uint32_t i) { return r.p_model_w[i] > 0.0; },
+          min_rows),
+      from_s);
+  if (!std::isfinite(q.step) || !std::isfinite(p.step)) {
+    *why = "no P_el days on both sides of the onset to compare";
+    return false;
+  }
+  const bool with_it = p.separated && (p.step > 0.0) == (q.step > 0.0) && p.p <= r.options->alpha;
+  *why = "measured / modelled P_el " + std::string(p.step > 0.0 ? "rises" : "falls") + " by " +
+         FixedDecimals(100.0 * std::fabs(std::expm1(p.step)), 1) + " % from that day (Q_u by " +
+         FixedDecimals(100.0 * std::fabs(std::expm1(q.step)), 1) + " %, " +
+         (q.step > 0.0 ? "up" : "down") + "), " +
+         (p.separated ? "days separated, one-sided p = " + PValue(p.p) : "days not separated");
+  return with_it;
 }
 
 }  // namespace
@@ -184,6 +237,32 @@ DaySeries DailyMedians(const SensorResiduals& r, const std::function<bool(std::u
     s.y.push_back(Median(std::move(v)));
   }
   return s;
+}
+
+DaySeries DailyLogRatios(const SensorResiduals& r, const std::vector<double>& meas,
+                         const std::vector<double>& model,
+                         const std::function<bool(std::uint32_t)>& keep, int min_rows) {
+  struct Sums {
+    double mm = 0.0, pp = 0.0;
+    int n = 0;
+  };
+  std::map<std::int64_t, Sums> by_day;
+  for (std::uint32_t i : r.rows) {
+    if (!keep(i)) continue;
+    const double m = meas[i], p = model[i];
+    if (!std::isfinite(m) || !std::isfinite(p)) continue;
+    Sums& s = by_day[r.day_s[i]];
+    s.mm += m * p;
+    s.pp += p * p;
+    ++s.n;
+  }
+  DaySeries out;
+  for (const auto& [day, s] : by_day) {
+    if (s.n < min_rows || !(s.pp > 0.0) || !(s.mm > 0.0)) continue;
+    out.days.push_back(day);
+    out.y.push_back(std::log(s.mm / s.pp));
+  }
+  return out;
 }
 
 FaultFit FitFault(const SensorResiduals& r, std::int64_t from_s,
@@ -276,7 +355,18 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
   if (!r) return {};
   std::vector<ResidualFinding> found;
   for (const ResidualSensorCheck& check : ResidualSensorChecks()) {
-    if (std::optional<ResidualFinding> f = check(*r, progress)) found.push_back(std::move(*f));
+    std::optional<ResidualFinding> f = check(*r, progress);
+    if (!f) continue;
+    if (f->explains == "q_th_w") {
+      std::string why;
+      const bool light = LightStepsWithIt(*r, f->finding.from_s, &why);
+      progress("sensor checks: " + f->finding.channel + " " + f->finding.kind + " from " +
+               f->finding.from + ": " + why +
+               (light ? ": dropped, the light both outputs share changed, not the heat meter"
+                      : ""));
+      if (light) continue;
+    }
+    found.push_back(std::move(*f));
   }
   // Each fault model fitted on the model of the days before the earliest
   // onset of the findings that explain the same residual: its size, and the

@@ -3,7 +3,8 @@
 // them: the inlet temperature reading high by a constant from one day on
 // (the heat meter then reads ṁ·c_p·ΔT low: offset_step); the logged outlet
 // reading low from one day on, seen with the pump on at night (pair_offset);
-// the flow meter reading 10 % high from one day on (scale).
+// the flow meter reading 10 % high from one day on (scale); and no heat
+// meter fault where both outputs lose the same light from one day on.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -212,6 +213,21 @@ TEST(DiagnosisSensors, NoResidualSensorFaultOnAPlantPumpingAtNightWithoutOne) {
       Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 0.0, &onset_s, true), plant);
   for (const SensorFinding& f : r.sensors) {
     EXPECT_TRUE(f.kind != "offset_step" && f.kind != "pair_offset" && f.kind != "scale")
+        << f.channel << " " << f.kind << ": " << f.detail;
+  }
+}
+
+// A loss of light from one day on (a cover absorbing 90 % of the sun, as
+// dirt, partial snow or a new obstacle does) lowers Q_u in proportion from
+// that day, as a flow meter reading 10 % low would, but it lowers P_el with
+// it: no heat meter fault is named.
+TEST(DiagnosisSensors, ALightLossOnBothOutputsFromOneDayOnIsNoHeatMeterFault) {
+  const Plant plant = DesignExamplePlant();
+  std::int64_t onset_s = 0;
+  const DiagnosisResult r = DiagnoseSoilingOnly(
+      Plant21Days(plant, DisturbanceKind::kSnowCover, 0.9, &onset_s, true), plant);
+  for (const SensorFinding& f : r.sensors) {
+    EXPECT_TRUE(f.kind != "offset_step" && f.kind != "scale")
         << f.channel << " " << f.kind << ": " << f.detail;
   }
 }

@@ -178,11 +178,11 @@ void ChildProcess::Kill() {
 }
 
 std::string SelfExecutable() {
-  char buf[4096];
-  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof(buf) - 1);
-  if (n <= 0) return "pvtwin";
-  buf[n] = '\0';
-  return buf;
+  // The kernel resolves this link to the image the process runs, also when
+  // its file has been replaced or deleted since; the name readlink gives is
+  // then "… (deleted)", which nothing can start.
+  if (::access("/proc/self/exe", X_OK) == 0) return "/proc/self/exe";
+  return "pvtwin";
 }
 
 std::string LastOutputLine(const std::string& output_path) {

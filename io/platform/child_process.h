@@ -57,7 +57,11 @@ class ChildProcess {
   std::string pending_;  // stdout read but not yet returned as a line
 };
 
-// Path of the running executable (/proc/self/exe).
+// A path that starts the running executable: /proc/self/exe, so that the
+// daemon's children (the nightly calibration and diagnosis) run the daemon's
+// own version even after a package upgrade replaced or deleted its file
+// under it (the file's own path then starts nothing, or another version).
+// "pvtwin" (found on PATH) where /proc is not mounted.
 std::string SelfExecutable();
 
 // The last non-empty line of a child's output file (Start's output_path):

@@ -17,8 +17,16 @@
 # the forecast band's coverage per output and day, the performance index band
 # holding 1, and the performance alarms. The store, both logs and the configs
 # stay in OUTDIR. Defaults: SEED 1, START 2025-06-09 (a Monday).
+#
+# With FORECAST_SIGMA set (e.g. FORECAST_SIGMA=0.15) the daemon also has a
+# weather forecast, as a plant with `[forecast] weather_url` has: the hourly
+# means of the plant's own weather over the history and the week with an
+# hourly AR(1) error of that size (doc/scripts/weather_forecast_with_error.py,
+# its seed the plant's), imported into weather_forecast before the daemon
+# starts. Without it the daemon persists the weather, as a plant without one.
 set -eu
 pvtwin=$1 out=$2 scenario=$3 seed=${4:-1} start=${5:-2025-06-09}
+sigma=${FORECAST_SIGMA:-}
 case $scenario in
   healthy) truth="2N2CrI+wind+transport_delay" ;;
   clipping) truth="2N2CrI+wind+transport_delay+pv_clipping" ;;
@@ -63,6 +71,16 @@ echo "history: 28 days before $start (seed $seed, healthy)"
 "$pvtwin" sim --config sim.toml --export history.csv --days 28 --step 60 \
   --start $((t0 - 28 * 86400)) --seed "$seed" > export.log 2>&1
 "$pvtwin" import --config pvtwin.toml --csv history.csv --db pvtwin.db > import.log 2>&1
+if [ -n "$sigma" ]; then
+  echo "weather forecast: the plant's hourly weather with an AR(1) error of sigma $sigma"
+  "$pvtwin" sim --config sim.toml --export weather-truth.csv --days $((28 + days)) --step 60 \
+    --start $((t0 - 28 * 86400)) --seed "$seed" >> export.log 2>&1
+  python3 "$here/doc/scripts/weather_forecast_with_error.py" weather-truth.csv \
+    weather-forecast.csv "$sigma" "$seed"
+  "$pvtwin" import-weather --config pvtwin.toml --db pvtwin.db weather-forecast.csv \
+    > import-weather.log 2>&1
+  rm -f weather-truth.csv
+fi
 
 anchor=$(date +%s)
 "$pvtwin" sim --config sim.toml --speed $speed --start "$t0" \

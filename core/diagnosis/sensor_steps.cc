@@ -168,16 +168,12 @@ StepAt StepAtDay(const DaySeries& s, std::int64_t from_s) {
 // says what P_el did either way.
 bool LightStepsWithIt(const SensorResiduals& r, std::int64_t from_s, std::string* why) {
   const int min_rows = r.options->sensor_step_min_rows;
-  const StepAt q = StepAtDay(
-      DailyLogRatios(
-          r, r.q_meas_w, r.q_model_w,
-          [&r](std::uint32_t i) { return r.capacity_flow_w_k[i] > 0.0; }, min_rows),
-      from_s);
-  const StepAt p = StepAtDay(
-      DailyLogRatios(
-          r, r.p_meas_w, r.p_model_w, [&r](std::uint32_t i) { return r.p_model_w[i] > 0.0; },
-          min_rows),
-      from_s);
+  auto with_flow = [&r](std::uint32_t i) { return r.capacity_flow_w_k[i] > 0.0; };
+  auto with_power = [&r](std::uint32_t i) { return r.p_model_w[i] > 0.0; };
+  const StepAt q =
+      StepAtDay(DailyLogRatios(r, r.q_meas_w, r.q_model_w, with_flow, min_rows), from_s);
+  const StepAt p =
+      StepAtDay(DailyLogRatios(r, r.p_meas_w, r.p_model_w, with_power, min_rows), from_s);
   if (!std::isfinite(q.step) || !std::isfinite(p.step)) {
     *why = "no P_el days on both sides of the onset to compare";
     return false;
@@ -360,10 +356,10 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
     if (f->explains == "q_th_w") {
       std::string why;
       const bool light = LightStepsWithIt(*r, f->finding.from_s, &why);
-      progress("sensor checks: " + f->finding.channel + " " + f->finding.kind + " from " +
-               f->finding.from + ": " + why +
-               (light ? ": dropped, the light both outputs share changed, not the heat meter"
-                      : ""));
+      progress(
+          "sensor checks: " + f->finding.channel + " " + f->finding.kind + " from " +
+          f->finding.from + ": " + why +
+          (light ? ": dropped, the light both outputs share changed, not the heat meter" : ""));
       if (light) continue;
     }
     found.push_back(std::move(*f));

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/common/calendar.h"
 #include "core/data/qc.h"
@@ -61,6 +62,14 @@ const SensorFinding* FindKind(const DiagnosisResult& r, const std::string& kind)
     if (f.kind == kind) return &f;
   }
   return nullptr;
+}
+
+void ExpectNoFindingOfKinds(const DiagnosisResult& r, const std::vector<std::string>& kinds) {
+  for (const SensorFinding& f : r.sensors) {
+    for (const std::string& kind : kinds) {
+      EXPECT_NE(f.kind, kind) << f.channel << " " << f.kind << ": " << f.detail;
+    }
+  }
 }
 
 DiagnosisResult DiagnoseSoilingOnly(const Series& s, const Plant& plant) {
@@ -209,12 +218,10 @@ TEST(DiagnosisSensors, FlowMeterScaleFromOneDayOnIsNamedWithItsRatio) {
 TEST(DiagnosisSensors, NoResidualSensorFaultOnAPlantPumpingAtNightWithoutOne) {
   const Plant plant = DesignExamplePlant();
   std::int64_t onset_s = 0;
-  const DiagnosisResult r = DiagnoseSoilingOnly(
-      Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 0.0, &onset_s, true), plant);
-  for (const SensorFinding& f : r.sensors) {
-    EXPECT_TRUE(f.kind != "offset_step" && f.kind != "pair_offset" && f.kind != "scale")
-        << f.channel << " " << f.kind << ": " << f.detail;
-  }
+  ExpectNoFindingOfKinds(
+      DiagnoseSoilingOnly(Plant21Days(plant, DisturbanceKind::kFlowMeterScale, 0.0, &onset_s, true),
+                          plant),
+      {"offset_step", "pair_offset", "scale"});
 }
 
 // A loss of light from one day on (a cover absorbing 90 % of the sun, as
@@ -224,12 +231,10 @@ TEST(DiagnosisSensors, NoResidualSensorFaultOnAPlantPumpingAtNightWithoutOne) {
 TEST(DiagnosisSensors, ALightLossOnBothOutputsFromOneDayOnIsNoHeatMeterFault) {
   const Plant plant = DesignExamplePlant();
   std::int64_t onset_s = 0;
-  const DiagnosisResult r = DiagnoseSoilingOnly(
-      Plant21Days(plant, DisturbanceKind::kSnowCover, 0.9, &onset_s, true), plant);
-  for (const SensorFinding& f : r.sensors) {
-    EXPECT_TRUE(f.kind != "offset_step" && f.kind != "scale")
-        << f.channel << " " << f.kind << ": " << f.detail;
-  }
+  ExpectNoFindingOfKinds(
+      DiagnoseSoilingOnly(Plant21Days(plant, DisturbanceKind::kSnowCover, 0.9, &onset_s, true),
+                          plant),
+      {"offset_step", "scale"});
 }
 
 // The daemon's nightly diagnosis (`pvtwin diagnose --db … --record`) puts a

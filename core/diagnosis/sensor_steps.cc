@@ -140,6 +140,15 @@ std::optional<SensorResiduals> FitAllDays(
   return r;
 }
 
+// True when every value from `split` on lies beyond every value before it,
+// above when `up`, else below (both sides non-empty).
+bool SeparatedAt(const std::vector<double>& y, std::size_t split, bool up) {
+  const auto mid = y.begin() + static_cast<std::ptrdiff_t>(split);
+  const auto [lo1, hi1] = std::minmax_element(y.begin(), mid);
+  const auto [lo2, hi2] = std::minmax_element(mid, y.end());
+  return up ? *lo2 > *hi1 : *hi2 < *lo1;
+}
+
 // Mean of the day values from from_s on minus the mean of those before
 // (NaN without a day on either side), and the one-sided probability that
 // the two sides separate in that direction when the series has no step.
@@ -149,17 +158,15 @@ struct StepAt {
   double p = 1.0;
 };
 StepAt StepAtDay(const DaySeries& s, std::int64_t from_s) {
-  std::vector<double> before, after;
-  for (std::size_t k = 0; k < s.days.size(); ++k) {
-    (s.days[k] < from_s ? before : after).push_back(s.y[k]);
-  }
+  // Days ascend: the first day from from_s on splits the series.
+  const std::size_t split = static_cast<std::size_t>(
+      std::lower_bound(s.days.begin(), s.days.end(), from_s) - s.days.begin());
+  const std::size_t n = s.y.size();
   StepAt out;
-  if (before.empty() || after.empty()) return out;
-  out.step = Mean(after, 0, after.size()) - Mean(before, 0, before.size());
-  const auto [lo1, hi1] = std::minmax_element(before.begin(), before.end());
-  const auto [lo2, hi2] = std::minmax_element(after.begin(), after.end());
-  out.separated = out.step > 0.0 ? *lo2 > *hi1 : *hi2 < *lo1;
-  out.p = SeparationP(before.size(), after.size()) / 2.0;
+  if (split == 0 || split == n) return out;
+  out.step = Mean(s.y, split, n) - Mean(s.y, 0, split);
+  out.separated = SeparatedAt(s.y, split, out.step > 0.0);
+  out.p = SeparationP(split, n - split) / 2.0;
   return out;
 }
 
@@ -206,12 +213,9 @@ std::optional<DayStep> TestDayStep(const DaySeries& s, double alpha) {
     }
   }
   const std::size_t splits = n - 2 * min_side + 1;
-  const auto mid = y.begin() + static_cast<std::ptrdiff_t>(d.split);
   d.before = Mean(y, 0, d.split);
   d.after = Mean(y, d.split, n);
-  const double lo1 = *std::min_element(y.begin(), mid), hi1 = *std::max_element(y.begin(), mid);
-  const double lo2 = *std::min_element(mid, y.end()), hi2 = *std::max_element(mid, y.end());
-  d.separated = d.after > d.before ? lo2 > hi1 : hi2 < lo1;
+  d.separated = SeparatedAt(y, d.split, d.after > d.before);
   d.p = std::min(1.0, SeparationP(d.split, n - d.split) * static_cast<double>(splits));
   d.beats_line = best_sse < LineSse(y);
   d.found = d.separated && d.beats_line && d.p <= alpha;

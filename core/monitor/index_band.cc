@@ -124,6 +124,18 @@ std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool the
   return out;
 }
 
+std::int64_t ChangeOnsetS(std::span<const IndexDay> days) {
+  auto newest = std::find_if(days.rbegin(), days.rend(), [](const IndexDay& d) { return d.alarm; });
+  if (newest == days.rend()) return -1;
+  std::int64_t onset = newest->day_start_s;
+  for (auto it = newest; it != days.rend(); ++it) {
+    if (!it->banded) continue;  // withheld: no part in the CUSUM, no break in the run
+    if (!it->suspect) break;
+    onset = it->day_start_s;
+  }
+  return onset;
+}
+
 void SetIndexBands(std::span<const DayPerformance> earlier, const IndexBandOptions& bands,
                    const IndexCusumOptions& cusum, DayPerformance* day) {
   std::vector<DayPerformance> days(earlier.begin(), earlier.end());

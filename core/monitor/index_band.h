@@ -144,6 +144,17 @@ struct IndexDay {
 std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool thermal,
                                   const IndexBandOptions& bands, const IndexCusumOptions& cusum);
 
+// The first day of the plant's newest change as the alarm sees it (-1:
+// no alarm among `days`, FollowIndex's output): the first day of the
+// newest alarm's excursion, or of the excursions that ended in an alarm
+// right before it. A loss that stays alarms again every few days, each
+// time from S = 0 (the days of one alarm leave the reference of the next),
+// so an unbroken run of judged days (suspect) is one change, and its first
+// day is where that change began. The diagnosis judges the days from it
+// (daemon/service/nightly_diagnosis.h): a model fitted across a change
+// judges neither state.
+std::int64_t ChangeOnsetS(std::span<const IndexDay> days);
+
 // Sets day->pi_*_low and pi_*_high of each output day is scored for, as
 // FollowIndex over `earlier` (days before it, time order) and the day.
 void SetIndexBands(std::span<const DayPerformance> earlier, const IndexBandOptions& bands,

@@ -301,5 +301,52 @@ TEST(IndexCusum, AnOpenExcursionsDaysStayInTheReferenceSoANewHealthyRegimeIsLear
   EXPECT_TRUE(run[static_cast<std::size_t>(first_alarm)].suspect);
 }
 
+TEST(IndexCusum, TheChangeBeganOnTheFirstDayOfTheAlarmsUnbrokenRun) {
+  // 20 calm days, then a loss that stays (8 % from day 20 on): the CUSUM
+  // alarms, starts again from 0, and alarms again every few days. The
+  // change began on day 20, the first day of the first of those runs.
+  std::vector<double> errors(20, 0.0);
+  for (int d = 0; d < 20; ++d) errors[static_cast<std::size_t>(d)] = 0.02 * ((d % 5) - 2) / 2.0;
+  for (int d = 20; d < 30; ++d) errors.push_back(-0.08);
+  const std::vector<DayPerformance> days = Banded(errors);
+  const std::vector<IndexDay> run =
+      FollowIndex(days, false, IndexBandOptions{}, IndexCusumOptions{});
+  ASSERT_EQ(run.size(), 30u);
+  int alarms = 0;
+  for (const IndexDay& c : run) alarms += c.alarm;
+  EXPECT_GE(alarms, 2);  // more than one alarm, so the run of runs is what is tested
+  EXPECT_EQ(ChangeOnsetS(run), kJune1 + 20 * kDayS);
+  // Only the days up to the first alarm: the same first day.
+  std::vector<IndexDay> first;
+  for (const IndexDay& c : run) {
+    first.push_back(c);
+    if (c.alarm) break;
+  }
+  EXPECT_EQ(ChangeOnsetS(first), kJune1 + 20 * kDayS);
+  // The calm days alone: no alarm, no change.
+  EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + 20)), -1);
+}
+
+TEST(IndexCusum, AChangeAfterTheLastOneEndedBeginsAnew) {
+  // A loss on days 20–22 that alarms on its third day and ends (a snow
+  // cover gone), 11 calm days, and a second loss from day 34: the newest
+  // change began on day 34, not on day 20. (A loss that outlasted its alarm
+  // would keep the CUSUM above 0 through the calm days: one excursion.)
+  std::vector<double> errors(20, 0.0);
+  for (int d = 0; d < 20; ++d) errors[static_cast<std::size_t>(d)] = 0.02 * ((d % 5) - 2) / 2.0;
+  for (int d = 20; d < 23; ++d) errors.push_back(-0.08);
+  for (int d = 23; d < 34; ++d) errors.push_back(0.02 * ((d % 5) - 2) / 2.0);
+  for (int d = 34; d < 40; ++d) errors.push_back(-0.08);
+  const std::vector<DayPerformance> days = Banded(errors);
+  const std::vector<IndexDay> run =
+      FollowIndex(days, false, IndexBandOptions{}, IndexCusumOptions{});
+  ASSERT_EQ(run.size(), 40u);
+  EXPECT_TRUE(run[22].alarm);
+  EXPECT_EQ(run[23].run_days, 0);
+  EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + 34)),
+            kJune1 + 20 * kDayS);
+  EXPECT_EQ(ChangeOnsetS(run), kJune1 + 34 * kDayS);
+}
+
 }  // namespace
 }  // namespace pvtwin

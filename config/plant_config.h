@@ -79,6 +79,7 @@ struct ForecastConfig {
 struct DiagnosisConfig {
   bool enabled = true;
   int every_days = 7;       // [1, 365]: at most one diagnosis per this many days
+                            // (after a performance alarm: nightly on the days since)
   double timeout_s = 1800;  // [1, 86400]: the child is stopped after this
   int keep = 10;            // [1, 1000] HTML reports kept in <state dir>/reports
 };

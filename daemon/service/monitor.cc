@@ -124,6 +124,26 @@ void CheckPerformanceAlarm(Store& store, const DailyCheckInputs& in, std::int64_
   }
 }
 
+}  // namespace
+
+bool NewestChangeOnset(Store& store, const DailyCheckInputs& in, std::int64_t* onset_s,
+                       std::string* error) {
+  *onset_s = -1;
+  std::vector<DayPerformance> days;
+  if (!store.ReadPerformanceDays(LookBackStart(in, IndexBandOptions{}), in.now_s / kDayS * kDayS,
+                                 &days, error)) {
+    return false;
+  }
+  for (const bool thermal : {false, true}) {
+    const std::vector<IndexDay> followed =
+        FollowIndex(days, thermal, IndexBandOptions{}, CusumOptionsOf(*in.config));
+    *onset_s = std::max(*onset_s, ChangeOnsetS(followed));
+  }
+  return true;
+}
+
+namespace {
+
 // Sensor faults of the last two days (a fault that goes on is recorded again
 // with its later end).
 void CheckSensors(Store& store, const DailyCheckInputs& in, const Series& window, LogLines* log) {

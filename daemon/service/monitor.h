@@ -31,4 +31,10 @@ struct DailyCheckInputs {
 // (journald priority, line) pairs for the log; storage errors included.
 std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const DailyCheckInputs& in);
 
+// The first day of the plant's newest change that a performance alarm saw
+// (ChangeOnsetS over the days the alarm looks back on, the later of the two
+// outputs'), -1 when neither alarmed there; false on a storage error.
+bool NewestChangeOnset(Store& store, const DailyCheckInputs& in, std::int64_t* onset_s,
+                       std::string* error);
+
 }  // namespace pvtwin::cli

@@ -44,6 +44,23 @@ void PruneReports(const fs::path& dir, int keep) {
 
 }  // namespace
 
+NightlyDiagnosis::Plan NightlyDiagnosis::PlanFor(const DiagnosisConfig& config,
+                                                 const Store::DiagnosisRow* last, const Job& job) {
+  Plan plan;
+  plan.window_start = job.window_start;
+  if (job.change_from > job.window_start && job.window_end - job.change_from >= 2 * kDayS) {
+    plan.window_start = job.change_from;
+    plan.why = "the days since the plant changed on " +
+               FormatIsoUtc(job.change_from).substr(0, 10) +
+               " (the first day of the performance alarm's excursion)";
+    plan.start = true;
+    return plan;
+  }
+  // An hour's slack: the nightly runs drift by the calibration's runtime.
+  plan.start = last == nullptr || job.now_s - last->run_at >= config.every_days * kDayS - 3600;
+  return plan;
+}
+
 void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, const Job& job,
                                   const LogFn& log) {
   if (!config.enabled || child_.running() || job.calibration_id <= 0) return;
@@ -54,8 +71,8 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
     log(kErr, "diagnosis not started: " + error);
     return;
   }
-  // An hour's slack: the nightly runs drift by the calibration's runtime.
-  if (found && job.now_s - last.run_at < config.every_days * kDayS - 3600) return;
+  const Plan plan = PlanFor(config, found ? &last : nullptr, job);
+  if (!plan.start) return;
   const fs::path work = state_dir_ / "diagnosis";
   std::error_code ec;
   fs::remove_all(work, ec);
@@ -69,7 +86,7 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
                                          "--variant",
                                          job.variant,
                                          "--from",
-                                         std::to_string(job.window_start),
+                                         std::to_string(plan.window_start),
                                          "--to",
                                          std::to_string(job.window_end),
                                          "--record",
@@ -91,8 +108,9 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
   }
   started_wall_s_ = WallNowS();
   job_now_s_ = job.now_s;
-  log(kInfo, "diagnosis of " + job.variant + " started on " + FormatIsoUtc(job.window_start) +
-                 " .. " + FormatIsoUtc(job.window_end));
+  log(kInfo, "diagnosis of " + job.variant + " started on " + FormatIsoUtc(plan.window_start) +
+                 " .. " + FormatIsoUtc(job.window_end) +
+                 (plan.why.empty() ? std::string() : ": " + plan.why));
 }
 
 void NightlyDiagnosis::Check(const DiagnosisConfig& config, Store& store, const LogFn& log) {

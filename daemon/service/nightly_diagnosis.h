@@ -1,7 +1,8 @@
 // The daemon's diagnosis of the sim-to-real gap (core/diagnosis.h), run after
 // a nightly calibration on its window as a child process
 // (`pvtwin diagnose --db … --record`), so that a slow or failing diagnosis
-// never holds up polling: at most once every [diagnosis] every_days, stopped
+// never holds up polling: at most once every [diagnosis] every_days (after a
+// performance alarm nightly, on the days since the change: PlanFor), stopped
 // after timeout_s. The child writes its diagnosis row itself; the HTML report
 // is kept as <state dir>/reports/diagnosis-<date>.html, the newest `keep` of
 // them. Failures and timeouts become monitor_event rows and log lines.
@@ -28,13 +29,35 @@ class NightlyDiagnosis {
     std::int64_t window_start = 0, window_end = 0;
     std::int64_t calibration_id = 0;
     std::int64_t now_s = 0;  // the daemon's clock (simulated under --speed)
+    // The first day of the plant's newest change that a performance alarm
+    // saw (monitor.h NewestChangeOnset); 0 or less: none.
+    std::int64_t change_from = 0;
   };
+
+  // Whether a job starts tonight, and on which days (Plan). A change the
+  // alarm saw inside the calibration window, with at least the two days
+  // the diagnosis needs after it (a training and a held-out day), moves
+  // the window's start to the change: a model fitted across it judges
+  // neither state (the week of doc/validation.md: clipping from the week's
+  // first day is not among the candidates on the 14 days, and named on the
+  // days since). The diagnosis of a change runs every night, whatever
+  // every_days, while the change lies inside the window: each night adds a
+  // day of the changed plant, and a verdict on a few days is a low-confidence
+  // one (hours as units), not one to stop on. Otherwise at most once every
+  // every_days.
+  struct Plan {
+    bool start = false;
+    std::int64_t window_start = 0;
+    std::string why;  // for the log: why the window starts there ("" the calibration's)
+  };
+  static Plan PlanFor(const DiagnosisConfig& config, const Store::DiagnosisRow* last,
+                      const Job& job);
 
   // state_dir holds reports/ and the child's scratch folder diagnosis/.
   explicit NightlyDiagnosis(std::filesystem::path state_dir) : state_dir_(std::move(state_dir)) {}
 
-  // Starts the child when enabled and the newest diagnosis row is at least
-  // every_days old (none running).
+  // Starts the child when enabled, none is running and PlanFor says so, on
+  // the days PlanFor gives.
   void MaybeStart(const DiagnosisConfig& config, Store& store, const Job& job, const LogFn& log);
   // Non-blocking: a finished child's report is kept and its verdict logged;
   // a child past timeout_s is killed.

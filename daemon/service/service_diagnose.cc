@@ -25,6 +25,14 @@ void Service::MaybeStartDiagnosis() {
   job.window_end = job_.window_end;
   job.calibration_id = params_id_;
   job.now_s = static_cast<std::int64_t>(Now());
+  cli::DailyCheckInputs checks;
+  checks.config = &config_;
+  checks.spec = spec_;
+  checks.now_s = job.now_s;
+  std::string error;
+  if (!cli::NewestChangeOnset(*store_, checks, &job.change_from, &error)) {
+    LogToStderr(kErr, "diagnosis: the performance alarm's days not read: " + error);
+  }
   diagnosis_->MaybeStart(config_.diagnosis, *store_, job, LogToStderr);
 }
 

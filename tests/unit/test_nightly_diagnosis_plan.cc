@@ -1,0 +1,100 @@
+// daemon/service/nightly_diagnosis.h, NightlyDiagnosis::PlanFor: when the
+// nightly diagnosis starts and on which days. Without a change it runs at
+// most every every_days on the calibration's window; after a change that a
+// performance alarm saw inside the window it judges the days since, every
+// night while the change lies inside the window.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+
+#include "daemon/service/nightly_diagnosis.h"
+
+namespace pvtwin::cli {
+namespace {
+
+constexpr std::int64_t kDayS = 86400;
+constexpr std::int64_t kJune16 = 1750032000;  // 2025-06-16T00:00:00Z
+
+// Tonight's job: the 14-day calibration window ending at midnight, the
+// daemon's clock at 00:30.
+NightlyDiagnosis::Job Tonight(std::int64_t change_from = 0) {
+  NightlyDiagnosis::Job job;
+  job.window_start = kJune16 - 14 * kDayS;
+  job.window_end = kJune16;
+  job.now_s = kJune16 + 1800;
+  job.calibration_id = 7;
+  job.change_from = change_from;
+  return job;
+}
+
+Store::DiagnosisRow Row(std::int64_t run_at, std::int64_t window_start, const char* verdict) {
+  Store::DiagnosisRow row;
+  row.run_at = run_at;
+  row.window_start = window_start;
+  row.window_end = run_at - 1800;
+  row.verdict = verdict;
+  return row;
+}
+
+TEST(NightlyDiagnosisPlan, WithoutAChangeEveryEveryDaysOnTheCalibrationWindow) {
+  DiagnosisConfig config;
+  config.every_days = 7;
+  const NightlyDiagnosis::Job job = Tonight();
+  NightlyDiagnosis::Plan plan = NightlyDiagnosis::PlanFor(config, nullptr, job);
+  EXPECT_TRUE(plan.start);  // the first diagnosis of the store
+  EXPECT_EQ(plan.window_start, job.window_start);
+  EXPECT_EQ(plan.why, "");
+  const Store::DiagnosisRow three_days = Row(job.now_s - 3 * kDayS, job.window_start, "unknown");
+  EXPECT_FALSE(NightlyDiagnosis::PlanFor(config, &three_days, job).start);
+  // Seven days less the hour the nightly runs drift by.
+  const Store::DiagnosisRow a_week = Row(job.now_s - 7 * kDayS + 3000, job.window_start, "none");
+  EXPECT_TRUE(NightlyDiagnosis::PlanFor(config, &a_week, job).start);
+}
+
+TEST(NightlyDiagnosisPlan, AChangeInsideTheWindowIsJudgedOnTheDaysSinceEveryNight) {
+  DiagnosisConfig config;
+  config.every_days = 7;
+  const std::int64_t change = kJune16 - 7 * kDayS;  // clipping from 2025-06-09
+  const NightlyDiagnosis::Job job = Tonight(change);
+  // Last night's diagnosis, on the calibration window or already on the
+  // days since the change, whatever it said: tonight's judges the days
+  // since the change (a day more), whatever every_days says.
+  for (const std::int64_t last_from : {job.window_start, change}) {
+    for (const char* verdict : {"undecided", "unknown", "none", "pv_clipping"}) {
+      const Store::DiagnosisRow last = Row(job.now_s - kDayS, last_from, verdict);
+      const NightlyDiagnosis::Plan plan = NightlyDiagnosis::PlanFor(config, &last, job);
+      EXPECT_TRUE(plan.start) << verdict;
+      EXPECT_EQ(plan.window_start, change) << verdict;
+      EXPECT_NE(plan.why.find("2025-06-09"), std::string::npos) << plan.why;
+    }
+  }
+  EXPECT_TRUE(NightlyDiagnosis::PlanFor(config, nullptr, job).start);
+}
+
+TEST(NightlyDiagnosisPlan, AChangeTooRecentOrBeforeTheWindowLeavesTheWindowAlone) {
+  DiagnosisConfig config;
+  config.every_days = 7;
+  const Store::DiagnosisRow recent = Row(kJune16 - kDayS, kJune16 - 15 * kDayS, "unknown");
+  // One day since the change: no training and held-out day of the changed plant yet.
+  NightlyDiagnosis::Job job = Tonight(kJune16 - kDayS);
+  NightlyDiagnosis::Plan plan = NightlyDiagnosis::PlanFor(config, &recent, job);
+  EXPECT_FALSE(plan.start);
+  EXPECT_EQ(plan.window_start, job.window_start);
+  // Two days since: judged.
+  job = Tonight(kJune16 - 2 * kDayS);
+  plan = NightlyDiagnosis::PlanFor(config, &recent, job);
+  EXPECT_TRUE(plan.start);
+  EXPECT_EQ(plan.window_start, kJune16 - 2 * kDayS);
+  // A change at or before the window's start: the whole window is the
+  // changed plant, the calibration's window and every_days as always.
+  for (const std::int64_t from : {kJune16 - 14 * kDayS, kJune16 - 20 * kDayS}) {
+    job = Tonight(from);
+    plan = NightlyDiagnosis::PlanFor(config, &recent, job);
+    EXPECT_FALSE(plan.start);
+    EXPECT_EQ(plan.window_start, job.window_start);
+    EXPECT_EQ(plan.why, "");
+  }
+}
+
+}  // namespace
+}  // namespace pvtwin::cli

@@ -1,7 +1,7 @@
 #!/bin/sh
 # A week of operation against `pvtwin sim` (not in CI: about 35 min of wall time).
 #
-#   doc/scripts/week_against_sim.sh PVTWIN OUTDIR healthy|clipping [SEED] [START]
+#   doc/scripts/week_against_sim.sh PVTWIN OUTDIR healthy|clipping|shading [SEED] [START]
 #
 # 28 days of history of the example plant (config/examples/sim-plant.toml,
 # truth 2N2CrI+wind+transport_delay, seed SEED) are exported and imported, so
@@ -11,12 +11,14 @@
 # forecasts, daily checks, weekly diagnosis) polls it for seven simulated days
 # from START 00:00 UTC at 300 simulated seconds per wall second. With
 # `clipping` the served plant has an inverter that clips P_el (+pv_clipping)
-# from START on: the history is healthy, the week is not.
+# from START on: the history is healthy, the week is not; with `shading` an
+# obstacle (+shading, a box in the west-south-west) stands from START on.
 #
 # It prints what an operator would check after the week: nightly fits taken,
 # the forecast band's coverage per output and day, the performance index band
-# holding 1, and the performance alarms. The store, both logs and the configs
-# stay in OUTDIR. Defaults: SEED 1, START 2025-06-09 (a Monday).
+# holding 1, the performance alarms and the diagnoses. The store, both logs
+# and the configs stay in OUTDIR. Defaults: SEED 1, START 2025-06-09 (a
+# Monday).
 #
 # With FORECAST_SIGMA set (e.g. FORECAST_SIGMA=0.15) the daemon also has a
 # weather forecast, as a plant with `[forecast] weather_url` has: the hourly
@@ -30,7 +32,8 @@ sigma=${FORECAST_SIGMA:-}
 case $scenario in
   healthy) truth="2N2CrI+wind+transport_delay" ;;
   clipping) truth="2N2CrI+wind+transport_delay+pv_clipping" ;;
-  *) echo "scenario: healthy or clipping" >&2; exit 2 ;;
+  shading) truth="2N2CrI+wind+transport_delay+shading" ;;
+  *) echo "scenario: healthy, clipping or shading" >&2; exit 2 ;;
 esac
 here=$(cd "$(dirname "$0")/../.." && pwd)
 speed=300
@@ -41,7 +44,7 @@ cd "$out"
 rm -f pvtwin.db pvtwin.db-wal pvtwin.db-shm daemon.log sim.log
 
 # Ports of the two devices, apart for each scenario so that two weeks can run at once.
-case $scenario in healthy) offset=100 ;; clipping) offset=200 ;; esac
+case $scenario in healthy) offset=100 ;; clipping) offset=200 ;; shading) offset=300 ;; esac
 sed -e "s/^port = 5020/port = $((5020 + offset))/" -e "s/^port = 5021/port = $((5021 + offset))/" \
   "$here/config/examples/sim-plant.toml" > sim.toml
 cat sim.toml - > pvtwin.toml <<EOF
@@ -145,4 +148,9 @@ SELECT sum(pi_el_low <= 1 AND 1 <= pi_el_high) || ' of ' || count(pi_el_low) AS 
 .print == Performance alarms of the week
 SELECT datetime(ts, 'unixepoch') AS at, kind, message FROM monitor_event
  WHERE kind LIKE 'performance_%' AND ts >= $t0 ORDER BY ts;
+.print
+.print == Diagnoses (the first on the history; after an alarm on the days since the change)
+SELECT datetime(run_at, 'unixepoch') AS at, date(window_start, 'unixepoch') AS from_day,
+       date(window_end, 'unixepoch') AS to_day, verdict, low_confidence
+  FROM diagnosis ORDER BY run_at;
 EOF

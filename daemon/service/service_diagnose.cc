@@ -14,7 +14,8 @@ void Service::AfterCalibration() {
 }
 
 void Service::MaybeStartDiagnosis() {
-  if (!have_params_ || !diagnosis_) return;
+  // Disabled: not even the alarm's days are read.
+  if (!have_params_ || !diagnosis_ || !config_.diagnosis.enabled) return;
   cli::NightlyDiagnosis::Job job;
   job.exe = options_.exe_path.empty() ? SelfExecutable() : options_.exe_path;
   job.config_path = options_.config_path;

@@ -127,11 +127,20 @@ std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool the
 std::int64_t ChangeOnsetS(std::span<const IndexDay> days) {
   auto newest = std::find_if(days.rbegin(), days.rend(), [](const IndexDay& d) { return d.alarm; });
   if (newest == days.rend()) return -1;
+  // The maximum-likelihood change point (index_band.h), walking back from
+  // the alarm: ties keep the later day.
   std::int64_t onset = newest->day_start_s;
+  double best = 0.0, loss = 0.0;
+  int count = 0;
   for (auto it = newest; it != days.rend(); ++it) {
-    if (!it->banded) continue;  // withheld: no part in the CUSUM, no break in the run
-    if (!it->suspect) break;
-    onset = it->day_start_s;
+    if (!it->banded) continue;
+    loss -= it->z;
+    ++count;
+    const double statistic = loss > 0.0 ? loss * loss / count : 0.0;
+    if (statistic > best) {
+      best = statistic;
+      onset = it->day_start_s;
+    }
   }
   return onset;
 }

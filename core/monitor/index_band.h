@@ -144,15 +144,24 @@ struct IndexDay {
 std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool thermal,
                                   const IndexBandOptions& bands, const IndexCusumOptions& cusum);
 
-// The first day of the plant's newest change as the alarm sees it (-1:
-// no alarm among `days`, FollowIndex's output): the first day of the
-// newest alarm's excursion, or of the excursions that ended in an alarm
-// right before it. A loss that stays alarms again every few days, each
-// time from S = 0 (the days of one alarm leave the reference of the next),
-// so an unbroken run of judged days (suspect) is one change, and its first
-// day is where that change began. The diagnosis judges the days from it
+// The first day of the plant's newest change as the alarm sees it (-1: no
+// alarm among `days`, FollowIndex's output): the maximum-likelihood change
+// point of a step loss of unknown size in the standardised daily errors z
+// (D. V. Hinkley, "Inference about the change-point in a sequence of random
+// variables", Biometrika 57, 1970), over the banded days up to the newest
+// alarm: the day τ that maximises (Σ_{t ≥ τ} −z_t)² / (the banded days from
+// τ on), with a positive sum. Before the change z is the healthy plant's,
+// standardised to N(0, 1) by its reference days; after it its mean is
+// lowered by the loss, which the estimate does not need to know. Unlike the
+// day after the CUSUM was last 0, it is not moved early by mildly low days
+// before the change (counted in, days lower by less than about half the
+// loss lower the likelihood), and a loss
+// seen on clear days only, on which the CUSUM returns to 0 on the cloudy
+// days between and alarms again from 0, stays one change as long as the
+// days between carry less evidence of its end than the days after of its
+// going on. The diagnosis judges the days from it
 // (daemon/service/nightly_diagnosis.h): a model fitted across a change
-// judges neither state.
+// judges neither state. Withheld days take no part.
 std::int64_t ChangeOnsetS(std::span<const IndexDay> days);
 
 // Sets day->pi_*_low and pi_*_high of each output day is scored for, as

@@ -348,5 +348,53 @@ TEST(IndexCusum, AChangeAfterTheLastOneEndedBeginsAnew) {
   EXPECT_EQ(ChangeOnsetS(run), kJune1 + 34 * kDayS);
 }
 
+TEST(IndexCusum, ALossSeenOnClearDaysOnlyIsOneChangeThroughTheCloudyDaysBetween) {
+  // An inverter that clips shows on clear days only: a loss on days 20–22
+  // (an alarm), three cloudy days without it, on which the CUSUM returns to
+  // 0, and the loss again from day 26 (a second alarm). One change, from
+  // day 20: the cloudy days between carry no evidence of its end. (The
+  // first day of the second alarm's own excursion would date it day 25.)
+  std::vector<double> errors;
+  for (int d = 0; d < 30; ++d) {
+    const bool lossy = (d >= 20 && d < 23) || d >= 26;
+    errors.push_back(lossy ? -0.08 : 0.02 * ((d % 5) - 2) / 2.0);
+  }
+  const std::vector<DayPerformance> days = Banded(errors);
+  const std::vector<IndexDay> run =
+      FollowIndex(days, false, IndexBandOptions{}, IndexCusumOptions{});
+  ASSERT_EQ(run.size(), 30u);
+  EXPECT_TRUE(run[22].alarm);
+  EXPECT_EQ(run[23].run_days, 0);  // the run is broken: S was 0 on the cloudy day after
+  int second_alarm = -1;
+  for (int d = 23; d < 30 && second_alarm < 0; ++d) {
+    if (run[static_cast<std::size_t>(d)].alarm) second_alarm = d;
+  }
+  ASSERT_GT(second_alarm, 25);
+  EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + second_alarm + 1)),
+            kJune1 + 20 * kDayS);
+}
+
+TEST(IndexCusum, TheChangeIsDatedByTheLikelihoodOfAStepNotByTheLastZero) {
+  // Two mildly low days before the loss (z ≈ −1.3, at the band's edge)
+  // keep the CUSUM above 0, so its last zero lies on day 17; the step's
+  // likelihood puts the change where the loss begins, day 20.
+  std::vector<double> errors;
+  for (int d = 0; d < 26; ++d) {
+    errors.push_back(d >= 20 ? -0.08 : (d == 18 || d == 19) ? -0.02 : 0.02 * ((d % 5) - 2) / 2.0);
+  }
+  const std::vector<DayPerformance> days = Banded(errors);
+  const std::vector<IndexDay> run =
+      FollowIndex(days, false, IndexBandOptions{}, IndexCusumOptions{});
+  ASSERT_EQ(run.size(), 26u);
+  int alarm = -1;
+  for (int d = 20; d < 26 && alarm < 0; ++d) {
+    if (run[static_cast<std::size_t>(d)].alarm) alarm = d;
+  }
+  ASSERT_GE(alarm, 20);
+  EXPECT_GT(run[19].run_days, 0);  // the excursion opened before the loss
+  EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + alarm + 1)),
+            kJune1 + 20 * kDayS);
+}
+
 }  // namespace
 }  // namespace pvtwin

@@ -72,6 +72,12 @@ struct RunFigures {
   int banded_el = 0, hold_el = 0, banded_th = 0, hold_th = 0;
   int alarms = 0;            // performance_low_* events
   int first_alarm_day = -1;  // the day scored the night of the first electricity alarm
+  // The change's first day as the daemon dates it each night
+  // (NewestChangeOnset; -1: none), by the night's number (day scored + 1).
+  std::vector<int> onset_by_night = std::vector<int>(kDays + 1, -1);
+  int OnsetAtFirstAlarm() const {
+    return first_alarm_day < 0 ? -1 : onset_by_night[static_cast<std::size_t>(first_alarm_day + 1)];
+  }
 };
 
 // Writes `data` to a new store with `params` as the accepted calibration of
@@ -94,12 +100,16 @@ RunFigures Monitor(const Series& data, const ParamVector& params, const Config& 
   DailyCheckInputs in;
   in.config = &config;
   in.spec = testing::SpecOf(kModel);
+  RunFigures f;
   for (int night = kTrainDays; night <= kDays; ++night) {
     in.now_s = kJune1 + night * kDayS + 2 * 3600;
     RunDailyChecks(*store, in);
+    std::int64_t onset_s = -1;
+    EXPECT_TRUE(NewestChangeOnset(*store, in, &onset_s, &error)) << error;
+    f.onset_by_night[static_cast<std::size_t>(night)] =
+        onset_s < 0 ? -1 : static_cast<int>((onset_s - kJune1) / kDayS);
   }
   testing::RawDb db(dir.path() / "pvtwin.db");
-  RunFigures f;
   const std::string monitored =
       " FROM performance_daily WHERE day >= " + std::to_string(kJune1 + kTrainDays * kDayS);
   f.banded_el =
@@ -170,12 +180,18 @@ void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
     }
     std::printf(
         "seed %llu: healthy band holds 1 on %d/%d days (P_el), %d/%d (Q_u), %d alarm(s); "
-        "clipping from day %d: first alarm on day %d, %d clear day(s) after the switch\n",
+        "clipping from day %d: first alarm on day %d, %d clear day(s) after the switch; "
+        "change dated day %d the night of that alarm, day %d on the last night\n",
         static_cast<unsigned long long>(seed), h.hold_el, h.banded_el, h.hold_th, h.banded_th,
-        h.alarms, kSwitchDay, s.first_alarm_day, clear_days);
+        h.alarms, kSwitchDay, s.first_alarm_day, clear_days, s.OnsetAtFirstAlarm(),
+        s.onset_by_night.back());
     EXPECT_EQ(h.alarms, 0) << "seed " << seed;
     EXPECT_GE(s.first_alarm_day, kSwitchDay) << "seed " << seed;
     EXPECT_LE(clear_days, 3) << "seed " << seed;
+    // The night of that alarm the change is dated (NewestChangeOnset, for
+    // the diagnosis's window) neither before the switch nor after the alarm.
+    EXPECT_GE(s.OnsetAtFirstAlarm(), kSwitchDay) << "seed " << seed;
+    EXPECT_LE(s.OnsetAtFirstAlarm(), s.first_alarm_day) << "seed " << seed;
     banded_el += h.banded_el, hold_el += h.hold_el;
     banded_th += h.banded_th, hold_th += h.hold_th;
   }

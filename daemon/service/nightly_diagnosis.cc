@@ -6,6 +6,7 @@
 #include <fstream>
 #include <vector>
 
+#include "core/common/calendar.h"
 #include "core/common/clock.h"
 #include "io/platform/log.h"
 #include "io/platform/time_format.h"
@@ -42,17 +43,25 @@ void PruneReports(const fs::path& dir, int keep) {
   }
 }
 
+// The local solar midnight nearest t_s (calendar.h).
+std::int64_t NearestSolarMidnight(std::int64_t t_s, std::int64_t solar_offset_s) {
+  return SolarDayStartS(t_s + kDayS / 2, solar_offset_s);
+}
+
 }  // namespace
 
 NightlyDiagnosis::Plan NightlyDiagnosis::PlanFor(const DiagnosisConfig& config,
                                                  const Store::DiagnosisRow* last, const Job& job) {
   Plan plan;
-  plan.window_start = job.window_start;
-  if (job.change_from > job.window_start && job.window_end - job.change_from >= 2 * kDayS) {
-    plan.window_start = job.change_from;
+  plan.window_start = NearestSolarMidnight(job.window_start, job.solar_offset_s);
+  plan.window_end = NearestSolarMidnight(job.window_end, job.solar_offset_s);
+  const std::int64_t change_from = NearestSolarMidnight(job.change_from, job.solar_offset_s);
+  if (job.change_from > 0 && change_from > plan.window_start &&
+      plan.window_end - change_from >= 2 * kDayS) {
+    plan.window_start = change_from;
     plan.why = "the days since the plant changed on " +
                FormatIsoUtc(job.change_from).substr(0, 10) +
-               " (the first day of the performance alarm's excursion)";
+               " (the performance alarm's change point)";
     plan.start = true;
     return plan;
   }
@@ -88,7 +97,7 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
                                          "--from",
                                          std::to_string(plan.window_start),
                                          "--to",
-                                         std::to_string(job.window_end),
+                                         std::to_string(plan.window_end),
                                          "--record",
                                          "--calibration-id",
                                          std::to_string(job.calibration_id),
@@ -109,7 +118,7 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
   started_wall_s_ = WallNowS();
   job_now_s_ = job.now_s;
   log(kInfo, "diagnosis of " + job.variant + " started on " + FormatIsoUtc(plan.window_start) +
-                 " .. " + FormatIsoUtc(job.window_end) +
+                 " .. " + FormatIsoUtc(plan.window_end) +
                  (plan.why.empty() ? std::string() : ": " + plan.why));
 }
 

@@ -32,6 +32,7 @@ class NightlyDiagnosis {
     // The first day of the plant's newest change that a performance alarm
     // saw (monitor.h NewestChangeOnset); 0 or less: none.
     std::int64_t change_from = 0;
+    std::int64_t solar_offset_s = 0;  // SolarDayOffsetS of the plant
   };
 
   // Whether a job starts tonight, and on which days (Plan). A change the
@@ -45,9 +46,17 @@ class NightlyDiagnosis {
   // day of the changed plant, and a verdict on a few days is a low-confidence
   // one (hours as units), not one to stop on. Otherwise at most once every
   // every_days.
+  //
+  // The diagnosis splits its data by local solar day (core/diagnosis/
+  // diagnosis.h): both ends of its window move to the nearest local solar
+  // midnight, when the sun is down, so that every day it judges is a whole
+  // one. The calibration's window ends at the night's run (02:00 local, an
+  // hour or two past solar midnight in Europe): without this the hours since
+  // solar midnight, all dark, were a held-out day of their own, and with two
+  // days since a change the only one.
   struct Plan {
     bool start = false;
-    std::int64_t window_start = 0;
+    std::int64_t window_start = 0, window_end = 0;
     std::string why;  // for the log: why the window starts there ("" the calibration's)
   };
   static Plan PlanFor(const DiagnosisConfig& config, const Store::DiagnosisRow* last,

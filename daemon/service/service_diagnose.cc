@@ -1,6 +1,7 @@
 // The diagnose job of the Service (service_internal.h): once the night's
 // calibration is done, the daily checks (monitor.h) and the nightly
 // diagnosis child (nightly_diagnosis.h).
+#include "core/common/calendar.h"
 #include "daemon/service/monitor.h"
 #include "daemon/service/service_internal.h"
 #include "io/platform/log.h"
@@ -26,6 +27,7 @@ void Service::MaybeStartDiagnosis() {
   job.window_end = job_.window_end;
   job.calibration_id = params_id_;
   job.now_s = static_cast<std::int64_t>(Now());
+  job.solar_offset_s = SolarDayOffsetS(config_.plant);
   cli::DailyCheckInputs checks;
   checks.config = &config_;
   checks.spec = spec_;

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <numbers>
 
+#include "core/common/calendar.h"
 #include "daemon/service/nightly_diagnosis.h"
 
 namespace pvtwin::cli {
@@ -94,6 +96,51 @@ TEST(NightlyDiagnosisPlan, AChangeTooRecentOrBeforeTheWindowLeavesTheWindowAlone
     EXPECT_EQ(plan.window_start, job.window_start);
     EXPECT_EQ(plan.why, "");
   }
+}
+
+TEST(NightlyDiagnosisPlan, TheWindowHoldsWholeLocalSolarDays) {
+  DiagnosisConfig config;
+  config.every_days = 7;
+  // Graz, 15.44° E: local mean solar midnight at 22:58:14 UTC. The night's
+  // run at 02:00 CEST ends the calibration window at 00:00 UTC, an hour
+  // into the next solar day: the diagnosis ends at that day's start, and a
+  // change from 9 June (00:00 UTC) is judged from its solar day's start.
+  Plant graz;
+  graz.longitude_rad = 15.44 * std::numbers::pi / 180.0;
+  const std::int64_t offset = SolarDayOffsetS(graz);
+  ASSERT_EQ(offset, 3706);
+  const std::int64_t solar_midnight_16 = kJune16 - offset;
+  NightlyDiagnosis::Job job = Tonight(kJune16 - 7 * kDayS);
+  job.solar_offset_s = offset;
+  NightlyDiagnosis::Plan plan = NightlyDiagnosis::PlanFor(config, nullptr, job);
+  EXPECT_TRUE(plan.start);
+  EXPECT_EQ(plan.window_end, solar_midnight_16);
+  EXPECT_EQ(plan.window_start, solar_midnight_16 - 7 * kDayS);
+  EXPECT_EQ(SolarDayStartS(plan.window_end - 1, offset), solar_midnight_16 - kDayS);
+  // Two UTC days since the change are two whole solar days: judged.
+  job.change_from = kJune16 - 2 * kDayS;
+  plan = NightlyDiagnosis::PlanFor(config, nullptr, job);
+  EXPECT_TRUE(plan.start);
+  EXPECT_EQ(plan.window_end - plan.window_start, 2 * kDayS);
+  // Without a change, the calibration's window, rounded the same way.
+  job.change_from = 0;
+  plan = NightlyDiagnosis::PlanFor(config, nullptr, job);
+  EXPECT_EQ(plan.window_start, solar_midnight_16 - 14 * kDayS);
+  EXPECT_EQ(plan.window_end, solar_midnight_16);
+  // Chicago, 87.63° W (solar midnight at 05:50:31 UTC), run at 02:00 CDT
+  // (07:00 UTC): the window ends at the solar midnight an hour before; its
+  // start, 00:00 UTC (18:09 solar time the evening before), moves to the
+  // solar midnight after it, the change day's own.
+  Plant chicago;
+  chicago.longitude_rad = -87.63 * std::numbers::pi / 180.0;
+  job.solar_offset_s = SolarDayOffsetS(chicago);
+  job.window_end = kJune16 + 7 * 3600;
+  job.change_from = kJune16 - 7 * kDayS;
+  plan = NightlyDiagnosis::PlanFor(config, nullptr, job);
+  EXPECT_EQ(plan.window_end, kJune16 - job.solar_offset_s);
+  EXPECT_EQ(plan.window_start, kJune16 - 7 * kDayS - job.solar_offset_s);
+  EXPECT_LT(plan.window_end, job.window_end);
+  EXPECT_GT(plan.window_start, job.change_from);
 }
 
 }  // namespace

@@ -93,10 +93,10 @@ class DaemonPaths : public ::testing::Test {
   // (measurement_1min) or as a coarser logger's rows (measurement_interval).
   void ImportHistory(std::int64_t end, int days, int step_s = 60) {
     fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
-    auto run = RunPvtwin(dir_.path(), "sim --config sim.toml --export history.csv --days " +
-                                          std::to_string(days) + " --step " +
-                                          std::to_string(step_s) + " --start " +
-                                          std::to_string(end - days * kDay));
+    auto run =
+        RunPvtwin(dir_.path(), "sim --config sim.toml --export history.csv --days " +
+                                   std::to_string(days) + " --step " + std::to_string(step_s) +
+                                   " --start " + std::to_string(end - days * kDay));
     ASSERT_EQ(run.exit_code, 0) << run.err;
     run = RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + DbPath());
     ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -237,9 +237,9 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
     const auto run = RunPvtwin(dir_.path(), "run --config other.toml");
     EXPECT_EQ(run.exit_code, 2) << run.err;
     EXPECT_NE(run.err.find("belongs to another plant"), std::string::npos) << run.err;
-    const std::string both =
-        other_site ? "latitude_deg = 47.9, longitude_deg = 16.128, the store's 47.358"
-                   : "area_m2 = 3.6, the store's 1.8";
+    const std::string both = other_site
+                                 ? "latitude_deg = 47.9, longitude_deg = 16.128, the store's 47.358"
+                                 : "area_m2 = 3.6, the store's 1.8";
     EXPECT_NE(run.err.find(both), std::string::npos) << run.err;
     Db db(DbPath());
     EXPECT_EQ(db.Number("SELECT value FROM plant_config WHERE key = 'area_m2'"), 1.8);
@@ -273,7 +273,7 @@ TEST_F(DaemonPaths, TheJournalPrefixOnlyOnTheJournalStreamAndDatedLinesElsewhere
   ::unsetenv("JOURNAL_STREAM");
   ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
   EXPECT_TRUE(std::regex_search(Log(), std::regex("(^|\n)20[0-9]{2}-[0-9]{2}-[0-9]{2}T[0-9]{2}:"
-                                                   "[0-9]{2}:[0-9]{2}Z info: ready: ")))
+                                                  "[0-9]{2}:[0-9]{2}Z info: ready: ")))
       << Log();
   EXPECT_EQ(Log().find("<6>"), std::string::npos) << Log();
 
@@ -415,8 +415,9 @@ TEST_F(DaemonPaths, TheRefitCanBeTurnedOff) {
 }
 
 // After the first calibration the daemon diagnoses its window in a child:
-// the diagnosis row names the calibration and the window, the HTML report is
-// kept under reports/, the verdict is logged, and the daemon goes on.
+// the diagnosis row names the calibration and its window moved to whole
+// local solar days, the HTML report is kept under reports/, the verdict is
+// logged, and the daemon goes on.
 TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
   ImportHistory(kJune1, 4);
   WriteConfig(Settings());
@@ -424,9 +425,14 @@ TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(180, [&] { return db.Number("SELECT count(*) FROM diagnosis") >= 1; }))
       << Log();
+  // 16.128° E: local mean solar midnight at 22:55:29 UTC (86400 − 3871 s
+  // past 00:00 UTC), the nearest to the calibration window's ends (00:00 UTC).
+  const std::string solar_midnight = "% 86400 = 86400 - 3871";
   EXPECT_EQ(db.Number("SELECT count(*) FROM diagnosis d JOIN calibration c ON c.id = "
-                      "d.calibration_id WHERE c.accepted = 1 AND d.window_start = c.window_start "
-                      "AND d.window_end = c.window_end AND d.base_variant = c.variant"),
+                      "d.calibration_id WHERE c.accepted = 1 AND d.base_variant = c.variant "
+                      "AND d.window_start = c.window_start - 3871 AND d.window_end = "
+                      "c.window_end - 3871 AND d.window_start " +
+                      solar_midnight + " AND d.window_end " + solar_midnight),
             1)
       << Log();
   EXPECT_NE(db.Text("SELECT verdict FROM diagnosis"), "");
@@ -613,7 +619,7 @@ TEST_F(LiveDaemon, AggregatesWithTheConfiguredPeriodAndFluid) {
 // (a forecast's once ran to 800).
 TEST_F(LiveDaemon, AHealthLineEveryStatusMinAndSystemdStatusKeptCurrent) {
   const std::int64_t t0 = kJune1 + 10 * 3600;  // a June morning
-  ImportHistory(t0 - 120, 3);  // calibrated and forecast at the start
+  ImportHistory(t0 - 120, 3);                  // calibrated and forecast at the start
   StartSim(t0, 60.0, {});
   WriteLiveConfig(Settings(), "3650");
   std::ofstream(dir_ / "pvtwin.toml", std::ios::app) << "\n[log]\nstatus_min = 1\n";

@@ -43,8 +43,10 @@ mkdir -p "$out"
 cd "$out"
 rm -f pvtwin.db pvtwin.db-wal pvtwin.db-shm daemon.log sim.log
 
-# Ports of the two devices, apart for each scenario so that two weeks can run at once.
+# Ports of the two devices, apart for each scenario so that two weeks can run at once
+# (PORT_OFFSET for two weeks of the same scenario).
 case $scenario in healthy) offset=100 ;; clipping) offset=200 ;; shading) offset=300 ;; esac
+offset=${PORT_OFFSET:-$offset}
 sed -e "s/^port = 5020/port = $((5020 + offset))/" -e "s/^port = 5021/port = $((5021 + offset))/" \
   "$here/config/examples/sim-plant.toml" > sim.toml
 cat sim.toml - > pvtwin.toml <<EOF
@@ -149,8 +151,9 @@ SELECT sum(pi_el_low <= 1 AND 1 <= pi_el_high) || ' of ' || count(pi_el_low) AS 
 SELECT datetime(ts, 'unixepoch') AS at, kind, message FROM monitor_event
  WHERE kind LIKE 'performance_%' AND ts >= $t0 ORDER BY ts;
 .print
-.print == Diagnoses (the first on the history; after an alarm on the days since the change)
-SELECT datetime(run_at, 'unixepoch') AS at, date(window_start, 'unixepoch') AS from_day,
-       date(window_end, 'unixepoch') AS to_day, verdict, low_confidence
+.print == Diagnoses (the first on the history; after an alarm on the days since the change;
+.print    the first and last solar day judged)
+SELECT datetime(run_at, 'unixepoch') AS at, date(window_start + 43200, 'unixepoch') AS from_day,
+       date(window_end - 43200, 'unixepoch') AS to_day, verdict, low_confidence
   FROM diagnosis ORDER BY run_at;
 EOF

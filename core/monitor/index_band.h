@@ -155,13 +155,12 @@ std::vector<IndexDay> FollowIndex(std::span<const DayPerformance> days, bool the
 // lowered by the loss, which the estimate does not need to know. Unlike the
 // day after the CUSUM was last 0, it is not moved early by mildly low days
 // before the change (counted in, days lower by less than about half the
-// loss lower the likelihood), and a loss
-// seen on clear days only, on which the CUSUM returns to 0 on the cloudy
-// days between and alarms again from 0, stays one change as long as the
-// days between carry less evidence of its end than the days after of its
-// going on. The diagnosis judges the days from it
-// (daemon/service/nightly_diagnosis.h): a model fitted across a change
-// judges neither state. Withheld days take no part.
+// loss lower the likelihood), and a loss seen on clear days only, on which
+// the CUSUM returns to 0 on the cloudy days between and alarms again from
+// 0, stays one change as long as the days between carry less evidence of
+// its end than the days after of its going on. The diagnosis judges the
+// days from it (daemon/service/nightly_diagnosis.h): a model fitted across
+// a change judges neither state. Withheld days take no part.
 std::int64_t ChangeOnsetS(std::span<const IndexDay> days);
 
 // Sets day->pi_*_low and pi_*_high of each output day is scored for, as

@@ -135,7 +135,7 @@ void Service::MaybeStartCalibration() {
     row.status = "skipped";
     row.reason = "window holds " + Format("%.1f", span / 86400.0) + " days of " +
                  (data.source == cli::WindowSource::kIntervals ? data.Describe()
-                                                                : std::string("1-min data")) +
+                                                               : std::string("1-min data")) +
                  "; two are needed (training days and a held-out day)";
     RecordCalibration(row);
     return;
@@ -170,6 +170,13 @@ void Service::MaybeStartCalibration() {
                          HeldOutText() + ")");
 }
 
+bool Service::WriteConfigInUse(std::string* path, std::string* error) {
+  const fs::path file = fs::path(config_.storage.path).parent_path() / "config-in-use.toml";
+  if (!WriteTextFileAtomically(file.string(), config_text_, error)) return false;
+  *path = file.string();
+  return true;
+}
+
 bool Service::StartCalibrateChild(const Series& data, const std::string& csv_name,
                                   std::string* error) {
   std::error_code ec;
@@ -184,23 +191,25 @@ bool Service::StartCalibrateChild(const Series& data, const std::string& csv_nam
   fs::remove(new_json, ec);
   fs::remove(log_path, ec);
   if (!WriteCsv(csv.string(), data, channels, error)) return false;
-  std::vector<std::string> argv = {options_.exe_path.empty() ? SelfExecutable() : options_.exe_path,
-                                   "calibrate",
-                                   "--config",
-                                   options_.config_path,
-                                   "--csv",
-                                   csv.string(),
-                                   "--variant",
-                                   spec_.Name(),
-                                   "--step",
-                                   Format("%.0f", cli::StepForData(config_.calibration.step_s,
-                                                                   data.step_s)),
-                                   "--ftol",
-                                   Format("%g", options_.calibration_ftol),
-                                   "--out",
-                                   new_json.string(),
-                                   "--parent-pid",
-                                   std::to_string(::getpid())};
+  std::string config_path;
+  if (!WriteConfigInUse(&config_path, error)) return false;
+  std::vector<std::string> argv = {
+      options_.exe_path.empty() ? SelfExecutable() : options_.exe_path,
+      "calibrate",
+      "--config",
+      config_path,
+      "--csv",
+      csv.string(),
+      "--variant",
+      spec_.Name(),
+      "--step",
+      Format("%.0f", cli::StepForData(config_.calibration.step_s, data.step_s)),
+      "--ftol",
+      Format("%g", options_.calibration_ftol),
+      "--out",
+      new_json.string(),
+      "--parent-pid",
+      std::to_string(::getpid())};
   if (have_params_) {
     const fs::path current = job_dir_ / "current-params.json";
     if (WriteTextFileAtomically(current.string(), params_json_, error)) {

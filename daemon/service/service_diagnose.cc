@@ -19,7 +19,11 @@ void Service::MaybeStartDiagnosis() {
   if (!have_params_ || !diagnosis_ || !config_.diagnosis.enabled) return;
   cli::NightlyDiagnosis::Job job;
   job.exe = options_.exe_path.empty() ? SelfExecutable() : options_.exe_path;
-  job.config_path = options_.config_path;
+  std::string error;
+  if (!WriteConfigInUse(&job.config_path, &error)) {
+    LogToStderr(kErr, "diagnosis not started: " + error);
+    return;
+  }
   job.db_path = config_.storage.path;
   job.variant = spec_.Name();
   job.step_s = Format("%.0f", config_.calibration.step_s);
@@ -32,7 +36,6 @@ void Service::MaybeStartDiagnosis() {
   checks.config = &config_;
   checks.spec = spec_;
   checks.now_s = job.now_s;
-  std::string error;
   if (!cli::NewestChangeOnset(*store_, checks, &job.change_from, &error)) {
     LogToStderr(kErr, "diagnosis: the performance alarm's days not read: " + error);
   }

@@ -108,6 +108,12 @@ class Service {
   bool StartCalibrateChild(const Series& data, const std::string& csv_name, std::string* error);
   void StartRefit();
   void FinishRefit(int exit_code);
+  // Writes the config the daemon runs with (config_text_) to
+  // <store dir>/config-in-use.toml for the calibrate and diagnose children,
+  // and sets *path to it. The file on disk may hold an edit that a reload
+  // refused, or one not yet reloaded: a child started on it would fail, or
+  // run on settings the daemon does not use.
+  bool WriteConfigInUse(std::string* path, std::string* error);
   // Daily checks and the diagnosis, once the night's calibration is done.
   void AfterCalibration();
   // performance_daily, sensor faults, drift and alarms (daemon/service/monitor.h).

@@ -395,6 +395,39 @@ TEST_F(DaemonPaths, AnAcceptedFitIsRefitOnTheWholeWindow) {
   EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
 }
 
+// The fits run on the config the daemon runs with, not on the file as it
+// is now: an edit that the reload refused (period_s = 7) broke the refit
+// and the next night's calibration, whose children read the file afresh.
+TEST_F(DaemonPaths, TheFitsUseTheConfigInUseNotAnEditTheReloadRefused) {
+  ImportHistory(kJune1, 4);
+  DaemonSettings settings = Settings();
+  settings.calibrate_at = "00:30";  // UTC, 30 simulated minutes after the start
+  WriteConfig(settings);
+  StartDaemon(kJune1, 60.0);
+  const std::string valid = ReadFile(dir_ / "pvtwin.toml");
+  std::ofstream(dir_ / "pvtwin.toml")
+      << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
+  ::kill(daemon_.pid(), SIGHUP);
+  ASSERT_TRUE(WaitFor(10, [&] {
+    return Log().find("; running with the previous config") != std::string::npos;
+  })) << Log();
+  Db db(DbPath());
+  // The first calibration (its child may have read the file before the
+  // edit), its refit and the one at 00:30 (after it).
+  ASSERT_TRUE(WaitFor(120, [&] { return db.Number("SELECT count(*) FROM calibration") >= 2; }))
+      << Log();
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE status IN ('failed', 'crashed')"), 0)
+      << Log();
+  EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE reason LIKE '%period_s%'"), 0);
+  EXPECT_GE(db.Number("SELECT count(*) FROM calibration WHERE reason LIKE "
+                      "'%; refit on the whole window (held-out days included) in %'"),
+            1)
+      << Log();
+  EXPECT_EQ(Log().find("refit of calibration"), std::string::npos) << Log();
+  EXPECT_EQ(ReadFile(dir_ / "config-in-use.toml"), valid);
+  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+}
+
 // Without the refit the held-out-checked parameters are the ones used.
 TEST_F(DaemonPaths, TheRefitCanBeTurnedOff) {
   ImportHistory(kJune1, 4);

@@ -27,6 +27,7 @@
 #include "tests/support/files.h"
 #include "tests/support/http_server.h"
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/stop_timeout.h"
 
 namespace pvtwin {
 namespace {
@@ -36,6 +37,7 @@ using testing::LoopbackHttpServer;
 using testing::ReadFile;
 using testing::RunPvtwin;
 using testing::ScratchDir;
+using testing::UnitStopTimeoutS;
 
 const fs::path kData = fs::path(PVTWIN_SOURCE_DIR) / "tests" / "weather" / "data";
 const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
@@ -605,14 +607,14 @@ TEST_F(DaemonWeatherFetch, FetchesAcrossAnOutageAndNamesTheSourceInTheForecast) 
   EXPECT_NE(inputs.find("t_amb_c=weather_forecast"), std::string::npos) << inputs;
   EXPECT_NE(inputs.find("g_poa_w_m2=weather_forecast"), std::string::npos) << inputs;
 
-  // SIGTERM is served at once.
+  // SIGTERM is served well within systemd's stop timeout.
   const double start = WallNowS();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0);
-  EXPECT_LT(WallNowS() - start, 5.0);
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS()), 0) << DaemonLog();
+  EXPECT_LT(WallNowS() - start, UnitStopTimeoutS() / 2) << DaemonLog();
 }
 
-// A weather server that takes its time (the fetch's limit is 2 min) does not
-// hold up SIGTERM.
+// A weather server that takes its time (the fetch's limit is 2 min, the
+// answer comes after 1 min) does not hold up SIGTERM.
 class DaemonWeatherFetchSlowServer : public DaemonWeatherFetch {
  protected:
   DaemonWeatherFetchSlowServer() { timeout_s_ = 120.0; }
@@ -632,8 +634,8 @@ TEST_F(DaemonWeatherFetchSlowServer, StopsPromptlyWhileTheServerIsSlow) {
       << error;
   ASSERT_TRUE(WaitFor(30, [&] { return server.requests() > 0; })) << DaemonLog();
   const double start = WallNowS();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
-  EXPECT_LT(WallNowS() - start, 5.0) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS()), 0) << DaemonLog();
+  EXPECT_LT(WallNowS() - start, UnitStopTimeoutS() / 2) << DaemonLog();
 }
 
 }  // namespace

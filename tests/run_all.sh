@@ -6,8 +6,9 @@
 #      UndefinedBehaviorSanitizer and libFuzzer's coverage (build-check/):
 #      the suite again under the sanitizers, halting on the first error, then
 #      every libFuzzer harness of tests/fuzz for PVTWIN_FUZZ_SECONDS each
-#      (default 60) on its seeds, the golden inputs and the example configs,
-#      after replaying every kept crash.
+#      (default 60; one harness per core at a time) on its seeds, the
+#      golden inputs and the example configs, after replaying every kept
+#      crash.
 # Neither build uses link-time optimisation (it buys the product a few per
 # cent and costs the test build minutes), and both carry line tables only
 # (-g1): the sanitizers' backtraces keep their file:line, the code is the
@@ -79,22 +80,42 @@ stage "5/5 fuzzing, ${fuzz_seconds} s per harness"
 ctest --test-dir build-check --output-on-failure -L fuzz  # every kept seed and crash
 harnesses=(modbus_reply csv config model weather)
 mkdir -p build-check/crashes
-for name in "${harnesses[@]}"; do
+fuzz_one() {
+  local name=$1 d
   # New inputs go to the first directory (scratch); the others are read-only seeds.
-  scratch=build-check/corpus-$name
+  local scratch=build-check/corpus-$name
   mkdir -p "$scratch"
-  seeds=(tests/fuzz/corpus/"$name")
+  local seeds=(tests/fuzz/corpus/"$name") existing=()
   case "$name" in
     csv | model) seeds+=(tests/golden/csv tests/data/htwsaar-pvt) ;;
     config) seeds+=(tests/golden/config config/examples) ;;
     weather) seeds+=(tests/weather/data) ;;
   esac
-  existing=()
   for d in "${seeds[@]}"; do [ -d "$d" ] && existing+=("$d"); done
-  echo "fuzz_$name: ${fuzz_seconds} s"
   build-check/tests/fuzz/fuzz_"$name" -max_total_time="$fuzz_seconds" -max_len=65536 \
     -artifact_prefix=build-check/crashes/"$name"- -print_final_stats=1 \
-    "$scratch" "${existing[@]}" 2>build-check/fuzz_"$name".log ||
-    { tail -n 60 build-check/fuzz_"$name".log; exit 1; }
-  grep -E '^stat::number_of_executed_units|^Done' build-check/fuzz_"$name".log || true
+    "$scratch" "${existing[@]}" 2>build-check/fuzz_"$name".log
+}
+# One harness per core at a time (each fuzzes on one core for the full
+# time); a harness that finds a crash fails the stage after its round.
+failed=0
+for ((i = 0; i < ${#harnesses[@]}; i += jobs)); do
+  round=("${harnesses[@]:i:jobs}")
+  pids=()
+  for name in "${round[@]}"; do
+    echo "fuzz_$name: ${fuzz_seconds} s"
+    fuzz_one "$name" &
+    pids+=("$!")
+  done
+  for k in "${!round[@]}"; do
+    name=${round[$k]}
+    if wait "${pids[$k]}"; then
+      grep -E '^stat::number_of_executed_units|^Done' build-check/fuzz_"$name".log || true
+    else
+      echo "fuzz_$name failed; a crash it found is kept as build-check/crashes/$name-*"
+      tail -n 60 build-check/fuzz_"$name".log
+      failed=1
+    fi
+  done
 done
+((failed == 0))

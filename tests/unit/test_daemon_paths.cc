@@ -128,6 +128,17 @@ class DaemonPaths : public ::testing::Test {
         << Log();
   }
 
+  // Writes an error into the config file (a poll period that does not
+  // divide a minute) and sends SIGHUP: the reload is refused and the daemon
+  // runs on with the previous config. Returns the valid text.
+  std::string EditInvalidAndReload() {
+    const std::string valid = ReadFile(dir_ / "pvtwin.toml");
+    std::ofstream(dir_ / "pvtwin.toml")
+        << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
+    ::kill(daemon_.pid(), SIGHUP);
+    return valid;
+  }
+
   DaemonSettings Settings() const {
     DaemonSettings s;
     s.db_path = DbPath();
@@ -164,10 +175,7 @@ TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
       << Log();
 
   // A reload with an invalid config keeps the running one.
-  const std::string valid = ReadFile(dir_ / "pvtwin.toml");
-  std::ofstream(dir_ / "pvtwin.toml")
-      << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
-  ::kill(daemon_.pid(), SIGHUP);
+  EditInvalidAndReload();
   ASSERT_TRUE(WaitFor(10, [&] {
     return Log().find("; running with the previous config") != std::string::npos;
   })) << Log();
@@ -404,10 +412,7 @@ TEST_F(DaemonPaths, TheFitsUseTheConfigInUseNotAnEditTheReloadRefused) {
   settings.calibrate_at = "00:30";  // UTC, 30 simulated minutes after the start
   WriteConfig(settings);
   StartDaemon(kJune1, 60.0);
-  const std::string valid = ReadFile(dir_ / "pvtwin.toml");
-  std::ofstream(dir_ / "pvtwin.toml")
-      << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
-  ::kill(daemon_.pid(), SIGHUP);
+  const std::string valid = EditInvalidAndReload();
   ASSERT_TRUE(WaitFor(10, [&] {
     return Log().find("; running with the previous config") != std::string::npos;
   })) << Log();
@@ -687,10 +692,7 @@ TEST_F(LiveDaemon, AHealthLineEveryStatusMinAndSystemdStatusKeptCurrent) {
       << notify.received();
 
   // A reload with an error: the STATUS says so until the next health line.
-  const std::string valid = ReadFile(dir_ / "pvtwin.toml");
-  std::ofstream(dir_ / "pvtwin.toml")
-      << std::regex_replace(valid, std::regex("period_s = [0-9.]+"), "period_s = 7");
-  ::kill(daemon_.pid(), SIGHUP);
+  EditInvalidAndReload();
   ASSERT_TRUE(notify.WaitFor("STATUS=reload failed: ", 10)) << notify.received();
   EXPECT_TRUE(std::regex_search(notify.received(),
                                 std::regex("STATUS=reload failed: [^\\]]*period_s = 7: [^\\]]*; "

@@ -12,9 +12,9 @@
 # Neither build uses link-time optimisation (it buys the product a few per
 # cent and costs the test build minutes), and both carry line tables only
 # (-g1): the sanitizers' backtraces keep their file:line, the code is the
-# same as with -g, and the full debug information cost a third of the
-# compile time. Each stage's time is printed, and
-# a summary at the end. Stops at the first failure. A crash the fuzzer finds
+# same as with -g, and the full debug information cost a quarter to a third
+# of each file's compile time. Each stage's time is printed, and a summary
+# at the end. Stops at the first failure. A crash the fuzzer finds
 # is written to build-check/crashes/: copy it into tests/fuzz/corpus/<harness>/
 # once fixed, where the replay keeps it as a regression case.
 set -euo pipefail

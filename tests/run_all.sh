@@ -2,9 +2,11 @@
 # The whole test run (README "Run the tests", and what .ci/run runs), in two
 # builds:
 #   1. the suite on an optimised GCC build with warnings as errors (build/);
-#   2. one clang build instrumented with AddressSanitizer,
-#      UndefinedBehaviorSanitizer and libFuzzer's coverage (build-check/):
-#      the suite again under the sanitizers, halting on the first error, then
+#   2. one clang build instrumented with AddressSanitizer and
+#      UndefinedBehaviorSanitizer, whose libraries under tests/fuzz's
+#      harnesses also carry libFuzzer's coverage (build-check/):
+#      the suite again under the sanitizers, halting on the first error (all
+#      but the statistical batteries, which stage 2 ran), then
 #      every libFuzzer harness of tests/fuzz for PVTWIN_FUZZ_SECONDS each
 #      (default 60; one harness per core at a time) on its seeds, the
 #      golden inputs and the example configs, after replaying every kept
@@ -74,7 +76,8 @@ stage "4/5 test suite under AddressSanitizer and UndefinedBehaviorSanitizer"
 # new/free, a false report on every stable_sort; fixed in GCC 13's headers.
 export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1:alloc_dealloc_mismatch=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
-ctest --test-dir build-check --output-on-failure -j"$jobs" --timeout 900 -LE fuzz
+# The statistical batteries (label battery, tests/CMakeLists.txt) ran in stage 2.
+ctest --test-dir build-check --output-on-failure -j"$jobs" --timeout 900 -LE 'fuzz|battery'
 
 stage "5/5 fuzzing, ${fuzz_seconds} s per harness"
 ctest --test-dir build-check --output-on-failure -L fuzz  # every kept seed and crash

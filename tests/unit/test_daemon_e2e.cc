@@ -16,6 +16,7 @@
 #include "io/platform/child_process.h"
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
+#include "tests/support/stop_timeout.h"
 
 namespace pvtwin {
 namespace {
@@ -24,6 +25,7 @@ namespace fs = std::filesystem;
 using testing::ReadFile;
 using testing::RunPvtwin;
 using testing::ScratchDir;
+using testing::UnitStopTimeoutS;
 
 const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
 constexpr double kSpeed = 120.0;
@@ -108,7 +110,7 @@ class DaemonE2E : public ::testing::Test {
     std::ofstream(dir_ / "pvtwin.toml") << text;
   }
   void TearDown() override {
-    daemon_.Stop(SIGTERM, 10.0);
+    daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2);
     sim_.SendLine("quit");
     sim_.Stop(0, 5.0);
   }
@@ -203,7 +205,7 @@ TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
   // measurements exist (20 simulated minutes after the start: 10 s here).
   ASSERT_TRUE(WaitFor(60, [&] { return db.Count("SELECT count(*) FROM forecast_skill") >= 1; }))
       << DaemonLog();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << DaemonLog();
   EXPECT_NE(DaemonLog().find("stopping"), std::string::npos);
 }
 
@@ -303,7 +305,7 @@ TEST_F(DaemonE2ETwoNights, DiagnosesTheMissingEffectAndRecordsTheFrozenSensor) {
       << db.Text("SELECT group_concat(reason, '; ') FROM calibration WHERE status = 'failed'");
   int code = 0;
   EXPECT_FALSE(daemon_.Finished(&code)) << DaemonLog();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << DaemonLog();
 }
 
 TEST_F(DaemonE2E, KillNineLosesNoCommittedRowAndCorruptsNothing) {
@@ -335,7 +337,7 @@ TEST_F(DaemonE2E, KillNineLosesNoCommittedRowAndCorruptsNothing) {
   EXPECT_EQ(db.Count("SELECT count(*) FROM (SELECT ts FROM measurement_1min GROUP BY ts HAVING "
                      "count(*) > 1)"),
             0);
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << DaemonLog();
   EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
 }
 
@@ -360,7 +362,7 @@ TEST_F(DaemonE2E, AReaderHoldingATransactionDoesNotStopIngestion) {
                            std::to_string(t0_)),
             0);
   reader.Exec("COMMIT");
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << DaemonLog();
 }
 
 // A new plant: an empty store, the simulator's plant polled live from 08:00
@@ -412,7 +414,7 @@ TEST_F(DaemonE2EDayOne, ForecastsFromTheStartValuesAndWaitsWithoutAWarning) {
   EXPECT_EQ(db.Count("SELECT count(*) FROM event WHERE severity != 'info'"), 0)
       << db.Text("SELECT group_concat(message, ' | ') FROM event");
   EXPECT_EQ(db.Count("SELECT count(*) FROM event WHERE kind = 'calibration_waiting'"), 1);
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << DaemonLog();
   const std::string log = DaemonLog();
   EXPECT_EQ(log.find(" warning: "), std::string::npos) << log;
   std::size_t announced = 0;
@@ -466,7 +468,7 @@ TEST_F(DaemonE2EDayTwo, TheFirstAcceptedCalibrationTurnsTheForecastsCalibrated) 
                      " AND basis IS NOT 'calibrated'"),
             0);
   EXPECT_EQ(db.Count("SELECT count(*) FROM event WHERE kind = 'calibration_skipped'"), 0);
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << DaemonLog();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << DaemonLog();
 }
 
 }  // namespace

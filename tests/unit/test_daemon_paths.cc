@@ -27,6 +27,7 @@
 #include "tests/support/files.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
+#include "tests/support/stop_timeout.h"
 #include "tests/support/wait.h"
 
 namespace pvtwin {
@@ -36,6 +37,7 @@ namespace fs = std::filesystem;
 using testing::ReadFile;
 using testing::RunPvtwin;
 using testing::ScratchDir;
+using testing::UnitStopTimeoutS;
 using testing::WaitFor;
 using Db = testing::RawDb;
 
@@ -219,7 +221,7 @@ TEST_F(DaemonPaths, AReloadLogsEachChangedKeyAndWhatNeedsARestart) {
       << log;
   // The applied key only: the storage path stayed.
   EXPECT_EQ(log.find("[storage]"), std::string::npos) << log;
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // A daemon started on the store of another plant (a copied config pointing
@@ -237,7 +239,7 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
   };
   write("pvtwin.toml", "47.358", "1.8");
   StartDaemon(kJune1, 1.0);  // the store records this plant
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 
   // Another site 60 km north, and the same site with another area.
   for (const bool other_site : {true, false}) {
@@ -257,7 +259,7 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
   write("pvtwin.toml", "47.359", "1.8");
   fs::remove(dir_ / "daemon.log");
   StartDaemon(kJune1, 1.0);
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   EXPECT_EQ(Log().find("belongs to another plant"), std::string::npos) << Log();
 
   // --adopt-store takes it over, and the store records the new plant.
@@ -265,7 +267,7 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
   fs::remove(dir_ / "daemon.log");
   StartDaemon(kJune1, 1.0, {"--adopt-store"});
   EXPECT_NE(Log().find("adopted for"), std::string::npos) << Log();
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   Db db(DbPath());
   EXPECT_EQ(db.Number("SELECT value FROM plant_config WHERE key = 'area_m2'"), 3.6);
 }
@@ -279,7 +281,7 @@ TEST_F(DaemonPaths, TheJournalPrefixOnlyOnTheJournalStreamAndDatedLinesElsewhere
   ::setenv("JOURNAL_STREAM", "8:12345", 1);  // another stream than stderr
   StartDaemon(kJune1, 1.0);
   ::unsetenv("JOURNAL_STREAM");
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   EXPECT_TRUE(std::regex_search(Log(), std::regex("(^|\n)20[0-9]{2}-[0-9]{2}-[0-9]{2}T[0-9]{2}:"
                                                   "[0-9]{2}:[0-9]{2}Z info: ready: ")))
       << Log();
@@ -299,7 +301,7 @@ TEST_F(DaemonPaths, TheJournalPrefixOnlyOnTheJournalStreamAndDatedLinesElsewhere
   ::unsetenv("JOURNAL_STREAM");
   ASSERT_TRUE(started) << error;
   ASSERT_TRUE(WaitFor(20, [&] { return Log().find("<6>ready: ") != std::string::npos; })) << Log();
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
@@ -318,7 +320,7 @@ TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
             std::string::npos);
   int code = 0;
   EXPECT_FALSE(daemon_.Finished(&code)) << "the daemon stopped: " << Log();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
@@ -334,7 +336,7 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
       return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
     })) << Log();
   }
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   // The training days now read 40 % less heat than the plant made (a failed
   // heat meter); the held-out last day is left as it was.
   {
@@ -364,7 +366,7 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
   EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE accepted = 1"), 1);
   // Forecasts still come from the first calibration.
   EXPECT_EQ(db.Number("SELECT count(DISTINCT calibration_id) FROM forecast"), 1);
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // A fit that passes the held-out check is fitted again on the whole window
@@ -400,7 +402,7 @@ TEST_F(DaemonPaths, AnAcceptedFitIsRefitOnTheWholeWindow) {
     const std::size_t refit = log.find("refit on the whole window");
     return refit != std::string::npos && log.find("forecast issued", refit) != std::string::npos;
   })) << Log();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // The fits run on the config the daemon runs with, not on the file as it
@@ -430,7 +432,7 @@ TEST_F(DaemonPaths, TheFitsUseTheConfigInUseNotAnEditTheReloadRefused) {
       << Log();
   EXPECT_EQ(Log().find("refit of calibration"), std::string::npos) << Log();
   EXPECT_EQ(ReadFile(dir_ / "config-in-use.toml"), valid);
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // Without the refit the held-out-checked parameters are the ones used.
@@ -449,7 +451,7 @@ TEST_F(DaemonPaths, TheRefitCanBeTurnedOff) {
       << Log();
   EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE reason LIKE '%refit%'"), 0);
   EXPECT_EQ(Log().find("refit"), std::string::npos) << Log();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // After the first calibration the daemon diagnoses its window in a child:
@@ -482,7 +484,7 @@ TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
   EXPECT_TRUE(fs::exists(dir_ / "reports" / "diagnosis-2024-06-01.html")) << Log();
   int code = 0;
   EXPECT_FALSE(daemon_.Finished(&code)) << "the daemon stopped: " << Log();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // A plant whose history came from a 2-min logger (measurement_interval, no
@@ -509,7 +511,7 @@ TEST_F(DaemonPaths, IntervalHistoryIsCalibratedAtItsOwnStep) {
   ASSERT_FALSE(logs.empty());
   const std::string calibrate_log = ReadFile(logs.front());
   EXPECT_NE(calibrate_log.find("step 120 s"), std::string::npos) << calibrate_log;
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // A diagnosis over [diagnosis] timeout_s is stopped, logged and recorded as
@@ -527,7 +529,7 @@ TEST_F(DaemonPaths, ADiagnosisOverItsTimeLimitIsStoppedAndTheDaemonGoesOn) {
   EXPECT_EQ(db.Number("SELECT count(*) FROM diagnosis"), 0);
   int code = 0;
   EXPECT_FALSE(daemon_.Finished(&code)) << "the daemon stopped: " << Log();
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // The README's workflow that once crash-looped the daemon: history with a
@@ -568,7 +570,7 @@ TEST_F(DaemonPaths, APyranometerOutageInTheHistoryIsForecastAround) {
   int code = 0;
   EXPECT_FALSE(daemon_.Finished(&code)) << "exit " << code << ": " << Log();
   EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE accepted = 1"), 1);
-  EXPECT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  EXPECT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 }
 
 // Live polling through `pvtwin sim`, the daemon configured with another
@@ -616,7 +618,7 @@ class LiveDaemon : public DaemonPaths {
     std::ofstream(dir_ / "pvtwin.toml") << text;
   }
   void TearDown() override {
-    daemon_.Stop(SIGTERM, 10.0);
+    daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2);
     sim_.SendLine("quit");
     sim_.Stop(0, 5.0);
   }
@@ -700,7 +702,7 @@ TEST_F(LiveDaemon, AHealthLineEveryStatusMinAndSystemdStatusKeptCurrent) {
       << notify.received();
   ASSERT_TRUE(notify.WaitFor("STATUS=2/2 devices up, ", 10)) << notify.received();
 
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   std::istringstream lines(Log());
   std::size_t longest = 0;
   for (std::string l; std::getline(lines, l);) {
@@ -739,7 +741,7 @@ TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
   })) << Log();
   int code = 0;
   ASSERT_FALSE(daemon_.Finished(&code)) << "exit " << code << ": " << Log();
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   const std::int64_t last1 = static_cast<std::int64_t>(db.Number("SELECT max(ts) FROM sample_5s"));
 
   anchor_ = WallNowS();  // the restart, 30 simulated minutes later
@@ -749,7 +751,7 @@ TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
   })) << Log();
   ASSERT_FALSE(daemon_.Finished(&code)) << "exit " << code << ": " << Log();
   const std::int64_t last2 = static_cast<std::int64_t>(db.Number("SELECT max(ts) FROM sample_5s"));
-  ASSERT_EQ(daemon_.Stop(SIGTERM, 10.0), 0) << Log();
+  ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 
   // Every period of both runs has its row.
   const auto rows = [&](std::int64_t from, std::int64_t to) {

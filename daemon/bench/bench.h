@@ -15,6 +15,8 @@
 namespace pvtwin::cli {
 
 double Median(std::vector<double> v);
+// User plus system CPU seconds of this process so far (getrusage).
+double SelfCpuSeconds();
 using pvtwin::SecondsSince;  // core/common/clock.h
 
 // The pvtwin executable the benchmarks start as child processes (`run`,

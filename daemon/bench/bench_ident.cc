@@ -50,8 +50,8 @@ namespace pvtwin::cli {
 
 namespace {
 
-constexpr int kTrainDays = 14;
-constexpr int kHeldOutDays = 3;
+constexpr int kIdentTrainDays = 14;
+constexpr int kIdentHeldOutDays = 3;
 constexpr const char* kVariant = "2N1Ccolwr";
 // Issue 16's target for the whole `pvtwin calibrate` process at 1 min.
 constexpr double kTargetProcessS = 0.05;
@@ -67,17 +67,17 @@ struct SplitData {
   Measurements train_meas, held_out_meas;
 };
 
-// Generates kTrainDays + kHeldOutDays of synthetic data at step_s and splits
+// Generates kIdentTrainDays + kIdentHeldOutDays of synthetic data at step_s and splits
 // it. False (and *error) if the drivers cannot be built.
 bool MakeSplitData(const Plant& plant, const ModelSpec& spec, double step_s, std::uint64_t seed,
                    SplitData* out, std::string* error) {
   WeatherOptions weather;
-  weather.num_days = kTrainDays + kHeldOutDays;
+  weather.num_days = kIdentTrainDays + kIdentHeldOutDays;
   weather.step_s = step_s;
   weather.seed = seed;
   const Series data = MakeSyntheticPlantData(plant, weather, spec, ReferenceTruthParams(plant),
                                              RealisticSensorNoise(seed));
-  const auto train_rows = static_cast<std::size_t>(kTrainDays * 86400.0 / step_s + 0.5);
+  const auto train_rows = static_cast<std::size_t>(kIdentTrainDays * 86400.0 / step_s + 0.5);
   if (data.size() <= train_rows) {
     *error = "the generated series is shorter than the training window";
     return false;
@@ -385,7 +385,7 @@ std::vector<FitFigures> CompareAlgorithms(const SplitData& d1, const ParamVector
       "%g) unless named; NLopt methods with max_evaluations 6000, ftol_rel 1e-6; median runtime "
       "over %d (lad_lm) or %d runs; J: derivatives from the runs with sensitivities (sens, each "
       "counted as %d sims) or forward differences (diff)\n",
-      kTrainDays, IdentOptions{}.optimizer.ftol_rel, repeats, slow_runs, kSensitivityRunCost);
+      kIdentTrainDays, IdentOptions{}.optimizer.ftol_rel, repeats, slow_runs, kSensitivityRunCost);
   std::printf("  %-22s %-4s %9s %5s %7s %5s  %-18s %5s %9s %9s %7s\n", "algorithm", "J", "median s",
               "runs", "sims", "sens", "status", "free", "train", "held-out", "/ref");
   for (const FitFigures& f : table) PrintFitRow(f, ref_held_out);
@@ -503,8 +503,8 @@ void BenchIdentification(int repeats, std::uint64_t seed, const std::string& dat
   std::printf(
       "\ndata: %d days at 1 min (%zu rows): train = first %d days (%zu rows, %zu in the "
       "objective), held-out = last %d days (%zu rows, %zu in the objective)\n",
-      kTrainDays + kHeldOutDays, d1.rows, kTrainDays, d1.train_meas.size(),
-      d1.train_meas.rows.size(), kHeldOutDays, d1.held_out_meas.size(),
+      kIdentTrainDays + kIdentHeldOutDays, d1.rows, kIdentTrainDays, d1.train_meas.size(),
+      d1.train_meas.rows.size(), kIdentHeldOutDays, d1.held_out_meas.size(),
       d1.held_out_meas.rows.size());
   // Where train.csv and held_out.csv go (7. runs `pvtwin calibrate` on them).
   std::string dir = data_dir;

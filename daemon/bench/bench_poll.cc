@@ -10,7 +10,6 @@
 //     wall time); per cycle the longest device poll (connect + reads +
 //     decoding), p50 and p99; and CPU time per cycle.
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -126,13 +125,6 @@ struct ServerChild {
   }
 };
 
-double CpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
 double Percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -162,7 +154,7 @@ RunFigures Run(const ModbusConfig& map, double speed, int cycles) {
   std::mutex mutex;
   std::condition_variable cv;
   ModbusPoller poller(map, options, clock, [](int, const std::string&) {});
-  const double cpu0 = CpuSeconds();
+  const double cpu0 = SelfCpuSeconds();
   const auto wall0 = std::chrono::steady_clock::now();
   poller.Start([&](const Sample& s) {
     double latency = 0;
@@ -181,7 +173,7 @@ RunFigures Run(const ModbusConfig& map, double speed, int cycles) {
                 [&] { return f.cycles >= cycles; });
   }
   poller.Stop();
-  f.cpu_s = CpuSeconds() - cpu0;
+  f.cpu_s = SelfCpuSeconds() - cpu0;
   f.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return f;
 }

@@ -8,7 +8,6 @@
 // Printed per batch size: the time to queue the backlog (the triggers'
 // first install on an existing store), then rows, wall time, rows/s and
 // CPU seconds (user + system) of the upload itself.
-#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -27,13 +26,6 @@ namespace pvtwin::cli {
 namespace {
 
 constexpr int kBacklogDays = 30;
-
-double CpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
 
 // One upload of the backlog with batch_rows into a fresh database.
 void RunOne(const PgScratchServer& server, const Series& minutes, int batch_rows,
@@ -63,7 +55,7 @@ void RunOne(const PgScratchServer& server, const Series& minutes, int batch_rows
   }
   const double queue_s = SecondsSince(start);
   start = std::chrono::steady_clock::now();
-  const double cpu_start = CpuSeconds();
+  const double cpu_start = SelfCpuSeconds();
   std::int64_t total = 0;
   bool more = true;
   while (more) {
@@ -76,7 +68,7 @@ void RunOne(const PgScratchServer& server, const Series& minutes, int batch_rows
     total += rows;
   }
   const double wall_s = SecondsSince(start);
-  const double cpu_s = CpuSeconds() - cpu_start;
+  const double cpu_s = SelfCpuSeconds() - cpu_start;
   std::printf("  %10d %10.2f %8lld %10.2f %10.0f %10.2f %7.0f %%\n", batch_rows, queue_s,
               static_cast<long long>(total), wall_s, static_cast<double>(total) / wall_s, cpu_s,
               100.0 * cpu_s / wall_s);

@@ -35,7 +35,7 @@ constexpr std::size_t kSampleBatch = 17280;
 constexpr std::size_t kMinuteBatch = 1440;
 
 // Progress on stderr, every batch, for inputs of more than two batches.
-void Progress(const char* what, std::size_t done, std::size_t total, std::size_t batch) {
+void PrintImportProgress(const char* what, std::size_t done, std::size_t total, std::size_t batch) {
   if (total > 2 * batch) {
     std::cerr << "import: " << done << "/" << total << " " << what << " (" << (100 * done / total)
               << " %)\n";
@@ -62,7 +62,7 @@ int ImportSamples(Store& store, const Series& series, const std::string& csv) {
       return kExitRuntime;
     }
     minutes_total += minutes;
-    Progress("samples", end, samples.size(), kSampleBatch);
+    PrintImportProgress("samples", end, samples.size(), kSampleBatch);
   }
   std::cerr << "imported " << samples.size() << " samples (" << series.step_s
             << " s) into sample_5s and aggregated " << minutes_total
@@ -107,7 +107,7 @@ int ImportMinutes(Store& store, Series series, const std::string& csv) {
       std::cerr << csv << ": " << error << "\n";
       return kExitRuntime;
     }
-    Progress("1-min rows", end, series.size(), kMinuteBatch);
+    PrintImportProgress("1-min rows", end, series.size(), kMinuteBatch);
   }
   std::cerr << "imported " << series.size() << " 1-min rows into measurement_1min of "
             << store.path() << "\n";
@@ -123,7 +123,7 @@ int ImportIntervals(Store& store, Series series, const std::string& csv) {
       std::cerr << csv << ": " << error << "\n";
       return kExitRuntime;
     }
-    Progress("rows", end, series.size(), kMinuteBatch);
+    PrintImportProgress("rows", end, series.size(), kMinuteBatch);
   }
   const int step_min = static_cast<int>(series.step_s) / kMinuteS;
   std::cerr << "imported " << series.size() << " rows of " << step_min

@@ -17,13 +17,13 @@ std::atomic<bool> g_stop(false);
 std::atomic<bool> g_reload(false);
 
 // Signal handlers only set a flag; the loop acts on it.
-extern "C" void OnStopSignal(int) { g_stop.store(true); }
+extern "C" void OnRunStopSignal(int) { g_stop.store(true); }
 extern "C" void OnHangup(int) { g_reload.store(true); }
 
 void InstallSignalHandlers() {
   struct sigaction sa {};
   sigemptyset(&sa.sa_mask);
-  sa.sa_handler = OnStopSignal;
+  sa.sa_handler = OnRunStopSignal;
   sigaction(SIGTERM, &sa, nullptr);
   sigaction(SIGINT, &sa, nullptr);
   sa.sa_handler = OnHangup;

@@ -26,7 +26,7 @@ namespace pvtwin::cli {
 namespace {
 
 volatile std::sig_atomic_t g_stop_signal = 0;
-void OnStopSignal(int) { g_stop_signal = 1; }
+void OnSimStopSignal(int) { g_stop_signal = 1; }
 
 struct SimArgs {
   std::string config;
@@ -186,8 +186,8 @@ int RunSim(const SimArgs& a) {
   // Generate the first day now, not on the first request (it takes a moment).
   source->At(static_cast<double>(start_s));
   std::signal(SIGPIPE, SIG_IGN);
-  std::signal(SIGTERM, OnStopSignal);
-  std::signal(SIGINT, OnStopSignal);
+  std::signal(SIGTERM, OnSimStopSignal);
+  std::signal(SIGINT, OnSimStopSignal);
   std::string error;
   if (!server.Start(&error)) {
     std::cerr << error << "\n";

@@ -50,7 +50,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kPeriodS = 5.0;
+constexpr double kHostilePeriodS = 5.0;
 constexpr std::int64_t kStartS = 1718964000;  // 2024-06-21T10:00:00Z
 
 enum class Reply { kCorrect, kWrongUnit, kProtocolId7, kLength65535, kLength0 };
@@ -294,7 +294,7 @@ TEST_P(ModbusHostileServer, FaultedRepliesAreNeverStoredAndThePollerRecovers) {
 
   SteppedClock clock(static_cast<double>(kStartS));
   PollerOptions options;
-  options.period_s = kPeriodS;
+  options.period_s = kHostilePeriodS;
   options.backoff_max_periods = 2;
   std::mutex mutex;
   std::vector<Sample> samples;
@@ -313,7 +313,7 @@ TEST_P(ModbusHostileServer, FaultedRepliesAreNeverStoredAndThePollerRecovers) {
     served[static_cast<std::size_t>(step)] = TablesAt(map, step);
     const Tables& t = served[static_cast<std::size_t>(step)];
     server.Set(mode_at(step), t.input, t.holding);
-    clock.Advance(kPeriodS);
+    clock.Advance(kHostilePeriodS);
     ASSERT_TRUE(WaitFor([&] { return polls() >= static_cast<std::uint64_t>(step); }))
         << "step " << step << ": the period was not polled";
   }

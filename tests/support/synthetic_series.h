@@ -10,6 +10,7 @@
 
 #include "core/common/series.h"
 #include "core/model/variant.h"
+#include "tests/support/fixtures.h"
 
 namespace pvtwin::testing {
 
@@ -42,11 +43,6 @@ inline Series MakeConstantSeries(std::size_t rows, double step_s, const Constant
   fill(Channel::kValid, 1.0);
   return s;
 }
-
-// 2024-06-01 00:00 UTC: a start for series whose rows need the sun. The 'I'
-// variants weight the beam with the IAM at its angle of incidence, computed
-// from the plant's site and the row times unless an aoi_deg column is given.
-inline constexpr std::int64_t kJune1_2024UtcS = 1717200000;
 
 // Adds the in-plane diffuse irradiance that the 'I' variants need to split
 // g_poa_w_m2 into beam and diffuse parts (core/physics/irradiance.h,

@@ -7,11 +7,12 @@
 #include <vector>
 
 #include "core/data/aggregate.h"
+#include "tests/support/fixtures.h"
 
 namespace pvtwin {
 namespace {
 
-constexpr std::int64_t kMinute0 = 1717243200;  // 2024-06-01T12:00:00Z, a multiple of 60
+using testing::kJune1Noon2024UtcS;
 constexpr double kCpJKgK = 3650.0;
 
 // n samples every 5 s from t0 with every required channel set to a constant,
@@ -42,9 +43,9 @@ MinuteRows Aggregate(const std::vector<Sample>& samples, double period_s = 5.0) 
 }
 
 TEST(Aggregate, FullMinuteMeansAndThermalPowerFromFlowCpAndDeltaT) {
-  const MinuteRows m = Aggregate(Samples(kMinute0, 12));
+  const MinuteRows m = Aggregate(Samples(kJune1Noon2024UtcS, 12));
   ASSERT_EQ(m.rows.size(), 1u);
-  EXPECT_EQ(m.rows.time_s[0], kMinute0);
+  EXPECT_EQ(m.rows.time_s[0], kJune1Noon2024UtcS);
   EXPECT_EQ(m.rows.step_s, 60.0);
   EXPECT_EQ(m.n_samples[0], 12);
   // Ramp 10 + 0.1·t at t = 0, 5, ..., 55 s: mean 10 + 0.1·27.5.
@@ -63,7 +64,7 @@ TEST(Aggregate, FullMinuteMeansAndThermalPowerFromFlowCpAndDeltaT) {
 }
 
 TEST(Aggregate, ThermalPowerIsTheMeanOfThePerSampleProductsNotTheProductOfMeans) {
-  std::vector<Sample> samples = Samples(kMinute0, 12);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 12);
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const bool odd = i % 2 == 1;
     samples[i].Set(Channel::kMdotKgS, odd ? 0.04 : 0.02);
@@ -77,7 +78,7 @@ TEST(Aggregate, ThermalPowerIsTheMeanOfThePerSampleProductsNotTheProductOfMeans)
 }
 
 TEST(Aggregate, MeasuredThermalPowerIsAveragedNotRecomputed) {
-  std::vector<Sample> samples = Samples(kMinute0, 12);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 12);
   for (std::size_t i = 0; i < samples.size(); ++i) {
     samples[i].Set(Channel::kQThW, i < 6 ? 1000.0 : std::nan(""));  // meter read half the time
   }
@@ -88,23 +89,23 @@ TEST(Aggregate, MeasuredThermalPowerIsAveragedNotRecomputed) {
 
 TEST(Aggregate, HalfTheExpectedSamplesIsEnoughFewerIsFlagged) {
   // 6 of 12 expected: valid; 5 of 12: kQcFewSamples and valid 0.
-  MinuteRows m = Aggregate(Samples(kMinute0, 6));
+  MinuteRows m = Aggregate(Samples(kJune1Noon2024UtcS, 6));
   EXPECT_EQ(m.n_samples[0], 6);
   EXPECT_FALSE(m.qc_flags[0] & kQcFewSamples);
   EXPECT_EQ(m.rows[Channel::kValid][0], 1.0);
-  m = Aggregate(Samples(kMinute0, 5));
+  m = Aggregate(Samples(kJune1Noon2024UtcS, 5));
   EXPECT_EQ(m.n_samples[0], 5);
   EXPECT_TRUE(m.qc_flags[0] & kQcFewSamples);
   EXPECT_EQ(m.rows[Channel::kValid][0], 0.0);
   // At a 10 s poll period, 3 of 6 expected samples are enough.
-  std::vector<Sample> slow = Samples(kMinute0, 6);
+  std::vector<Sample> slow = Samples(kJune1Noon2024UtcS, 6);
   slow = {slow[0], slow[2], slow[4]};  // t = 0, 10, 20 s
   m = Aggregate(slow, 10.0);
   EXPECT_FALSE(m.qc_flags[0] & kQcFewSamples);
 }
 
 TEST(Aggregate, PaperCorrectionsApplyBeforeAveragingAndAreFlagged) {
-  std::vector<Sample> samples = Samples(kMinute0, 12);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 12);
   samples[3].Set(Channel::kGPoaWM2, 6500.0);   // night-time glitch (paper Table 2) → 0
   samples[4].Set(Channel::kMdotKgS, -0.0005);  // pump off noise (paper Table 1) → 0
   samples[5].Set(Channel::kMdotKgS, -0.5);     // broken meter → dropped
@@ -120,7 +121,7 @@ TEST(Aggregate, PaperCorrectionsApplyBeforeAveragingAndAreFlagged) {
 }
 
 TEST(Aggregate, RejectedAndMissingChannelsAreFlaggedAndLeftOutOfTheMeans) {
-  std::vector<Sample> samples = Samples(kMinute0, 12);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 12);
   samples[0].Set(Channel::kPElW, 90.0);
   samples[0].Reject(Channel::kPElW);  // rejected reading: NaN with its bit
   samples[1].Set(Channel::kPElW, 90.0);
@@ -135,7 +136,7 @@ TEST(Aggregate, RejectedAndMissingChannelsAreFlaggedAndLeftOutOfTheMeans) {
 }
 
 TEST(Aggregate, HorizontalIrradianceReplacesThePlaneOfArrayOneAsRequiredInput) {
-  std::vector<Sample> samples = Samples(kMinute0, 12);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 12);
   for (Sample& s : samples) {
     s.Set(Channel::kGPoaWM2, std::nan(""));
     s.Set(Channel::kGhiWM2, 500.0);
@@ -146,7 +147,7 @@ TEST(Aggregate, HorizontalIrradianceReplacesThePlaneOfArrayOneAsRequiredInput) {
 }
 
 TEST(Aggregate, AnInvalidSampleMakesTheMinuteInvalid) {
-  std::vector<Sample> samples = Samples(kMinute0, 12);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 12);
   samples[7].Set(Channel::kValid, 0.0);
   const MinuteRows m = Aggregate(samples);
   EXPECT_EQ(m.rows[Channel::kValid][0], 0.0);
@@ -156,11 +157,12 @@ TEST(Aggregate, AnInvalidSampleMakesTheMinuteInvalid) {
 TEST(Aggregate, MinutesAlignToUnixMinutesAndGapsStayGaps) {
   // 35 s into minute 0: samples at 35..55 (5), minute 1 complete (12),
   // minute 2 empty, minute 3 with 2 samples.
-  std::vector<Sample> samples = Samples(kMinute0 + 35, 17);
-  const std::vector<Sample> late = Samples(kMinute0 + 180, 2);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS + 35, 17);
+  const std::vector<Sample> late = Samples(kJune1Noon2024UtcS + 180, 2);
   samples.insert(samples.end(), late.begin(), late.end());
   const MinuteRows m = Aggregate(samples);
-  EXPECT_EQ(m.rows.time_s, (std::vector<std::int64_t>{kMinute0, kMinute0 + 60, kMinute0 + 180}));
+  EXPECT_EQ(m.rows.time_s, (std::vector<std::int64_t>{kJune1Noon2024UtcS, kJune1Noon2024UtcS + 60,
+                                                      kJune1Noon2024UtcS + 180}));
   EXPECT_EQ(m.n_samples, (std::vector<int>{5, 12, 2}));
 }
 
@@ -169,17 +171,17 @@ TEST(Aggregate, RejectsBadPeriodsAndUnorderedSamples) {
   MinuteRows rows;
   std::string error;
   options.sample_period_s = 7.0;  // does not divide 60
-  EXPECT_FALSE(AggregateSamples(Samples(kMinute0, 3), options, &rows, &error));
+  EXPECT_FALSE(AggregateSamples(Samples(kJune1Noon2024UtcS, 3), options, &rows, &error));
   EXPECT_NE(error.find("sample_period_s = 7"), std::string::npos) << error;
   options.sample_period_s = 5.0;
-  std::vector<Sample> samples = Samples(kMinute0, 3);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 3);
   std::swap(samples[1], samples[2]);
   EXPECT_FALSE(AggregateSamples(samples, options, &rows, &error));
   EXPECT_NE(error.find("strictly increasing"), std::string::npos) << error;
 }
 
 TEST(Aggregate, SamplesAndSeriesConvertBothWays) {
-  std::vector<Sample> samples = Samples(kMinute0, 3);
+  std::vector<Sample> samples = Samples(kJune1Noon2024UtcS, 3);
   const Series s = SeriesFromSamples(samples, 5.0);
   EXPECT_EQ(s.step_s, 5.0);
   EXPECT_TRUE(s.Has(Channel::kTInC));

@@ -3,13 +3,14 @@
 
 #include "core/synth/synthetic_plant.h"
 #include "daemon/service/calibration_acceptance.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin::cli {
 namespace {
 
-constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
-constexpr std::int64_t kDayS = 86400;
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
 
 TEST(CalibrationAcceptance, FirstParametersAreTakenAndTheirBoundsNamed) {
   const AcceptanceDecision d = DecideCalibration(7.0, std::nullopt, {"f_th"}, 1.8);
@@ -73,7 +74,7 @@ TEST(CalibrationAcceptance, TheToleranceIsTheSpreadOfTheHeldOutComparison) {
 Series FiveDays() {
   const Plant plant = DesignExamplePlant();
   WeatherOptions weather;
-  weather.start_time_s = kJune1;
+  weather.start_time_s = kJune1_2024UtcS;
   weather.num_days = 5;
   weather.step_s = 60.0;
   weather.seed = 3;
@@ -84,7 +85,7 @@ Series FiveDays() {
 
 TEST(HeldOutDays, ADayWithoutThePumpInSunshineIsNotEnoughToJudge) {
   Series s = FiveDays();
-  const std::int64_t end = kJune1 + 5 * kDayS;
+  const std::int64_t end = kJune1_2024UtcS + 5 * kDayS;
   HeldOutChoice c = ChooseHeldOutDays(s, end);
   EXPECT_EQ(c.days, 1);
   EXPECT_GT(c.informative_rows, 300u);  // a clear June day, pump on for hours
@@ -105,7 +106,7 @@ TEST(HeldOutDays, ADayWithoutThePumpInSunshineIsNotEnoughToJudge) {
 
 TEST(HeldOutDays, TheSpreadOfTheComparisonIsZeroForEqualParametersAndGrowsWithTheirDifference) {
   const Plant plant = DesignExamplePlant();
-  const Series s = FiveDays().Between(kJune1 + 4 * kDayS, kJune1 + 5 * kDayS);
+  const Series s = FiveDays().Between(kJune1_2024UtcS + 4 * kDayS, kJune1_2024UtcS + 5 * kDayS);
   const ParamVector truth = ReferenceTruthParams(plant);
   const ModelSpec spec = testing::SpecOf("2N1Ccolwr");
   EXPECT_EQ(HeldOutDifferenceSe(s, plant, spec, truth, truth), 0.0);
@@ -117,10 +118,10 @@ TEST(HeldOutDays, TheSpreadOfTheComparisonIsZeroForEqualParametersAndGrowsWithTh
   EXPECT_GT(se_near, 0.0);
   EXPECT_GT(se_far, se_near);
   // Fewer than three hours: no spread to speak of.
-  EXPECT_EQ(
-      HeldOutDifferenceSe(s.Between(kJune1 + 4 * kDayS + 12 * 3600, kJune1 + 4 * kDayS + 14 * 3600),
-                          plant, spec, far, truth),
-      0.0);
+  EXPECT_EQ(HeldOutDifferenceSe(s.Between(kJune1_2024UtcS + 4 * kDayS + 12 * 3600,
+                                          kJune1_2024UtcS + 4 * kDayS + 14 * 3600),
+                                plant, spec, far, truth),
+            0.0);
 }
 
 }  // namespace

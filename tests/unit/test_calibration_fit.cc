@@ -3,15 +3,15 @@
 // back with CalibrationFit::FromParamsJson into its calibration and
 // calibration_param rows. Checked on a real calibrate run on the htw saar
 // days (tests/data/htwsaar-pvt/PROVENANCE.md).
-#include "daemon/service/calibration_fit.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "daemon/service/calibration_fit.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 
 namespace pvtwin {
@@ -19,9 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kData = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
-
-std::string DataArg(const std::string& name) { return "'" + (kData / name).string() + "'"; }
+using testing::HtwSaarArg;
 
 // Read back and written again, the fit calibrate wrote is the same text,
 // byte for byte: every member is read, with its type (an integer stays an
@@ -29,9 +27,9 @@ std::string DataArg(const std::string& name) { return "'" + (kData / name).strin
 TEST(CalibrationFit, WhatCalibrateWritesReadsBackToTheSameText) {
   testing::ScratchDir dir("calibration_fit");
   const testing::ProcessResult run = testing::RunPvtwin(
-      dir.path(), "calibrate --config " + DataArg("plant.toml") + " --csv " +
-                      DataArg("day3_clear_medium_dT.csv") + " --test-csv " +
-                      DataArg("day1_clear_low_dT.csv") + " --variant 1N1Cwr --out params.json");
+      dir.path(), "calibrate --config " + HtwSaarArg("plant.toml") + " --csv " +
+                      HtwSaarArg("day3_clear_medium_dT.csv") + " --test-csv " +
+                      HtwSaarArg("day1_clear_low_dT.csv") + " --variant 1N1Cwr --out params.json");
   ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
   const std::string text = testing::ReadFile(dir.path() / "params.json");
   const nlohmann::ordered_json written = nlohmann::ordered_json::parse(text)["fit"];

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/unit_labels.h"
 
@@ -21,14 +22,12 @@ using testing::ProcessResult;
 using testing::ReadFile;
 using testing::RunPvtwin;
 
-const fs::path kData = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
-
-// The htw saar file `name` as a quoted command-line argument.
-std::string DataArg(const std::string& name) { return "'" + (kData / name).string() + "'"; }
+using testing::HtwSaarArg;
+using testing::kHtwSaarDir;
 
 class CliModel : public ::testing::Test {
  protected:
-  std::string Data(const char* name) const { return DataArg(name); }
+  std::string Data(const char* name) const { return HtwSaarArg(name); }
   testing::ScratchDir scratch_{"cli_model"};
   const fs::path dir_ = scratch_.path();
 };
@@ -44,10 +43,10 @@ std::vector<std::string> Lines(const std::string& text) {
 // predictions of `simulate` with dir/params.json against the measured column.
 double SimulatedMaePElW(const fs::path& dir, const std::string& day, const std::string& variant) {
   const ProcessResult run =
-      RunPvtwin(dir, "simulate --config " + DataArg("plant.toml") + " --csv " + DataArg(day) +
+      RunPvtwin(dir, "simulate --config " + HtwSaarArg("plant.toml") + " --csv " + HtwSaarArg(day) +
                          " --variant " + variant + " --params params.json --out pred.csv");
   EXPECT_EQ(run.exit_code, 0) << run.err;
-  const std::vector<std::string> meas = Lines(ReadFile(kData / day));
+  const std::vector<std::string> meas = Lines(ReadFile(kHtwSaarDir / day));
   const std::vector<std::string> pred = Lines(ReadFile(dir / "pred.csv"));
   EXPECT_EQ(meas.size(), pred.size());
   double sum = 0.0;
@@ -80,7 +79,7 @@ TEST_F(CliModel, SimulateWritesTheCanonicalPredictionColumns) {
 
 TEST_F(CliModel, SimulateNamesMissingColumnsAndBadVariants) {
   // A copy of the data without wind: the 'w' variants cannot run.
-  std::ifstream in(kData / "day1_clear_low_dT.csv");
+  std::ifstream in(kHtwSaarDir / "day1_clear_low_dT.csv");
   std::ofstream out(dir_ / "no_wind.csv");
   for (std::string line; std::getline(in, line);) {
     std::vector<std::string> cells;
@@ -161,7 +160,7 @@ TEST_F(CliModel, CalibrateThenSimulateRoundTrip) {
 //    the fit lowers to the emissivity's lower bound 0.075.
 TEST_F(CliModel, CalibratePrintsParametersAtTheirBound) {
   std::ofstream(dir_ / "measured-sky.toml")
-      << testing::ReadFile(kData / "plant.toml") << "sky = \"measured\"\n";
+      << testing::ReadFile(kHtwSaarDir / "plant.toml") << "sky = \"measured\"\n";
   const auto lines_at_bound = [&](const std::string& variant, const std::string& param) {
     const ProcessResult run = RunPvtwin(dir_, "calibrate --config measured-sky.toml --csv " +
                                                   Data("day3_clear_medium_dT.csv") + " --variant " +
@@ -200,7 +199,8 @@ TEST_F(CliModel, CalibrateReportsTheWindowAndTheHeldOutDataFromTheirOwnRows) {
   std::vector<std::string> window_times;
   std::vector<double> window_flows;
   {
-    const std::vector<std::string> lines = Lines(ReadFile(kData / "day3_clear_medium_dT.csv"));
+    const std::vector<std::string> lines =
+        Lines(ReadFile(kHtwSaarDir / "day3_clear_medium_dT.csv"));
     std::ofstream out(dir_ / "train.csv");
     out << lines[0] << "\n";
     for (std::size_t i = 1; i < lines.size(); ++i) {

@@ -12,7 +12,7 @@
 namespace pvtwin {
 namespace {
 
-const std::string kGoldenConfigDir = std::string(PVTWIN_GOLDEN_DIR) + "/config/";
+const std::string kConfigGoldenPrefix = std::string(PVTWIN_GOLDEN_DIR) + "/config/";
 const std::string kExamplesDir = std::string(PVTWIN_GOLDEN_DIR) + "/../../config/examples/";
 
 constexpr char kMinimalPlant[] =
@@ -20,7 +20,7 @@ constexpr char kMinimalPlant[] =
     "azimuth_deg = 180\narea_m2 = 1.8\n";
 
 TEST(ConfigLoad, FullConfigValuesAreReadAndAnglesConvertedToRadians) {
-  const std::string path = kGoldenConfigDir + "ok_full/config.toml";
+  const std::string path = kConfigGoldenPrefix + "ok_full/config.toml";
   Config config;
   Diagnostics errors;
   ASSERT_TRUE(LoadConfig(path, &config, &errors)) << errors.front().ToString();
@@ -63,7 +63,7 @@ TEST(ConfigLoad, FullConfigValuesAreReadAndAnglesConvertedToRadians) {
 TEST(ConfigLoad, PlantKeyValuesRoundTrip) {
   Config config;
   Diagnostics errors;
-  ASSERT_TRUE(LoadConfig(kGoldenConfigDir + "ok_full/config.toml", &config, &errors));
+  ASSERT_TRUE(LoadConfig(kConfigGoldenPrefix + "ok_full/config.toml", &config, &errors));
   const std::vector<std::pair<std::string, double>> values = PlantKeyValues(config.plant);
   EXPECT_EQ(values[0].first, "latitude_deg");
   EXPECT_NEAR(values[0].second, -33.9, 1e-12);

@@ -19,7 +19,9 @@ namespace fs = std::filesystem;
 using pvtwin::testing::kGoldenConfigDir;
 using pvtwin::testing::ReadFile;
 
-std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kGoldenConfigDir); }
+std::vector<std::string> ConfigCaseNames() {
+  return pvtwin::testing::SubfolderNames(kGoldenConfigDir);
+}
 
 class ConfigGoldenTest : public ::testing::TestWithParam<std::string> {};
 
@@ -32,13 +34,13 @@ TEST_P(ConfigGoldenTest, MessagesMatchExpected) {
   EXPECT_EQ(actual, ReadFile(dir / "expected.txt"));
 }
 
-INSTANTIATE_TEST_SUITE_P(Config, ConfigGoldenTest, ::testing::ValuesIn(CaseNames()),
+INSTANTIATE_TEST_SUITE_P(Config, ConfigGoldenTest, ::testing::ValuesIn(ConfigCaseNames()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param;
                          });
 
 TEST(ConfigGolden, HasTheCatalogueOfCases) {
-  const std::vector<std::string> names = CaseNames();
+  const std::vector<std::string> names = ConfigCaseNames();
   for (const char* required :
        {"ok_minimal", "ok_full", "latitude_out_of_range", "several_errors_at_once", "unknown_key",
         "wrong_type", "missing_required", "unknown_section", "bad_toml_syntax",

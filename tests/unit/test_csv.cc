@@ -20,14 +20,15 @@
 #include "io/files/csv.h"
 #include "io/platform/local_time.h"
 #include "io/platform/time_format.h"
+#include "tests/support/fixtures.h"
 
 namespace pvtwin {
 namespace {
 
 // 2024-06-01T00:00:00Z: rows of the tests below start here, a plausible
 // measurement time (the reader refuses times before 1980).
-constexpr std::int64_t kT0 = 1717200000;
-std::string At(std::int64_t offset_s) { return std::to_string(kT0 + offset_s); }
+using testing::kJune1_2024UtcS;
+std::string RowTime(std::int64_t offset_s) { return std::to_string(kJune1_2024UtcS + offset_s); }
 
 const std::string kRealDataDir = std::string(PVTWIN_DATA_DIR) + "/htwsaar-pvt/";
 
@@ -249,7 +250,7 @@ TEST(CsvRead, AcceptsCrlfByteOrderMarkSpacesAndEmptyLines) {
   Diagnostics errors;
   ASSERT_TRUE(ParseText(text, &s, &errors)) << errors.front().ToString();
   ASSERT_EQ(s.size(), 2u);
-  EXPECT_EQ(s.time_s[1], kT0 + 60);
+  EXPECT_EQ(s.time_s[1], kJune1_2024UtcS + 60);
   EXPECT_EQ(s[Channel::kTInC][0], 1.0);
   EXPECT_EQ(s[Channel::kTAmbC][0], 20.0);
   EXPECT_EQ(s[Channel::kPElW][0], 100.0);
@@ -264,10 +265,11 @@ TEST(CsvRead, AcceptsCrlfByteOrderMarkSpacesAndEmptyLines) {
 // cell's text (which then is no number).
 TEST(CsvRead, RowsWithAndWithoutQuotesReadAlike) {
   const std::string header = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
-  const std::string plain = At(0) + ", 1.5 ,2,0.03,\t500\t,,100\n" + At(60) + ",1,2,0.03,500,20,\n";
-  const std::string quoted = "\"" + At(0) +
-                             "\", \"1.5\" ,\"2\",\"0.03\",\t\"500\"\t,\"\",\"100\"\n\"" + At(60) +
-                             "\",\"1\",\"2\",\"0.03\",\"500\",\"20\",\"\"\n";
+  const std::string plain =
+      RowTime(0) + ", 1.5 ,2,0.03,\t500\t,,100\n" + RowTime(60) + ",1,2,0.03,500,20,\n";
+  const std::string quoted = "\"" + RowTime(0) +
+                             "\", \"1.5\" ,\"2\",\"0.03\",\t\"500\"\t,\"\",\"100\"\n\"" +
+                             RowTime(60) + "\",\"1\",\"2\",\"0.03\",\"500\",\"20\",\"\"\n";
   Series a, b;
   Diagnostics errors;
   ASSERT_TRUE(ParseText(header + plain, &a, &errors)) << errors.front().ToString();
@@ -289,7 +291,7 @@ TEST(CsvRead, RowsWithAndWithoutQuotesReadAlike) {
   EXPECT_TRUE(std::isnan(a[Channel::kPElW][1]));
   Series c;
   errors.clear();
-  EXPECT_FALSE(ParseText(header + At(0) + ",1,2,0.03,5\"00,20,100\n", &c, &errors));
+  EXPECT_FALSE(ParseText(header + RowTime(0) + ",1,2,0.03,5\"00,20,100\n", &c, &errors));
   ASSERT_FALSE(errors.empty());
   EXPECT_EQ(errors.front().field, "g_poa_w_m2");
   EXPECT_EQ(errors.front().value, "5\"00");
@@ -311,10 +313,10 @@ TEST(CsvRead, AStreamThatCannotSeekReadsAsAFileDoes) {
   // first row; a pipe tells no size, and rows longer than the first would
   // outgrow the estimate.
   std::string text =
-      "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n" + At(0) + ",1,2,0,0,9,0\n";
+      "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n" + RowTime(0) + ",1,2,0,0,9,0\n";
   for (int i = 1; i < 3000; ++i) {
-    text +=
-        At(60 * i) + ",21.125,22.5,0.0316,812.75,19.0625," + std::to_string(100 + i % 7) + ".5\n";
+    text += RowTime(60 * i) + ",21.125,22.5,0.0316,812.75,19.0625," + std::to_string(100 + i % 7) +
+            ".5\n";
   }
   Series from_string;
   Diagnostics errors;
@@ -489,7 +491,7 @@ TEST(CsvRead, FlowInLitresPerHourUsesTheConfiguredDensity) {
 
 TEST(CsvRead, StopsAfterTooManyErrors) {
   std::string text = "time,t_in_c,t_out_c,flow_kg_s,g_poa_w_m2,t_amb_c,p_el_w\n";
-  for (int i = 0; i < 1000; ++i) text += At(i) + ",x,2,0.03,500,20,100\n";
+  for (int i = 0; i < 1000; ++i) text += RowTime(i) + ",x,2,0.03,500,20,100\n";
   Series s;
   Diagnostics errors;
   EXPECT_FALSE(ParseText(text, &s, &errors));
@@ -551,7 +553,7 @@ TEST(CsvRead, NumbersReadAsStdFromCharsReadsThem) {
     const bool ok = ec == std::errc() && end == cell.data() + cell.size();
     std::vector<std::string>& list = ok ? accepted : rejected;
     (ok ? accepted_text : rejected_text) +=
-        At(60 * static_cast<std::int64_t>(list.size())) + ",1,2,0.03,500," + cell + ",100\n";
+        RowTime(60 * static_cast<std::int64_t>(list.size())) + ",1,2,0.03,500," + cell + ",100\n";
     list.push_back(cell);
     if (ok) expected.push_back(v);
   }
@@ -593,7 +595,7 @@ struct RealDay {
   double first_aoi_deg;
 };
 
-class CsvRealData : public testing::TestWithParam<RealDay> {};
+class CsvRealData : public ::testing::TestWithParam<RealDay> {};
 
 TEST_P(CsvRealData, LoadsCleanlyWithAllColumns) {
   const RealDay& day = GetParam();
@@ -632,13 +634,13 @@ TEST_P(CsvRealData, LoadsCleanlyWithAllColumns) {
   EXPECT_GT(n_valid, 0u);
 }
 
-INSTANTIATE_TEST_SUITE_P(CsvHtwSaar, CsvRealData,
-                         testing::Values(RealDay{"day1_clear_low_dT.csv", 306, 1502094241, 43.9403},
-                                         RealDay{"day3_clear_medium_dT.csv", 341, 1500969360,
-                                                 60.9237}),
-                         [](const testing::TestParamInfo<RealDay>& info) {
-                           return std::string(info.param.file).substr(0, 4);
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    CsvHtwSaar, CsvRealData,
+    ::testing::Values(RealDay{"day1_clear_low_dT.csv", 306, 1502094241, 43.9403},
+                      RealDay{"day3_clear_medium_dT.csv", 341, 1500969360, 60.9237}),
+    [](const ::testing::TestParamInfo<RealDay>& info) {
+      return std::string(info.param.file).substr(0, 4);
+    });
 
 TEST(CsvRealData, PlantConfigOfTheTestBenchLoads) {
   Config config;

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 using pvtwin::testing::kGoldenCsvDir;
 using pvtwin::testing::ReadFile;
 
-std::vector<std::string> CaseNames() { return pvtwin::testing::SubfolderNames(kGoldenCsvDir); }
+std::vector<std::string> CsvCaseNames() { return pvtwin::testing::SubfolderNames(kGoldenCsvDir); }
 
 class CsvGoldenTest : public ::testing::TestWithParam<std::string> {};
 
@@ -40,13 +40,13 @@ TEST_P(CsvGoldenTest, ReadOnTwoThreadsAsInOnePiece) {
   EXPECT_EQ(split, ReadFile(dir / "expected.txt"));
 }
 
-INSTANTIATE_TEST_SUITE_P(Csv, CsvGoldenTest, ::testing::ValuesIn(CaseNames()),
+INSTANTIATE_TEST_SUITE_P(Csv, CsvGoldenTest, ::testing::ValuesIn(CsvCaseNames()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param;
                          });
 
 TEST(CsvGolden, HasTheCatalogueOfCases) {
-  const std::vector<std::string> names = CaseNames();
+  const std::vector<std::string> names = CsvCaseNames();
   for (const char* required :
        {"bad_number", "wrong_field_count", "missing_required_column", "time_not_increasing",
         "bad_time", "ok_unknown_column_warning", "ok_flow_l_h_conversion", "ok_iso_offset_time",

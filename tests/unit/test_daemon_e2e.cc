@@ -15,6 +15,7 @@
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/stop_timeout.h"
 
@@ -27,7 +28,7 @@ using testing::RunPvtwin;
 using testing::ScratchDir;
 using testing::UnitStopTimeoutS;
 
-const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
+using testing::kExamplePlantConfig;
 constexpr double kSpeed = 120.0;
 // 2024-06-01 08:00 UTC: a June morning at the example plant (47° N, 16° E).
 constexpr std::int64_t kMorning = 1717228800;
@@ -36,13 +37,13 @@ constexpr std::int64_t kMorning = 1717228800;
 constexpr std::int64_t kBeforeMidnight = 1717285200;
 
 // One connection to the daemon's database, as a dashboard would hold it.
-class Db {
+class E2eDb {
  public:
-  explicit Db(const fs::path& path) {
+  explicit E2eDb(const fs::path& path) {
     sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr);
     sqlite3_busy_timeout(db_, 5000);
   }
-  ~Db() { sqlite3_close(db_); }
+  ~E2eDb() { sqlite3_close(db_); }
   // First column of the first row as text ("" when there is none).
   std::string Text(const std::string& sql) const {
     sqlite3_stmt* st = nullptr;
@@ -69,8 +70,8 @@ class Db {
 class DaemonE2E : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_TRUE(fs::exists(kExampleMap)) << kExampleMap;
-    fs::copy_file(kExampleMap, dir_ / "sim.toml");
+    ASSERT_TRUE(fs::exists(kExamplePlantConfig)) << kExamplePlantConfig;
+    fs::copy_file(kExamplePlantConfig, dir_ / "sim.toml");
     const std::string truth = truth_variant_.empty() ? "" : " --truth-variant " + truth_variant_;
     if (history_days_ > 0) {
       const auto exported = RunPvtwin(
@@ -79,7 +80,7 @@ class DaemonE2E : public ::testing::Test {
                            std::to_string(t0_ - history_days_ * 86400) + truth);
       ASSERT_EQ(exported.exit_code, 0) << exported.err;
       const auto imported =
-          RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + Db());
+          RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + E2eDb());
       ASSERT_EQ(imported.exit_code, 0) << imported.err;
     }
     anchor_ = WallNowS();
@@ -101,11 +102,11 @@ class DaemonE2E : public ::testing::Test {
     ASSERT_TRUE(sim_.StartPiped(sim_args, (dir_ / "sim.log").string(), &error)) << error;
     std::vector<std::string> lines;
     ASSERT_TRUE(sim_.ReadUntil("ready", 20.0, &lines)) << ReadFile(dir_ / "sim.log");
-    settings_.db_path = Db();
+    settings_.db_path = E2eDb();
     DaemonSettings& settings = settings_;
     std::string text;
-    ASSERT_TRUE(
-        EditConfig(ReadFile(kExampleMap), ParseListeningLines(lines), settings, &text, &error))
+    ASSERT_TRUE(EditConfig(ReadFile(kExamplePlantConfig), ParseListeningLines(lines), settings,
+                           &text, &error))
         << error;
     std::ofstream(dir_ / "pvtwin.toml") << text;
   }
@@ -115,7 +116,7 @@ class DaemonE2E : public ::testing::Test {
     sim_.Stop(0, 5.0);
   }
 
-  std::string Db() const { return (dir_ / "pvtwin.db").string(); }
+  std::string E2eDb() const { return (dir_ / "pvtwin.db").string(); }
 
   // exe: the pvtwin binary to run (a copy, to delete under the running daemon).
   void StartDaemon(const std::string& exe = PVTWIN_BINARY) {
@@ -157,7 +158,7 @@ class DaemonE2EOverMidnight : public DaemonE2E {
 
 TEST_F(DaemonE2EOverMidnight, PollsAggregatesCalibratesForecastsAndScores) {
   StartDaemon();
-  const class Db db(Db());
+  const class E2eDb db(E2eDb());
   const std::string live = " WHERE ts >= " + std::to_string(t0_);
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Count("SELECT count(*) FROM calibration WHERE status = 'accepted'") >= 1;
@@ -241,7 +242,7 @@ TEST_F(DaemonE2ETwoNights, DiagnosesTheMissingEffectAndRecordsTheFrozenSensor) {
   const fs::path exe = dir_ / "pvtwin-upgraded-away";
   fs::copy_file(PVTWIN_BINARY, exe);
   StartDaemon(exe.string());
-  const class Db db(Db());
+  const class E2eDb db(E2eDb());
   ASSERT_TRUE(WaitFor(120, [&] {
     return db.Count("SELECT count(*) FROM calibration WHERE status = 'accepted'") >= 1;
   })) << DaemonLog();
@@ -313,7 +314,7 @@ TEST_F(DaemonE2E, KillNineLosesNoCommittedRowAndCorruptsNothing) {
   const std::string live = " WHERE ts >= " + std::to_string(t0_);
   long long samples = 0, minutes = 0;
   {
-    const class Db db(Db());
+    const class E2eDb db(E2eDb());
     ASSERT_TRUE(WaitFor(30, [&] {
       return db.Count("SELECT count(*) FROM measurement_1min" + live) >= 3;
     })) << DaemonLog();
@@ -323,13 +324,13 @@ TEST_F(DaemonE2E, KillNineLosesNoCommittedRowAndCorruptsNothing) {
   ::kill(daemon_.pid(), SIGKILL);
   EXPECT_EQ(daemon_.Stop(0, 5.0), -SIGKILL);
   {
-    const class Db db(Db());
+    const class E2eDb db(E2eDb());
     EXPECT_EQ(db.Text("PRAGMA integrity_check"), "ok");
     EXPECT_GE(db.Count("SELECT count(*) FROM sample_5s"), samples);
     EXPECT_GE(db.Count("SELECT count(*) FROM measurement_1min"), minutes);
   }
   StartDaemon();
-  const class Db db(Db());
+  const class E2eDb db(E2eDb());
   ASSERT_TRUE(WaitFor(30, [&] {
     return db.Count("SELECT count(*) FROM sample_5s") > samples + 24;
   })) << DaemonLog();
@@ -343,8 +344,8 @@ TEST_F(DaemonE2E, KillNineLosesNoCommittedRowAndCorruptsNothing) {
 
 TEST_F(DaemonE2E, AReaderHoldingATransactionDoesNotStopIngestion) {
   StartDaemon();
-  const class Db reader(Db());
-  const class Db observer(Db());
+  const class E2eDb reader(E2eDb());
+  const class E2eDb observer(E2eDb());
   ASSERT_TRUE(WaitFor(30, [&] { return observer.Count("SELECT count(*) FROM sample_5s") > 0; }))
       << DaemonLog();
   reader.Exec("BEGIN");
@@ -381,8 +382,8 @@ class DaemonE2EDayOne : public DaemonE2E {
 TEST_F(DaemonE2EDayOne, ForecastsFromTheStartValuesAndWaitsWithoutAWarning) {
   StartDaemon();
   // The daemon creates the store: a connection opened before would see none.
-  ASSERT_TRUE(WaitFor(30, [&] { return fs::exists(Db()); })) << DaemonLog();
-  const class Db db(Db());
+  ASSERT_TRUE(WaitFor(30, [&] { return fs::exists(E2eDb()); })) << DaemonLog();
+  const class E2eDb db(E2eDb());
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Count("SELECT count(*) FROM forecast WHERE basis = 'start_values'") >= 1440;
   })) << DaemonLog();
@@ -438,11 +439,11 @@ class DaemonE2EDayTwo : public DaemonE2E {
 
 TEST_F(DaemonE2EDayTwo, TheFirstAcceptedCalibrationTurnsTheForecastsCalibrated) {
   {
-    const class Db setup(Db());
+    const class E2eDb setup(E2eDb());
     setup.Exec("DELETE FROM measurement_1min WHERE ts < " + std::to_string(t0_ - 171000));
   }
   StartDaemon();
-  const class Db db(Db());
+  const class E2eDb db(E2eDb());
   ASSERT_TRUE(WaitFor(120, [&] {
     return db.Count("SELECT count(*) FROM forecast WHERE basis = 'calibrated'") >= 1440;
   })) << DaemonLog();

@@ -25,6 +25,7 @@
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/stop_timeout.h"
@@ -41,10 +42,9 @@ using testing::UnitStopTimeoutS;
 using testing::WaitFor;
 using Db = testing::RawDb;
 
-const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
-// 2024-06-01 00:00 UTC.
-constexpr std::int64_t kJune1 = 1717200000;
-constexpr std::int64_t kDay = 86400;
+using testing::kDayS;
+using testing::kExamplePlantConfig;
+using testing::kJune1_2024UtcS;
 
 // The systemd notification socket: a datagram socket whose path goes into
 // the daemon's NOTIFY_SOCKET, as systemd sets it for Type=notify units.
@@ -94,11 +94,11 @@ class DaemonPaths : public ::testing::Test {
   // `days` of the example plant's history up to `end`, imported at 1 min
   // (measurement_1min) or as a coarser logger's rows (measurement_interval).
   void ImportHistory(std::int64_t end, int days, int step_s = 60) {
-    fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
+    fs::copy_file(kExamplePlantConfig, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
     auto run =
         RunPvtwin(dir_.path(), "sim --config sim.toml --export history.csv --days " +
                                    std::to_string(days) + " --step " + std::to_string(step_s) +
-                                   " --start " + std::to_string(end - days * kDay));
+                                   " --start " + std::to_string(end - days * kDayS));
     ASSERT_EQ(run.exit_code, 0) << run.err;
     run = RunPvtwin(dir_.path(), "import --config sim.toml --csv history.csv --db " + DbPath());
     ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -158,7 +158,7 @@ TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
   NotifySocket notify(dir_ / "notify.sock");
   ::setenv("NOTIFY_SOCKET", (dir_ / "notify.sock").c_str(), 1);
   ::setenv("WATCHDOG_USEC", "1000000", 1);  // the unit's WatchdogSec=1
-  StartDaemon(kJune1, 1.0);
+  StartDaemon(kJune1_2024UtcS, 1.0);
   ::unsetenv("NOTIFY_SOCKET");
   ::unsetenv("WATCHDOG_USEC");
   ASSERT_TRUE(notify.WaitFor("READY=1", 20)) << notify.received() << Log();
@@ -196,7 +196,7 @@ TEST_F(DaemonPaths, TellsSystemdReadyWatchdogReloadingAndStopping) {
 // did.
 TEST_F(DaemonPaths, AReloadLogsEachChangedKeyAndWhatNeedsARestart) {
   WriteConfig(Settings());
-  StartDaemon(kJune1, 1.0);
+  StartDaemon(kJune1_2024UtcS, 1.0);
   ::kill(daemon_.pid(), SIGHUP);
   ASSERT_TRUE(WaitFor(10, [&] { return Log().find("reload: no change") != std::string::npos; }))
       << Log();
@@ -238,7 +238,7 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
     std::ofstream(dir_ / file) << text;
   };
   write("pvtwin.toml", "47.358", "1.8");
-  StartDaemon(kJune1, 1.0);  // the store records this plant
+  StartDaemon(kJune1_2024UtcS, 1.0);  // the store records this plant
   ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
 
   // Another site 60 km north, and the same site with another area.
@@ -258,14 +258,14 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
   // A corrected coordinate 100 m away is the same site.
   write("pvtwin.toml", "47.359", "1.8");
   fs::remove(dir_ / "daemon.log");
-  StartDaemon(kJune1, 1.0);
+  StartDaemon(kJune1_2024UtcS, 1.0);
   ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   EXPECT_EQ(Log().find("belongs to another plant"), std::string::npos) << Log();
 
   // --adopt-store takes it over, and the store records the new plant.
   write("pvtwin.toml", "47.358", "3.6");
   fs::remove(dir_ / "daemon.log");
-  StartDaemon(kJune1, 1.0, {"--adopt-store"});
+  StartDaemon(kJune1_2024UtcS, 1.0, {"--adopt-store"});
   EXPECT_NE(Log().find("adopted for"), std::string::npos) << Log();
   ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   Db db(DbPath());
@@ -279,7 +279,7 @@ TEST_F(DaemonPaths, AStoreOfAnotherSiteOrAreaIsRefusedUnlessAdopted) {
 TEST_F(DaemonPaths, TheJournalPrefixOnlyOnTheJournalStreamAndDatedLinesElsewhere) {
   WriteConfig(Settings());
   ::setenv("JOURNAL_STREAM", "8:12345", 1);  // another stream than stderr
-  StartDaemon(kJune1, 1.0);
+  StartDaemon(kJune1_2024UtcS, 1.0);
   ::unsetenv("JOURNAL_STREAM");
   ASSERT_EQ(daemon_.Stop(SIGTERM, UnitStopTimeoutS() / 2), 0) << Log();
   EXPECT_TRUE(std::regex_search(Log(), std::regex("(^|\n)20[0-9]{2}-[0-9]{2}-[0-9]{2}T[0-9]{2}:"
@@ -305,13 +305,13 @@ TEST_F(DaemonPaths, TheJournalPrefixOnlyOnTheJournalStreamAndDatedLinesElsewhere
 }
 
 TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
-  ImportHistory(kJune1, 4);
+  ImportHistory(kJune1_2024UtcS, 4);
   WriteConfig(Settings());
   // At 3600× the loop looks at the child every 1.4 ms of wall time (one
   // 5-s poll period), so it sees the 10-ms limit pass long before the
   // calibration of 4 days, a process of some 50 ms, can finish; at 60× it
   // looked every 83 ms and a fast child could finish unseen.
-  StartDaemon(kJune1, 3600.0, {"--calibration-timeout", "0.01"});
+  StartDaemon(kJune1_2024UtcS, 3600.0, {"--calibration-timeout", "0.01"});
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(30, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE status = 'timeout'") >= 1;
@@ -324,12 +324,12 @@ TEST_F(DaemonPaths, ACalibrationOverItsTimeLimitIsAbandonedAndTheDaemonGoesOn) {
 }
 
 TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
-  ImportHistory(kJune1, 5);
+  ImportHistory(kJune1_2024UtcS, 5);
   DaemonSettings settings = Settings();
   settings.calibrate_at = "00:30";  // UTC, 30 simulated minutes after the start
   WriteConfig(settings);
   // First run: no parameters yet, so it calibrates at once and accepts.
-  StartDaemon(kJune1, 600.0);
+  StartDaemon(kJune1_2024UtcS, 600.0);
   {
     Db db(DbPath());
     ASSERT_TRUE(WaitFor(60, [&] {
@@ -344,14 +344,14 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
     sqlite3_open(DbPath().c_str(), &raw);
     ASSERT_EQ(sqlite3_exec(raw,
                            ("UPDATE measurement_1min SET q_th_w = 0.6 * q_th_w WHERE ts < " +
-                            std::to_string(kJune1 - kDay))
+                            std::to_string(kJune1_2024UtcS - kDayS))
                                .c_str(),
                            nullptr, nullptr, nullptr),
               SQLITE_OK);
     sqlite3_close(raw);
   }
   anchor_ = WallNowS();
-  StartDaemon(kJune1, 600.0);
+  StartDaemon(kJune1_2024UtcS, 600.0);
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE status = 'rejected'") >= 1;
@@ -373,9 +373,9 @@ TEST_F(DaemonPaths, AWorseCalibrationIsRejectedAndTheParametersKept) {
 // (the held-out days included), and the forecast is issued again with it;
 // the calibration row and its parameter rows hold the refit.
 TEST_F(DaemonPaths, AnAcceptedFitIsRefitOnTheWholeWindow) {
-  ImportHistory(kJune1, 4);
+  ImportHistory(kJune1_2024UtcS, 4);
   WriteConfig(Settings());
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Number(
@@ -409,11 +409,11 @@ TEST_F(DaemonPaths, AnAcceptedFitIsRefitOnTheWholeWindow) {
 // is now: an edit that the reload refused (period_s = 7) broke the refit
 // and the next night's calibration, whose children read the file afresh.
 TEST_F(DaemonPaths, TheFitsUseTheConfigInUseNotAnEditTheReloadRefused) {
-  ImportHistory(kJune1, 4);
+  ImportHistory(kJune1_2024UtcS, 4);
   DaemonSettings settings = Settings();
   settings.calibrate_at = "00:30";  // UTC, 30 simulated minutes after the start
   WriteConfig(settings);
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   const std::string valid = EditInvalidAndReload();
   ASSERT_TRUE(WaitFor(10, [&] {
     return Log().find("; running with the previous config") != std::string::npos;
@@ -437,12 +437,12 @@ TEST_F(DaemonPaths, TheFitsUseTheConfigInUseNotAnEditTheReloadRefused) {
 
 // Without the refit the held-out-checked parameters are the ones used.
 TEST_F(DaemonPaths, TheRefitCanBeTurnedOff) {
-  ImportHistory(kJune1, 4);
+  ImportHistory(kJune1_2024UtcS, 4);
   WriteConfig(Settings());
   const std::string text = ReadFile(dir_ / "pvtwin.toml");
   std::ofstream(dir_ / "pvtwin.toml") << std::regex_replace(
       text, std::regex("\\[calibration\\]\n"), "[calibration]\nrefit_full_window = false\n");
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
@@ -459,9 +459,9 @@ TEST_F(DaemonPaths, TheRefitCanBeTurnedOff) {
 // local solar days, the HTML report is kept under reports/, the verdict is
 // logged, and the daemon goes on.
 TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
-  ImportHistory(kJune1, 4);
+  ImportHistory(kJune1_2024UtcS, 4);
   WriteConfig(Settings());
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(180, [&] { return db.Number("SELECT count(*) FROM diagnosis") >= 1; }))
       << Log();
@@ -492,9 +492,9 @@ TEST_F(DaemonPaths, TheNightlyDiagnosisIsRecordedWithItsReport) {
 // [calibration] step_s of 60 s gives way), judges it on a held-out day and
 // accepts it; before, it was skipped as "0.0 days of 1-min data".
 TEST_F(DaemonPaths, IntervalHistoryIsCalibratedAtItsOwnStep) {
-  ImportHistory(kJune1, 4, 120);
+  ImportHistory(kJune1_2024UtcS, 4, 120);
   WriteConfig(Settings());
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(60, [&] {
     return db.Number("SELECT count(*) FROM calibration WHERE accepted = 1") == 1;
@@ -517,10 +517,10 @@ TEST_F(DaemonPaths, IntervalHistoryIsCalibratedAtItsOwnStep) {
 // A diagnosis over [diagnosis] timeout_s is stopped, logged and recorded as
 // an event; no diagnosis row is written and the daemon goes on.
 TEST_F(DaemonPaths, ADiagnosisOverItsTimeLimitIsStoppedAndTheDaemonGoesOn) {
-  ImportHistory(kJune1, 14);  // 14 days at 1 min: seconds of diagnosis
+  ImportHistory(kJune1_2024UtcS, 14);  // 14 days at 1 min: seconds of diagnosis
   WriteConfig(Settings());
   std::ofstream(dir_ / "pvtwin.toml", std::ios::app) << "\n[diagnosis]\ntimeout_s = 1\n";
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   ASSERT_TRUE(WaitFor(120, [&] {
     return db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'diagnosis_timeout'") >= 1;
@@ -536,11 +536,11 @@ TEST_F(DaemonPaths, ADiagnosisOverItsTimeLimitIsStoppedAndTheDaemonGoesOn) {
 // 15-minute outage of the plane-of-array pyranometer (GHI and DHI logged)
 // imported, then `pvtwin run` without devices calibrates and forecasts.
 TEST_F(DaemonPaths, APyranometerOutageInTheHistoryIsForecastAround) {
-  fs::copy_file(kExampleMap, dir_ / "sim.toml");
+  fs::copy_file(kExamplePlantConfig, dir_ / "sim.toml");
   auto run = RunPvtwin(dir_.path(),
                        "sim --config sim.toml --export full.csv --days 3 --step 60 "
                        "--start " +
-                           std::to_string(kJune1 - 3 * kDay));
+                           std::to_string(kJune1_2024UtcS - 3 * kDayS));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   // Blank g_poa_w_m2 (5th column) for 15 minutes at noon of every day.
   std::ifstream in(dir_ / "full.csv");
@@ -560,7 +560,7 @@ TEST_F(DaemonPaths, APyranometerOutageInTheHistoryIsForecastAround) {
   run = RunPvtwin(dir_.path(), "import --config sim.toml --csv gaps.csv --db " + DbPath());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   WriteConfig(Settings());
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   ASSERT_EQ(db.Number("SELECT count(*) FROM measurement_1min WHERE g_poa_w_m2 IS NULL AND "
                       "ghi_w_m2 > 100"),
@@ -578,7 +578,7 @@ TEST_F(DaemonPaths, APyranometerOutageInTheHistoryIsForecastAround) {
 class LiveDaemon : public DaemonPaths {
  protected:
   void StartSim(std::int64_t start, double speed, const std::vector<std::string>& faults) {
-    fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
+    fs::copy_file(kExamplePlantConfig, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
     std::vector<std::string> argv = {PVTWIN_BINARY,
                                      "sim",
                                      "--config",
@@ -603,7 +603,7 @@ class LiveDaemon : public DaemonPaths {
   void WriteLiveConfig(const DaemonSettings& settings, const std::string& fluid_cp,
                        bool without_heat_meter = false) {
     std::string text, error;
-    std::string map = ReadFile(kExampleMap);
+    std::string map = ReadFile(kExamplePlantConfig);
     map = std::regex_replace(map, std::regex("area_m2 = 1.8\n"),
                              "area_m2 = 1.8\nfluid_cp_j_kgk = " + fluid_cp + "\n");
     if (without_heat_meter) {
@@ -627,7 +627,7 @@ class LiveDaemon : public DaemonPaths {
 };
 
 TEST_F(LiveDaemon, AggregatesWithTheConfiguredPeriodAndFluid) {
-  const std::int64_t t0 = kJune1 + 10 * 3600;  // a June morning
+  const std::int64_t t0 = kJune1_2024UtcS + 10 * 3600;  // a June morning
   StartSim(t0, 60.0, {});
   DaemonSettings settings = Settings();
   settings.poll_period_s = 10;
@@ -659,7 +659,7 @@ TEST_F(LiveDaemon, AggregatesWithTheConfiguredPeriodAndFluid) {
 // STATUS until the next health line; no log line runs over 200 characters
 // (a forecast's once ran to 800).
 TEST_F(LiveDaemon, AHealthLineEveryStatusMinAndSystemdStatusKeptCurrent) {
-  const std::int64_t t0 = kJune1 + 10 * 3600;  // a June morning
+  const std::int64_t t0 = kJune1_2024UtcS + 10 * 3600;  // a June morning
   ImportHistory(t0 - 120, 3);                  // calibrated and forecast at the start
   StartSim(t0, 60.0, {});
   WriteLiveConfig(Settings(), "3650");
@@ -718,7 +718,7 @@ TEST_F(LiveDaemon, AHealthLineEveryStatusMinAndSystemdStatusKeptCurrent) {
 // the daemon never exits on its own, and every poll period has a row
 // (values, or NULL where the device was away).
 TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
-  const std::int64_t t0 = kJune1 - 4 * 3600;  // 20:00 UTC; calibration at 02:00 UTC
+  const std::int64_t t0 = kJune1_2024UtcS - 4 * 3600;  // 20:00 UTC; calibration at 02:00 UTC
   ImportHistory(t0 - 120, 3);
   constexpr double kSpeed = 600.0;
   const auto drop = [](const char* device, int from_min, int for_min) {
@@ -800,7 +800,7 @@ TEST_F(LiveDaemon, SoakWithDevicesOfflineAcrossCalibrationAndRestart) {
             1)
       << Log();
   EXPECT_GE(db.Number("SELECT count(*) FROM calibration WHERE run_at >= " +
-                      std::to_string(kJune1 + 2 * 3600)),
+                      std::to_string(kJune1_2024UtcS + 2 * 3600)),
             1);
   EXPECT_EQ(db.Number("SELECT count(*) FROM calibration WHERE status IN ('crashed', 'failed')"), 0)
       << db.Text("SELECT group_concat(reason, ' | ') FROM calibration");

@@ -16,26 +16,27 @@
 #include "io/files/params_json.h"
 #include "io/platform/log.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin::cli {
 namespace {
 
-constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
-constexpr std::int64_t kDayS = 86400;
-constexpr int kDays = 14;
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
+constexpr int kHistoryDays = 14;
 constexpr int kLossDay = 10;  // P_el at 85 % from this day on
 
 class DailyChecks : public ::testing::Test {
  protected:
   void SetUp() override {
     config_.plant = DesignExamplePlant();
-    config_.calibration.window_days = kDays;
+    config_.calibration.window_days = kHistoryDays;
     config_.monitor.alarm_days = 3;
     WeatherOptions weather;
-    weather.start_time_s = kJune1;
-    weather.num_days = kDays;
+    weather.start_time_s = kJune1_2024UtcS;
+    weather.num_days = kHistoryDays;
     weather.step_s = 60.0;
     weather.seed = 11;
     weather.day_types = {DayType::kClear};
@@ -43,16 +44,16 @@ class DailyChecks : public ::testing::Test {
     Series s = MakeSyntheticPlantData(config_.plant, weather, testing::SpecOf("2N1Ccolwr"), truth,
                                       RealisticSensorNoise(5));
     for (std::size_t i = 0; i < s.size(); ++i) {
-      if (s.time_s[i] >= kJune1 + kLossDay * kDayS) s[Channel::kPElW][i] *= 0.85;
+      if (s.time_s[i] >= kJune1_2024UtcS + kLossDay * kDayS) s[Channel::kPElW][i] *= 0.85;
       // t_amb frozen 01:00–03:00 of the last day.
-      const std::int64_t t = s.time_s[i] - (kJune1 + (kDays - 1) * kDayS);
+      const std::int64_t t = s.time_s[i] - (kJune1_2024UtcS + (kHistoryDays - 1) * kDayS);
       if (t >= 3600 && t < 3 * 3600) s[Channel::kTAmbC][i] = 11.5;
     }
     std::string error;
     store_ = Store::Open((dir_ / "pvtwin.db").string(), &error);
     ASSERT_NE(store_, nullptr) << error;
     ASSERT_TRUE(store_->WriteMinutes(s, &error)) << error;
-    Accept(kJune1, truth, 0.0);
+    Accept(kJune1_2024UtcS, truth, 0.0);
   }
 
   // An accepted calibration of truth with u_front_w_m2k shifted by du.
@@ -61,7 +62,7 @@ class DailyChecks : public ::testing::Test {
     u_front += du;
     Store::CalibrationRow row;
     row.run_at = run_at;
-    row.window_start = run_at - kDays * kDayS;  // the 14 days before it
+    row.window_start = run_at - kHistoryDays * kDayS;  // the 14 days before it
     row.window_end = run_at;
     row.variant = "2N1Ccolwr";
     row.status = "accepted";
@@ -78,7 +79,7 @@ class DailyChecks : public ::testing::Test {
     DailyCheckInputs in;
     in.config = &config_;
     in.spec = testing::SpecOf("2N1Ccolwr");
-    in.now_s = kJune1 + kDays * kDayS + 2 * 3600;  // 02:00 after the last day
+    in.now_s = kJune1_2024UtcS + kHistoryDays * kDayS + 2 * 3600;  // 02:00 after the last day
     in.accepted_now = accepted_now;
     return in;
   }
@@ -93,16 +94,17 @@ class DailyChecks : public ::testing::Test {
 // forecast_skill_day, and the view computes nothing before today.
 TEST_F(DailyChecks, ForecastSkillIsMaterialisedForTheDaysThatEnded) {
   std::vector<Store::ForecastRow> rows;
-  for (std::int64_t t = kJune1; t < kJune1 + 2 * kDayS; t += 60) rows.push_back({t, 50.0, 300.0});
+  for (std::int64_t t = kJune1_2024UtcS; t < kJune1_2024UtcS + 2 * kDayS; t += 60)
+    rows.push_back({t, 50.0, 300.0});
   std::string error;
-  ASSERT_TRUE(store_->InsertForecast(kJune1 - 3600, 0, "test", rows, &error)) << error;
+  ASSERT_TRUE(store_->InsertForecast(kJune1_2024UtcS - 3600, 0, "test", rows, &error)) << error;
   testing::RawDb db(dir_ / "pvtwin.db");
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 0.0);
   const auto skill = db.Rows("SELECT * FROM forecast_skill ORDER BY day");
   ASSERT_EQ(skill.size(), 2u) << "the issue before day 1 is the newest before day 2 too";
   const auto log = RunDailyChecks(*store_, Inputs(false));
   EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
-            static_cast<double>(kJune1 + kDays * kDayS));
+            static_cast<double>(kJune1_2024UtcS + kHistoryDays * kDayS));
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill_day ORDER BY day"), skill);
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill ORDER BY day"), skill);
   const auto line = std::find_if(log.begin(), log.end(), [](const auto& l) {
@@ -114,10 +116,10 @@ TEST_F(DailyChecks, ForecastSkillIsMaterialisedForTheDaysThatEnded) {
 TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
   const auto log = RunDailyChecks(*store_, Inputs(false));
   testing::RawDb db(dir_ / "pvtwin.db");
-  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily"), kDays);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily"), kHistoryDays);
   // Days before kLossDay as the truth, the rest at 85 % of P_el, heat unchanged.
-  for (int d = 0; d < kDays; ++d) {
-    const std::string day = std::to_string(kJune1 + d * kDayS);
+  for (int d = 0; d < kHistoryDays; ++d) {
+    const std::string day = std::to_string(kJune1_2024UtcS + d * kDayS);
     const double pi_el = db.Number("SELECT pi_el FROM performance_daily WHERE day = " + day);
     const double pi_th = db.Number("SELECT pi_th FROM performance_daily WHERE day = " + day);
     EXPECT_NEAR(pi_el, d < kLossDay ? 1.0 : 0.85, 0.005) << d;
@@ -129,11 +131,11 @@ TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
   // its rank 1 of 11; the third's lies at 1 within the noise (not
   // asserted); after the alarm its days leave the reference and the fourth
   // loss day's band lies below 1 again.
-  const std::string loss = std::to_string(kJune1 + kLossDay * kDayS);
+  const std::string loss = std::to_string(kJune1_2024UtcS + kLossDay * kDayS);
   EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily WHERE pi_el_low IS NOT NULL"),
-            kDays - 9);
+            kHistoryDays - 9);
   for (const int d : {kLossDay, kLossDay + 1, kLossDay + 3}) {
-    const std::string day = std::to_string(kJune1 + d * kDayS);
+    const std::string day = std::to_string(kJune1_2024UtcS + d * kDayS);
     EXPECT_EQ(db.Number("SELECT pi_el_high < 1 FROM performance_daily WHERE day = " + day),
               d == kLossDay + 1 ? 0 : 1)
         << d;
@@ -152,13 +154,13 @@ TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
   }
   EXPECT_TRUE(logged);
   // The frozen air temperature: an interval from the second frozen minute.
-  const std::int64_t last_day = kJune1 + (kDays - 1) * kDayS;
+  const std::int64_t last_day = kJune1_2024UtcS + (kHistoryDays - 1) * kDayS;
   EXPECT_EQ(db.Rows("SELECT channel, kind, start_ts - " + std::to_string(last_day) + ", end_ts - " +
                     std::to_string(last_day) + " FROM qc_event"),
             (std::vector<std::vector<std::string>>{{"t_amb_c", "frozen", "3660", "10800"}}));
   // The next night scores nothing again and raises no new alarm.
   RunDailyChecks(*store_, Inputs(false));
-  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily"), kDays);
+  EXPECT_EQ(db.Number("SELECT count(*) FROM performance_daily"), kHistoryDays);
   EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event"), 1);
   EXPECT_EQ(db.Number("SELECT count(*) FROM qc_event"), 1);
   // The operator's list: newest first, the calibration included.
@@ -174,8 +176,8 @@ TEST_F(DailyChecks, ScoreEveryDayAlarmOnTheLossAndRecordTheFrozenSensor) {
 // where the newest's began, moved 0.6 > 3·0.141.
 TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
   const ParamVector truth = ReferenceTruthParams(config_.plant);
-  Accept(kJune1 + 7 * kDayS, truth, 0.3);
-  Accept(kJune1 + 14 * kDayS, truth, 0.6);
+  Accept(kJune1_2024UtcS + 7 * kDayS, truth, 0.3);
+  Accept(kJune1_2024UtcS + 14 * kDayS, truth, 0.6);
   const auto log = RunDailyChecks(*store_, Inputs(true));
   testing::RawDb db(dir_ / "pvtwin.db");
   // The log's line is the event's without the scale's parts (log lines stay
@@ -207,8 +209,8 @@ TEST_F(DailyChecks, ADriftAcrossAcceptedCalibrationsIsAnEvent) {
 // no longer finds it; the log says it each night.
 TEST_F(DailyChecks, ADriftIsOneEventUntilItEnds) {
   const ParamVector truth = ReferenceTruthParams(config_.plant);
-  Accept(kJune1 + 7 * kDayS, truth, 0.3);
-  Accept(kJune1 + 14 * kDayS, truth, 0.6);
+  Accept(kJune1_2024UtcS + 7 * kDayS, truth, 0.3);
+  Accept(kJune1_2024UtcS + 14 * kDayS, truth, 0.6);
   DailyCheckInputs night = Inputs(true);
   RunDailyChecks(*store_, night);
   testing::RawDb db(dir_ / "pvtwin.db");
@@ -217,7 +219,7 @@ TEST_F(DailyChecks, ADriftIsOneEventUntilItEnds) {
   ASSERT_EQ(db.Rows(events).size(), 1u);
   // The next night's fit drifted a little further: the log says so, no new
   // event.
-  Accept(kJune1 + 15 * kDayS, truth, 0.65);
+  Accept(kJune1_2024UtcS + 15 * kDayS, truth, 0.65);
   night.now_s += kDayS;
   const auto log = RunDailyChecks(*store_, night);
   EXPECT_EQ(db.Rows(events).size(), 1u);
@@ -230,7 +232,7 @@ TEST_F(DailyChecks, ADriftIsOneEventUntilItEnds) {
             log.end());
   // Back where it was: the drift ends, once.
   for (int k = 16; k <= 17; ++k) {
-    Accept(kJune1 + k * kDayS, truth, 0.0);
+    Accept(kJune1_2024UtcS + k * kDayS, truth, 0.0);
     night.now_s += kDayS;
     RunDailyChecks(*store_, night);
   }
@@ -248,8 +250,8 @@ TEST_F(DailyChecks, ADriftIsOneEventUntilItEnds) {
 TEST_F(DailyChecks, DriftDaysShorterThanTwoWindowsIsSaidInTheLog) {
   config_.monitor.drift_days = 10;
   const ParamVector truth = ReferenceTruthParams(config_.plant);
-  Accept(kJune1 + 7 * kDayS, truth, 0.3);
-  Accept(kJune1 + 14 * kDayS, truth, 0.6);
+  Accept(kJune1_2024UtcS + 7 * kDayS, truth, 0.3);
+  Accept(kJune1_2024UtcS + 14 * kDayS, truth, 0.6);
   const auto log = RunDailyChecks(*store_, Inputs(true));
   testing::RawDb db(dir_ / "pvtwin.db");
   EXPECT_EQ(db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'parameter_drift'"), 0);

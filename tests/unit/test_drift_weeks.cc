@@ -35,6 +35,7 @@
 #include "daemon/service/monitor.h"
 #include "io/files/params_json.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/seeds.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
@@ -42,17 +43,17 @@
 namespace pvtwin::cli {
 namespace {
 
-constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
-constexpr std::int64_t kDayS = 86400;
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
 constexpr int kWindowDays = 14;  // [calibration] window_days' default
 constexpr int kSuiteNights = 16;
 constexpr int kDriftStart = kWindowDays;  // the truth's parameter rises from this day on
 constexpr double kDriftDays = 42.0;       // ... by 30 % over six weeks
 constexpr double kDriftFraction = 0.30;
-constexpr const char* kTruth = "2N2CrI+wind+transport_delay";
-constexpr const char* kModel = "2N1Ccolwr";
+using testing::kExampleDaemonModel;
+using testing::kExamplePlantTruth;
 
-std::vector<std::uint64_t> Seeds() { return testing::SeedsFromEnv("PVTWIN_DRIFT_SEEDS", "1"); }
+std::vector<std::uint64_t> DriftSeeds() { return testing::SeedsFromEnv("PVTWIN_DRIFT_SEEDS", "1"); }
 
 // The truth's parameter that rises: PVTWIN_DRIFT_PARAM, u_back_w_m2k by
 // default (the back loss coefficient; fouling: r0_fluid_m2k_w).
@@ -70,7 +71,7 @@ int Nights() {
 
 WeatherOptions WeatherOf(std::uint64_t seed, int days) {
   WeatherOptions w;
-  w.start_time_s = kJune1;
+  w.start_time_s = kJune1_2024UtcS;
   w.num_days = days;
   w.step_s = 60.0;
   w.seed = seed;
@@ -86,14 +87,14 @@ Series PlantData(std::uint64_t seed, int days, bool drift) {
   const Plant plant = DesignExamplePlant();
   const WeatherOptions weather = WeatherOf(seed, days);
   const ParamVector truth = ReferenceTruthParams(plant);
-  Series healthy = MakeSyntheticPlantData(plant, weather, testing::SpecOf(kTruth), truth,
-                                          RealisticSensorNoise(seed));
+  Series healthy = MakeSyntheticPlantData(plant, weather, testing::SpecOf(kExamplePlantTruth),
+                                          truth, RealisticSensorNoise(seed));
   if (!drift) return healthy;
   ParamVector wet = truth;
   wet[static_cast<std::size_t>(Drifting())] *= 1.0 + kDriftFraction;
-  const Series risen = MakeSyntheticPlantData(plant, weather, testing::SpecOf(kTruth), wet,
-                                              RealisticSensorNoise(seed));
-  const double start_s = static_cast<double>(kJune1 + kDriftStart * kDayS);
+  const Series risen = MakeSyntheticPlantData(plant, weather, testing::SpecOf(kExamplePlantTruth),
+                                              wet, RealisticSensorNoise(seed));
+  const double start_s = static_cast<double>(kJune1_2024UtcS + kDriftStart * kDayS);
   for (std::size_t i = 0; i < healthy.size(); ++i) {
     const double f = std::clamp(
         (static_cast<double>(healthy.time_s[i]) - start_s) / (kDriftDays * kDayS), 0.0, 1.0);
@@ -109,7 +110,7 @@ Series PlantData(std::uint64_t seed, int days, bool drift) {
 
 // The night's fit on the window before it, as an accepted calibration row.
 Store::CalibrationRow FitNight(const Series& data, std::int64_t night_s, const Plant& plant) {
-  const ModelSpec model = testing::SpecOf(kModel);
+  const ModelSpec model = testing::SpecOf(kExampleDaemonModel);
   const Series window = data.Between(night_s - kWindowDays * kDayS, night_s);
   Drivers drivers;
   std::string error;
@@ -119,12 +120,12 @@ Store::CalibrationRow FitNight(const Series& data, std::int64_t night_s, const P
       Identify(drivers, MakeMeasurements(window, drivers), StartParams(plant), IdentOptions{});
   EXPECT_TRUE(fit.ok) << fit.BriefReport();
   row.run_at = night_s;
-  row.variant = kModel;
+  row.variant = kExampleDaemonModel;
   row.window_start = night_s - kWindowDays * kDayS;
   row.window_end = night_s;
   row.status = "accepted";
   row.accepted = true;
-  row.params_json = FormatParamsJson(kModel, fit.params, {}, "");
+  row.params_json = FormatParamsJson(kExampleDaemonModel, fit.params, {}, "");
   for (const ParamEstimate& e : fit.estimates) {
     const ParamInfo& info = Info(e.param);
     const std::string status = !e.free ? "fixed" : e.at_bound ? "at bound" : "identified";
@@ -139,7 +140,7 @@ std::vector<std::string> DriftWarnings(const Series& data, int nights) {
   testing::ScratchDir dir("drift_weeks");
   Config config;
   config.plant = DesignExamplePlant();
-  config.calibration.variant = kModel;
+  config.calibration.variant = kExampleDaemonModel;
   config.calibration.window_days = kWindowDays;
   std::string error;
   std::unique_ptr<Store> store = Store::Open((dir.path() / "pvtwin.db").string(), &error);
@@ -147,10 +148,10 @@ std::vector<std::string> DriftWarnings(const Series& data, int nights) {
   EXPECT_TRUE(store->WriteMinutes(data, &error)) << error;
   DailyCheckInputs in;
   in.config = &config;
-  in.spec = testing::SpecOf(kModel);
+  in.spec = testing::SpecOf(kExampleDaemonModel);
   in.accepted_now = true;
   for (int night = kWindowDays; night < kWindowDays + nights; ++night) {
-    const std::int64_t night_s = kJune1 + night * kDayS;
+    const std::int64_t night_s = kJune1_2024UtcS + night * kDayS;
     Store::CalibrationRow row = FitNight(data, night_s, config.plant);
     EXPECT_TRUE(store->InsertCalibration(&row, &error)) << error;
     in.now_s = night_s + 2 * 3600;
@@ -181,7 +182,7 @@ std::vector<std::string> DriftWarnings(const Series& data, int nights) {
 // them to see the rise) are run and reported.
 TEST(DriftWeeks, AHealthyPlantRaisesNoDriftAndARisingBackLossDoes) {
   const int nights = Nights();
-  for (const std::uint64_t seed : Seeds()) {
+  for (const std::uint64_t seed : DriftSeeds()) {
     const int days = kWindowDays + nights;
     const std::vector<std::string> healthy = DriftWarnings(PlantData(seed, days, false), nights);
     std::printf("seed %llu, %d nights, healthy: %zu parameter_drift warning(s)\n",

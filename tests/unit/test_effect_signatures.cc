@@ -19,7 +19,7 @@ namespace pvtwin {
 namespace {
 
 // n rows at 60 s, all usable, one stretch; rows 0 … n−1 are objective rows.
-Drivers Rows(std::size_t n, std::vector<std::uint32_t>* rows) {
+Drivers SignatureRows(std::size_t n, std::vector<std::uint32_t>* rows) {
   Drivers d;
   d.plant.area_m2 = 2.0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -33,7 +33,7 @@ Drivers Rows(std::size_t n, std::vector<std::uint32_t>* rows) {
 
 TEST(BestLag, FindsTheShiftOfARandomWalkInEitherDirection) {
   std::vector<std::uint32_t> rows;
-  const Drivers d = Rows(600, &rows);
+  const Drivers d = SignatureRows(600, &rows);
   std::mt19937 rng(3);
   std::normal_distribution<double> step(0.0, 1.0);
   std::vector<double> pred(600, 0.0), late(600, 0.0), early(600, 0.0);
@@ -57,7 +57,7 @@ TEST(BestLag, FindsTheShiftOfARandomWalkInEitherDirection) {
 // with 0.5 W noise for a clipping inverter, = DC for one that does not clip.
 TEST(PvClippingSignature, APlateauAtTheFittedLimitIsShownAndMissingWithoutOne) {
   std::vector<std::uint32_t> rows;
-  const Drivers d = Rows(720, &rows);
+  const Drivers d = SignatureRows(720, &rows);
   std::mt19937 rng(5);
   std::normal_distribution<double> noise(0.0, 0.5);
   SimOutputs before, after;
@@ -96,7 +96,7 @@ TEST(PvClippingSignature, APlateauAtTheFittedLimitIsShownAndMissingWithoutOne) {
 // loss, which the same-form battery's second node had been taken for).
 TEST(TransportDelaySignature, ASubStepDelayIsNotShown) {
   std::vector<std::uint32_t> rows;
-  Drivers d = Rows(100, &rows);
+  Drivers d = SignatureRows(100, &rows);
   d.spec = testing::SpecOf("1N1Cwr+transport_delay");
   SimOutputs out;
   out.q_th_w.assign(100, 0.0);

@@ -20,7 +20,7 @@
 namespace pvtwin {
 namespace {
 
-constexpr int kDays = 10;
+constexpr int kIdentDays = 10;
 constexpr int kTrainDays = 7;
 
 // Tolerances: a few standard errors of each parameter on 7 training days
@@ -118,7 +118,7 @@ TEST_P(EffectIdentification, RecoversTheEffectAndReachesTheNoiseFloor) {
   const ModelSpec with = WithEffect(base, testing::EffectNamed(c.effect));
   SyntheticOptions options;
   std::string error;
-  ASSERT_TRUE(DefaultSyntheticOptions(plant, with.Name(), kDays, c.seed, &options, &error))
+  ASSERT_TRUE(DefaultSyntheticOptions(plant, with.Name(), kIdentDays, c.seed, &options, &error))
       << error;
   Series data = MakeSyntheticPlantData(plant, options);
   ApplyPaperCorrections(&data);
@@ -189,7 +189,7 @@ TEST(EffectIdentificationShading, FindsTheObstacleFromTheReferenceStart) {
   for (std::uint64_t seed = 101; seed <= 112; ++seed) {
     SyntheticOptions options;
     std::string error;
-    ASSERT_TRUE(DefaultSyntheticOptions(plant, spec.Name(), kDays, seed, &options, &error))
+    ASSERT_TRUE(DefaultSyntheticOptions(plant, spec.Name(), kIdentDays, seed, &options, &error))
         << error;
     Series data = MakeSyntheticPlantData(plant, options);
     ApplyPaperCorrections(&data);

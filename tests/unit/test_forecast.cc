@@ -10,27 +10,28 @@
 #include "core/forecast/forecast.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
 
-constexpr std::int64_t kDay = 86400;
+using testing::kDayS;
 
-struct Case {
+struct ForecastCase {
   Plant plant = DesignExamplePlant();
   ModelSpec spec = testing::SpecOf("2N1Ccolwr");
   ParamVector truth = ReferenceTruthParams(DesignExamplePlant());
   Series data;  // 15 days, noise-free truth outputs
   std::int64_t t_forecast = 0;
 
-  Case() {
+  ForecastCase() {
     WeatherOptions weather;
     weather.num_days = 15;
     weather.seed = 5;
     weather.flow_mode = FlowMode::kVariable;
     data = MakeSyntheticPlantData(plant, weather, spec, truth, SensorNoise{});
-    t_forecast = weather.start_time_s + 14 * kDay;
+    t_forecast = weather.start_time_s + 14 * kDayS;
   }
   std::size_t RowOf(std::int64_t t) const {
     return static_cast<std::size_t>((t - data.time_s.front()) / 60);
@@ -49,7 +50,7 @@ double MaxAbsDiff(const std::vector<double>& a, const std::vector<double>& b, st
 }
 
 TEST(Forecast, PerfectInputsReproduceTheTruthModel) {
-  const Case c;
+  const ForecastCase c;
   const Series future = c.From(c.t_forecast);
   ForecastRequest request;
   request.issued_at_s = c.t_forecast;
@@ -72,11 +73,11 @@ TEST(Forecast, PerfectInputsReproduceTheTruthModel) {
 }
 
 TEST(Forecast, WithoutWeatherForecastPersistsTheLastDay) {
-  const Case c;
+  const ForecastCase c;
   const Series plan = c.From(c.t_forecast);
   // Broken clouds on the last day: every other 5 minutes at 30 % of the sun.
   Series history = c.Before(c.t_forecast);
-  const std::size_t yesterday = history.RowAtOrAfter(c.t_forecast - kDay);
+  const std::size_t yesterday = history.RowAtOrAfter(c.t_forecast - kDayS);
   for (Channel ch :
        {Channel::kGPoaWM2, Channel::kGhiWM2, Channel::kDhiWM2, Channel::kGPoaDiffuseWM2}) {
     if (!history.Has(ch)) continue;
@@ -124,13 +125,13 @@ TEST(Forecast, WithoutWeatherForecastPersistsTheLastDay) {
 }
 
 TEST(Forecast, WithoutPlanRunsTheMedianDayOfTheWindow) {
-  const Case c;
+  const ForecastCase c;
   Series history = c.Before(c.t_forecast);
   // Inlet temperature: 30 °C on most days, 50 °C on a minority; the typical
   // day is the median, not the mean.
   auto& t_in = history[Channel::kTInC];
   for (std::size_t i = 0; i < history.size(); ++i) {
-    const std::int64_t day = (history.time_s[i] - history.time_s.front()) / kDay;
+    const std::int64_t day = (history.time_s[i] - history.time_s.front()) / kDayS;
     t_in[i] = day % 3 == 0 ? 50.0 : 30.0;
   }
   ForecastRequest request;
@@ -151,7 +152,7 @@ TEST(Forecast, WithoutPlanRunsTheMedianDayOfTheWindow) {
 // rows are means, not the table's value at the interval's start; the rows
 // then carry the energy of the minutes.
 TEST(Forecast, AtAFifteenMinuteStepTheWeatherForecastIsAveragedOverEachRow) {
-  const Case c;
+  const ForecastCase c;
   Series history;
   std::string error;
   ASSERT_TRUE(Resample(c.Before(c.t_forecast), 900.0, &history, &error)) << error;
@@ -182,7 +183,7 @@ TEST(Forecast, AtAFifteenMinuteStepTheWeatherForecastIsAveragedOverEachRow) {
 // The inputs column says, per channel, where the values came from, and names
 // the weather_forecast rows' source where the table was used.
 TEST(Forecast, InputsNameTheSourceOfEachChannel) {
-  const Case c;
+  const ForecastCase c;
   Series weather = c.From(c.t_forecast);
   weather[Channel::kTAmbC].clear();  // the air temperature is not forecast: persisted
   ForecastRequest request;
@@ -212,7 +213,7 @@ TEST(Forecast, InputsNameTheSourceOfEachChannel) {
 // irradiance than its clear sky gives (import-weather marks their source):
 // the forecast's inputs say so; rows of a physical file do not.
 TEST(Forecast, InputsWarnOfWeatherAboveItsClearSky) {
-  const Case c;
+  const ForecastCase c;
   ForecastRequest request;
   request.issued_at_s = c.t_forecast;
   Forecast f;
@@ -231,7 +232,7 @@ TEST(Forecast, InputsWarnOfWeatherAboveItsClearSky) {
 }
 
 TEST(Forecast, RefusesHistoryShorterThanADay) {
-  const Case c;
+  const ForecastCase c;
   ForecastRequest request;
   request.issued_at_s = c.t_forecast;
   const Series short_history = c.data.Slice(c.RowOf(c.t_forecast) - 600, c.RowOf(c.t_forecast));
@@ -247,7 +248,7 @@ TEST(Forecast, RefusesHistoryShorterThanADay) {
 // forecast global (the model splits the forecast's own irradiance), and the
 // rows count as weather-forecast rows for the bands.
 TEST(Forecast, AnIrradianceChannelTheWeatherForecastLacksIsLeftOutNotPersisted) {
-  const Case c;
+  const ForecastCase c;
   ASSERT_TRUE(c.data.Has(Channel::kGPoaDiffuseWM2));
   Series weather = c.From(c.t_forecast);
   weather[Channel::kGPoaDiffuseWM2].clear();

@@ -13,12 +13,13 @@
 #include "core/forecast/forecast_bands.h"
 #include "core/forecast/operation_forecast.h"
 #include "core/synth/synthetic_plant.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
 
-constexpr std::int64_t kDay = 86400;
+using testing::kDayS;
 
 TEST(SampleQuantile, IsHyndmanFanType7) {
   // R: quantile(c(4, 1, 3, 2), c(0, .1, .5, .9, 1)) = 1, 1.3, 2.5, 3.7, 4.
@@ -50,7 +51,7 @@ struct Month {
   std::size_t RowOf(std::int64_t t) const {
     return static_cast<std::size_t>((t - data.time_s.front()) / 60);
   }
-  std::int64_t Day(int d) const { return weather.start_time_s + d * kDay; }
+  std::int64_t Day(int d) const { return weather.start_time_s + d * kDayS; }
   Series Span(std::int64_t from, std::int64_t to) const {
     return data.Slice(RowOf(from), std::min(RowOf(to), data.size()));
   }
@@ -104,12 +105,12 @@ struct DayScore {
 void ScoreDay(const Month& m, int d, const Series* weather_forecast, DayScore* score,
               bool choose_operation = true, std::int64_t issue_offset_s = 0, int window_days = 14) {
   const std::int64_t t0 = m.Day(d) + issue_offset_s;
-  const Series history = m.Span(t0 - window_days * kDay, t0);
+  const Series history = m.Span(t0 - window_days * kDayS, t0);
   const Series wf_past =
-      weather_forecast ? weather_forecast->Slice(m.RowOf(t0 - window_days * kDay), m.RowOf(t0))
+      weather_forecast ? weather_forecast->Slice(m.RowOf(t0 - window_days * kDayS), m.RowOf(t0))
                        : Series{};
   const Series wf_day =
-      weather_forecast ? weather_forecast->Slice(m.RowOf(t0), m.RowOf(t0 + kDay)) : Series{};
+      weather_forecast ? weather_forecast->Slice(m.RowOf(t0), m.RowOf(t0 + kDayS)) : Series{};
   ForecastRequest request;
   request.issued_at_s = t0;
   ForecastErrors errors;

@@ -12,18 +12,19 @@
 #include <vector>
 
 #include "core/monitor/index_band.h"
+#include "tests/support/fixtures.h"
 
 namespace pvtwin {
 namespace {
 
-constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
-constexpr std::int64_t kDayS = 86400;
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
 constexpr double kZ90 = 1.2815515655446004;
 
 // A day scored for electricity only, with pi = exp(error).
 DayPerformance DayWithError(int d, double error) {
   DayPerformance p;
-  p.day_start_s = kJune1 + d * kDayS;
+  p.day_start_s = kJune1_2024UtcS + d * kDayS;
   p.scored_el = true;
   p.pi_el = std::exp(error);
   p.e_el_model_wh = 1000.0;  // every day alike: the nearest are the most recent
@@ -166,7 +167,7 @@ TEST(IndexCusum, ThreeDaysTwoSigmaLowAlarmOneBandEdgeDoesNot) {
   EXPECT_TRUE(run[9].banded);
   // Day 30: the band edge, z = −z90, S = z90 − 1 = 0.28: no alarm.
   const IndexDay& edge = run[30];
-  EXPECT_EQ(edge.day_start_s, kJune1 + 30 * kDayS);
+  EXPECT_EQ(edge.day_start_s, kJune1_2024UtcS + 30 * kDayS);
   EXPECT_NEAR(edge.z, -kZ90, 1e-9);
   EXPECT_NEAR(edge.s, kZ90 - 1.0, 1e-9);
   EXPECT_FALSE(edge.alarm);
@@ -174,7 +175,7 @@ TEST(IndexCusum, ThreeDaysTwoSigmaLowAlarmOneBandEdgeDoesNot) {
   // Days 33–35, 2.1σ low each: S = 1.1, 2.2, 3.3 σ; the alarm on the third.
   for (int d = 33; d <= 35; ++d) {
     const IndexDay& c = run[static_cast<std::size_t>(d)];
-    ASSERT_EQ(c.day_start_s, kJune1 + d * kDayS);
+    ASSERT_EQ(c.day_start_s, kJune1_2024UtcS + d * kDayS);
     EXPECT_NEAR(c.z, -2.1, 1e-9) << d;
     EXPECT_EQ(c.alarm, d == 35) << d;
     EXPECT_EQ(c.run_days, d - 32) << d;
@@ -315,14 +316,14 @@ TEST(IndexCusum, TheChangeBeganOnTheFirstDayOfTheAlarmsUnbrokenRun) {
   int alarms = 0;
   for (const IndexDay& c : run) alarms += c.alarm;
   EXPECT_GE(alarms, 2);  // more than one alarm, so the run of runs is what is tested
-  EXPECT_EQ(ChangeOnsetS(run), kJune1 + 20 * kDayS);
+  EXPECT_EQ(ChangeOnsetS(run), kJune1_2024UtcS + 20 * kDayS);
   // Only the days up to the first alarm: the same first day.
   std::vector<IndexDay> first;
   for (const IndexDay& c : run) {
     first.push_back(c);
     if (c.alarm) break;
   }
-  EXPECT_EQ(ChangeOnsetS(first), kJune1 + 20 * kDayS);
+  EXPECT_EQ(ChangeOnsetS(first), kJune1_2024UtcS + 20 * kDayS);
   // The calm days alone: no alarm, no change.
   EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + 20)), -1);
 }
@@ -344,8 +345,8 @@ TEST(IndexCusum, AChangeAfterTheLastOneEndedBeginsAnew) {
   EXPECT_TRUE(run[22].alarm);
   EXPECT_EQ(run[23].run_days, 0);
   EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + 34)),
-            kJune1 + 20 * kDayS);
-  EXPECT_EQ(ChangeOnsetS(run), kJune1 + 34 * kDayS);
+            kJune1_2024UtcS + 20 * kDayS);
+  EXPECT_EQ(ChangeOnsetS(run), kJune1_2024UtcS + 34 * kDayS);
 }
 
 TEST(IndexCusum, ALossSeenOnClearDaysOnlyIsOneChangeThroughTheCloudyDaysBetween) {
@@ -371,7 +372,7 @@ TEST(IndexCusum, ALossSeenOnClearDaysOnlyIsOneChangeThroughTheCloudyDaysBetween)
   }
   ASSERT_GT(second_alarm, 25);
   EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + second_alarm + 1)),
-            kJune1 + 20 * kDayS);
+            kJune1_2024UtcS + 20 * kDayS);
 }
 
 TEST(IndexCusum, TheChangeIsDatedByTheLikelihoodOfAStepNotByTheLastZero) {
@@ -393,7 +394,7 @@ TEST(IndexCusum, TheChangeIsDatedByTheLikelihoodOfAStepNotByTheLastZero) {
   ASSERT_GE(alarm, 20);
   EXPECT_GT(run[19].run_days, 0);  // the excursion opened before the loss
   EXPECT_EQ(ChangeOnsetS(std::vector<IndexDay>(run.begin(), run.begin() + alarm + 1)),
-            kJune1 + 20 * kDayS);
+            kJune1_2024UtcS + 20 * kDayS);
 }
 
 }  // namespace

@@ -9,15 +9,15 @@
 
 #include <filesystem>
 #include <fstream>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "config/plant_config.h"
 #include "core/model/variant.h"
 #include "daemon/service/monitor.h"
 #include "daemon/service/window_data.h"
 #include "io/store/store.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
 
@@ -29,11 +29,11 @@ using testing::ProcessResult;
 using testing::RawDb;
 using testing::RunPvtwin;
 
-const fs::path kData = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
+using testing::kHtwSaarDir;
 // The htw saar days: day 3 is 2017-07-25, day 1 2017-08-07 (UTC).
 const std::string kWindow = " --from 2017-07-25 --to 2017-08-08";
 
-std::string Data(const std::string& name) { return "'" + (kData / name).string() + "'"; }
+std::string Data(const std::string& name) { return "'" + (kHtwSaarDir / name).string() + "'"; }
 
 // n rows of step_s from t0 with a P_el of `p_el_w`.
 Series Flat(std::int64_t t0, std::size_t n, double step_s, double p_el_w) {
@@ -47,7 +47,7 @@ Series Flat(std::int64_t t0, std::size_t n, double step_s, double p_el_w) {
   return s;
 }
 
-constexpr std::int64_t kT0 = 1717243200;  // 2024-06-01T12:00:00Z
+using testing::kJune1Noon2024UtcS;
 
 TEST(WindowData, OneMinuteRowsFirstElseTheIntervalRowsAtTheirStep) {
   const fs::path dir = fs::temp_directory_path() / ("pvtwin_window_" + std::to_string(getpid()));
@@ -57,10 +57,14 @@ TEST(WindowData, OneMinuteRowsFirstElseTheIntervalRowsAtTheirStep) {
   std::unique_ptr<Store> store = Store::Open((dir / "t.db").string(), &error);
   ASSERT_TRUE(store) << error;
   // An hour of 2-min rows, and 1-min rows in its second half only.
-  ASSERT_TRUE(store->WriteIntervalRows(Flat(kT0, 30, 120.0, 200.0), &error)) << error;
-  ASSERT_TRUE(store->WriteMinutes(Flat(kT0 + 1800, 30, 60.0, 100.0), &error)) << error;
+  ASSERT_TRUE(store->WriteIntervalRows(Flat(kJune1Noon2024UtcS, 30, 120.0, 200.0), &error))
+      << error;
+  ASSERT_TRUE(store->WriteMinutes(Flat(kJune1Noon2024UtcS + 1800, 30, 60.0, 100.0), &error))
+      << error;
   cli::WindowData w;
-  ASSERT_TRUE(cli::ReadWindowData(*store, kT0, kT0 + 1800, &w, &error)) << error;
+  ASSERT_TRUE(
+      cli::ReadWindowData(*store, kJune1Noon2024UtcS, kJune1Noon2024UtcS + 1800, &w, &error))
+      << error;
   EXPECT_EQ(w.source, cli::WindowSource::kIntervals);
   EXPECT_STREQ(w.Table(), "measurement_interval");
   EXPECT_EQ(w.Describe(), "2-min rows of measurement_interval");
@@ -68,13 +72,17 @@ TEST(WindowData, OneMinuteRowsFirstElseTheIntervalRowsAtTheirStep) {
   EXPECT_EQ(w.rows.step_s, 120.0);
   EXPECT_EQ(w.rows.At(Channel::kPElW, 0), 200.0);
   // A window with 1-min rows reads those only.
-  ASSERT_TRUE(cli::ReadWindowData(*store, kT0, kT0 + 3600, &w, &error)) << error;
+  ASSERT_TRUE(
+      cli::ReadWindowData(*store, kJune1Noon2024UtcS, kJune1Noon2024UtcS + 3600, &w, &error))
+      << error;
   EXPECT_EQ(w.source, cli::WindowSource::kMinutes);
   ASSERT_EQ(w.rows.size(), 30u);
   EXPECT_EQ(w.rows.step_s, 60.0);
   EXPECT_EQ(w.rows.At(Channel::kPElW, 0), 100.0);
   // Neither.
-  ASSERT_TRUE(cli::ReadWindowData(*store, kT0 - 7200, kT0, &w, &error)) << error;
+  ASSERT_TRUE(
+      cli::ReadWindowData(*store, kJune1Noon2024UtcS - 7200, kJune1Noon2024UtcS, &w, &error))
+      << error;
   EXPECT_EQ(w.source, cli::WindowSource::kNone);
   EXPECT_EQ(w.rows.size(), 0u);
   EXPECT_STREQ(w.Table(), "");
@@ -116,8 +124,8 @@ class IntervalStore : public testing::TempDirTest {
   // The htw saar days in time order as one CSV, as `diagnose --csv` reads them.
   void WriteHtwCsv(const fs::path& csv) {
     std::ofstream out(csv);
-    out << testing::ReadFile(kData / "day3_clear_medium_dT.csv");
-    const std::string day1 = testing::ReadFile(kData / "day1_clear_low_dT.csv");
+    out << testing::ReadFile(kHtwSaarDir / "day3_clear_medium_dT.csv");
+    const std::string day1 = testing::ReadFile(kHtwSaarDir / "day1_clear_low_dT.csv");
     out << day1.substr(day1.find('\n') + 1);
   }
 };
@@ -200,7 +208,7 @@ TEST_F(IntervalStore, TheDailyChecksRecordTheLongWaveChannelOfIntervalRows) {
   ImportHtwDays();
   Config config;
   Diagnostics errors;
-  ASSERT_TRUE(LoadConfig((kData / "plant.toml").string(), &config, &errors));
+  ASSERT_TRUE(LoadConfig((kHtwSaarDir / "plant.toml").string(), &config, &errors));
   std::string error;
   std::unique_ptr<Store> store = Store::Open((dir_ / "t.db").string(), &error);
   ASSERT_TRUE(store) << error;

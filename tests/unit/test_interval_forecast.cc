@@ -20,6 +20,7 @@
 #include "core/common/clock.h"
 #include "io/platform/child_process.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/forecast_skill_check.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
@@ -34,10 +35,10 @@ using testing::RunPvtwin;
 using testing::WaitFor;
 using Db = testing::RawDb;
 
-const fs::path kData = fs::path(PVTWIN_DATA_DIR) / "htwsaar-pvt";
-const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
-constexpr std::int64_t kDay = 86400;
-constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01 00:00 UTC
+using testing::kDayS;
+using testing::kExamplePlantConfig;
+using testing::kHtwSaarDir;
+using testing::kJune1_2024UtcS;
 // 2017-08-07 18:36 UTC: one row (2 min) after the last of htw saar day 1.
 constexpr std::int64_t kAfterHtwDay1 = 1502064000 + 18 * 3600 + 36 * 60;
 constexpr std::int64_t kHtwDay1 = 1502064000;  // 2017-08-07 00:00 UTC
@@ -53,18 +54,18 @@ class IntervalForecast : public testing::TempDirTest {
   void ImportHtwDays() {
     for (const char* day : {"day3_clear_medium_dT.csv", "day1_clear_low_dT.csv"}) {
       const auto run =
-          RunPvtwin(dir_, "import --config '" + (kData / "plant.toml").string() + "' --csv '" +
-                              (kData / day).string() + "' --db " + DbPath());
+          RunPvtwin(dir_, "import --config '" + (kHtwSaarDir / "plant.toml").string() +
+                              "' --csv '" + (kHtwSaarDir / day).string() + "' --db " + DbPath());
       ASSERT_EQ(run.exit_code, 0) << run.err;
     }
   }
   // `days` of the example plant up to `end` at step_s, imported (1-min rows
   // into measurement_1min, coarser ones into measurement_interval).
   void ImportSim(std::int64_t end, int days, int step_s) {
-    fs::copy_file(kExampleMap, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
+    fs::copy_file(kExamplePlantConfig, dir_ / "sim.toml", fs::copy_options::overwrite_existing);
     auto run = RunPvtwin(dir_, "sim --config sim.toml --export history.csv --days " +
                                    std::to_string(days) + " --step " + std::to_string(step_s) +
-                                   " --start " + std::to_string(end - days * kDay));
+                                   " --start " + std::to_string(end - days * kDayS));
     ASSERT_EQ(run.exit_code, 0) << run.err;
     run = RunPvtwin(dir_, "import --config sim.toml --csv history.csv --db " + DbPath());
     ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -74,7 +75,7 @@ class IntervalForecast : public testing::TempDirTest {
   // stamps set to their minute) and its measured operation written into
   // operation_plan, as another program would, for both minutes of each row.
   void MeasuredDayAsForecastInputs(const std::string& file, std::int64_t day) {
-    std::ifstream in(kData / file);
+    std::ifstream in(kHtwSaarDir / file);
     std::string line;
     std::getline(in, line);
     std::vector<std::string> header;
@@ -95,11 +96,12 @@ class IntervalForecast : public testing::TempDirTest {
       out << "\n";
     }
     out.close();
-    const auto run = RunPvtwin(dir_, "import-weather --config '" + (kData / "plant.toml").string() +
-                                         "' --db " + DbPath() + " weather.csv");
+    const auto run =
+        RunPvtwin(dir_, "import-weather --config '" + (kHtwSaarDir / "plant.toml").string() +
+                            "' --db " + DbPath() + " weather.csv");
     ASSERT_EQ(run.exit_code, 0) << run.err;
-    const std::string of_day =
-        " FROM measurement_interval WHERE ts >= " + Format(day) + " AND ts < " + Format(day + kDay);
+    const std::string of_day = " FROM measurement_interval WHERE ts >= " + Format(day) +
+                               " AND ts < " + Format(day + kDayS);
     Db db(DbPath());
     ASSERT_EQ(db.Exec("INSERT INTO operation_plan(ts, t_in_c, flow_kg_s) SELECT ts, t_in_c, "
                       "flow_kg_s" +
@@ -153,7 +155,7 @@ class IntervalForecast : public testing::TempDirTest {
 // forecast", no calibrated forecast at all).
 TEST_F(IntervalForecast, TheHtwSaarDaysAreForecastAtTheirOwnStepFromTheirLastRows) {
   ImportHtwDays();
-  WriteConfig(ReadFile(kData / "plant.toml"));
+  WriteConfig(ReadFile(kHtwSaarDir / "plant.toml"));
   StartDaemon(kAfterHtwDay1, 1.0);
   Db db(DbPath());
   ASSERT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 0.0);
@@ -178,17 +180,17 @@ TEST_F(IntervalForecast, TheHtwSaarDaysAreForecastAtTheirOwnStepFromTheirLastRow
   EXPECT_FALSE(std::isnan(db.Number("SELECT t_out_c" + of_issue + " ORDER BY ts LIMIT 1")));
   // Day 1's daylight persisted into the next day: P_el forecast at noon.
   EXPECT_GT(db.Number("SELECT p_el_w" + of_issue + " AND ts = " +
-                      Format(kAfterHtwDay1 - 18 * 3600 - 36 * 60 + kDay + 12 * 3600)),
+                      Format(kAfterHtwDay1 - 18 * 3600 - 36 * 60 + kDayS + 12 * 3600)),
             100.0);
 }
 
 // A store with both (the poller's 1-min rows and an older logger's 2-min
 // rows of the same days) forecasts from the 1-min rows, at 1 min.
 TEST_F(IntervalForecast, OneMinuteRowsAreUsedWhereTheStoreAlsoHasIntervalRows) {
-  ImportSim(kJune1, 3, 120);
-  ImportSim(kJune1, 3, 60);
+  ImportSim(kJune1_2024UtcS, 3, 120);
+  ImportSim(kJune1_2024UtcS, 3, 60);
   WriteConfig(SimPlant());
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   ASSERT_GT(db.Number("SELECT COUNT(*) FROM measurement_interval"), 2000.0);
   const double issued_at = WaitForCalibratedForecast(db, 120);
@@ -206,9 +208,9 @@ TEST_F(IntervalForecast, OneMinuteRowsAreUsedWhereTheStoreAlsoHasIntervalRows) {
 // on the replayed errors of 10-min rows (the errors of interval means are
 // the ones a 10-min forecast row has).
 TEST_F(IntervalForecast, TenMinuteHistoryIsForecastEveryTenMinutesWithBands) {
-  ImportSim(kJune1, 6, 600);
+  ImportSim(kJune1_2024UtcS, 6, 600);
   WriteConfig(SimPlant());
-  StartDaemon(kJune1, 60.0);
+  StartDaemon(kJune1_2024UtcS, 60.0);
   Db db(DbPath());
   const double issued_at = WaitForCalibratedForecast(db, 180);
   ASSERT_FALSE(std::isnan(issued_at)) << Log();
@@ -238,7 +240,7 @@ TEST_F(IntervalForecast, TenMinuteHistoryIsForecastEveryTenMinutesWithBands) {
 // operation as its plan.
 TEST_F(IntervalForecast, TheHtwSaarDaysAreScoredFromTheirTwoMinuteRows) {
   ImportHtwDays();
-  WriteConfig(ReadFile(kData / "plant.toml"));
+  WriteConfig(ReadFile(kHtwSaarDir / "plant.toml"));
   Db db(DbPath());
   const std::vector<std::pair<const char*, std::int64_t>> days = {
       {"day3_clear_medium_dT.csv", kHtwDay3}, {"day1_clear_low_dT.csv", kHtwDay1}};
@@ -255,7 +257,7 @@ TEST_F(IntervalForecast, TheHtwSaarDaysAreScoredFromTheirTwoMinuteRows) {
   ASSERT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 0.0);
   testing::Rows by_hand;
   for (const auto& [file, day] : days) {
-    const auto score = testing::ScoreDayByHand(db, "measurement_interval", day, day + kDay, day);
+    const auto score = testing::ScoreDayByHand(db, "measurement_interval", day, day + kDayS, day);
     EXPECT_GE(score.minutes, 360.0) << file << ": the day's valid rows with a forecast";
     EXPECT_EQ(score.minutes, 2.0 * score.pairs);
     EXPECT_FALSE(std::isnan(score.mae_p_el_w));

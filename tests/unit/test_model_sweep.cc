@@ -56,7 +56,7 @@ std::vector<std::string> AllTestedVariants() {
   return v;
 }
 
-ParamVector Sample(const Plant& plant, std::mt19937_64& rng, int mode) {
+ParamVector DrawParams(const Plant& plant, std::mt19937_64& rng, int mode) {
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   ParamVector p{};
   for (std::size_t i = 0; i < kNumParams; ++i) {
@@ -96,7 +96,7 @@ TEST(ModelSweep, FiniteAndBoundedAcrossBoundsAndSteps) {
       }
       SimOutputs out;
       for (int sample = 0; sample < 12; ++sample) {
-        const ParamVector p = Sample(plant, rng, std::min(sample, 2));
+        const ParamVector p = DrawParams(plant, rng, std::min(sample, 2));
         Simulate(d, p, &out);
         // Minimum principle: with non-negative absorbed heat no node falls
         // below the coldest boundary temperature. Upper bound: all absorbed

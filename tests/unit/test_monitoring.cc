@@ -16,17 +16,18 @@
 #include "core/physics/solar_position.h"
 #include "core/synth/synthetic_plant.h"
 #include "io/files/csv.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
 
-constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
-constexpr std::int64_t kDayS = 86400;
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
 
 Series ClearDays(const Plant& plant, int days, double step_s = 60.0) {
   WeatherOptions weather;
-  weather.start_time_s = kJune1;
+  weather.start_time_s = kJune1_2024UtcS;
   weather.num_days = days;
   weather.step_s = step_s;
   weather.seed = 7;
@@ -40,10 +41,10 @@ TEST(Performance, TheTruthModelScoresOneAndLeavesTheBandToTheResidualModel) {
   const Series s = ClearDays(plant, 2);
   DayPerformance p;
   std::string error;
-  ASSERT_TRUE(ScoreDay(s, kJune1 + kDayS, plant, testing::SpecOf("2N1Ccolwr"),
+  ASSERT_TRUE(ScoreDay(s, kJune1_2024UtcS + kDayS, plant, testing::SpecOf("2N1Ccolwr"),
                        ReferenceTruthParams(plant), PerformanceOptions{}, &p, &error))
       << error;
-  EXPECT_EQ(p.day_start_s, kJune1 + kDayS);
+  EXPECT_EQ(p.day_start_s, kJune1_2024UtcS + kDayS);
   EXPECT_GT(p.valid_minutes, 600);  // a clear June day
   ASSERT_TRUE(p.scored_el && p.scored_th);
   // Only sensor noise separates the truth from the measurement: 0.5 % of
@@ -63,7 +64,7 @@ TEST(Performance, ALossOfFifteenPercentScoresItsShare) {
   for (int d = 0; d < 2; ++d) {
     DayPerformance p;
     std::string error;
-    ASSERT_TRUE(ScoreDay(s, kJune1 + d * kDayS, plant, testing::SpecOf("2N1Ccolwr"),
+    ASSERT_TRUE(ScoreDay(s, kJune1_2024UtcS + d * kDayS, plant, testing::SpecOf("2N1Ccolwr"),
                          ReferenceTruthParams(plant), PerformanceOptions{}, &p, &error))
         << error;
     EXPECT_NEAR(p.pi_el, 0.85, 0.003) << d;
@@ -73,11 +74,12 @@ TEST(Performance, ALossOfFifteenPercentScoresItsShare) {
 
 TEST(Performance, ADayWithTooFewMinutesIsMarkedNotScored) {
   const Plant plant = DesignExamplePlant();
-  const Series s = ClearDays(plant, 1).Between(kJune1 + 10 * 3600, kJune1 + 11 * 3600);
+  const Series s =
+      ClearDays(plant, 1).Between(kJune1_2024UtcS + 10 * 3600, kJune1_2024UtcS + 11 * 3600);
   DayPerformance p;
   std::string error;
-  ASSERT_TRUE(ScoreDay(s, kJune1, plant, testing::SpecOf("2N1Ccolwr"), ReferenceTruthParams(plant),
-                       PerformanceOptions{}, &p, &error));
+  ASSERT_TRUE(ScoreDay(s, kJune1_2024UtcS, plant, testing::SpecOf("2N1Ccolwr"),
+                       ReferenceTruthParams(plant), PerformanceOptions{}, &p, &error));
   EXPECT_EQ(p.valid_minutes, 60);
   EXPECT_FALSE(p.scored_el);
   EXPECT_FALSE(p.scored_th);
@@ -89,12 +91,13 @@ TEST(Performance, ADayWithTooFewMinutesIsMarkedNotScored) {
 // three hours are 180 minutes, enough to score, not 90.
 TEST(Performance, RowsOfACoarserLoggerCountTheMinutesTheyCover) {
   const Plant plant = DesignExamplePlant();
-  const Series s = ClearDays(plant, 1, 120.0).Between(kJune1 + 9 * 3600, kJune1 + 12 * 3600);
+  const Series s =
+      ClearDays(plant, 1, 120.0).Between(kJune1_2024UtcS + 9 * 3600, kJune1_2024UtcS + 12 * 3600);
   ASSERT_EQ(s.size(), 90u);
   DayPerformance p;
   std::string error;
-  ASSERT_TRUE(ScoreDay(s, kJune1, plant, testing::SpecOf("2N1Ccolwr"), ReferenceTruthParams(plant),
-                       PerformanceOptions{}, &p, &error))
+  ASSERT_TRUE(ScoreDay(s, kJune1_2024UtcS, plant, testing::SpecOf("2N1Ccolwr"),
+                       ReferenceTruthParams(plant), PerformanceOptions{}, &p, &error))
       << error;
   EXPECT_EQ(p.valid_minutes, 180);
   EXPECT_TRUE(p.scored_el);
@@ -225,19 +228,19 @@ TEST(SensorFaults, FoundWherePlanted) {
   ASSERT_NE(frozen, nullptr);
   // The first row of the run is where the value was first seen; the run of
   // identical values starts one row later.
-  EXPECT_EQ(frozen->start_s, kJune1 + 2 * 3600 + 60);
-  EXPECT_EQ(frozen->end_s, kJune1 + 3 * 3600 + 30 * 60);
+  EXPECT_EQ(frozen->start_s, kJune1_2024UtcS + 2 * 3600 + 60);
+  EXPECT_EQ(frozen->end_s, kJune1_2024UtcS + 3 * 3600 + 30 * 60);
   const SensorFault* missing = find("p_el_w", "missing");
   ASSERT_NE(missing, nullptr);
-  EXPECT_EQ(missing->start_s, kJune1 + 9 * 3600);
-  EXPECT_EQ(missing->end_s, kJune1 + 9 * 3600 + 20 * 60);
+  EXPECT_EQ(missing->start_s, kJune1_2024UtcS + 9 * 3600);
+  EXPECT_EQ(missing->end_s, kJune1_2024UtcS + 9 * 3600 + 20 * 60);
   const SensorFault* heat = find("q_th_w", "heat_without_flow");
   ASSERT_NE(heat, nullptr);
-  EXPECT_EQ(heat->start_s, kJune1 + 5 * 3600);
+  EXPECT_EQ(heat->start_s, kJune1_2024UtcS + 5 * 3600);
   const SensorFault* sky = find("lw_down_w_m2", "sky_warmer_than_air");
   ASSERT_NE(sky, nullptr);
-  EXPECT_EQ(sky->start_s, kJune1 + 12 * 3600);
-  EXPECT_EQ(sky->end_s, kJune1 + 12 * 3600 + 30 * 60);
+  EXPECT_EQ(sky->start_s, kJune1_2024UtcS + 12 * 3600);
+  EXPECT_EQ(sky->end_s, kJune1_2024UtcS + 12 * 3600 + 30 * 60);
   // Nothing else: the untouched channels of a synthetic day are healthy
   // (lw_down is missing outside the planted half hour, which is reported).
   for (const SensorFault& f : faults) {
@@ -268,17 +271,17 @@ TEST(SensorFaults, IrradianceAboveTheClearSkyOrAgainstGhiDhi) {
   bool low = false, high = false, high_also_disagrees = false;
   for (const SensorFault& f : FindSensorFaults(s, plant)) {
     EXPECT_EQ(f.channel, "g_poa_w_m2") << f.kind;
-    if (f.kind == "poa_disagrees_with_ghi_dhi" && f.start_s == kJune1 + 10 * 3600) {
+    if (f.kind == "poa_disagrees_with_ghi_dhi" && f.start_s == kJune1_2024UtcS + 10 * 3600) {
       low = true;
-      EXPECT_EQ(f.end_s, kJune1 + 11 * 3600);
+      EXPECT_EQ(f.end_s, kJune1_2024UtcS + 11 * 3600);
     } else if (f.kind == "above_clear_sky") {
       high = true;
-      EXPECT_GE(f.start_s, kJune1 + 13 * 3600);
-      EXPECT_LE(f.end_s, kJune1 + 13 * 3600 + 30 * 60);
-    } else if (f.kind == "poa_disagrees_with_ghi_dhi" && f.start_s == kJune1 + 13 * 3600) {
+      EXPECT_GE(f.start_s, kJune1_2024UtcS + 13 * 3600);
+      EXPECT_LE(f.end_s, kJune1_2024UtcS + 13 * 3600 + 30 * 60);
+    } else if (f.kind == "poa_disagrees_with_ghi_dhi" && f.start_s == kJune1_2024UtcS + 13 * 3600) {
       high_also_disagrees = true;
     } else {
-      ADD_FAILURE() << f.kind << " from " << f.start_s - kJune1 << " s: " << f.detail;
+      ADD_FAILURE() << f.kind << " from " << f.start_s - kJune1_2024UtcS << " s: " << f.detail;
     }
   }
   EXPECT_TRUE(low);

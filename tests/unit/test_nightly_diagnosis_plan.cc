@@ -10,11 +10,12 @@
 
 #include "core/common/calendar.h"
 #include "daemon/service/nightly_diagnosis.h"
+#include "tests/support/fixtures.h"
 
 namespace pvtwin::cli {
 namespace {
 
-constexpr std::int64_t kDayS = 86400;
+using testing::kDayS;
 constexpr std::int64_t kJune16 = 1750032000;  // 2025-06-16T00:00:00Z
 
 // Tonight's job: the 14-day calibration window ending at midnight, the

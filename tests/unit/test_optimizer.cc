@@ -36,7 +36,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string Name(const testing::TestParamInfo<OptAlgorithm>& info) {
+std::string Name(const ::testing::TestParamInfo<OptAlgorithm>& info) {
   return std::string(ToString(info.param));
 }
 
@@ -85,7 +85,7 @@ OptimizerOptions With(OptAlgorithm algorithm) {
 
 // --- every algorithm on a smooth problem --------------------------------
 
-class OptimizerEveryAlgorithm : public testing::TestWithParam<OptAlgorithm> {};
+class OptimizerEveryAlgorithm : public ::testing::TestWithParam<OptAlgorithm> {};
 
 TEST_P(OptimizerEveryAlgorithm, FindsShiftedQuadraticMinimumIn3D) {
   const std::vector<double> center = {0.3, -1.2, 2.5};
@@ -135,7 +135,7 @@ TEST_P(OptimizerEveryAlgorithm, NanEverywhereIsAFailedResult) {
   EXPECT_NE(result.message.find("NaN or infinite"), std::string::npos) << result.message;
 }
 
-INSTANTIATE_TEST_SUITE_P(Optimizer, OptimizerEveryAlgorithm, testing::ValuesIn(kAllOptAlgorithms),
+INSTANTIATE_TEST_SUITE_P(Optimizer, OptimizerEveryAlgorithm, ::testing::ValuesIn(kAllOptAlgorithms),
                          Name);
 
 // --- derivative-free methods on non-smooth, log-scaled problems --------
@@ -165,7 +165,7 @@ OptimizerResult MinimizeAbsoluteSum(OptAlgorithm algorithm, bool relative) {
   return Minimize(cost, x0, Box(3, 1e-3, 1e3, /*log=*/true), options);
 }
 
-class OptimizerDerivativeFree : public testing::TestWithParam<OptAlgorithm> {};
+class OptimizerDerivativeFree : public ::testing::TestWithParam<OptAlgorithm> {};
 
 // Σ |x_i − a_i| / a_i with a = 1e-2, 1, 1e2, each searched over [1e-3, 1e3]
 // on a log scale: every kink has the same slope in the unit box.
@@ -178,13 +178,13 @@ TEST_P(OptimizerDerivativeFree, SolvesRelativeAbsoluteSumAcrossDecadesTo1Percent
 
 // COBYLA is left out: its linear models stall on the kinks (it ends 50 % off).
 INSTANTIATE_TEST_SUITE_P(Optimizer, OptimizerDerivativeFree,
-                         testing::Values(OptAlgorithm::kBobyqa, OptAlgorithm::kSbplx,
-                                         OptAlgorithm::kNelderMead, OptAlgorithm::kCrs2Bobyqa,
-                                         OptAlgorithm::kMultiStartBobyqa,
-                                         OptAlgorithm::kMlslBobyqa),
+                         ::testing::Values(OptAlgorithm::kBobyqa, OptAlgorithm::kSbplx,
+                                           OptAlgorithm::kNelderMead, OptAlgorithm::kCrs2Bobyqa,
+                                           OptAlgorithm::kMultiStartBobyqa,
+                                           OptAlgorithm::kMlslBobyqa),
                          Name);
 
-class OptimizerSimplex : public testing::TestWithParam<OptAlgorithm> {};
+class OptimizerSimplex : public ::testing::TestWithParam<OptAlgorithm> {};
 
 // Σ |x_i − a_i| unweighted, same log-scaled box. In unit coordinates the
 // kinks now have slopes in the ratio 1 : 100 : 1e4, and only the simplex
@@ -198,7 +198,7 @@ TEST_P(OptimizerSimplex, SolvesAbsoluteSumAcrossDecadesTo1Percent) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Optimizer, OptimizerSimplex,
-                         testing::Values(OptAlgorithm::kSbplx, OptAlgorithm::kNelderMead), Name);
+                         ::testing::Values(OptAlgorithm::kSbplx, OptAlgorithm::kNelderMead), Name);
 
 TEST(OptimizerRestarts, RestartsGetBobyqaOffAKink) {
   OptimizerOptions options = With(OptAlgorithm::kBobyqa);
@@ -222,7 +222,7 @@ TEST(OptimizerRestarts, RestartsGetBobyqaOffAKink) {
 
 // --- bounds -------------------------------------------------------------
 
-class OptimizerLocal : public testing::TestWithParam<OptAlgorithm> {};
+class OptimizerLocal : public ::testing::TestWithParam<OptAlgorithm> {};
 
 // Minimum of Σ (x − a)² with a = (−0.5, 0.3, 2) over [0, 1]³ is (0, 0.3, 1).
 TEST_P(OptimizerLocal, MinimumOnABoundSitsOnTheBound) {
@@ -239,9 +239,9 @@ TEST_P(OptimizerLocal, MinimumOnABoundSitsOnTheBound) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Optimizer, OptimizerLocal,
-                         testing::Values(OptAlgorithm::kBobyqa, OptAlgorithm::kSbplx,
-                                         OptAlgorithm::kNelderMead, OptAlgorithm::kCobyla,
-                                         OptAlgorithm::kLbfgs, OptAlgorithm::kMma),
+                         ::testing::Values(OptAlgorithm::kBobyqa, OptAlgorithm::kSbplx,
+                                           OptAlgorithm::kNelderMead, OptAlgorithm::kCobyla,
+                                           OptAlgorithm::kLbfgs, OptAlgorithm::kMma),
                          Name);
 
 TEST(OptimizerBobyqa, MinimumOnABoundIsExactlyTheBound) {
@@ -470,7 +470,7 @@ TEST(OptimizerGradient, UnitBoxRoundTripsAndIsExactAtTheBounds) {
   EXPECT_NEAR(x[1], 1e-1, 1e-15);
 }
 
-class OptimizerGradientMethod : public testing::TestWithParam<OptAlgorithm> {};
+class OptimizerGradientMethod : public ::testing::TestWithParam<OptAlgorithm> {};
 
 // Σ (x_i / a_i − 1)² over log-scaled [1e-3, 1e3]: smooth, badly scaled in x,
 // well scaled in z. A wrong chain-rule factor leaves the gradient methods
@@ -496,11 +496,11 @@ TEST_P(OptimizerGradientMethod, ConvergesOnLogScaledProblem) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Optimizer, OptimizerGradientMethod,
-                         testing::Values(OptAlgorithm::kLbfgs, OptAlgorithm::kMma), Name);
+                         ::testing::Values(OptAlgorithm::kLbfgs, OptAlgorithm::kMma), Name);
 
 // --- determinism, time limit, allocation --------------------------------
 
-class OptimizerStochastic : public testing::TestWithParam<OptAlgorithm> {};
+class OptimizerStochastic : public ::testing::TestWithParam<OptAlgorithm> {};
 
 std::vector<std::vector<double>> Trace(OptAlgorithm algorithm, std::uint64_t seed) {
   std::vector<std::vector<double>> points;
@@ -524,8 +524,9 @@ TEST_P(OptimizerStochastic, SameSeedGivesTheSameEvaluations) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Optimizer, OptimizerStochastic,
-                         testing::Values(OptAlgorithm::kCrs2Bobyqa, OptAlgorithm::kMultiStartBobyqa,
-                                         OptAlgorithm::kMlslBobyqa),
+                         ::testing::Values(OptAlgorithm::kCrs2Bobyqa,
+                                           OptAlgorithm::kMultiStartBobyqa,
+                                           OptAlgorithm::kMlslBobyqa),
                          Name);
 
 TEST(OptimizerSeed, DifferentSeedGivesDifferentSearch) {

@@ -40,6 +40,7 @@
 #include "io/files/params_json.h"
 #include "tests/support/effect_named.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/seeds.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/synthetic_series.h"
@@ -47,20 +48,22 @@
 namespace pvtwin::cli {
 namespace {
 
-constexpr std::int64_t kJune1 = 1717200000;  // 2024-06-01T00:00:00Z
-constexpr std::int64_t kDayS = 86400;
-constexpr int kDays = 30;
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
+constexpr int kWeeksDays = 30;
 constexpr int kTrainDays = 10;  // the first calibration's window; scored the first night
 constexpr int kSwitchDay = 18;  // pv_clipping from this day on
-constexpr const char* kTruth = "2N2CrI+wind+transport_delay";
-constexpr const char* kModel = "2N1Ccolwr";
+using testing::kExampleDaemonModel;
+using testing::kExamplePlantTruth;
 
-std::vector<std::uint64_t> Seeds() { return testing::SeedsFromEnv("PVTWIN_PI_SEEDS", "1,2,3"); }
+std::vector<std::uint64_t> IndexSeeds() {
+  return testing::SeedsFromEnv("PVTWIN_PI_SEEDS", "1,2,3");
+}
 
 WeatherOptions WeatherOf(std::uint64_t seed) {
   WeatherOptions w;
-  w.start_time_s = kJune1;
-  w.num_days = kDays;
+  w.start_time_s = kJune1_2024UtcS;
+  w.num_days = kWeeksDays;
   w.step_s = 60.0;
   w.seed = seed;
   w.flow_mode = FlowMode::kVariable;
@@ -74,7 +77,7 @@ struct RunFigures {
   int first_alarm_day = -1;  // the day scored the night of the first electricity alarm
   // The change's first day as the daemon dates it each night
   // (NewestChangeOnset; -1: none), by the night's number (day scored + 1).
-  std::vector<int> onset_by_night = std::vector<int>(kDays + 1, -1);
+  std::vector<int> onset_by_night = std::vector<int>(kWeeksDays + 1, -1);
   int OnsetAtFirstAlarm() const {
     return first_alarm_day < 0 ? -1 : onset_by_night[static_cast<std::size_t>(first_alarm_day + 1)];
   }
@@ -89,29 +92,29 @@ RunFigures Monitor(const Series& data, const ParamVector& params, const Config& 
   EXPECT_NE(store, nullptr) << error;
   EXPECT_TRUE(store->WriteMinutes(data, &error)) << error;
   Store::CalibrationRow row;
-  row.run_at = kJune1 + kTrainDays * kDayS;
-  row.variant = kModel;
-  row.window_start = kJune1;
+  row.run_at = kJune1_2024UtcS + kTrainDays * kDayS;
+  row.variant = kExampleDaemonModel;
+  row.window_start = kJune1_2024UtcS;
   row.window_end = row.run_at;
   row.status = "accepted";
   row.accepted = true;
-  row.params_json = FormatParamsJson(kModel, params, {}, "");
+  row.params_json = FormatParamsJson(kExampleDaemonModel, params, {}, "");
   EXPECT_TRUE(store->InsertCalibration(&row, &error)) << error;
   DailyCheckInputs in;
   in.config = &config;
-  in.spec = testing::SpecOf(kModel);
+  in.spec = testing::SpecOf(kExampleDaemonModel);
   RunFigures f;
-  for (int night = kTrainDays; night <= kDays; ++night) {
-    in.now_s = kJune1 + night * kDayS + 2 * 3600;
+  for (int night = kTrainDays; night <= kWeeksDays; ++night) {
+    in.now_s = kJune1_2024UtcS + night * kDayS + 2 * 3600;
     RunDailyChecks(*store, in);
     std::int64_t onset_s = -1;
     EXPECT_TRUE(NewestChangeOnset(*store, in, &onset_s, &error)) << error;
     f.onset_by_night[static_cast<std::size_t>(night)] =
-        onset_s < 0 ? -1 : static_cast<int>((onset_s - kJune1) / kDayS);
+        onset_s < 0 ? -1 : static_cast<int>((onset_s - kJune1_2024UtcS) / kDayS);
   }
   testing::RawDb db(dir.path() / "pvtwin.db");
-  const std::string monitored =
-      " FROM performance_daily WHERE day >= " + std::to_string(kJune1 + kTrainDays * kDayS);
+  const std::string monitored = " FROM performance_daily WHERE day >= " +
+                                std::to_string(kJune1_2024UtcS + kTrainDays * kDayS);
   f.banded_el =
       static_cast<int>(db.Number("SELECT count(*)" + monitored + " AND pi_el_low IS NOT NULL"));
   f.hold_el = static_cast<int>(
@@ -125,7 +128,8 @@ RunFigures Monitor(const Series& data, const ParamVector& params, const Config& 
   if (db.Number("SELECT count(*) FROM monitor_event WHERE kind = 'performance_low_el'") > 0) {
     const double ts =
         db.Number("SELECT min(ts) FROM monitor_event WHERE kind = 'performance_low_el'");
-    f.first_alarm_day = static_cast<int>((static_cast<std::int64_t>(ts) - kJune1) / kDayS) - 1;
+    f.first_alarm_day =
+        static_cast<int>((static_cast<std::int64_t>(ts) - kJune1_2024UtcS) / kDayS) - 1;
   }
   return f;
 }
@@ -138,10 +142,10 @@ void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
   const Plant plant = DesignExamplePlant();
   Config config;
   config.plant = plant;
-  config.calibration.variant = kModel;
-  const ModelSpec truth_spec = testing::SpecOf(kTruth);
-  const ModelSpec clipping_spec = testing::SpecOf(std::string(kTruth) + "+pv_clipping");
-  const ModelSpec model = testing::SpecOf(kModel);
+  config.calibration.variant = kExampleDaemonModel;
+  const ModelSpec truth_spec = testing::SpecOf(kExamplePlantTruth);
+  const ModelSpec clipping_spec = testing::SpecOf(std::string(kExamplePlantTruth) + "+pv_clipping");
+  const ModelSpec model = testing::SpecOf(kExampleDaemonModel);
   ParamVector clipping_truth = ReferenceTruthParams(plant);
   for (const auto& [param, value] : testing::EffectNamed("pv_clipping").typical_truth) {
     clipping_truth[static_cast<std::size_t>(param)] = value;
@@ -157,13 +161,13 @@ void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
     Series switched = healthy;  // pv_clipping from kSwitchDay on
     for (std::size_t c = 0; c < kNumChannels; ++c) {
       for (std::size_t i = 0; i < switched.size() && !switched.columns[c].empty(); ++i) {
-        if (switched.time_s[i] >= kJune1 + kSwitchDay * kDayS) {
+        if (switched.time_s[i] >= kJune1_2024UtcS + kSwitchDay * kDayS) {
           switched.columns[c][i] = clipped.columns[c][i];
         }
       }
     }
     // The first calibration: the first kTrainDays, from the start values.
-    const Series train = healthy.Between(kJune1, kJune1 + kTrainDays * kDayS);
+    const Series train = healthy.Between(kJune1_2024UtcS, kJune1_2024UtcS + kTrainDays * kDayS);
     Drivers drivers;
     std::string error;
     ASSERT_TRUE(PrepareDrivers(train, plant, model, &drivers, &error)) << error;
@@ -205,7 +209,7 @@ void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
 }
 
 TEST(PerformanceWeeks, AHealthyPlantsBandHoldsOneAndClippingAlarmsWithinThreeClearDays) {
-  CheckSeeds(Seeds(), true);
+  CheckSeeds(IndexSeeds(), true);
 }
 
 // Seeds 30, 37 and 61 (37 and 61 the regime test's spent final seeds) had

@@ -22,6 +22,7 @@
 #include "core/synth/weather_generator.h"
 #include "io/files/csv.h"
 #include "io/sim/plant_source.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 
 namespace pvtwin {
@@ -31,7 +32,7 @@ namespace fs = std::filesystem;
 
 constexpr std::int64_t kNov19_2024 = 1731974400;  // 00:00 UTC
 constexpr std::int64_t kNov20_2024 = 1732060800;
-constexpr std::int64_t kJune20_2024 = 1718841600;
+using testing::kJune20_2024UtcS;
 
 DifferentialControlState Step(const DifferentialControlParams& p, DifferentialControlState s,
                               double t_coll_c, double t_ref_c, double dt_s, bool enabled = true) {
@@ -319,7 +320,7 @@ TEST(HeatPumpSourceExport, NovemberAt47NorthMakesHeatOnSunnyHours) {
 }
 
 TEST(HeatPumpSourceExport, JuneMakesHeatOnSunnyHours) {
-  const Series s = ExportHeatPumpDay("jun", kJune20_2024);
+  const Series s = ExportHeatPumpDay("jun", kJune20_2024UtcS);
   ASSERT_EQ(s.size(), 1440u);
   const SunnyHours h = Midday(s);
   EXPECT_EQ(h.positive_share, 1.0);

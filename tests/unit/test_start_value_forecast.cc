@@ -14,12 +14,13 @@
 #include "core/forecast/start_value_forecast.h"
 #include "core/model/thermal_model.h"
 #include "core/synth/synthetic_plant.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/synthetic_series.h"
 
 namespace pvtwin {
 namespace {
 
-constexpr std::int64_t kDay = 86400;
+using testing::kDayS;
 
 struct Days {
   Plant plant = DesignExamplePlant();
@@ -35,7 +36,7 @@ struct Days {
     data = MakeSyntheticPlantData(plant, weather, spec, truth, RealisticSensorNoise(seed));
   }
   std::int64_t At(int day, double hour) const {
-    return weather.start_time_s + day * kDay + static_cast<std::int64_t>(hour * 3600);
+    return weather.start_time_s + day * kDayS + static_cast<std::int64_t>(hour * 3600);
   }
 };
 

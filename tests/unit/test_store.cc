@@ -11,6 +11,7 @@
 
 #include "core/common/units.h"
 #include "io/store/store.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
 #include "tests/support/store_schema_v11.h"
@@ -20,14 +21,14 @@ namespace {
 
 using testing::RawDb;
 
-constexpr std::int64_t kDay0 = 1717200000;            // 2024-06-01T00:00:00Z
-constexpr std::int64_t kMinute0 = kDay0 + 12 * 3600;  // 12:00 UTC
+using testing::kJune1_2024UtcS;
+using testing::kJune1Noon2024UtcS;
 
 // A sample whose values follow from its time, so reads can be checked.
 Sample MakeSample(std::int64_t ts) {
   Sample s;
   s.ts_s = ts;
-  const double k = static_cast<double>(ts - kMinute0) / 5.0;
+  const double k = static_cast<double>(ts - kJune1Noon2024UtcS) / 5.0;
   s.Set(Channel::kTInC, 20.0 + 0.01 * k);
   s.Set(Channel::kTOutC, 30.0 + 0.01 * k);
   s.Set(Channel::kMdotKgS, 0.03);
@@ -151,7 +152,7 @@ TEST_F(StoreTest, AVersionOneStoreIsMigratedAndKeepsItsRows) {
   {
     auto store = OpenStore();
     std::string error;
-    ASSERT_TRUE(store->InsertSamples(MakeSamples(kMinute0, 3), &error)) << error;
+    ASSERT_TRUE(store->InsertSamples(MakeSamples(kJune1Noon2024UtcS, 3), &error)) << error;
   }
   {
     RawDb db(DbPath());
@@ -243,13 +244,14 @@ TEST_F(StoreTest, ReopeningKeepsDataAndANewerSchemaOrAForeignFileIsRefused) {
   {
     auto store = OpenStore();
     std::string error;
-    ASSERT_TRUE(store->InsertSamples(MakeSamples(kMinute0, 3), &error)) << error;
+    ASSERT_TRUE(store->InsertSamples(MakeSamples(kJune1Noon2024UtcS, 3), &error)) << error;
   }
   {
     auto store = OpenStore();  // second open: no migration runs again
     std::vector<Sample> out;
     std::string error;
-    ASSERT_TRUE(store->ReadSamples(kMinute0, kMinute0 + 60, &out, &error)) << error;
+    ASSERT_TRUE(store->ReadSamples(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 60, &out, &error))
+        << error;
     EXPECT_EQ(out.size(), 3u);
   }
   {
@@ -274,13 +276,14 @@ TEST_F(StoreTest, ReopeningKeepsDataAndANewerSchemaOrAForeignFileIsRefused) {
 
 TEST_F(StoreTest, SamplesRoundTripWithMissingAndRejectedValuesAndAoiInDegrees) {
   auto store = OpenStore();
-  std::vector<Sample> in = MakeSamples(kMinute0, 4);
+  std::vector<Sample> in = MakeSamples(kJune1Noon2024UtcS, 4);
   in[1].Set(Channel::kPElW, std::nan(""));  // not read
   in[2].Reject(Channel::kTAmbC);            // read but rejected
   std::string error;
   ASSERT_TRUE(store->InsertSamples(in, &error)) << error;
   std::vector<Sample> out;
-  ASSERT_TRUE(store->ReadSamples(kMinute0 + 5, kMinute0 + 20, &out, &error)) << error;
+  ASSERT_TRUE(store->ReadSamples(kJune1Noon2024UtcS + 5, kJune1Noon2024UtcS + 20, &out, &error))
+      << error;
   ASSERT_EQ(out.size(), 3u);  // [from, to): ts 5, 10, 15
   for (std::size_t i = 0; i < out.size(); ++i) {
     const Sample& expected = in[i + 1];
@@ -299,50 +302,50 @@ TEST_F(StoreTest, SamplesRoundTripWithMissingAndRejectedValuesAndAoiInDegrees) {
   // SQL users see degrees in aoi_deg, NULL for missing values.
   EXPECT_NEAR(db.Number("SELECT aoi_deg FROM sample_5s LIMIT 1"), 30.0, 1e-12);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s WHERE p_el_w IS NULL"), 1.0);
-  EXPECT_EQ(
-      db.Number("SELECT rejected_mask FROM sample_5s WHERE ts = " + std::to_string(kMinute0 + 10)),
-      static_cast<double>(1u << static_cast<unsigned>(Channel::kTAmbC)));
+  EXPECT_EQ(db.Number("SELECT rejected_mask FROM sample_5s WHERE ts = " +
+                      std::to_string(kJune1Noon2024UtcS + 10)),
+            static_cast<double>(1u << static_cast<unsigned>(Channel::kTAmbC)));
 }
 
 TEST_F(StoreTest, InsertingTheSameTimeAgainReplacesTheSample) {
   auto store = OpenStore();
   std::string error;
-  std::vector<Sample> batch = MakeSamples(kMinute0, 2);
+  std::vector<Sample> batch = MakeSamples(kJune1Noon2024UtcS, 2);
   ASSERT_TRUE(store->InsertSamples(batch, &error)) << error;
   batch[1].Set(Channel::kPElW, 999.0);
   ASSERT_TRUE(store->InsertSamples(batch, &error)) << error;
   std::vector<Sample> out;
-  ASSERT_TRUE(store->ReadSamples(0, kMinute0 + 3600, &out, &error)) << error;
+  ASSERT_TRUE(store->ReadSamples(0, kJune1Noon2024UtcS + 3600, &out, &error)) << error;
   ASSERT_EQ(out.size(), 2u);
   EXPECT_EQ(out[1].Get(Channel::kPElW), 999.0);
 }
 
 TEST_F(StoreTest, AMinuteSplitByARestartIsAggregatedOnceWithAllTwelveSamples) {
-  const std::vector<Sample> minute = MakeSamples(kMinute0, 12);
+  const std::vector<Sample> minute = MakeSamples(kJune1Noon2024UtcS, 12);
   std::string error;
   int written = -1;
   {
     auto store = OpenStore();
     ASSERT_TRUE(store->InsertSamples({minute.begin(), minute.begin() + 6}, &error)) << error;
     // The minute is still being polled: nothing to aggregate yet.
-    ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 30, &written, &error)) << error;
+    ASSERT_TRUE(store->AggregateMinutes(kJune1Noon2024UtcS + 30, &written, &error)) << error;
     EXPECT_EQ(written, 0);
   }  // "crash": the process ends in the middle of the minute
   auto store = OpenStore();
   ASSERT_TRUE(store->InsertSamples({minute.begin() + 6, minute.end()}, &error)) << error;
-  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kJune1Noon2024UtcS + 60, &written, &error)) << error;
   EXPECT_EQ(written, 1);
-  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kJune1Noon2024UtcS + 60, &written, &error)) << error;
   EXPECT_EQ(written, 0);
   {
     auto again = OpenStore();  // a fresh process scans the whole table: still no duplicate
-    ASSERT_TRUE(again->AggregateMinutes(kMinute0 + 3600, &written, &error)) << error;
+    ASSERT_TRUE(again->AggregateMinutes(kJune1Noon2024UtcS + 3600, &written, &error)) << error;
     EXPECT_EQ(written, 0);
   }
   MinuteRows rows;
-  ASSERT_TRUE(store->ReadMinuteRows(0, kMinute0 + 3600, &rows, &error)) << error;
+  ASSERT_TRUE(store->ReadMinuteRows(0, kJune1Noon2024UtcS + 3600, &rows, &error)) << error;
   ASSERT_EQ(rows.rows.size(), 1u);
-  EXPECT_EQ(rows.rows.time_s[0], kMinute0);
+  EXPECT_EQ(rows.rows.time_s[0], kJune1Noon2024UtcS);
   EXPECT_EQ(rows.n_samples[0], 12);
   // p_el_w = 150 + k for k = 0..11: mean 155.5; q_th from 0.03 kg/s · 3650 · 10 K.
   EXPECT_DOUBLE_EQ(rows.rows[Channel::kPElW][0], 155.5);
@@ -356,18 +359,20 @@ TEST_F(StoreTest, AMinuteSplitByARestartIsAggregatedOnceWithAllTwelveSamples) {
 
 TEST_F(StoreTest, ReaggregationReplacesMinutesAfterLateSamples) {
   auto store = OpenStore();
-  const std::vector<Sample> minute = MakeSamples(kMinute0, 12);
+  const std::vector<Sample> minute = MakeSamples(kJune1Noon2024UtcS, 12);
   std::string error;
   int written = 0;
   ASSERT_TRUE(store->InsertSamples({minute.begin(), minute.begin() + 4}, &error)) << error;
-  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kJune1Noon2024UtcS + 60, &written, &error)) << error;
   ASSERT_TRUE(store->InsertSamples({minute.begin() + 4, minute.end()}, &error)) << error;
-  ASSERT_TRUE(store->AggregateMinutes(kMinute0 + 60, &written, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kJune1Noon2024UtcS + 60, &written, &error)) << error;
   EXPECT_EQ(written, 0);  // AggregateMinutes never writes a minute twice
-  ASSERT_TRUE(store->ReaggregateMinutes(kMinute0, kMinute0 + 1, &written, &error)) << error;
+  ASSERT_TRUE(
+      store->ReaggregateMinutes(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 1, &written, &error))
+      << error;
   EXPECT_EQ(written, 1);
   MinuteRows rows;
-  ASSERT_TRUE(store->ReadMinuteRows(0, kMinute0 + 60, &rows, &error)) << error;
+  ASSERT_TRUE(store->ReadMinuteRows(0, kJune1Noon2024UtcS + 60, &rows, &error)) << error;
   ASSERT_EQ(rows.rows.size(), 1u);
   EXPECT_EQ(rows.n_samples[0], 12);
 }
@@ -376,7 +381,7 @@ TEST_F(StoreTest, ImportedMinutesRoundTripAndAreMarkedImported) {
   auto store = OpenStore();
   Series s;
   s.step_s = 60;
-  s.time_s = {kMinute0, kMinute0 + 60};
+  s.time_s = {kJune1Noon2024UtcS, kJune1Noon2024UtcS + 60};
   s[Channel::kPElW] = {100.0, std::nan("")};
   s[Channel::kAoiRad] = {DegToRad(45.0), DegToRad(50.0)};
   std::string error;
@@ -384,7 +389,7 @@ TEST_F(StoreTest, ImportedMinutesRoundTripAndAreMarkedImported) {
   s[Channel::kPElW][0] = 110.0;
   ASSERT_TRUE(store->WriteMinutes(s, &error)) << error;  // upsert
   MinuteRows rows;
-  ASSERT_TRUE(store->ReadMinuteRows(0, kMinute0 + 3600, &rows, &error)) << error;
+  ASSERT_TRUE(store->ReadMinuteRows(0, kJune1Noon2024UtcS + 3600, &rows, &error)) << error;
   ASSERT_EQ(rows.rows.size(), 2u);
   EXPECT_EQ(rows.rows[Channel::kPElW][0], 110.0);
   EXPECT_TRUE(std::isnan(rows.rows[Channel::kPElW][1]));
@@ -393,7 +398,7 @@ TEST_F(StoreTest, ImportedMinutesRoundTripAndAreMarkedImported) {
   EXPECT_TRUE(rows.qc_flags[0] & kQcRequiredMissing);  // no t_in_c etc.
   RawDb db(DbPath());
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min WHERE n_samples IS NULL"), 2.0);
-  s.time_s[1] = kMinute0 + 61;  // not a minute start
+  s.time_s[1] = kJune1Noon2024UtcS + 61;  // not a minute start
   EXPECT_FALSE(store->WriteMinutes(s, &error));
   EXPECT_NE(error.find("not the start of a minute"), std::string::npos) << error;
 }
@@ -403,20 +408,22 @@ TEST_F(StoreTest, RetentionDeletesOldSamplesAfterAggregatingThemKeepsMinutesPrun
   std::string error;
   // One full minute at noon of each of 41 days.
   for (int day = 0; day <= 40; ++day) {
-    ASSERT_TRUE(store->InsertSamples(MakeSamples(kMinute0 + day * 86400, 12), &error)) << error;
+    ASSERT_TRUE(store->InsertSamples(MakeSamples(kJune1Noon2024UtcS + day * 86400, 12), &error))
+        << error;
   }
   // Three issues for noon of day 5: the day-ahead one (23:00 the day
   // before), a superseded one (10:00) and the newest (11:00).
-  const std::int64_t noon5 = kMinute0 + 5 * 86400;
+  const std::int64_t noon5 = kJune1Noon2024UtcS + 5 * 86400;
   for (const std::int64_t issued : {noon5 - 13 * 3600, noon5 - 7200, noon5 - 3600}) {
     ASSERT_TRUE(store->InsertForecast(issued, 0, "", {{noon5, 1, 2, 3, 4}}, &error)) << error;
   }
-  const std::int64_t now = kMinute0 + 40 * 86400 + 3600;  // 13:00 of day 40
+  const std::int64_t now = kJune1Noon2024UtcS + 40 * 86400 + 3600;  // 13:00 of day 40
   ASSERT_TRUE(store->ApplyRetention(now, 30, &error)) << error;
   // Cutoff 13:00 of day 10: noon samples of days 0..10 are gone, 11..40 kept.
   RawDb db(DbPath());
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 30.0 * 12);
-  EXPECT_EQ(db.Number("SELECT MIN(ts) FROM sample_5s"), static_cast<double>(kMinute0 + 11 * 86400));
+  EXPECT_EQ(db.Number("SELECT MIN(ts) FROM sample_5s"),
+            static_cast<double>(kJune1Noon2024UtcS + 11 * 86400));
   // The deleted minutes were aggregated first; the kept ones wait for
   // AggregateMinutes.
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 11.0);
@@ -454,14 +461,15 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
     r.reason = reason;
     r.accepted = accepted;
     r.heldout_mae_w = accepted ? 23.0 : std::nan("");
-    r.params = {{"u_front_w_m2k", 9.5 + static_cast<double>(run_at - kDay0) / 86400.0, 0.25,
-                 "W/(m²·K)", "identified"},
+    r.params = {{"u_front_w_m2k", 9.5 + static_cast<double>(run_at - kJune1_2024UtcS) / 86400.0,
+                 0.25, "W/(m²·K)", "identified"},
                 {"eps_pvt", 0.15, std::nan(""), "-", "fixed"}};
     return r;
   };
-  Store::CalibrationRow first = make(kDay0, true, "first calibration");
-  Store::CalibrationRow worse = make(kDay0 + 2 * 86400, false, "held-out MAE 30 W > 23 W");
-  Store::CalibrationRow second = make(kDay0 + 86400, true, "held-out MAE 22 W <= 23 W");
+  Store::CalibrationRow first = make(kJune1_2024UtcS, true, "first calibration");
+  Store::CalibrationRow worse =
+      make(kJune1_2024UtcS + 2 * 86400, false, "held-out MAE 30 W > 23 W");
+  Store::CalibrationRow second = make(kJune1_2024UtcS + 86400, true, "held-out MAE 22 W <= 23 W");
   for (Store::CalibrationRow* r : {&first, &worse, &second}) {
     ASSERT_TRUE(store->InsertCalibration(r, &error)) << error;
   }
@@ -471,9 +479,9 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
   ASSERT_TRUE(store->LatestAcceptedCalibration(&row, &found, &error)) << error;
   ASSERT_TRUE(found);
   EXPECT_EQ(row.id, second.id);
-  EXPECT_EQ(row.run_at, kDay0 + 86400);
+  EXPECT_EQ(row.run_at, kJune1_2024UtcS + 86400);
   EXPECT_EQ(row.variant, "2N1Ccolwr");
-  EXPECT_EQ(row.window_start, kDay0 + 86400 - 14 * 86400);
+  EXPECT_EQ(row.window_start, kJune1_2024UtcS + 86400 - 14 * 86400);
   EXPECT_EQ(row.status, "accepted");
   EXPECT_EQ(row.mae_q_th_w, 20.25);
   EXPECT_EQ(row.n_evals, 4242);
@@ -486,7 +494,7 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
       "NULL");
   // The parameters of all three runs, in time order, with their acceptance;
   // a parameter without a standard error has NULL.
-  EXPECT_EQ(db.Rows("SELECT run_at - " + std::to_string(kDay0) +
+  EXPECT_EQ(db.Rows("SELECT run_at - " + std::to_string(kJune1_2024UtcS) +
                     ", accepted, value, std_error, unit, status FROM parameter_history WHERE "
                     "name = 'u_front_w_m2k' ORDER BY run_at"),
             (std::vector<std::vector<std::string>>{
@@ -500,7 +508,7 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
 TEST_F(StoreTest, ForecastLatestPicksTheNewestIssueForEachTime) {
   auto store = OpenStore();
   std::string error;
-  const std::int64_t t = kMinute0;
+  const std::int64_t t = kJune1Noon2024UtcS;
   // Issue A at 1000 covers t, t+60, t+120; issue B at 2000 covers t+60 … t+180.
   ASSERT_TRUE(store->InsertForecast(
       t - 1000, 1, "weather=persistence",
@@ -537,7 +545,7 @@ TEST_F(StoreTest, ForecastLatestPicksTheNewestIssueForEachTime) {
 TEST_F(StoreTest, StartValueForecastsAreFlaggedAndTheFirstWaitIsNoWarningInEvent) {
   auto store = OpenStore();
   std::string error;
-  const std::int64_t t = kMinute0;
+  const std::int64_t t = kJune1Noon2024UtcS;
   ASSERT_TRUE(store->InsertForecast(t - 1000, 0, ForecastBasis::kStartValues, "start values",
                                     {{t, 1, 10, 20, 30}, {t + 60, 2, 11, 21, 31}}, &error))
       << error;
@@ -581,7 +589,8 @@ TEST_F(StoreTest, StartValueForecastsAreFlaggedAndTheFirstWaitIsNoWarningInEvent
 TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements) {
   auto store = OpenStore();
   std::string error;
-  const std::int64_t m0 = kMinute0, m1 = kMinute0 + 60, m2 = kMinute0 + 120;
+  const std::int64_t m0 = kJune1Noon2024UtcS, m1 = kJune1Noon2024UtcS + 60,
+                     m2 = kJune1Noon2024UtcS + 120;
   // Measurements at three minutes of day 0; the third is invalid.
   Series meas;
   meas.step_s = 60;
@@ -592,11 +601,13 @@ TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements
   ASSERT_TRUE(store->WriteMinutes(meas, &error)) << error;
   // An old issue (two days before), the day-ahead issue (1 h before the day
   // starts) and an intraday issue (after the day started, not scored).
-  ASSERT_TRUE(store->InsertForecast(
-      kDay0 - 2 * 86400, 1, "", {{m0, 0, 0, 0, 0}, {m1, 0, 0, 0, 0}, {m2, 0, 0, 0, 0}}, &error));
-  ASSERT_TRUE(store->InsertForecast(
-      kDay0 - 3600, 2, "", {{m0, 100, 500, 0, 0}, {m1, 200, 0, 0, 0}, {m2, 0, 0, 0, 0}}, &error));
-  ASSERT_TRUE(store->InsertForecast(kDay0 + 600, 3, "",
+  ASSERT_TRUE(store->InsertForecast(kJune1_2024UtcS - 2 * 86400, 1, "",
+                                    {{m0, 0, 0, 0, 0}, {m1, 0, 0, 0, 0}, {m2, 0, 0, 0, 0}},
+                                    &error));
+  ASSERT_TRUE(store->InsertForecast(kJune1_2024UtcS - 3600, 2, "",
+                                    {{m0, 100, 500, 0, 0}, {m1, 200, 0, 0, 0}, {m2, 0, 0, 0, 0}},
+                                    &error));
+  ASSERT_TRUE(store->InsertForecast(kJune1_2024UtcS + 600, 3, "",
                                     {{m0, 110, 400, 0, 0}, {m1, 180, -100, 0, 0}}, &error));
   // Day-ahead errors: P_el |100 − 110| = 10, |200 − 180| = 20 → MAE 15 W,
   // mean |measured| 145 W → nMAE 15/145. Q_u: |500 − 400| = 100,
@@ -606,18 +617,20 @@ TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements
       "SELECT day, mae_p_el_w, mae_q_th_w, nmae_p_el, nmae_q_th FROM "
       "forecast_skill");
   ASSERT_EQ(rows.size(), 1u);
-  EXPECT_EQ(rows[0][0], std::to_string(kDay0));
+  EXPECT_EQ(rows[0][0], std::to_string(kJune1_2024UtcS));
   EXPECT_DOUBLE_EQ(std::stod(rows[0][1]), 15.0);
   EXPECT_DOUBLE_EQ(std::stod(rows[0][2]), 100.0);
   EXPECT_NEAR(std::stod(rows[0][3]), 15.0 / 145.0, 1e-12);
   EXPECT_NEAR(std::stod(rows[0][4]), 0.4, 1e-12);
   std::vector<Store::SkillRow> skill;
-  ASSERT_TRUE(store->ReadForecastSkill(kDay0, kDay0 + 86400, &skill, &error)) << error;
+  ASSERT_TRUE(store->ReadForecastSkill(kJune1_2024UtcS, kJune1_2024UtcS + 86400, &skill, &error))
+      << error;
   ASSERT_EQ(skill.size(), 1u);
-  EXPECT_EQ(skill[0].day, kDay0);
+  EXPECT_EQ(skill[0].day, kJune1_2024UtcS);
   EXPECT_DOUBLE_EQ(skill[0].mae_p_el_w, 15.0);
   EXPECT_NEAR(skill[0].nmae_q_th, 0.4, 1e-12);
-  ASSERT_TRUE(store->ReadForecastSkill(kDay0 + 86400, kDay0 + 2 * 86400, &skill, &error));
+  ASSERT_TRUE(store->ReadForecastSkill(kJune1_2024UtcS + 86400, kJune1_2024UtcS + 2 * 86400, &skill,
+                                       &error));
   EXPECT_TRUE(skill.empty());
 }
 
@@ -633,13 +646,13 @@ TEST_F(StoreTest, ForecastSkillScoresTheDayAheadForecastAgainstValidMeasurements
 TEST_F(StoreTest, ForecastSkillScoresAgainstTheReferenceAndCountsTheBandsCoverage) {
   auto store = OpenStore();
   std::string error;
-  const std::int64_t day1 = kDay0 + 86400;
+  const std::int64_t day1 = kJune1_2024UtcS + 86400;
   Series meas;
   meas.step_s = 60;
   std::vector<Store::ForecastRow> rows;
   std::vector<double> p_el, q_th;
   for (int k = 0; k < 400; ++k) {
-    const std::int64_t t = kDay0 + 60 * k;
+    const std::int64_t t = kJune1_2024UtcS + 60 * k;
     meas.time_s.push_back(t);
     p_el.push_back(100.0 + k % 4);
     q_th.push_back(510.0);
@@ -665,9 +678,9 @@ TEST_F(StoreTest, ForecastSkillScoresAgainstTheReferenceAndCountsTheBandsCoverag
   meas[Channel::kPElW] = p_el;
   meas[Channel::kQThW] = q_th;
   ASSERT_TRUE(store->WriteMinutes(meas, &error)) << error;
-  ASSERT_TRUE(store->InsertForecast(kDay0 - 3600, 1, "", rows, &error)) << error;
+  ASSERT_TRUE(store->InsertForecast(kJune1_2024UtcS - 3600, 1, "", rows, &error)) << error;
   std::vector<Store::SkillRow> skill;
-  ASSERT_TRUE(store->ReadForecastSkill(kDay0, day1 + 86400, &skill, &error)) << error;
+  ASSERT_TRUE(store->ReadForecastSkill(kJune1_2024UtcS, day1 + 86400, &skill, &error)) << error;
   ASSERT_EQ(skill.size(), 2u);
   EXPECT_EQ(skill[0].minutes, 400);
   EXPECT_DOUBLE_EQ(skill[0].mae_p_el_w, 1.5);
@@ -683,7 +696,8 @@ TEST_F(StoreTest, ForecastSkillScoresAgainstTheReferenceAndCountsTheBandsCoverag
   EXPECT_TRUE(std::isnan(skill[1].skill_p_el));
   EXPECT_TRUE(std::isnan(skill[1].coverage_p10_p90));
   std::vector<Store::ForecastRow> latest;
-  ASSERT_TRUE(store->ReadLatestForecast(kDay0, kDay0 + 120, &latest, &error)) << error;
+  ASSERT_TRUE(store->ReadLatestForecast(kJune1_2024UtcS, kJune1_2024UtcS + 120, &latest, &error))
+      << error;
   ASSERT_EQ(latest.size(), 2u);
   EXPECT_EQ(latest[1].p_el_w_p10, 99.0);
   EXPECT_EQ(latest[1].q_th_w_p90, 500.0);
@@ -698,7 +712,7 @@ TEST_F(StoreTest, PruningOldForecastsLeavesBothViewsAsTheyWere) {
   std::string error;
   // Hourly issues from 6 h before day 1 to 5 h into it, each 6 h ahead at
   // 1 min, and measurements for every minute they cover.
-  const std::int64_t day1 = kDay0 + 86400;
+  const std::int64_t day1 = kJune1_2024UtcS + 86400;
   Series meas;
   meas.step_s = 60;
   for (std::int64_t t = day1 - 6 * 3600; t < day1 + 11 * 3600; t += 60) {
@@ -724,7 +738,7 @@ TEST_F(StoreTest, PruningOldForecastsLeavesBothViewsAsTheyWere) {
   ASSERT_EQ(skill_before.size(), 1u);
   const double rows_before = db.Number("SELECT COUNT(*) FROM forecast");
   EXPECT_EQ(rows_before, 12.0 * 360);
-  ASSERT_TRUE(store->PruneForecasts(kDay0, day1 + 86400, &error)) << error;
+  ASSERT_TRUE(store->PruneForecasts(kJune1_2024UtcS, day1 + 86400, &error)) << error;
   EXPECT_EQ(db.Rows(latest), latest_before);
   EXPECT_EQ(db.Rows(skill), skill_before);
   // Left: the newest issue of each ts, plus the day-ahead issue of day 1
@@ -738,7 +752,7 @@ TEST_F(StoreTest, ForecastInputsWrittenBySqlAreReadAsSeries) {
   auto store = OpenStore();
   {
     RawDb db(DbPath());
-    const std::string t = std::to_string(kMinute0);
+    const std::string t = std::to_string(kJune1Noon2024UtcS);
     ASSERT_EQ(db.Exec("INSERT INTO weather_forecast(ts, g_poa_w_m2, t_amb_c, wind_m_s) VALUES "
                       "(" +
                       t + ", 500, 20, 2), (" + t + " + 900, 600, 21, NULL), (" + t +
@@ -750,14 +764,18 @@ TEST_F(StoreTest, ForecastInputsWrittenBySqlAreReadAsSeries) {
   }
   Series weather, plan;
   std::string error;
-  ASSERT_TRUE(store->ReadWeatherForecast(kMinute0, kMinute0 + 1800, &weather, &error)) << error;
+  ASSERT_TRUE(
+      store->ReadWeatherForecast(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 1800, &weather, &error))
+      << error;
   ASSERT_EQ(weather.size(), 2u);  // [from, to)
   EXPECT_EQ(weather.step_s, 900.0);
   EXPECT_EQ(weather[Channel::kGPoaWM2], (std::vector<double>{500.0, 600.0}));
   EXPECT_EQ(weather[Channel::kWindMS][0], 2.0);
   EXPECT_TRUE(std::isnan(weather[Channel::kWindMS][1]));
   EXPECT_FALSE(weather.Has(Channel::kGhiWM2));  // NULL everywhere: absent
-  ASSERT_TRUE(store->ReadOperationPlan(kMinute0, kMinute0 + 3600, &plan, &error)) << error;
+  ASSERT_TRUE(
+      store->ReadOperationPlan(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 3600, &plan, &error))
+      << error;
   EXPECT_EQ(plan[Channel::kTInC], (std::vector<double>{25.0, 26.0}));
   EXPECT_EQ(plan[Channel::kMdotKgS], (std::vector<double>{0.03, 0.0}));
 }
@@ -769,7 +787,7 @@ TEST_F(StoreTest, ForecastInputsWrittenBySqlAreReadAsSeries) {
 // (typeof() says so below), the same text stored as a BLOB stays one.
 TEST_F(StoreTest, TextInForecastInputsIsMissingAndCounted) {
   auto store = OpenStore();
-  const std::string t0 = std::to_string(kMinute0);
+  const std::string t0 = std::to_string(kJune1Noon2024UtcS);
   {
     RawDb db(DbPath());
     ASSERT_EQ(db.Exec("INSERT INTO weather_forecast(ts, g_poa_w_m2, t_amb_c, wind_m_s) VALUES "
@@ -790,7 +808,8 @@ TEST_F(StoreTest, TextInForecastInputsIsMissingAndCounted) {
   Series weather, plan;
   Store::TextCells text;
   std::string error;
-  ASSERT_TRUE(store->ReadWeatherForecast(kMinute0, kMinute0 + 300, &weather, &error, &text))
+  ASSERT_TRUE(store->ReadWeatherForecast(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 300, &weather,
+                                         &error, &text))
       << error;
   ASSERT_EQ(weather.size(), 5u);
   const std::vector<double>& t_amb = weather[Channel::kTAmbC];
@@ -809,7 +828,9 @@ TEST_F(StoreTest, TextInForecastInputsIsMissingAndCounted) {
   EXPECT_EQ(text.Warning("weather_forecast"),
             "weather_forecast: 2 cells of t_amb_c, 3 of wind_m_s hold text, read as missing");
 
-  ASSERT_TRUE(store->ReadOperationPlan(kMinute0, kMinute0 + 300, &plan, &error, &text)) << error;
+  ASSERT_TRUE(
+      store->ReadOperationPlan(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 300, &plan, &error, &text))
+      << error;
   ASSERT_EQ(plan.size(), 3u);
   EXPECT_TRUE(std::isnan(plan[Channel::kTInC][0]) && std::isnan(plan[Channel::kTInC][1]));
   EXPECT_TRUE(std::isnan(plan[Channel::kMdotKgS][1]));
@@ -819,7 +840,8 @@ TEST_F(StoreTest, TextInForecastInputsIsMissingAndCounted) {
   EXPECT_EQ(text.Warning("operation_plan"),
             "operation_plan: 2 cells of t_in_c, 1 of flow_kg_s hold text, read as missing");
   // A read without text: no warning.
-  ASSERT_TRUE(store->ReadOperationPlan(kMinute0 + 120, kMinute0 + 300, &plan, &error, &text));
+  ASSERT_TRUE(store->ReadOperationPlan(kJune1Noon2024UtcS + 120, kJune1Noon2024UtcS + 300, &plan,
+                                       &error, &text));
   EXPECT_EQ(text.Total(), 0u);
   EXPECT_EQ(text.Warning("operation_plan"), "");
 }
@@ -828,28 +850,32 @@ TEST_F(StoreTest, WeatherForecastRowsKeepTheirSourceAndAreReplacedPerMinute) {
   auto store = OpenStore();
   Series rows;
   rows.step_s = 60.0;
-  rows.time_s = {kMinute0, kMinute0 + 60};
+  rows.time_s = {kJune1Noon2024UtcS, kJune1Noon2024UtcS + 60};
   rows[Channel::kGPoaWM2] = {500.0, 510.0};
   rows[Channel::kTAmbC] = {20.0, std::nan("")};
   std::string error;
   ASSERT_TRUE(store->WriteWeatherForecast(rows, "import-weather a.json", &error)) << error;
-  rows.time_s = {kMinute0 + 60, kMinute0 + 120};
+  rows.time_s = {kJune1Noon2024UtcS + 60, kJune1Noon2024UtcS + 120};
   rows[Channel::kGPoaWM2] = {600.0, 610.0};
   rows[Channel::kTAmbC] = {21.0, 22.0};
   ASSERT_TRUE(store->WriteWeatherForecast(rows, "fetch http://x", &error)) << error;
   {
     RawDb db(DbPath());
     ASSERT_EQ(db.Exec("INSERT INTO weather_forecast(ts, t_amb_c) VALUES (" +
-                      std::to_string(kMinute0 + 180) + ", 23)"),
+                      std::to_string(kJune1Noon2024UtcS + 180) + ", 23)"),
               SQLITE_OK);
   }
   Series weather;
-  ASSERT_TRUE(store->ReadWeatherForecast(kMinute0, kMinute0 + 240, &weather, &error)) << error;
+  ASSERT_TRUE(
+      store->ReadWeatherForecast(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 240, &weather, &error))
+      << error;
   ASSERT_EQ(weather.size(), 4u);
   EXPECT_EQ(weather[Channel::kGPoaWM2][1], 600.0);  // the later write replaced the minute
   EXPECT_EQ(weather[Channel::kTAmbC][0], 20.0);
   std::vector<std::string> sources;
-  ASSERT_TRUE(store->ReadWeatherSources(kMinute0, kMinute0 + 240, &sources, &error)) << error;
+  ASSERT_TRUE(
+      store->ReadWeatherSources(kJune1Noon2024UtcS, kJune1Noon2024UtcS + 240, &sources, &error))
+      << error;
   EXPECT_EQ(sources, (std::vector<std::string>{"fetch http://x", "import-weather a.json",
                                                "weather_forecast"}));
 }

@@ -13,6 +13,7 @@
 #include "io/files/csv.h"
 #include "io/platform/time_format.h"
 #include "io/store/store.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/sqlite_db.h"
 
@@ -23,11 +24,11 @@ using testing::ProcessResult;
 using testing::RawDb;
 using testing::RunPvtwin;
 
-constexpr std::int64_t kMinute0 = 1717243200;  // 2024-06-01T12:00:00Z
+using testing::kJune1Noon2024UtcS;
 
 // rows at step_s from t0; p_el_w = 100 + i for row i (i counted from
-// kMinute0 in steps of step_s), so minute means are known by hand.
-Series Rows(std::int64_t t0, std::size_t n, double step_s) {
+// kJune1Noon2024UtcS in steps of step_s), so minute means are known by hand.
+Series MinuteRows(std::int64_t t0, std::size_t n, double step_s) {
   Series s;
   s.step_s = step_s;
   for (std::size_t i = 0; i < n; ++i) {
@@ -42,7 +43,7 @@ Series Rows(std::int64_t t0, std::size_t n, double step_s) {
   fill(Channel::kAoiRad, DegToRad(40.0));
   std::vector<double>& p = s.Ensure(Channel::kPElW);
   for (std::size_t i = 0; i < n; ++i) {
-    p[i] = 100.0 + static_cast<double>(s.time_s[i] - kMinute0) / step_s;
+    p[i] = 100.0 + static_cast<double>(s.time_s[i] - kJune1Noon2024UtcS) / step_s;
   }
   return s;
 }
@@ -70,8 +71,8 @@ class StoreCli : public testing::TempDirTest {
 };
 
 TEST_F(StoreCli, FiveSecondImportAggregatesAndReimportingOverlapsChangesNothing) {
-  WriteRows("a.csv", Rows(kMinute0, 36, 5.0));        // minutes 0, 1, 2
-  WriteRows("b.csv", Rows(kMinute0 + 120, 24, 5.0));  // minutes 2, 3
+  WriteRows("a.csv", MinuteRows(kJune1Noon2024UtcS, 36, 5.0));        // minutes 0, 1, 2
+  WriteRows("b.csv", MinuteRows(kJune1Noon2024UtcS + 120, 24, 5.0));  // minutes 2, 3
   ProcessResult run = Pvtwin("import --csv a.csv --db t.db");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("imported 36 samples"), std::string::npos) << run.err;
@@ -79,7 +80,7 @@ TEST_F(StoreCli, FiveSecondImportAggregatesAndReimportingOverlapsChangesNothing)
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 36.0);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 3.0);
   // Minute 1 holds p_el_w = 112 … 123: mean 117.5 W.
-  const std::string minute1 = std::to_string(kMinute0 + 60);
+  const std::string minute1 = std::to_string(kJune1Noon2024UtcS + 60);
   EXPECT_EQ(db.Number("SELECT p_el_w FROM measurement_1min WHERE ts = " + minute1), 117.5);
   // Q_u = 0.02 kg/s · 3600 J/(kg·K) (the config's c_p) · 10 K = 720 W.
   EXPECT_NEAR(db.Number("SELECT q_th_w FROM measurement_1min WHERE ts = " + minute1), 720.0, 1e-9);
@@ -90,7 +91,7 @@ TEST_F(StoreCli, FiveSecondImportAggregatesAndReimportingOverlapsChangesNothing)
     ASSERT_EQ(run.exit_code, 0) << run.err;
   }
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 48.0);
-  EXPECT_EQ(db.Rows("SELECT ts - " + std::to_string(kMinute0) +
+  EXPECT_EQ(db.Rows("SELECT ts - " + std::to_string(kJune1Noon2024UtcS) +
                     ", n_samples, p_el_w FROM measurement_1min ORDER BY ts"),
             (std::vector<std::vector<std::string>>{{"0", "12", "105.5"},
                                                    {"60", "12", "117.5"},
@@ -99,7 +100,7 @@ TEST_F(StoreCli, FiveSecondImportAggregatesAndReimportingOverlapsChangesNothing)
 }
 
 TEST_F(StoreCli, OneMinuteImportExportsBackToTheSameCsvValues) {
-  Series minutes = Rows(kMinute0 + 1, 5, 60.0);  // a logger writing hh:mm:01
+  Series minutes = MinuteRows(kJune1Noon2024UtcS + 1, 5, 60.0);  // a logger writing hh:mm:01
   WriteRows("m.csv", minutes);
   ProcessResult run = Pvtwin("import --csv m.csv --db t.db");
   ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -109,10 +110,11 @@ TEST_F(StoreCli, OneMinuteImportExportsBackToTheSameCsvValues) {
   RawDb db(dir_ / "t.db");
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 5.0);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM sample_5s"), 0.0);
-  EXPECT_EQ(db.Number("SELECT MIN(ts) FROM measurement_1min"), static_cast<double>(kMinute0));
+  EXPECT_EQ(db.Number("SELECT MIN(ts) FROM measurement_1min"),
+            static_cast<double>(kJune1Noon2024UtcS));
 
   run = Pvtwin("export --db t.db --from 2024-06-01T12:01:00Z --to " +
-               std::to_string(kMinute0 + 240) + " --out e.csv");
+               std::to_string(kJune1Noon2024UtcS + 240) + " --out e.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   Series back;
   Diagnostics errors;
@@ -120,7 +122,7 @@ TEST_F(StoreCli, OneMinuteImportExportsBackToTheSameCsvValues) {
       << (errors.empty() ? "" : errors[0].ToString());
   ASSERT_EQ(back.size(), 3u);  // [12:01, 12:04)
   for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(back.time_s[i], kMinute0 + 60 * static_cast<std::int64_t>(i + 1));
+    EXPECT_EQ(back.time_s[i], kJune1Noon2024UtcS + 60 * static_cast<std::int64_t>(i + 1));
     for (const Channel c : kWritten) {
       EXPECT_NEAR(back[c][i], minutes[c][i + 1], 1e-12) << ChannelName(c);
     }
@@ -131,7 +133,7 @@ TEST_F(StoreCli, OneMinuteImportExportsBackToTheSameCsvValues) {
 // ignored so that the write fails with EFBIG as on a full disk): exit 1, and
 // neither a truncated e.csv nor the partial file is left behind.
 TEST_F(StoreCli, ExportToAFullDiskLeavesNoPartialFile) {
-  WriteRows("m.csv", Rows(kMinute0, 5000, 60.0));  // about 400 kB as CSV
+  WriteRows("m.csv", MinuteRows(kJune1Noon2024UtcS, 5000, 60.0));  // about 400 kB as CSV
   ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
   const ProcessResult run =
       testing::RunCommand(dir_, "trap '' XFSZ; ulimit -f 128; '" + std::string(PVTWIN_BINARY) +
@@ -147,15 +149,15 @@ TEST_F(StoreCli, ExportToAFullDiskLeavesNoPartialFile) {
 // the closed days they changed (store schema 11): here the day a forecast
 // written by another program had made dirty.
 TEST_F(StoreCli, ImportMaterialisesTheForecastSkillOfTheDaysItChanged) {
-  WriteRows("m.csv", Rows(kMinute0, 360, 60.0));  // 12:00 to 18:00 of 2024-06-01
+  WriteRows("m.csv", MinuteRows(kJune1Noon2024UtcS, 360, 60.0));  // 12:00 to 18:00 of 2024-06-01
   ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
   RawDb db(dir_ / "t.db");
-  const std::int64_t day = kMinute0 - 12 * 3600;
+  const std::int64_t day = kJune1Noon2024UtcS - 12 * 3600;
   EXPECT_GT(db.Number("SELECT done_before FROM forecast_skill_state"), static_cast<double>(day))
       << "the day is over, and materialised (without a score: no forecast yet)";
-  ASSERT_EQ(db.Exec("WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kMinute0) +
+  ASSERT_EQ(db.Exec("WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kJune1Noon2024UtcS) +
                     " UNION ALL SELECT ts + 60 FROM t WHERE ts + 60 < " +
-                    std::to_string(kMinute0 + 360 * 60) +
+                    std::to_string(kJune1Noon2024UtcS + 360 * 60) +
                     ") INSERT INTO forecast(issued_at, ts, p_el_w) SELECT " +
                     std::to_string(day - 3600) + ", ts, 150 FROM t"),
             SQLITE_OK);
@@ -173,11 +175,11 @@ TEST_F(StoreCli, ImportMaterialisesTheForecastSkillOfTheDaysItChanged) {
 }
 
 TEST_F(StoreCli, FiveSecondTableExportsTheRawSamples) {
-  WriteRows("a.csv", Rows(kMinute0, 24, 5.0));
+  WriteRows("a.csv", MinuteRows(kJune1Noon2024UtcS, 24, 5.0));
   ASSERT_EQ(Pvtwin("import --csv a.csv --db t.db").exit_code, 0);
   const ProcessResult run =
-      Pvtwin("export --db t.db --table 5s --from " + std::to_string(kMinute0) + " --to " +
-             std::to_string(kMinute0 + 60));
+      Pvtwin("export --db t.db --table 5s --from " + std::to_string(kJune1Noon2024UtcS) + " --to " +
+             std::to_string(kJune1Noon2024UtcS + 60));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::istringstream csv(run.out);
   Series back;
@@ -189,7 +191,7 @@ TEST_F(StoreCli, FiveSecondTableExportsTheRawSamples) {
 }
 
 TEST_F(StoreCli, WithoutDbTheConfiguredPathIsUsed) {
-  WriteRows("a.csv", Rows(kMinute0, 12, 5.0));
+  WriteRows("a.csv", MinuteRows(kJune1Noon2024UtcS, 12, 5.0));
   ASSERT_EQ(Pvtwin("import --csv a.csv").exit_code, 0);
   RawDb db(dir_ / "configured.db");
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM measurement_1min"), 1.0);
@@ -199,9 +201,9 @@ TEST_F(StoreCli, WithoutDbTheConfiguredPathIsUsed) {
 // export needs no config when --db names the store, and takes a date or a
 // time relative to now; the 5 s table's period then comes from the samples.
 TEST_F(StoreCli, ExportWithOnlyTheDbADateAndARelativeTime) {
-  WriteRows("a.csv", Rows(kMinute0, 36, 5.0));  // three minutes of 5 s samples
+  WriteRows("a.csv", MinuteRows(kJune1Noon2024UtcS, 36, 5.0));  // three minutes of 5 s samples
   ASSERT_EQ(Pvtwin("import --csv a.csv --db t.db").exit_code, 0);
-  const std::string day = FormatIsoUtc(kMinute0).substr(0, 10);  // YYYY-MM-DD
+  const std::string day = FormatIsoUtc(kJune1Noon2024UtcS).substr(0, 10);  // YYYY-MM-DD
   ProcessResult run = RunPvtwin(dir_, "export --db t.db --from " + day + " --out m.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("exported 3 rows of measurement_1min"), std::string::npos) << run.err;
@@ -221,7 +223,8 @@ TEST_F(StoreCli, ExportWithOnlyTheDbADateAndARelativeTime) {
 }
 
 TEST_F(StoreCli, LongImportsReportProgress) {
-  WriteRows("days.csv", Rows(kMinute0, 3 * 17280, 5.0));  // three days of 5 s samples
+  WriteRows("days.csv",
+            MinuteRows(kJune1Noon2024UtcS, 3 * 17280, 5.0));  // three days of 5 s samples
   const ProcessResult run = Pvtwin("import --csv days.csv --db t.db");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("import: 17280/51840 samples (33 %)"), std::string::npos) << run.err;
@@ -232,7 +235,7 @@ TEST_F(StoreCli, LongImportsReportProgress) {
 
 TEST_F(StoreCli, BadInputsExitWithTwoAndSayWhatIsWrong) {
   // 90 s is neither a poll period (a divisor of 60 s) nor whole minutes.
-  WriteRows("ninety.csv", Rows(kMinute0, 5, 90.0));
+  WriteRows("ninety.csv", MinuteRows(kJune1Noon2024UtcS, 5, 90.0));
   ProcessResult run = Pvtwin("import --csv ninety.csv --db t.db");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("ninety.csv: time step = 90 s"), std::string::npos) << run.err;
@@ -246,7 +249,7 @@ TEST_F(StoreCli, BadInputsExitWithTwoAndSayWhatIsWrong) {
   run = Pvtwin("export --db nowhere.db --from 0 --to 60");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("--db = nowhere.db: no such database"), std::string::npos) << run.err;
-  WriteRows("a.csv", Rows(kMinute0, 12, 5.0));
+  WriteRows("a.csv", MinuteRows(kJune1Noon2024UtcS, 12, 5.0));
   ASSERT_EQ(Pvtwin("import --csv a.csv --db t.db").exit_code, 0);
   run = Pvtwin("export --db t.db --from 2024-06-02T00:00:00Z --to 2024-06-01T00:00:00Z");
   EXPECT_EQ(run.exit_code, 2);
@@ -265,7 +268,7 @@ TEST_F(StoreCli, CoarseLoggerDataAreStoredAtTheirOwnStep) {
     SCOPED_TRACE(step_min);
     const double step_s = 60.0 * step_min;
     const std::string name = std::to_string(step_min) + "min";
-    const Series rows = Rows(kMinute0, 8, step_s);
+    const Series rows = MinuteRows(kJune1Noon2024UtcS, 8, step_s);
     WriteRows(name + ".csv", rows);
     ProcessResult run = Pvtwin("import --csv " + name + ".csv --db " + name + ".db");
     ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -352,7 +355,7 @@ TEST_F(StoreCli, ALocalTimeTheClocksSkipIsAnError) {
 // a store of an older schema is refused with what to do, never migrated,
 // and its file is left byte for byte as it was.
 TEST_F(StoreCli, ReadOnlyVerbsRefuseAnOlderSchemaInsteadOfMigratingIt) {
-  WriteRows("m.csv", Rows(kMinute0, 5, 60.0));
+  WriteRows("m.csv", MinuteRows(kJune1Noon2024UtcS, 5, 60.0));
   ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
   {
     RawDb db(dir_ / "t.db");
@@ -378,7 +381,7 @@ TEST_F(StoreCli, ReadOnlyVerbsRefuseAnOlderSchemaInsteadOfMigratingIt) {
 // `pvtwin migrate`, named by that message, opens the store as the daemon
 // does (upgrading it) and says its schema; a current store stays as it is.
 TEST_F(StoreCli, MigrateNamesTheSchemaOfTheStore) {
-  WriteRows("m.csv", Rows(kMinute0, 5, 60.0));
+  WriteRows("m.csv", MinuteRows(kJune1Noon2024UtcS, 5, 60.0));
   ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
   ProcessResult run = Pvtwin("migrate --db t.db");
   EXPECT_EQ(run.exit_code, 0) << run.err;
@@ -404,7 +407,7 @@ TEST_F(StoreCli, ReadOnlyVerbsNeverCreateAStore) {
 // alone, immutable). As root only: setpriv acts as the other user.
 TEST_F(StoreCli, AReaderWithoutWriteAccessExportsWithAndWithoutTheDaemon) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root to act as another user (setpriv)";
-  WriteRows("m.csv", Rows(kMinute0, 5, 60.0));
+  WriteRows("m.csv", MinuteRows(kJune1Noon2024UtcS, 5, 60.0));
   ASSERT_EQ(Pvtwin("import --csv m.csv --db t.db").exit_code, 0);
   std::filesystem::permissions(dir_, std::filesystem::perms(0755));
   const std::string as_reader = "setpriv --reuid=65534 --regid=65534 --clear-groups '" +

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "io/store/store.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/sqlite_db.h"
 
 namespace pvtwin {
@@ -24,14 +25,14 @@ namespace {
 
 using testing::RawDb;
 
-constexpr std::int64_t kT0 = 1717243200;  // 2024-06-01T12:00:00Z
+using testing::kJune1Noon2024UtcS;
 constexpr int kWaitMs = 20000;            // bound of every wait on a child process
 
 std::vector<Sample> Batch(int index) {
   std::vector<Sample> batch(12);
   for (int i = 0; i < 12; ++i) {
     Sample& s = batch[static_cast<std::size_t>(i)];
-    s.ts_s = kT0 + 60 * index + 5 * i;
+    s.ts_s = kJune1Noon2024UtcS + 60 * index + 5 * i;
     s.Set(Channel::kPElW, 100.0 + index);
     s.Set(Channel::kTAmbC, 20.0);
   }
@@ -59,7 +60,7 @@ TEST_F(StoreConcurrency, AnOpenReadTransactionDoesNotBlockIngestion) {
     ASSERT_TRUE(store->InsertSamples(Batch(k), &error)) << error;
   }
   int written = 0;
-  ASSERT_TRUE(store->AggregateMinutes(kT0 + 6 * 60, &written, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kJune1Noon2024UtcS + 6 * 60, &written, &error)) << error;
   EXPECT_EQ(written, 6);
   ASSERT_TRUE(store->Checkpoint(nullptr, &error)) << error;          // best effort with a reader
   EXPECT_EQ(reader.Number("SELECT COUNT(*) FROM sample_5s"), 12.0);  // still its snapshot
@@ -158,11 +159,12 @@ TEST_F(StoreConcurrency, ACompetingWriterMakesAWriteFailWithAReasonThenItSucceed
   EXPECT_NE(error.find("busy"), std::string::npos) << error;
   EXPECT_NE(error.find(DbPath()), std::string::npos) << error;
   std::vector<Sample> read;
-  ASSERT_TRUE(store->ReadSamples(0, kT0 + 3600, &read, &error)) << error;  // still readable
+  ASSERT_TRUE(store->ReadSamples(0, kJune1Noon2024UtcS + 3600, &read, &error))
+      << error;  // still readable
   EXPECT_EQ(read.size(), 12u);
   ASSERT_EQ(writer.Exec("ROLLBACK"), SQLITE_OK);
   ASSERT_TRUE(store->InsertSamples(Batch(1), &error)) << error;  // the caller's retry
-  ASSERT_TRUE(store->ReadSamples(0, kT0 + 3600, &read, &error)) << error;
+  ASSERT_TRUE(store->ReadSamples(0, kJune1Noon2024UtcS + 3600, &read, &error)) << error;
   EXPECT_EQ(read.size(), 24u);
 }
 
@@ -210,7 +212,7 @@ TEST_F(StoreConcurrency, SigkillDuringALongInsertLoopLosesNoCommittedBatch) {
   auto store = Store::Open(DbPath(), &error);
   ASSERT_NE(store, nullptr) << error;
   std::vector<Sample> samples;
-  ASSERT_TRUE(store->ReadSamples(0, kT0 + 100000 * 60, &samples, &error)) << error;
+  ASSERT_TRUE(store->ReadSamples(0, kJune1Noon2024UtcS + 100000 * 60, &samples, &error)) << error;
   std::set<std::int64_t> stored;
   for (const Sample& s : samples) stored.insert(s.ts_s);
   for (const int batch : committed) {
@@ -220,7 +222,7 @@ TEST_F(StoreConcurrency, SigkillDuringALongInsertLoopLosesNoCommittedBatch) {
   EXPECT_EQ(samples.size() % 12, 0u);
   EXPECT_LE(samples.size() / 12, committed.size() + 1);
   int written = 0;
-  ASSERT_TRUE(store->AggregateMinutes(kT0 + 100000 * 60, &written, &error)) << error;
+  ASSERT_TRUE(store->AggregateMinutes(kJune1Noon2024UtcS + 100000 * 60, &written, &error)) << error;
   EXPECT_EQ(static_cast<std::size_t>(written), samples.size() / 12);
 }
 

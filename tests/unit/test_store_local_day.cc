@@ -20,6 +20,7 @@
 
 #include "io/store/store.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
 #include "tests/support/store_schema_v11.h"
@@ -30,15 +31,15 @@ namespace {
 using testing::RawDb;
 namespace chr = std::chrono;
 
-constexpr std::int64_t kDay = 86400;
+using testing::kDayS;
 
 std::int64_t UtcMidnight(chr::year_month_day ymd) {
-  return chr::sys_days{ymd}.time_since_epoch().count() * kDay;
+  return chr::sys_days{ymd}.time_since_epoch().count() * kDayS;
 }
 
 std::int64_t LastSundayUtcOneAm(chr::year y, chr::month m) {
   const chr::sys_days last{chr::year_month_weekday_last{y, m, chr::weekday_last{chr::Sunday}}};
-  return last.time_since_epoch().count() * kDay + 3600;
+  return last.time_since_epoch().count() * kDayS + 3600;
 }
 
 // UTC instant of 00:00 Vienna time on the date ymd (EU rule).
@@ -64,7 +65,7 @@ struct Day {
 // The days (Vienna or UTC) that overlap [from, to).
 std::vector<Day> DaysOverlapping(std::int64_t from, std::int64_t to, bool vienna) {
   std::vector<Day> days;
-  chr::year_month_day ymd{chr::sys_days{chr::days{from / kDay - 1}}};
+  chr::year_month_day ymd{chr::sys_days{chr::days{from / kDayS - 1}}};
   for (;; ymd = chr::sys_days{ymd} + chr::days{1}) {
     const chr::year_month_day next{chr::sys_days{ymd} + chr::days{1}};
     Day d{DateText(ymd), vienna ? ViennaMidnight(ymd) : UtcMidnight(ymd),
@@ -87,7 +88,7 @@ struct Minute {
 std::vector<Minute> MakeMinutes(std::int64_t from, std::int64_t to) {
   std::vector<Minute> minutes;
   for (std::int64_t ts = from; ts < to; ts += 60) {
-    const double hour = static_cast<double>(((ts % kDay) + kDay) % kDay) / 3600.0;
+    const double hour = static_cast<double>(((ts % kDayS) + kDayS) % kDayS) / 3600.0;
     const double sun = std::max(0.0, std::sin((hour - 5.0) / 14.0 * std::numbers::pi));
     Minute m;
     m.ts = ts;
@@ -122,8 +123,8 @@ struct Issue {
 
 std::vector<Issue> MakeIssues(const std::vector<Minute>& minutes) {
   std::vector<Issue> issues;
-  const std::int64_t from = minutes.front().ts - kDay, to = minutes.back().ts;
-  for (std::int64_t day = from - ((from % kDay) + kDay) % kDay; day < to; day += kDay) {
+  const std::int64_t from = minutes.front().ts - kDayS, to = minutes.back().ts;
+  for (std::int64_t day = from - ((from % kDayS) + kDayS) % kDayS; day < to; day += kDayS) {
     // Every 3 h from 23:00 UTC (winter's local midnight) on, and at 23:30
     // UTC (after it, before the UTC midnight).
     for (const std::int64_t at : {-3600, -1800, 7200, 18000, 28800, 39600, 50400, 61200, 72000}) {
@@ -143,7 +144,7 @@ std::vector<Issue> MakeIssues(const std::vector<Minute>& minutes) {
 // A UTC day's model energies: whatever a calibration said (not scored for
 // the electrical output on every third day).
 DayPerformance ModelDay(std::int64_t day_start) {
-  const std::int64_t k = day_start / kDay;
+  const std::int64_t k = day_start / kDayS;
   DayPerformance d;
   d.day_start_s = day_start;
   d.valid_minutes = 1000;
@@ -156,7 +157,7 @@ DayPerformance ModelDay(std::int64_t day_start) {
   return d;
 }
 
-std::int64_t UtcDayOf(std::int64_t ts) { return ts - ((ts % kDay) + kDay) % kDay; }
+std::int64_t UtcDayOf(std::int64_t ts) { return ts - ((ts % kDayS) + kDayS) % kDayS; }
 
 class StoreLocalDayTest : public testing::TempDirTest {
  protected:
@@ -205,7 +206,7 @@ class StoreLocalDayTest : public testing::TempDirTest {
       }
       ASSERT_TRUE(store->InsertForecast(issue.issued_at, 0, "test", rows, &error)) << error;
     }
-    for (std::int64_t day = UtcDayOf(from); day < to; day += kDay) {
+    for (std::int64_t day = UtcDayOf(from); day < to; day += kDayS) {
       ASSERT_TRUE(store->WritePerformanceDay(ModelDay(day), 0, &error)) << error;
     }
   }
@@ -216,7 +217,7 @@ class StoreLocalDayTest : public testing::TempDirTest {
     auto store = OpenIn("Europe/Vienna");
     if (store == nullptr) return store;
     for (const chr::year_month_day& first : firsts) {
-      Fill(store.get(), UtcMidnight(first), UtcMidnight(first) + 3 * kDay);
+      Fill(store.get(), UtcMidnight(first), UtcMidnight(first) + 3 * kDayS);
     }
     return store;
   }
@@ -294,7 +295,7 @@ const chr::year_month_day kAutumn{chr::year{2024}, chr::October, chr::day{26}};
 
 // Three UTC days of minutes from the UTC midnight of `first`.
 std::pair<std::int64_t, std::int64_t> ThreeDays(chr::year_month_day first) {
-  return {UtcMidnight(first), UtcMidnight(first) + 3 * kDay};
+  return {UtcMidnight(first), UtcMidnight(first) + 3 * kDayS};
 }
 
 TEST_F(StoreLocalDayTest, ViennaDaysHave23And25HoursAtTheClockChanges) {
@@ -309,7 +310,7 @@ TEST_F(StoreLocalDayTest, ViennaDaysHave23And25HoursAtTheClockChanges) {
   // Every day of the data and two after it, as the EU rule has them.
   for (const auto& first : {kSpring, kAutumn}) {
     const auto [from, to] = ThreeDays(first);
-    for (const Day& day : DaysOverlapping(from, to + 2 * kDay, true)) {
+    for (const Day& day : DaysOverlapping(from, to + 2 * kDayS, true)) {
       const auto rows =
           db.Rows("SELECT start_ts, end_ts FROM local_day WHERE day = '" + day.date + "'");
       ASSERT_EQ(rows.size(), 1u) << day.date;
@@ -440,7 +441,7 @@ TEST_F(StoreLocalDayTest, PruningLeavesForecastSkillLocalAsItWas) {
   const double before_rows = db.Number("SELECT COUNT(*) FROM forecast");
   const auto before = db.Rows("SELECT * FROM forecast_skill_local ORDER BY day");
   std::string error;
-  ASSERT_TRUE(store->PruneForecasts(from - kDay, to + kDay, &error)) << error;
+  ASSERT_TRUE(store->PruneForecasts(from - kDayS, to + kDayS, &error)) << error;
   EXPECT_LT(db.Number("SELECT COUNT(*) FROM forecast"), before_rows);
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill_local ORDER BY day"), before);
 }
@@ -486,7 +487,7 @@ TEST_F(StoreLocalDayTest, LocalDaysFollowTheZoneAndAreMadeAtMigration) {
   EXPECT_EQ(db.Number("PRAGMA user_version"), static_cast<double>(kStoreSchemaVersion));
   EXPECT_EQ(db.Number(q), 25.0 * 3600);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM local_day"),
-            static_cast<double>(DaysOverlapping(from, to + 2 * kDay, true).size()));
+            static_cast<double>(DaysOverlapping(from, to + 2 * kDayS, true).size()));
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_local"), 4.0);
 }
 

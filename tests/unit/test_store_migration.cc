@@ -11,6 +11,7 @@
 
 #include "io/store/store.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
 #include "tests/support/store_schema_v11.h"
@@ -20,7 +21,7 @@ namespace {
 
 using testing::RawDb;
 
-constexpr std::int64_t kMinute0 = 1717243200;  // 2024-06-01T12:00:00Z
+using testing::kJune1Noon2024UtcS;
 
 class StoreMigrationTest : public testing::TempDirTest {
  protected:
@@ -50,7 +51,7 @@ class StoreMigrationTest : public testing::TempDirTest {
       ASSERT_NE(store, nullptr);
       std::vector<Sample> samples(3);
       for (int i = 0; i < 3; ++i) {
-        samples[i].ts_s = kMinute0 + 5 * i;
+        samples[i].ts_s = kJune1Noon2024UtcS + 5 * i;
         samples[i].Set(Channel::kPElW, 100.0 + i);
       }
       std::string error;

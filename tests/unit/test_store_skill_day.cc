@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "io/store/store.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/forecast_skill_check.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
@@ -26,8 +27,8 @@ namespace {
 
 using testing::RawDb;
 
-constexpr std::int64_t kDay = 86400;
-constexpr std::int64_t kDay0 = 1717200000;  // 2024-06-01T00:00:00Z
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
 
 using testing::CostOf;
 using testing::ExpectSameRows;
@@ -57,9 +58,11 @@ class SkillDayTest : public testing::TempDirTest {
   // ahead from 12 h before day 0.
   void FillFourDays(Store* store) {
     std::string error;
-    ASSERT_TRUE(store->WriteMinutes(Minutes(kDay0, kDay0 + 3 * kDay + kDay / 2, 0.0), &error))
+    ASSERT_TRUE(store->WriteMinutes(
+        Minutes(kJune1_2024UtcS, kJune1_2024UtcS + 3 * kDayS + kDayS / 2, 0.0), &error))
         << error;
-    testing::InsertHourlyIssues(store, kDay0 - kDay / 2, kDay0 + 3 * kDay + kDay / 2);
+    testing::InsertHourlyIssues(store, kJune1_2024UtcS - kDayS / 2,
+                                kJune1_2024UtcS + 3 * kDayS + kDayS / 2);
   }
 };
 
@@ -77,23 +80,23 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
   ExpectSameRows(db.Rows(kViewRows), v10_before, "before the refresh");
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 0.0);
 
-  const std::int64_t now = kDay0 + 3 * kDay + kDay / 2;  // noon of day 3
+  const std::int64_t now = kJune1_2024UtcS + 3 * kDayS + kDayS / 2;  // noon of day 3
   int written = 0;
   std::string error;
   ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
   EXPECT_EQ(written, 3) << "the closed days 0, 1 and 2";
   EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
-            static_cast<double>(kDay0 + 3 * kDay));
+            static_cast<double>(kJune1_2024UtcS + 3 * kDayS));
   ExpectSameRows(db.Rows(kViewRows), db.Rows(kVersion10Rows), "after the refresh");
   ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
   EXPECT_EQ(written, 0) << "nothing more to do: no day written again";
 
   // A late import of day 1's morning and a late forecast issued at 00:00 of
   // day 2 (the newest at or before the day began) change two closed days.
-  const std::int64_t day1 = kDay0 + kDay, day2 = kDay0 + 2 * kDay;
+  const std::int64_t day1 = kJune1_2024UtcS + kDayS, day2 = kJune1_2024UtcS + 2 * kDayS;
   ASSERT_TRUE(store->WriteMinutes(Minutes(day1 + 6 * 3600, day1 + 9 * 3600, 60.0), &error))
       << error;
-  ASSERT_TRUE(store->InsertForecast(day2, 0, "late", Issue(day2, kDay, -40.0), &error)) << error;
+  ASSERT_TRUE(store->InsertForecast(day2, 0, "late", Issue(day2, kDayS, -40.0), &error)) << error;
   EXPECT_EQ(
       db.Rows("SELECT day FROM forecast_skill_dirty ORDER BY day"),
       (std::vector<std::vector<std::string>>{{std::to_string(day1)}, {std::to_string(day2)}}));
@@ -113,7 +116,7 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
 
   // Pruning superseded issues changes no score, so it marks no day dirty.
   const double rows_before = db.Number("SELECT COUNT(*) FROM forecast");
-  ASSERT_TRUE(store->PruneForecasts(kDay0 - kDay, now + 2 * kDay, &error)) << error;
+  ASSERT_TRUE(store->PruneForecasts(kJune1_2024UtcS - kDayS, now + 2 * kDayS, &error)) << error;
   EXPECT_LT(db.Number("SELECT COUNT(*) FROM forecast"), rows_before / 2);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0);
   ExpectSameRows(db.Rows(kViewRows), v10_late, "after the prune");
@@ -133,14 +136,14 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
 // live, a small fraction of version 10's query over the year, and it scans
 // no table of minutes in full.
 TEST_F(SkillDayTest, AfterTheRefreshAYearCostsTheViewOnlyTodaysMinutes) {
-  const std::int64_t today = kDay0 + 365 * kDay;
-  const std::int64_t now = today + kDay / 2;
+  const std::int64_t today = kJune1_2024UtcS + 365 * kDayS;
+  const std::int64_t now = today + kDayS / 2;
   {
     auto store = Open();
     ASSERT_NE(store, nullptr);
   }
   RawDb db(DbPath());
-  const std::string minutes = "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kDay0) +
+  const std::string minutes = "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kJune1_2024UtcS) +
                               " UNION ALL SELECT ts + 60 " + "FROM t WHERE ts + 60 < " +
                               std::to_string(now) + ") ";
   ASSERT_EQ(
@@ -222,7 +225,7 @@ TEST_F(SkillDayTest, MigratingFromVersionTenMaterialisesTheDaysAndKeepsTheValues
   // The stored days end on day 3, long over: all four are materialised.
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 4.0);
   EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
-            static_cast<double>(kDay0 + 4 * kDay));
+            static_cast<double>(kJune1_2024UtcS + 4 * kDayS));
   ExpectSameRows(db.Rows(kViewRows), v10, "after the migration");
   ExpectSameRows(db.Rows("SELECT * FROM forecast_skill_day ORDER BY day"), v10,
                  "the materialised rows");

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "io/store/store.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/forecast_skill_check.h"
 #include "tests/support/sqlite_db.h"
 #include "tests/support/store_schema_v10.h"
@@ -26,16 +27,16 @@ namespace pvtwin {
 namespace {
 
 using testing::ExpectSameRows;
-using testing::Issue;
 using testing::Measured;
 using testing::RawDb;
 using testing::Rows;
 using testing::ScoreDayByHand;
 
-constexpr std::int64_t kDay = 86400;
-constexpr std::int64_t kDay0 = 1717200000;  // 2024-06-01T00:00:00Z
-const std::string kViewRows = "SELECT * FROM forecast_skill ORDER BY day";
-const std::string kVersion10Rows = std::string(testing::kForecastSkillV10) + " ORDER BY day";
+using testing::kDayS;
+using testing::kJune1_2024UtcS;
+const std::string kIntervalViewRows = "SELECT * FROM forecast_skill ORDER BY day";
+const std::string kIntervalVersion10Rows =
+    std::string(testing::kForecastSkillV10) + " ORDER BY day";
 
 // The view's rows of the given days.
 Rows RowsOfDays(const Rows& rows, const std::vector<std::int64_t>& days) {
@@ -66,14 +67,18 @@ class SkillIntervalTest : public testing::TempDirTest {
   // hourly issues 26 h ahead from 12 h before day 0.
   static void FillDays(Store* store) {
     std::string error;
-    ASSERT_TRUE(store->WriteMinutes(Measured(kDay0, kDay0 + 2 * kDay, 60, 0.0), &error)) << error;
-    ASSERT_TRUE(
-        store->WriteIntervalRows(Measured(kDay0 + kDay, kDay0 + 3 * kDay, 600, 25.0), &error))
+    ASSERT_TRUE(store->WriteMinutes(Measured(kJune1_2024UtcS, kJune1_2024UtcS + 2 * kDayS, 60, 0.0),
+                                    &error))
         << error;
     ASSERT_TRUE(store->WriteIntervalRows(
-        Measured(kDay0 + 3 * kDay, kDay0 + 3 * kDay + kDay / 2, 900, -15.0), &error))
+        Measured(kJune1_2024UtcS + kDayS, kJune1_2024UtcS + 3 * kDayS, 600, 25.0), &error))
         << error;
-    testing::InsertHourlyIssues(store, kDay0 - kDay / 2, kDay0 + 3 * kDay + kDay / 2);
+    ASSERT_TRUE(store->WriteIntervalRows(
+        Measured(kJune1_2024UtcS + 3 * kDayS, kJune1_2024UtcS + 3 * kDayS + kDayS / 2, 900, -15.0),
+        &error))
+        << error;
+    testing::InsertHourlyIssues(store, kJune1_2024UtcS - kDayS / 2,
+                                kJune1_2024UtcS + 3 * kDayS + kDayS / 2);
   }
 
   // The rows forecast_skill should have for the interval days `days`,
@@ -81,7 +86,7 @@ class SkillIntervalTest : public testing::TempDirTest {
   static Rows IntervalDaysByHand(RawDb& db, const std::vector<std::int64_t>& days) {
     Rows rows;
     for (const std::int64_t day : days) {
-      rows.push_back(ScoreDayByHand(db, "measurement_interval", day, day + kDay, day)
+      rows.push_back(ScoreDayByHand(db, "measurement_interval", day, day + kDayS, day)
                          .Cells(std::to_string(day)));
     }
     return rows;
@@ -96,16 +101,17 @@ TEST_F(SkillIntervalTest, IntervalDaysAreScoredByTheirStepAndMinuteDaysKeepTheir
   ASSERT_NE(store, nullptr);
   ASSERT_NO_FATAL_FAILURE(FillDays(store.get()));
   RawDb db(DbPath());
-  const std::int64_t day2 = kDay0 + 2 * kDay, day3 = kDay0 + 3 * kDay;
-  const Rows view = db.Rows(kViewRows);
+  const std::int64_t day2 = kJune1_2024UtcS + 2 * kDayS, day3 = kJune1_2024UtcS + 3 * kDayS;
+  const Rows view = db.Rows(kIntervalViewRows);
   ASSERT_EQ(view.size(), 4u) << "days 0 to 3 are scored (version 11: days 0 and 1)";
-  const Rows v10 = db.Rows(kVersion10Rows);
+  const Rows v10 = db.Rows(kIntervalVersion10Rows);
   ASSERT_EQ(v10.size(), 2u);
-  EXPECT_EQ(RowsOfDays(view, {kDay0, kDay0 + kDay}), v10) << "the same text, to the last digit";
+  EXPECT_EQ(RowsOfDays(view, {kJune1_2024UtcS, kJune1_2024UtcS + kDayS}), v10)
+      << "the same text, to the last digit";
   ExpectSameRows(RowsOfDays(view, {day2, day3}), IntervalDaysByHand(db, {day2, day3}),
                  "interval days against the test's computation", 1e-9);
   // minutes stays minutes: ten per scored 10-min row, an integer.
-  const auto by_hand = ScoreDayByHand(db, "measurement_interval", day2, day2 + kDay, day2);
+  const auto by_hand = ScoreDayByHand(db, "measurement_interval", day2, day2 + kDayS, day2);
   EXPECT_GT(by_hand.pairs, 100);
   EXPECT_EQ(db.Text("SELECT minutes FROM forecast_skill WHERE day = " + std::to_string(day2)),
             std::to_string(10 * by_hand.pairs));
@@ -118,11 +124,11 @@ TEST_F(SkillIntervalTest, IntervalDaysAreScoredByTheirStepAndMinuteDaysKeepTheir
 
   int written = 0;
   std::string error;
-  ASSERT_TRUE(store->RefreshForecastSkill(day3 + kDay / 2, &written, &error)) << error;
+  ASSERT_TRUE(store->RefreshForecastSkill(day3 + kDayS / 2, &written, &error)) << error;
   EXPECT_EQ(written, 3) << "the closed days 0, 1 and 2";
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill_day ORDER BY day"),
-            RowsOfDays(view, {kDay0, kDay0 + kDay, day2}));
-  EXPECT_EQ(db.Rows(kViewRows), view) << "the same rows, materialised";
+            RowsOfDays(view, {kJune1_2024UtcS, kJune1_2024UtcS + kDayS, day2}));
+  EXPECT_EQ(db.Rows(kIntervalViewRows), view) << "the same rows, materialised";
 }
 
 // A late 10-min import into day 2 marks it dirty, one into day 0 (scored
@@ -132,15 +138,16 @@ TEST_F(SkillIntervalTest, IntervalTriggersMarkOnlyDaysScoredFromIntervalRows) {
   auto store = Open();
   ASSERT_NE(store, nullptr);
   ASSERT_NO_FATAL_FAILURE(FillDays(store.get()));
-  const std::int64_t day2 = kDay0 + 2 * kDay, now = kDay0 + 3 * kDay + kDay / 2;
+  const std::int64_t day2 = kJune1_2024UtcS + 2 * kDayS,
+                     now = kJune1_2024UtcS + 3 * kDayS + kDayS / 2;
   std::string error;
   ASSERT_TRUE(store->RefreshForecastSkill(now, nullptr, &error)) << error;
   RawDb db(DbPath());
   const std::string of_day2 = " WHERE day = " + std::to_string(day2);
   const std::string materialised = db.Text("SELECT mae_p_el_w FROM forecast_skill_day" + of_day2);
 
-  ASSERT_TRUE(
-      store->WriteIntervalRows(Measured(kDay0 + 6 * 3600, kDay0 + 9 * 3600, 600, 80.0), &error))
+  ASSERT_TRUE(store->WriteIntervalRows(
+      Measured(kJune1_2024UtcS + 6 * 3600, kJune1_2024UtcS + 9 * 3600, 600, 80.0), &error))
       << error;
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0)
       << "day 0 is scored from its 1-min rows: its interval rows change nothing";
@@ -162,7 +169,7 @@ TEST_F(SkillIntervalTest, IntervalTriggersMarkOnlyDaysScoredFromIntervalRows) {
       store->WriteMinutes(Measured(day2 + 12 * 3600, day2 + 12 * 3600 + 60, 60, 0.0), &error))
       << error;
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill" + of_day2),
-            RowsOfDays(db.Rows(kVersion10Rows), {day2}));
+            RowsOfDays(db.Rows(kIntervalVersion10Rows), {day2}));
   EXPECT_EQ(db.Number("SELECT minutes FROM forecast_skill" + of_day2), 1.0);
   ASSERT_TRUE(store->RefreshForecastSkill(now, nullptr, &error)) << error;
   ASSERT_EQ(db.Exec("DELETE FROM measurement_1min WHERE ts >= " + std::to_string(day2)), SQLITE_OK);
@@ -212,11 +219,11 @@ TEST_F(SkillIntervalTest, LocalDaysWithoutMinuteRowsAreScoredFromIntervalRows) {
 // steps stay below those of one more whole day, a small fraction of the
 // live year, and no table of rows is scanned in full.
 TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyToday) {
-  const std::int64_t today = kDay0 + 365 * kDay;
-  const std::int64_t now = today + kDay / 2;
+  const std::int64_t today = kJune1_2024UtcS + 365 * kDayS;
+  const std::int64_t now = today + kDayS / 2;
   { ASSERT_NE(Open(), nullptr); }
   RawDb db(DbPath());
-  const std::string rows = "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kDay0) +
+  const std::string rows = "WITH RECURSIVE t(ts) AS (SELECT " + std::to_string(kJune1_2024UtcS) +
                            " UNION ALL SELECT ts + 600 FROM t WHERE ts + 600 < " +
                            std::to_string(now) + ") ";
   ASSERT_EQ(
@@ -232,7 +239,7 @@ TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyTod
   const std::string view = "SELECT * FROM forecast_skill";
   const testing::QueryCost live = testing::CostOf(DbPath(), view);
   EXPECT_EQ(live.rows, 366) << "every day computed live";
-  const Rows before = db.Rows(kViewRows);
+  const Rows before = db.Rows(kIntervalViewRows);
   {
     auto store = Open();
     int written = 0;
@@ -240,8 +247,8 @@ TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyTod
     ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
     EXPECT_EQ(written, 365);
   }
-  ExpectSameRows(db.Rows(kViewRows), before, "after the refresh");
-  const std::int64_t day100 = kDay0 + 100 * kDay;
+  ExpectSameRows(db.Rows(kIntervalViewRows), before, "after the refresh");
+  const std::int64_t day100 = kJune1_2024UtcS + 100 * kDayS;
   ExpectSameRows(RowsOfDays(before, {day100}), IntervalDaysByHand(db, {day100}),
                  "day 100 against the test's computation", 1e-9);
   const testing::QueryCost cost = testing::CostOf(DbPath(), view);
@@ -274,14 +281,14 @@ TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyTod
 // day 2 is materialised from its interval rows, days 0 and 1 keep their
 // rows, and the backup is the version 11 file.
 TEST_F(SkillIntervalTest, MigratingFromVersionElevenScoresTheIntervalDays) {
-  const std::int64_t day2 = kDay0 + 2 * kDay, day3 = kDay0 + 3 * kDay;
+  const std::int64_t day2 = kJune1_2024UtcS + 2 * kDayS, day3 = kJune1_2024UtcS + 3 * kDayS;
   Rows v11;
   {
     auto store = Open();
     ASSERT_NE(store, nullptr);
     ASSERT_NO_FATAL_FAILURE(FillDays(store.get()));
     std::string error;
-    ASSERT_TRUE(store->RefreshForecastSkill(day3 + kDay / 2, nullptr, &error)) << error;
+    ASSERT_TRUE(store->RefreshForecastSkill(day3 + kDayS / 2, nullptr, &error)) << error;
   }
   {
     RawDb db(DbPath());
@@ -296,7 +303,7 @@ TEST_F(SkillIntervalTest, MigratingFromVersionElevenScoresTheIntervalDays) {
                         testing::kForecastSkillColumns + " AS " + testing::kForecastSkillLocalV11);
     downgrade.push_back("PRAGMA user_version = 11");
     for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
-    v11 = db.Rows(kViewRows);
+    v11 = db.Rows(kIntervalViewRows);
     ASSERT_EQ(v11.size(), 2u) << "version 11 scores the 1-min days only";
   }
   auto store = Open();
@@ -305,8 +312,8 @@ TEST_F(SkillIntervalTest, MigratingFromVersionElevenScoresTheIntervalDays) {
   EXPECT_EQ(store->upgrade().to_version, 12);
   RawDb db(DbPath());
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 3.0) << "days 0, 1 and 2";
-  const Rows view = db.Rows(kViewRows);
-  EXPECT_EQ(RowsOfDays(view, {kDay0, kDay0 + kDay}), v11);
+  const Rows view = db.Rows(kIntervalViewRows);
+  EXPECT_EQ(RowsOfDays(view, {kJune1_2024UtcS, kJune1_2024UtcS + kDayS}), v11);
   ExpectSameRows(RowsOfDays(view, {day2, day3}), IntervalDaysByHand(db, {day2, day3}),
                  "the interval days after the migration", 1e-9);
   ExpectSameRows(db.Rows("SELECT * FROM forecast_skill_day WHERE day = " + std::to_string(day2)),

@@ -30,7 +30,7 @@ Drivers MakeDrivers(const Series& s, const char* variant, const Plant& plant = {
   return d;
 }
 
-double& At(ParamVector& p, Param name) { return p[static_cast<std::size_t>(name)]; }
+double& ParamAt(ParamVector& p, Param name) { return p[static_cast<std::size_t>(name)]; }
 
 // Analytic mean of T(t) = T_eq + (T0 − T_eq)·e^(−t/τ) over [a, a + dt].
 double ExpMean(double t_eq, double t0, double tau, double a, double dt) {
@@ -241,9 +241,9 @@ TEST(ThermalModel, NoSunNoFlowRelaxesToAmbientBackMix) {
   s[Channel::kTAmbC][0] = 50.0;
   s[Channel::kTBackC][0] = 50.0;
   ParamVector p = StartParams(Plant{});
-  At(p, Param::kUFrontWM2K) = 5.0;
-  At(p, Param::kUBackWM2K) = 15.0;
-  At(p, Param::kCPvJM2K) = 6.0e4;
+  ParamAt(p, Param::kUFrontWM2K) = 5.0;
+  ParamAt(p, Param::kUBackWM2K) = 15.0;
+  ParamAt(p, Param::kCPvJM2K) = 6.0e4;
   const double t_eq = (5.0 * 10.0 + 15.0 * 30.0) / 20.0;
   const double tau = 6.0e4 / 20.0;
   SimOutputs out;
@@ -278,17 +278,17 @@ TEST(ThermalModel, IrradianceStepGivesFirstOrderResponse) {
   plant.area_m2 = 2.0;
   plant.fluid_cp_j_kgk = 4000.0;
   ParamVector p = StartParams(plant);
-  At(p, Param::kPvTempCoeffPerK) = 0.0;
-  At(p, Param::kUFrontWM2K) = 8.0;
-  At(p, Param::kUBackWM2K) = 2.0;
-  At(p, Param::kUCollWM2K) = 30.0;
-  At(p, Param::kR0FluidM2KW) = 0.01;
-  At(p, Param::kR1Fluid) = 1.0;
-  At(p, Param::kCPvJM2K) = 3.0e4;
-  At(p, Param::kCCollJM2K) = 5.0e4;
-  const double eta =
-      At(p, Param::kEtaPvRef) * (1.0 + plant.pv_irr_coeff_m2_w * (800.0 - plant.pv_g_ref_w_m2));
-  const double q_abs_w_m2 = (1.0 - eta) * At(p, Param::kFTh) * 800.0;
+  ParamAt(p, Param::kPvTempCoeffPerK) = 0.0;
+  ParamAt(p, Param::kUFrontWM2K) = 8.0;
+  ParamAt(p, Param::kUBackWM2K) = 2.0;
+  ParamAt(p, Param::kUCollWM2K) = 30.0;
+  ParamAt(p, Param::kR0FluidM2KW) = 0.01;
+  ParamAt(p, Param::kR1Fluid) = 1.0;
+  ParamAt(p, Param::kCPvJM2K) = 3.0e4;
+  ParamAt(p, Param::kCCollJM2K) = 5.0e4;
+  const double eta = ParamAt(p, Param::kEtaPvRef) *
+                     (1.0 + plant.pv_irr_coeff_m2_w * (800.0 - plant.pv_g_ref_w_m2));
+  const double q_abs_w_m2 = (1.0 - eta) * ParamAt(p, Param::kFTh) * 800.0;
   const double w = 0.04 * 4000.0 / 2.0;  // specific capacity flow, W/m²K
   const double u_fluid = 1.0 / (1.0 / (2.0 * w) + 0.01);
   SimOutputs out;

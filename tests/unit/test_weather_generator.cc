@@ -9,6 +9,7 @@
 #include "core/physics/irradiance.h"
 #include "core/physics/solar_position.h"
 #include "core/synth/weather_generator.h"
+#include "tests/support/fixtures.h"
 
 namespace pvtwin {
 namespace {
@@ -26,11 +27,11 @@ Plant ExamplePlant() {
   return plant;
 }
 
-constexpr std::int64_t kJune20_2024 = 1718841600;  // 00:00 UTC
+using testing::kJune20_2024UtcS;
 
 WeatherOptions OneDayOf(DayType type) {
   WeatherOptions options;
-  options.start_time_s = kJune20_2024;
+  options.start_time_s = kJune20_2024UtcS;
   options.num_days = 1;
   options.day_types = {type};
   options.seed = 7;

@@ -10,14 +10,15 @@
 #include "core/physics/clear_sky.h"
 #include "core/physics/sky_radiation.h"
 #include "core/physics/wind.h"
+#include "tests/support/fixtures.h"
 
 namespace pvtwin {
 namespace {
 
 // 2024-06-01 00:00 UTC.
-constexpr std::int64_t kDay = 1717200000;
+using testing::kJune1_2024UtcS;
 
-Plant ExamplePlant() {
+Plant SitePlant() {
   Plant p;
   p.latitude_rad = DegToRad(47.358);
   p.longitude_rad = DegToRad(16.128);
@@ -35,7 +36,7 @@ const std::vector<double> kDhi = {0,   0,   0,   0,   20, 55, 80, 95, 105, 110, 
 
 ProviderWeather HourlyDay() {
   ProviderWeather w;
-  for (int h = 0; h < 24; ++h) w.time_s.push_back(kDay + h * 3600);
+  for (int h = 0; h < 24; ++h) w.time_s.push_back(kJune1_2024UtcS + h * 3600);
   w.step_s = 3600.0;
   w.irradiance_offset_s = -3600.0;
   w.ghi_w_m2 = kGhi;
@@ -124,9 +125,9 @@ TEST(WeatherResample, EveryIntervalKeepsItsEnergy) {
   Series out;
   WeatherResampleSummary summary;
   std::string error;
-  ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error)) << error;
+  ASSERT_TRUE(ResampleWeatherTo1Min(SitePlant(), w, {}, &out, &summary, &error)) << error;
   ASSERT_EQ(out.size(), 24u * 60u);
-  EXPECT_EQ(out.time_s.front(), kDay - 3600);
+  EXPECT_EQ(out.time_s.front(), kJune1_2024UtcS - 3600);
   for (std::size_t i = 0; i < w.time_s.size(); ++i) {
     const std::int64_t from = w.time_s[i] - 3600, to = w.time_s[i];
     EXPECT_NEAR(MeanOver(out, Channel::kGhiWM2, from, to), kGhi[i], 1e-9 * (1 + kGhi[i])) << i;
@@ -136,7 +137,8 @@ TEST(WeatherResample, EveryIntervalKeepsItsEnergy) {
         << i;
   }
   // 07:00-08:00 UTC, a rising morning hour: the first minute below the last.
-  const std::size_t first = static_cast<std::size_t>((kDay + 7 * 3600 - out.time_s[0]) / 60);
+  const std::size_t first =
+      static_cast<std::size_t>((kJune1_2024UtcS + 7 * 3600 - out.time_s[0]) / 60);
   EXPECT_LT(out[Channel::kGhiWM2][first] + 50.0, out[Channel::kGhiWM2][first + 59]);
   for (std::size_t k = 0; k < out.size(); ++k) {
     EXPECT_LE(out[Channel::kDhiWM2][k], out[Channel::kGhiWM2][k] + 1e-9) << k;
@@ -154,8 +156,9 @@ TEST(WeatherResample, EveryIntervalKeepsItsEnergy) {
 // beyond the bounds (100 W/m² in an hour whose clear sky gives a few W/m²)
 // is flagged and stored at the bounds: its mean is their mean.
 TEST(WeatherResample, AnUnshapeableSunsetHourKeepsItsEnergyInDaylight) {
-  const std::int64_t from = kDay + 18 * 3600, to = kDay + 19 * 3600;
-  const ClearSkyGrid g = MakeClearSkyGrid(ExamplePlant(), kDay - 3600, kDay + 23 * 3600, 3.0);
+  const std::int64_t from = kJune1_2024UtcS + 18 * 3600, to = kJune1_2024UtcS + 19 * 3600;
+  const ClearSkyGrid g =
+      MakeClearSkyGrid(SitePlant(), kJune1_2024UtcS - 3600, kJune1_2024UtcS + 23 * 3600, 3.0);
   const std::vector<double> bound = BoundOf(g, false);
   const std::size_t first = static_cast<std::size_t>((from - g.time_s[0]) / 60);
   double clear_mean = 0.0, bound_mean = 0.0;
@@ -179,7 +182,7 @@ TEST(WeatherResample, AnUnshapeableSunsetHourKeepsItsEnergyInDaylight) {
     Series out;
     WeatherResampleSummary summary;
     std::string error;
-    ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error)) << error;
+    ASSERT_TRUE(ResampleWeatherTo1Min(SitePlant(), w, {}, &out, &summary, &error)) << error;
     ASSERT_EQ(out.time_s, g.time_s);
     EXPECT_GE(summary.flat_intervals, 1u);
     EXPECT_GT(out[Channel::kGhiWM2][first], std::min(value, bound_mean));  // daylight carries it
@@ -223,9 +226,9 @@ TEST(WeatherResample, AnswerShiftedByHoursIsClippedToItsClearSkyAndNamed) {
   Series out;
   WeatherResampleSummary summary;
   std::string error;
-  ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error)) << error;
+  ASSERT_TRUE(ResampleWeatherTo1Min(SitePlant(), w, {}, &out, &summary, &error)) << error;
   const ClearSkyGrid g =
-      MakeClearSkyGrid(ExamplePlant(), out.time_s.front(), out.time_s.back() + 60, 3.0);
+      MakeClearSkyGrid(SitePlant(), out.time_s.front(), out.time_s.back() + 60, 3.0);
   const std::vector<double> ghi_bound = BoundOf(g, false), poa_bound = BoundOf(g, true);
   for (std::size_t k = 0; k < out.size(); ++k) {
     EXPECT_LE(out[Channel::kGhiWM2][k], ghi_bound[k] + 1e-9) << k;
@@ -235,7 +238,8 @@ TEST(WeatherResample, AnswerShiftedByHoursIsClippedToItsClearSkyAndNamed) {
   }
   // 19:00-20:00 UTC (stamped 20:00) is night for the whole hour at the
   // plant: its 270 W/m² (kGhi[17]) cannot be there.
-  const std::int64_t night_from = kDay + 19 * 3600, night_to = kDay + 20 * 3600;
+  const std::int64_t night_from = kJune1_2024UtcS + 19 * 3600,
+                     night_to = kJune1_2024UtcS + 20 * 3600;
   bool named = false;
   for (const IrradianceAboveClearSky& a : summary.above_clear_sky) {
     EXPECT_GT(a.value_w_m2, a.bound_w_m2);
@@ -254,7 +258,7 @@ TEST(WeatherResample, AnswerShiftedByHoursIsClippedToItsClearSkyAndNamed) {
   EXPECT_EQ(summary.above_clear_sky_rows[night + 59], 1);
   // 09:00-10:00 UTC (stamped 10:00) carries kGhi[7] = 430 W/m², a value its
   // clear sky can give: kept exactly, not flagged.
-  const std::int64_t from = kDay + 9 * 3600, to = kDay + 10 * 3600;
+  const std::int64_t from = kJune1_2024UtcS + 9 * 3600, to = kJune1_2024UtcS + 10 * 3600;
   EXPECT_NEAR(MeanOver(out, Channel::kGhiWM2, from, to), w.ghi_w_m2[10], 1e-9);
   EXPECT_EQ(summary.above_clear_sky_rows[static_cast<std::size_t>((from - out.time_s[0]) / 60)], 0);
 }
@@ -263,11 +267,12 @@ TEST(WeatherResample, GhiDhiAreTransposedToThePlaneWithoutTiltedIrradiance) {
   Series out;
   WeatherResampleSummary summary;
   std::string error;
-  ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), HourlyDay(), {}, &out, &summary, &error));
+  ASSERT_TRUE(ResampleWeatherTo1Min(SitePlant(), HourlyDay(), {}, &out, &summary, &error));
   ASSERT_TRUE(out.Has(Channel::kGPoaWM2));
   ASSERT_TRUE(out.Has(Channel::kGPoaDiffuseWM2));
   // Around noon a south plane tilted 20° at 47° N gets more than GHI.
-  const std::size_t noon = static_cast<std::size_t>((kDay + 11 * 3600 - out.time_s[0]) / 60);
+  const std::size_t noon =
+      static_cast<std::size_t>((kJune1_2024UtcS + 11 * 3600 - out.time_s[0]) / 60);
   EXPECT_GT(out[Channel::kGPoaWM2][noon], out[Channel::kGhiWM2][noon]);
   EXPECT_LT(out[Channel::kGPoaWM2][noon], 1.2 * out[Channel::kGhiWM2][noon]);
 }
@@ -281,10 +286,11 @@ TEST(WeatherResample, TemperatureInterpolatedAndWindAtCollectorHeight) {
   Series out;
   WeatherResampleSummary summary;
   std::string error;
-  ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, options, &out, &summary, &error));
+  ASSERT_TRUE(ResampleWeatherTo1Min(SitePlant(), w, options, &out, &summary, &error));
   EXPECT_NEAR(summary.wind_factor, 0.794597, 1e-6);
   // The minute 10:14-10:15 has its middle at 10:14:30, 14.5/60 of the way.
-  const std::size_t k = static_cast<std::size_t>((kDay + 10 * 3600 + 14 * 60 - out.time_s[0]) / 60);
+  const std::size_t k =
+      static_cast<std::size_t>((kJune1_2024UtcS + 10 * 3600 + 14 * 60 - out.time_s[0]) / 60);
   const double x = 14.5 / 60.0;
   EXPECT_NEAR(out[Channel::kTAmbC][k], w.t_amb_c[10] + x * (w.t_amb_c[11] - w.t_amb_c[10]), 1e-9);
   EXPECT_NEAR(out[Channel::kWindMS][k],
@@ -302,8 +308,9 @@ TEST(WeatherResample, MissingValuesStayMissing) {
   Series out;
   WeatherResampleSummary summary;
   std::string error;
-  ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error));
-  const std::size_t k = static_cast<std::size_t>((kDay + 11 * 3600 + 30 * 60 - out.time_s[0]) / 60);
+  ASSERT_TRUE(ResampleWeatherTo1Min(SitePlant(), w, {}, &out, &summary, &error));
+  const std::size_t k =
+      static_cast<std::size_t>((kJune1_2024UtcS + 11 * 3600 + 30 * 60 - out.time_s[0]) / 60);
   EXPECT_TRUE(std::isnan(out[Channel::kGhiWM2][k]));
   EXPECT_TRUE(std::isnan(out[Channel::kGPoaWM2][k]));
   EXPECT_TRUE(std::isnan(out[Channel::kTAmbC][k]));
@@ -318,7 +325,7 @@ TEST(WeatherResample, DiffuseFromBeamNormalStaysWithinGlobal) {
   Series out;
   WeatherResampleSummary summary;
   std::string error;
-  ASSERT_TRUE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error));
+  ASSERT_TRUE(ResampleWeatherTo1Min(SitePlant(), w, {}, &out, &summary, &error));
   for (std::size_t k = 0; k < out.size(); ++k) {
     EXPECT_GE(out[Channel::kDhiWM2][k], 0.0);
     EXPECT_LE(out[Channel::kDhiWM2][k], out[Channel::kGhiWM2][k] + 1e-9);
@@ -331,7 +338,7 @@ TEST(WeatherResample, RefusesUnevenStamps) {
   Series out;
   WeatherResampleSummary summary;
   std::string error;
-  EXPECT_FALSE(ResampleWeatherTo1Min(ExamplePlant(), w, {}, &out, &summary, &error));
+  EXPECT_FALSE(ResampleWeatherTo1Min(SitePlant(), w, {}, &out, &summary, &error));
   EXPECT_NE(error.find("row 5"), std::string::npos) << error;
 }
 

@@ -25,6 +25,7 @@
 #include "io/store/store.h"
 #include "io/weather/http_client.h"
 #include "tests/support/files.h"
+#include "tests/support/fixtures.h"
 #include "tests/support/http_server.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/stop_timeout.h"
@@ -40,7 +41,7 @@ using testing::ScratchDir;
 using testing::UnitStopTimeoutS;
 
 const fs::path kData = fs::path(PVTWIN_SOURCE_DIR) / "tests" / "weather" / "data";
-const fs::path kExampleMap = fs::path(PVTWIN_SOURCE_DIR) / "config" / "examples" / "sim-plant.toml";
+using testing::kExamplePlantConfig;
 
 LoopbackHttpServer::Answer Recorded(const std::string& file) {
   LoopbackHttpServer::Answer a;
@@ -175,7 +176,7 @@ TEST(UrlForLogs, HidesCredentialLikeQueryParameters) {
 Plant ExamplePlant() {
   Config config;
   Diagnostics errors;
-  EXPECT_TRUE(LoadConfig(kExampleMap.string(), &config, &errors));
+  EXPECT_TRUE(LoadConfig(kExamplePlantConfig.string(), &config, &errors));
   return config.plant;
 }
 
@@ -343,7 +344,7 @@ TEST_F(WeatherWorkerTest, StopsPromptlyDuringASlowAnswer) {
 
 TEST(ImportWeatherCommand, ImportsEachFormatAndRefusesBadInputWithExit2) {
   ScratchDir dir("import-weather");
-  fs::copy_file(kExampleMap, dir / "plant.toml");
+  fs::copy_file(kExamplePlantConfig, dir / "plant.toml");
   const auto hourly = RunPvtwin(dir.path(), "import-weather --config plant.toml --db w.db " +
                                                 (kData / "open-meteo-hourly.json").string());
   EXPECT_EQ(hourly.exit_code, 0) << hourly.err;
@@ -435,7 +436,7 @@ std::size_t ExpectWithinClearSkyBounds(const fs::path& db_path) {
 // warning, nothing marked.
 TEST(ImportWeatherCommand, IrradianceAboveItsClearSkyIsClippedAndNamed) {
   ScratchDir dir("import-weather-clear-sky");
-  fs::copy_file(kExampleMap, dir / "plant.toml");
+  fs::copy_file(kExamplePlantConfig, dir / "plant.toml");
   std::ofstream(dir / "december.json") << Restamped(2025, 12, 20, 0);
   std::ofstream(dir / "late.json") << Restamped(2024, 6, 1, 3);
 
@@ -502,7 +503,7 @@ class DaemonWeatherFetch : public ::testing::Test {
   static constexpr std::int64_t kMorning = 1717228800;
 
   void SetUp() override {
-    fs::copy_file(kExampleMap, dir_ / "sim.toml");
+    fs::copy_file(kExamplePlantConfig, dir_ / "sim.toml");
     const auto exported = RunPvtwin(
         dir_.path(), "sim --config sim.toml --export history.csv --days 14 --step 60 --start " +
                          std::to_string(kMorning - 14 * 86400));
@@ -529,8 +530,8 @@ class DaemonWeatherFetch : public ::testing::Test {
     settings.weather_refresh_min = 5;
     settings.weather_timeout_s = timeout_s_;
     std::string text;
-    ASSERT_TRUE(
-        EditConfig(ReadFile(kExampleMap), ParseListeningLines(lines), settings, &text, &error))
+    ASSERT_TRUE(EditConfig(ReadFile(kExamplePlantConfig), ParseListeningLines(lines), settings,
+                           &text, &error))
         << error;
     std::ofstream(dir_ / "pvtwin.toml") << text;
   }

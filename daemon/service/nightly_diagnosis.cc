@@ -17,8 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::int64_t kDayS = 86400;
-
 // The first line of the child's output that starts with prefix, without it.
 std::string LineAfter(const fs::path& path, const std::string& prefix) {
   std::ifstream in(path);
@@ -45,7 +43,7 @@ void PruneReports(const fs::path& dir, int keep) {
 
 // The local solar midnight nearest t_s (calendar.h).
 std::int64_t NearestSolarMidnight(std::int64_t t_s, std::int64_t solar_offset_s) {
-  return SolarDayStartS(t_s + kDayS / 2, solar_offset_s);
+  return SolarDayStartS(t_s + kSecondsPerDay / 2, solar_offset_s);
 }
 
 }  // namespace
@@ -57,7 +55,7 @@ NightlyDiagnosis::Plan NightlyDiagnosis::PlanFor(const DiagnosisConfig& config,
   plan.window_end = NearestSolarMidnight(job.window_end, job.solar_offset_s);
   const std::int64_t change_from = NearestSolarMidnight(job.change_from, job.solar_offset_s);
   if (job.change_from > 0 && change_from > plan.window_start &&
-      plan.window_end - change_from >= 2 * kDayS) {
+      plan.window_end - change_from >= 2 * kSecondsPerDay) {
     plan.window_start = change_from;
     plan.why = "the days since the plant changed on " +
                FormatIsoUtc(job.change_from).substr(0, 10) +
@@ -66,7 +64,7 @@ NightlyDiagnosis::Plan NightlyDiagnosis::PlanFor(const DiagnosisConfig& config,
     return plan;
   }
   // An hour's slack: the nightly runs drift by the calibration's runtime.
-  plan.start = last == nullptr || job.now_s - last->run_at >= config.every_days * kDayS - 3600;
+  plan.start = last == nullptr || job.now_s - last->run_at >= config.every_days * kSecondsPerDay - 3600;
   return plan;
 }
 

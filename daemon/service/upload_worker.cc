@@ -1,21 +1,11 @@
 #include "daemon/service/upload_worker.h"
 
 #include <algorithm>
-#include <cstdio>
 
 #include "core/common/clock.h"
+#include "core/common/text.h"
 
 namespace pvtwin {
-
-namespace {
-
-std::string Seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.0f s", s);
-  return buf;
-}
-
-}  // namespace
 
 UploadSettings UploadSettingsFor(const Config& config) {
   UploadSettings s;
@@ -69,7 +59,7 @@ void UploadWorker::Enter(UploadState next, const PgError& error) {
         log_(kNotice, "upload: connected to " + server + " as plant_id " + settings_.plant_id);
       } else {
         log_(kNotice, "upload: recovered (" + std::string(UploadStateName(before)) + " for " +
-                          Seconds(WallNowS() - down_since_s_) + "), connected to " + server +
+                          FixedDecimals(WallNowS() - down_since_s_, 0) + " s), connected to " + server +
                           "; the queued rows follow");
       }
       break;

@@ -1,11 +1,11 @@
 #include "daemon/service/weather_worker.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "core/common/clock.h"
+#include "core/common/text.h"
 #include "core/common/diagnostic.h"
 #include "daemon/service/weather_import.h"
 #include "io/weather/http_client.h"
@@ -13,12 +13,6 @@
 namespace pvtwin {
 
 namespace {
-
-std::string Seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.0f s", s);
-  return buf;
-}
 
 // Open-Meteo answers a bad request with {"error": true, "reason": "..."}.
 std::string ServerReason(const std::string& body) {
@@ -83,7 +77,7 @@ void WeatherWorker::Report(const Outcome& outcome) {
   if (outcome.ok) {
     if (state_ == State::kFailing) {
       log_(kNotice, "weather: " + UrlForLogs(settings_.url) + " answers again after " +
-                        Seconds(WallNowS() - failing_since_s_) + " of failures; " + outcome.text);
+                        FixedDecimals(WallNowS() - failing_since_s_, 0) + " s of failures; " + outcome.text);
     } else {
       log_(kInfo, "weather: " + outcome.text);
     }

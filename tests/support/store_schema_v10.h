@@ -60,6 +60,11 @@ inline const std::string kForecastSkillV10 =
     " WHERE m.valid IS NULL OR m.valid != 0)" +
     kForecastSkillScoresV8ToV11;
 
+// forecast_skill's rows in day order: the store's view, and version 10's
+// definition above on the same tables.
+inline const std::string kForecastSkillRowsByDay = "SELECT * FROM forecast_skill ORDER BY day";
+inline const std::string kForecastSkillV10RowsByDay = kForecastSkillV10 + " ORDER BY day";
+
 // Removes version 11's tables and triggers (its forecast_skill view stays:
 // the caller replaces or drops it).
 inline std::vector<std::string> DropSchemaV11() {

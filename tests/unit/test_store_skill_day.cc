@@ -35,8 +35,8 @@ using testing::ExpectSameRows;
 using testing::Issue;
 using testing::QueryCost;
 
-const std::string kViewRows = "SELECT * FROM forecast_skill ORDER BY day";
-const std::string kVersion10Rows = std::string(testing::kForecastSkillV10) + " ORDER BY day";
+using testing::kForecastSkillRowsByDay;
+using testing::kForecastSkillV10RowsByDay;
 
 class SkillDayTest : public testing::TempDirTest {
  protected:
@@ -75,9 +75,9 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
   ASSERT_NE(store, nullptr);
   ASSERT_NO_FATAL_FAILURE(FillFourDays(store.get()));
   RawDb db(DbPath());
-  const auto v10_before = db.Rows(kVersion10Rows);
+  const auto v10_before = db.Rows(kForecastSkillV10RowsByDay);
   ASSERT_EQ(v10_before.size(), 4u) << "days 0 to 3 are scored";
-  ExpectSameRows(db.Rows(kViewRows), v10_before, "before the refresh");
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), v10_before, "before the refresh");
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 0.0);
 
   const std::int64_t now = kJune1_2024UtcS + 3 * kDayS + kDayS / 2;  // noon of day 3
@@ -87,7 +87,7 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
   EXPECT_EQ(written, 3) << "the closed days 0, 1 and 2";
   EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
             static_cast<double>(kJune1_2024UtcS + 3 * kDayS));
-  ExpectSameRows(db.Rows(kViewRows), db.Rows(kVersion10Rows), "after the refresh");
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), db.Rows(kForecastSkillV10RowsByDay), "after the refresh");
   ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
   EXPECT_EQ(written, 0) << "nothing more to do: no day written again";
 
@@ -100,8 +100,8 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
   EXPECT_EQ(
       db.Rows("SELECT day FROM forecast_skill_dirty ORDER BY day"),
       (std::vector<std::vector<std::string>>{{std::to_string(day1)}, {std::to_string(day2)}}));
-  const auto v10_late = db.Rows(kVersion10Rows);
-  ExpectSameRows(db.Rows(kViewRows), v10_late, "after the late import");
+  const auto v10_late = db.Rows(kForecastSkillV10RowsByDay);
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), v10_late, "after the late import");
   for (const std::int64_t day : {day1, day2}) {
     const std::string where = " WHERE day = " + std::to_string(day);
     EXPECT_NE(db.Text("SELECT mae_p_el_w FROM forecast_skill_day" + where),
@@ -112,22 +112,22 @@ TEST_F(SkillDayTest, TheViewEqualsVersionTensQueryBeforeAndAfterMaterialisingAnd
   ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
   EXPECT_EQ(written, 2);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0);
-  ExpectSameRows(db.Rows(kViewRows), v10_late, "after the second refresh");
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), v10_late, "after the second refresh");
 
   // Pruning superseded issues changes no score, so it marks no day dirty.
   const double rows_before = db.Number("SELECT COUNT(*) FROM forecast");
   ASSERT_TRUE(store->PruneForecasts(kJune1_2024UtcS - kDayS, now + 2 * kDayS, &error)) << error;
   EXPECT_LT(db.Number("SELECT COUNT(*) FROM forecast"), rows_before / 2);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 0.0);
-  ExpectSameRows(db.Rows(kViewRows), v10_late, "after the prune");
-  ExpectSameRows(db.Rows(kVersion10Rows), v10_late, "version 10's query after the prune");
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), v10_late, "after the prune");
+  ExpectSameRows(db.Rows(kForecastSkillV10RowsByDay), v10_late, "version 10's query after the prune");
 
   // Deleting a scored forecast row of a closed day does change its score.
   ASSERT_EQ(db.Exec("DELETE FROM forecast WHERE issued_at = " + std::to_string(day2) +
                     " AND ts = " + std::to_string(day2 + 12 * 3600)),
             SQLITE_OK);
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_dirty"), 1.0);
-  ExpectSameRows(db.Rows(kViewRows), db.Rows(kVersion10Rows), "after deleting a scored row");
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), db.Rows(kForecastSkillV10RowsByDay), "after deleting a scored row");
 }
 
 // A year of 1-min rows and one issue a day, made by SQL in one statement
@@ -214,7 +214,7 @@ TEST_F(SkillDayTest, MigratingFromVersionTenMaterialisesTheDaysAndKeepsTheValues
                         " AS " + testing::kForecastSkillV10);
     downgrade.push_back("PRAGMA user_version = 10");
     for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
-    v10 = db.Rows(kViewRows);
+    v10 = db.Rows(kForecastSkillRowsByDay);
     ASSERT_EQ(v10.size(), 4u);
   }
   auto store = Open();
@@ -226,7 +226,7 @@ TEST_F(SkillDayTest, MigratingFromVersionTenMaterialisesTheDaysAndKeepsTheValues
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 4.0);
   EXPECT_EQ(db.Number("SELECT done_before FROM forecast_skill_state"),
             static_cast<double>(kJune1_2024UtcS + 4 * kDayS));
-  ExpectSameRows(db.Rows(kViewRows), v10, "after the migration");
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), v10, "after the migration");
   ExpectSameRows(db.Rows("SELECT * FROM forecast_skill_day ORDER BY day"), v10,
                  "the materialised rows");
   RawDb copy(store->upgrade().backup_path);

@@ -34,9 +34,8 @@ using testing::ScoreDayByHand;
 
 using testing::kDayS;
 using testing::kJune1_2024UtcS;
-const std::string kIntervalViewRows = "SELECT * FROM forecast_skill ORDER BY day";
-const std::string kIntervalVersion10Rows =
-    std::string(testing::kForecastSkillV10) + " ORDER BY day";
+using testing::kForecastSkillRowsByDay;
+using testing::kForecastSkillV10RowsByDay;
 
 // The view's rows of the given days.
 Rows RowsOfDays(const Rows& rows, const std::vector<std::int64_t>& days) {
@@ -102,9 +101,9 @@ TEST_F(SkillIntervalTest, IntervalDaysAreScoredByTheirStepAndMinuteDaysKeepTheir
   ASSERT_NO_FATAL_FAILURE(FillDays(store.get()));
   RawDb db(DbPath());
   const std::int64_t day2 = kJune1_2024UtcS + 2 * kDayS, day3 = kJune1_2024UtcS + 3 * kDayS;
-  const Rows view = db.Rows(kIntervalViewRows);
+  const Rows view = db.Rows(kForecastSkillRowsByDay);
   ASSERT_EQ(view.size(), 4u) << "days 0 to 3 are scored (version 11: days 0 and 1)";
-  const Rows v10 = db.Rows(kIntervalVersion10Rows);
+  const Rows v10 = db.Rows(kForecastSkillV10RowsByDay);
   ASSERT_EQ(v10.size(), 2u);
   EXPECT_EQ(RowsOfDays(view, {kJune1_2024UtcS, kJune1_2024UtcS + kDayS}), v10)
       << "the same text, to the last digit";
@@ -128,7 +127,7 @@ TEST_F(SkillIntervalTest, IntervalDaysAreScoredByTheirStepAndMinuteDaysKeepTheir
   EXPECT_EQ(written, 3) << "the closed days 0, 1 and 2";
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill_day ORDER BY day"),
             RowsOfDays(view, {kJune1_2024UtcS, kJune1_2024UtcS + kDayS, day2}));
-  EXPECT_EQ(db.Rows(kIntervalViewRows), view) << "the same rows, materialised";
+  EXPECT_EQ(db.Rows(kForecastSkillRowsByDay), view) << "the same rows, materialised";
 }
 
 // A late 10-min import into day 2 marks it dirty, one into day 0 (scored
@@ -169,7 +168,7 @@ TEST_F(SkillIntervalTest, IntervalTriggersMarkOnlyDaysScoredFromIntervalRows) {
       store->WriteMinutes(Measured(day2 + 12 * 3600, day2 + 12 * 3600 + 60, 60, 0.0), &error))
       << error;
   EXPECT_EQ(db.Rows("SELECT * FROM forecast_skill" + of_day2),
-            RowsOfDays(db.Rows(kIntervalVersion10Rows), {day2}));
+            RowsOfDays(db.Rows(kForecastSkillV10RowsByDay), {day2}));
   EXPECT_EQ(db.Number("SELECT minutes FROM forecast_skill" + of_day2), 1.0);
   ASSERT_TRUE(store->RefreshForecastSkill(now, nullptr, &error)) << error;
   ASSERT_EQ(db.Exec("DELETE FROM measurement_1min WHERE ts >= " + std::to_string(day2)), SQLITE_OK);
@@ -239,7 +238,7 @@ TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyTod
   const std::string view = "SELECT * FROM forecast_skill";
   const testing::QueryCost live = testing::CostOf(DbPath(), view);
   EXPECT_EQ(live.rows, 366) << "every day computed live";
-  const Rows before = db.Rows(kIntervalViewRows);
+  const Rows before = db.Rows(kForecastSkillRowsByDay);
   {
     auto store = Open();
     int written = 0;
@@ -247,7 +246,7 @@ TEST_F(SkillIntervalTest, AfterTheRefreshAYearOfTenMinuteRowsCostsTheViewOnlyTod
     ASSERT_TRUE(store->RefreshForecastSkill(now, &written, &error)) << error;
     EXPECT_EQ(written, 365);
   }
-  ExpectSameRows(db.Rows(kIntervalViewRows), before, "after the refresh");
+  ExpectSameRows(db.Rows(kForecastSkillRowsByDay), before, "after the refresh");
   const std::int64_t day100 = kJune1_2024UtcS + 100 * kDayS;
   ExpectSameRows(RowsOfDays(before, {day100}), IntervalDaysByHand(db, {day100}),
                  "day 100 against the test's computation", 1e-9);
@@ -303,7 +302,7 @@ TEST_F(SkillIntervalTest, MigratingFromVersionElevenScoresTheIntervalDays) {
                         testing::kForecastSkillColumns + " AS " + testing::kForecastSkillLocalV11);
     downgrade.push_back("PRAGMA user_version = 11");
     for (const std::string& sql : downgrade) ASSERT_EQ(db.Exec(sql), SQLITE_OK) << sql;
-    v11 = db.Rows(kIntervalViewRows);
+    v11 = db.Rows(kForecastSkillRowsByDay);
     ASSERT_EQ(v11.size(), 2u) << "version 11 scores the 1-min days only";
   }
   auto store = Open();
@@ -312,7 +311,7 @@ TEST_F(SkillIntervalTest, MigratingFromVersionElevenScoresTheIntervalDays) {
   EXPECT_EQ(store->upgrade().to_version, 12);
   RawDb db(DbPath());
   EXPECT_EQ(db.Number("SELECT COUNT(*) FROM forecast_skill_day"), 3.0) << "days 0, 1 and 2";
-  const Rows view = db.Rows(kIntervalViewRows);
+  const Rows view = db.Rows(kForecastSkillRowsByDay);
   EXPECT_EQ(RowsOfDays(view, {kJune1_2024UtcS, kJune1_2024UtcS + kDayS}), v11);
   ExpectSameRows(RowsOfDays(view, {day2, day3}), IntervalDaysByHand(db, {day2, day3}),
                  "the interval days after the migration", 1e-9);

@@ -476,6 +476,13 @@ class Store {
                                const std::vector<CalibrationParamRow>& params,
                                const std::string& reason_note, std::string* error);
   bool LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error);
+  // The newest accepted calibration whose window ended at or before
+  // window_end_max: the model of the plant before a change (NightlyDiagnosis).
+  bool LatestAcceptedCalibrationBefore(std::int64_t window_end_max, CalibrationRow* row,
+                                       bool* found, std::string* error);
+  // Calibration `id` when it was accepted (*found false otherwise).
+  bool AcceptedCalibrationById(std::int64_t id, CalibrationRow* row, bool* found,
+                               std::string* error);
 
   // Upserts one forecast issue (all rows in one transaction); without a
   // basis, a calibrated one. calibration_id 0: NULL.
@@ -544,6 +551,11 @@ class Store {
   bool Checkpoint(std::int64_t* db_bytes, std::string* error);
 
  private:
+  // The first accepted calibration row of "… WHERE accepted != 0 AND
+  // <condition> ORDER BY run_at DESC, id DESC", its one `?` bound to value.
+  bool ReadAcceptedCalibration(const char* condition, std::int64_t value, CalibrationRow* row,
+                               bool* found, std::string* error);
+
   struct Impl;
   explicit Store(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;

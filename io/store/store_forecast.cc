@@ -3,6 +3,7 @@
 // (io/store/store.h).
 #include <sqlite3.h>
 
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -224,21 +225,39 @@ DbStatus Store::Impl::InsertCalibrationParams(std::int64_t calibration_id,
 }
 
 bool Store::LatestAcceptedCalibration(CalibrationRow* row, bool* found, std::string* error) {
+  return LatestAcceptedCalibrationBefore(std::numeric_limits<std::int64_t>::max(), row, found,
+                                         error);
+}
+
+bool Store::LatestAcceptedCalibrationBefore(std::int64_t window_end_max, CalibrationRow* row,
+                                            bool* found, std::string* error) {
+  return ReadAcceptedCalibration("window_end <= ?", window_end_max, row, found, error);
+}
+
+bool Store::AcceptedCalibrationById(std::int64_t id, CalibrationRow* row, bool* found,
+                                    std::string* error) {
+  return ReadAcceptedCalibration("id = ?", id, row, found, error);
+}
+
+bool Store::ReadAcceptedCalibration(const char* condition, std::int64_t value,
+                                    CalibrationRow* row, bool* found, std::string* error) {
   Impl& db = *impl_;
   std::lock_guard lock(db.mutex);
   CalibrationRow result;
   bool any = false;
   const bool ok = db.Run(
-      false, "read latest accepted calibration",
+      false, "read accepted calibration",
       [&]() -> DbStatus {
         any = false;
         sqlite3_stmt* stmt = nullptr;
         DbStatus s = db.Prepare(
             "SELECT id, run_at, variant, window_start, window_end, status, mae_p_el_w, "
             "mae_q_th_w, runtime_s, n_evals, params_json, reason, heldout_mae_w, accepted "
-            "FROM calibration WHERE accepted != 0 ORDER BY run_at DESC, id DESC LIMIT 1",
+            "FROM calibration WHERE accepted != 0 AND " +
+                std::string(condition) + " ORDER BY run_at DESC, id DESC LIMIT 1",
             &stmt);
         if (!s.ok()) return s;
+        sqlite3_bind_int64(stmt, 1, value);
         const int rc = sqlite3_step(stmt);
         if (rc == SQLITE_DONE) return {};
         if (rc != SQLITE_ROW) return db.Fail(rc, "read calibration");

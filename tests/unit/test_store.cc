@@ -503,6 +503,21 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
                 {"172800", "0", "11.5", "0.25", "W/(m²·K)", "identified"}}));
   EXPECT_EQ(db.Rows("SELECT std_error FROM calibration_param WHERE name = 'eps_pvt' LIMIT 1")[0][0],
             "NULL");
+  // By id, accepted ones only; by the end of the window, the newest accepted
+  // one that ended at or before it.
+  ASSERT_TRUE(store->AcceptedCalibrationById(first.id, &row, &found, &error)) << error;
+  ASSERT_TRUE(found);
+  EXPECT_EQ(row.reason, "first calibration");
+  ASSERT_TRUE(store->AcceptedCalibrationById(worse.id, &row, &found, &error)) << error;
+  EXPECT_FALSE(found);
+  ASSERT_TRUE(store->LatestAcceptedCalibrationBefore(kJune1_2024UtcS + 86400 - 1, &row, &found,
+                                                     &error))
+      << error;
+  ASSERT_TRUE(found);
+  EXPECT_EQ(row.id, first.id);
+  ASSERT_TRUE(store->LatestAcceptedCalibrationBefore(kJune1_2024UtcS - 1, &row, &found, &error))
+      << error;
+  EXPECT_FALSE(found);
 }
 
 TEST_F(StoreTest, ForecastLatestPicksTheNewestIssueForEachTime) {

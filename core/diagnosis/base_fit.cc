@@ -57,14 +57,29 @@ bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
   }
   progress("diagnosis: " + std::to_string(train_days) + " training days, " +
            std::to_string(heldout_days) + " held-out days, step " + FixedDecimals(r.step_s, 0) +
-           " s; fitting the base model " + r.base_variant);
-  RangedFit ranged = IdentifyInRanges(base_train.drivers, base_train.meas, StartParams(plant),
-                                      options);
-  const IdentSummary& base_fit = ranged.fit;
-  r.identifications = ranged.refitted.empty() ? 1 : 2;
-  r.base_refitted = ranged.refitted;
-  for (const RefittedParam& refit : ranged.refitted) {
-    r.notes.push_back("base model " + r.base_variant + ": " + RefittedSentence(refit));
+           " s; " +
+           (options.reference_params ? "the base model " + r.base_variant + " keeps the parameters of " +
+                                           options.reference_name
+                                     : "fitting the base model " + r.base_variant));
+  IdentSummary base_fit;
+  if (options.reference_params) {
+    // The plant before a change: nothing of the base is fitted on the days
+    // since (DiagnosisOptions::reference_params).
+    base_fit.ok = true;
+    base_fit.params = *options.reference_params;
+    r.notes.push_back("the base model " + r.base_variant + " keeps the parameters of " +
+                      options.reference_name +
+                      " (the plant before the change); each candidate fits only the parameters "
+                      "its effect adds: which effect explains what changed");
+  } else {
+    RangedFit ranged =
+        IdentifyInRanges(base_train.drivers, base_train.meas, StartParams(plant), options);
+    base_fit = std::move(ranged.fit);
+    r.identifications = ranged.refitted.empty() ? 1 : 2;
+    r.base_refitted = ranged.refitted;
+    for (const RefittedParam& refit : ranged.refitted) {
+      r.notes.push_back("base model " + r.base_variant + ": " + RefittedSentence(refit));
+    }
   }
   if (!base_fit.ok) {
     *error = "identification of the base model " + r.base_variant +

@@ -258,7 +258,22 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
     effect.start_from_residuals(
         ResidualsForStart(in.base->train.drivers, in.base->train_sim, in.base->train.meas), &start);
   }
-  RangedFit ranged = IdentifyInRanges(f.train.drivers, f.train.meas, start, *in.options);
+  if (!in.options->reference_params) {
+    RangedFit ranged = IdentifyInRanges(f.train.drivers, f.train.meas, start, *in.options);
+    f.fit = std::move(ranged.fit);
+    f.refitted = std::move(ranged.refitted);
+    return f;
+  }
+  // Against the plant before a change: only what the effect adds is fitted.
+  DiagnosisOptions own = *in.options;
+  own.ident.free = DefaultFreeParams(spec) & ~UsedParams(current.spec);
+  if (own.ident.free.none()) {  // a form without parameters of its own
+    f.fit.ok = true;
+    f.fit.variant = spec.Name();
+    f.fit.params = start;
+    return f;
+  }
+  RangedFit ranged = IdentifyInRanges(f.train.drivers, f.train.meas, start, own);
   f.fit = std::move(ranged.fit);
   f.refitted = std::move(ranged.refitted);
   return f;

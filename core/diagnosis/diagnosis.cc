@@ -64,6 +64,13 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
   if (!(unknown_noise_ratio > 1.0)) {
     out << "unknown_noise_ratio = " << unknown_noise_ratio << ": must be > 1; ";
   }
+  if (reference_params.has_value()) {
+    for (std::size_t i = 0; i < kNumParams; ++i) {
+      if (!std::isfinite((*reference_params)[i])) {
+        out << "reference_params: " << Info(static_cast<Param>(i)).name << " is not finite; ";
+      }
+    }
+  }
   const std::vector<std::string> names = EffectNames();
   for (const std::string& e : effects) {
     if (std::find(names.begin(), names.end(), e) == names.end()) {

@@ -7,8 +7,10 @@
 //     the next heldout_days days the held-out days. Each part gets its own
 //     drivers; states start at the steady state of each part's first row.
 //  2. Base: identify the base variant on the training days (Identify from
-//     StartParams) and simulate the held-out days: the gap (held-out MAE of
-//     P_el and Q_u) and its residuals r = predicted − measured.
+//     StartParams; against the plant before a change, keep
+//     DiagnosisOptions::reference_params instead) and simulate the held-out
+//     days: the gap (held-out MAE of P_el and Q_u) and its residuals
+//     r = predicted − measured.
 //  3. Where: the held-out residuals of each output are localised over the
 //     standard regime drivers (core/diagnosis/gap_localisation.h).
 //  4. Which: for each effect the model can take (core/diagnosis/effect_candidates.h),
@@ -43,6 +45,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -142,6 +145,20 @@ struct DiagnosisOptions {
   // plant (issue 52, item 3). A model whose start values lie outside Table
   // 3's range (built on such a re-fit) keeps the physical range for them.
   bool refit_in_physical_ranges = true;
+  // The model of the plant before a change, held fixed: the base model is
+  // not fitted on the training days but keeps these parameters, and each
+  // candidate fits only the parameters its effect adds to the model it is
+  // added to. The question is then which effect explains what changed, not
+  // which structure the plant has and the model lacks: that structure is in
+  // both states, and a base re-fitted on the few days since a change lets it
+  // compete with the change (doc/validation.md, the weeks after an alarm).
+  // The daemon sets it to its accepted calibration of the window before a
+  // performance alarm's change (`pvtwin diagnose --against-calibration`).
+  // Empty: the base is fitted on the training days.
+  std::optional<ParamVector> reference_params;
+  // Where reference_params come from, for the notes ("calibration 12, window
+  // 2025-05-26 to 2025-06-09").
+  std::string reference_name;
   // Effects to try (names of the vocabulary); empty = every candidate.
   std::vector<std::string> effects;
   LocaliseOptions where;

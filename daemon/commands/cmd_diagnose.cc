@@ -51,6 +51,8 @@ struct DiagnoseArgs {
   double alpha = 0.05;
   double min_shrink_pct = 1.0;
   int threads = 0;
+  std::string against_params;            // params.json of the plant before a change
+  std::int64_t against_calibration = 0;  // with --db: that calibration's parameters
 };
 
 // The diagnosis of a series (from a CSV or the store): runs, prints the
@@ -229,6 +231,59 @@ bool RecordIntervalSensorFaults(Store& store, const Series& rows, const Plant& p
   return true;
 }
 
+// --against-params or --against-calibration: the base model keeps the
+// parameters of the plant before a change (DiagnosisOptions::reference_params).
+bool AgainstModelBefore(const DiagnoseArgs& a, const Plant& plant, const ModelSpec& spec,
+                        Store* store, DiagnosisOptions* options) {
+  if (a.against_params.empty() && a.against_calibration == 0) return true;
+  if (!a.against_params.empty() && a.against_calibration != 0) {
+    std::cerr << "--against-params, --against-calibration: give one of them\n";
+    return false;
+  }
+  ParamsFile file;
+  file.values = StartParams(plant);
+  Diagnostics errors;
+  std::string name = a.against_params;
+  if (!a.against_params.empty()) {
+    if (!ReadParamsJson(a.against_params, plant, &file, &errors)) {
+      for (const Diagnostic& d : errors) std::cerr << d.ToString() << "\n";
+      return false;
+    }
+  } else {
+    if (store == nullptr) {
+      std::cerr << "--against-calibration: only with --db (the calibration of that store)\n";
+      return false;
+    }
+    Store::CalibrationRow row;
+    bool found = false;
+    std::string error;
+    if (!store->AcceptedCalibrationById(a.against_calibration, &row, &found, &error)) {
+      std::cerr << error << "\n";
+      return false;
+    }
+    if (!found) {
+      std::cerr << "--against-calibration = " << a.against_calibration
+                << ": no accepted calibration with that id in " << a.db << "\n";
+      return false;
+    }
+    name = "calibration " + std::to_string(row.id) + " (window " + FormatIsoUtc(row.window_start) +
+           " to " + FormatIsoUtc(row.window_end) + ")";
+    if (!ParseParamsJson(row.params_json, name, plant, &file, &errors)) {
+      for (const Diagnostic& d : errors) std::cerr << d.ToString() << "\n";
+      return false;
+    }
+    file.variant = row.variant;
+  }
+  if (!file.variant.empty() && file.variant != spec.Name()) {
+    std::cerr << name << ": parameters of " << file.variant
+              << ", but the diagnosis's base model is " << spec.Name() << " (--variant)\n";
+    return false;
+  }
+  options->reference_params = file.values;
+  options->reference_name = name;
+  return true;
+}
+
 int RunDiagnose(const DiagnoseArgs& a) {
   if (!DieWithParent(a.parent_pid)) return kExitRuntime;
   if (a.csv.empty() == a.db.empty()) {
@@ -281,6 +336,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
     return kExitBadInput;
   }
   const std::string source = a.db.empty() ? a.csv : a.db;
+  if (!AgainstModelBefore(a, config.plant, spec, store.get(), &options)) return kExitBadInput;
   Drivers drivers;
   if (!PrepareDriversOrReport(series, source, config, spec, &drivers)) return kExitBadInput;
   DiagnosisResult result;
@@ -534,6 +590,17 @@ void RegisterDiagnose(CLI::App& app) {
   cmd->add_option("--threads", args->threads, "worker threads, 0 = all cores (default 0)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--report", args->report, "directory for report.json and report.html");
+  cmd->add_option("--against-params", args->against_params,
+                  "params.json of the plant before a change (as calibrate --out writes it): the "
+                  "base model keeps these parameters, and each effect fits only its own, so the "
+                  "verdict says which effect explains what changed (default: fit the base on the "
+                  "training days)");
+  cmd->add_option("--against-calibration", args->against_calibration,
+                  "with --db: as --against-params, with the parameters of this accepted "
+                  "calibration of the store (pvtwin run passes the one before a performance "
+                  "alarm's change)")
+      ->check(CLI::PositiveNumber)
+      ->default_str("none");
   cmd->callback([args] { SetExitCode(RunDiagnose(*args)); });
 
   auto st = std::make_shared<SelftestArgs>();

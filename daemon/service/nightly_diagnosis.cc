@@ -46,6 +46,16 @@ std::int64_t NearestSolarMidnight(std::int64_t t_s, std::int64_t solar_offset_s)
   return SolarDayStartS(t_s + kSecondsPerDay / 2, solar_offset_s);
 }
 
+// The first minute from t_s on with the sun above the horizon (t_s + a day
+// when it stays down: polar night).
+std::int64_t FirstSunlight(std::int64_t t_s, SolarPositionInput site) {
+  for (std::int64_t t = t_s; t < t_s + kSecondsPerDay; t += 60) {
+    site.time_s = static_cast<double>(t);
+    if (ComputeSolarPosition(site).elevation_rad > 0.0) return t;
+  }
+  return t_s + kSecondsPerDay;
+}
+
 }  // namespace
 
 NightlyDiagnosis::Plan NightlyDiagnosis::PlanFor(const DiagnosisConfig& config,
@@ -61,11 +71,21 @@ NightlyDiagnosis::Plan NightlyDiagnosis::PlanFor(const DiagnosisConfig& config,
                FormatIsoUtc(job.change_from).substr(0, 10) +
                " (the performance alarm's change point)";
     plan.start = true;
+    plan.since_change = true;
     return plan;
   }
   // An hour's slack: the nightly runs drift by the calibration's runtime.
   plan.start = last == nullptr || job.now_s - last->run_at >= config.every_days * kSecondsPerDay - 3600;
   return plan;
+}
+
+bool NightlyDiagnosis::CalibrationBeforeChange(Store& store, const Plan& plan, const Job& job,
+                                               Store::CalibrationRow* row, bool* found,
+                                               std::string* error) {
+  *found = false;
+  if (!plan.since_change) return true;
+  return store.LatestAcceptedCalibrationBefore(FirstSunlight(plan.window_start, job.site), row,
+                                               found, error);
 }
 
 void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, const Job& job,
@@ -80,11 +100,17 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
   }
   const Plan plan = PlanFor(config, found ? &last : nullptr, job);
   if (!plan.start) return;
+  Store::CalibrationRow before;
+  bool have_before = false;
+  if (!CalibrationBeforeChange(store, plan, job, &before, &have_before, &error)) {
+    log(kErr, "diagnosis not started: " + error);
+    return;
+  }
   const fs::path work = state_dir_ / "diagnosis";
   std::error_code ec;
   fs::remove_all(work, ec);
   fs::create_directories(work, ec);
-  const std::vector<std::string> argv = {job.exe,
+  std::vector<std::string> argv = {job.exe,
                                          "diagnose",
                                          "--config",
                                          job.config_path,
@@ -109,6 +135,14 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
                                          (work / "report").string(),
                                          "--parent-pid",
                                          std::to_string(::getpid())};
+  std::string against;
+  if (have_before) {
+    argv.insert(argv.end(), {"--against-calibration", std::to_string(before.id)});
+    against = ", against calibration " + std::to_string(before.id) + " (window to " +
+              FormatIsoUtc(before.window_end) + "), the plant before it";
+  } else if (plan.since_change) {
+    against = ", the base re-fitted on them (no accepted calibration ends before the change)";
+  }
   if (!child_.Start(argv, (work / "diagnose.log").string(), &error)) {
     Event(store, "diagnosis_failed", "diagnosis not started: " + error, log);
     return;
@@ -117,7 +151,7 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
   job_now_s_ = job.now_s;
   log(kInfo, "diagnosis of " + job.variant + " started on " + FormatIsoUtc(plan.window_start) +
                  " .. " + FormatIsoUtc(plan.window_end) +
-                 (plan.why.empty() ? std::string() : ": " + plan.why));
+                 (plan.why.empty() ? std::string() : ": " + plan.why) + against);
 }
 
 void NightlyDiagnosis::Check(const DiagnosisConfig& config, Store& store, const LogFn& log) {

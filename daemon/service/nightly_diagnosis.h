@@ -14,6 +14,7 @@
 #include <string>
 
 #include "config/plant_config.h"
+#include "core/physics/solar_position.h"
 #include "io/platform/child_process.h"
 #include "io/store/store.h"
 
@@ -33,6 +34,7 @@ class NightlyDiagnosis {
     // saw (monitor.h NewestChangeOnset); 0 or less: none.
     std::int64_t change_from = 0;
     std::int64_t solar_offset_s = 0;  // SolarDayOffsetS of the plant
+    SolarPositionInput site;          // SiteAtStandardPressure of the plant
   };
 
   // Whether a job starts tonight, and on which days (Plan). A change the
@@ -58,15 +60,28 @@ class NightlyDiagnosis {
     bool start = false;
     std::int64_t window_start = 0, window_end = 0;
     std::string why;  // for the log: why the window starts there ("" the calibration's)
+    bool since_change = false;  // the window starts at the change
   };
   static Plan PlanFor(const DiagnosisConfig& config, const Store::DiagnosisRow* last,
                       const Job& job);
+
+  // The plant before the change of a plan on the days since one: the newest
+  // accepted calibration whose window ended before the sun rose on the
+  // change's first day (its dark hours hold nothing of the changed plant).
+  // *found false without one, or when the plan is not on the days since a
+  // change.
+  static bool CalibrationBeforeChange(Store& store, const Plan& plan, const Job& job,
+                                      Store::CalibrationRow* row, bool* found,
+                                      std::string* error);
 
   // state_dir holds reports/ and the child's scratch folder diagnosis/.
   explicit NightlyDiagnosis(std::filesystem::path state_dir) : state_dir_(std::move(state_dir)) {}
 
   // Starts the child when enabled, none is running and PlanFor says so, on
-  // the days PlanFor gives.
+  // the days PlanFor gives. On the days since a change it judges the
+  // effects against the plant before it (CalibrationBeforeChange; `diagnose
+  // --against-calibration`, DiagnosisOptions::reference_params), so that the
+  // structure the plant had all along does not compete with what changed.
   void MaybeStart(const DiagnosisConfig& config, Store& store, const Job& job, const LogFn& log);
   // Non-blocking: a finished child's report is kept and its verdict logged;
   // a child past timeout_s is killed.

@@ -32,6 +32,7 @@ void Service::MaybeStartDiagnosis() {
   job.calibration_id = params_id_;
   job.now_s = static_cast<std::int64_t>(Now());
   job.solar_offset_s = SolarDayOffsetS(config_.plant);
+  job.site = SiteAtStandardPressure(config_.plant);
   cli::DailyCheckInputs checks;
   checks.config = &config_;
   checks.spec = spec_;

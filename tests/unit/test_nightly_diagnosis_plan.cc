@@ -6,11 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <memory>
 #include <numbers>
+#include <string>
 
 #include "core/common/calendar.h"
+#include "core/physics/solar_position.h"
 #include "daemon/service/nightly_diagnosis.h"
 #include "tests/support/fixtures.h"
+#include "tests/support/sqlite_db.h"
 
 namespace pvtwin::cli {
 namespace {
@@ -142,6 +146,69 @@ TEST(NightlyDiagnosisPlan, TheWindowHoldsWholeLocalSolarDays) {
   EXPECT_EQ(plan.window_start, kJune16 - 7 * kDayS - job.solar_offset_s);
   EXPECT_LT(plan.window_end, job.window_end);
   EXPECT_GT(plan.window_start, job.change_from);
+}
+
+
+class CalibrationBeforeChangeTest : public testing::TempDirTest {};
+
+// The plant before a change is the calibration whose window ended before the
+// changed plant saw the sun: the example site (47.358° N, 16.128° E), whose
+// local solar day starts at 22:55 UTC and whose sun rises near 02:52 UTC on
+// 9 June; the daemon calibrates at 02:00 CEST, its window ending at 00:00 UTC.
+TEST_F(CalibrationBeforeChangeTest, TheNewestAcceptedOneEndedBeforeTheChangesFirstSunlight) {
+  std::string error;
+  std::unique_ptr<Store> store = Store::Open((dir_ / "pvtwin.db").string(), &error);
+  ASSERT_NE(store, nullptr) << error;
+  constexpr std::int64_t kJune9 = kJune16 - 7 * kDayS;  // 2025-06-09T00:00:00Z
+  auto insert = [&](std::int64_t window_end, bool accepted) {
+    Store::CalibrationRow row;
+    row.run_at = window_end + 60;
+    row.variant = "2N1Ccolwr";
+    row.window_start = window_end - 14 * kDayS;
+    row.window_end = window_end;
+    row.status = accepted ? "accepted" : "rejected";
+    row.params_json = "{\"u_front_w_m2k\": 9.5}";
+    row.accepted = accepted;
+    EXPECT_TRUE(store->InsertCalibration(&row, &error)) << error;
+    return row.id;
+  };
+  const std::int64_t day_before = insert(kJune9 - kDayS, true);
+  const std::int64_t change_night = insert(kJune9 + 180, true);  // its dark hours only
+  insert(kJune9 + 600, false);                                   // rejected
+  insert(kJune9 + 4 * 3600, true);  // after sunrise: it holds the changed plant's light
+  insert(kJune9 + kDayS, true);
+
+  Plant site;
+  site.latitude_rad = 47.358 * std::numbers::pi / 180.0;
+  site.longitude_rad = 16.128 * std::numbers::pi / 180.0;
+  NightlyDiagnosis::Job job = Tonight(kJune9);
+  job.solar_offset_s = SolarDayOffsetS(site);
+  job.site = SiteAtStandardPressure(site);
+  NightlyDiagnosis::Plan plan = NightlyDiagnosis::PlanFor(DiagnosisConfig{}, nullptr, job);
+  ASSERT_TRUE(plan.since_change);
+  ASSERT_EQ(plan.window_start, kJune9 - job.solar_offset_s);
+  Store::CalibrationRow row;
+  bool found = false;
+  ASSERT_TRUE(NightlyDiagnosis::CalibrationBeforeChange(*store, plan, job, &row, &found, &error))
+      << error;
+  ASSERT_TRUE(found);
+  EXPECT_EQ(row.id, change_night);
+  // A change a day earlier: the change night's calibration holds a day of it.
+  job.change_from = kJune9 - kDayS;
+  plan = NightlyDiagnosis::PlanFor(DiagnosisConfig{}, nullptr, job);
+  ASSERT_TRUE(NightlyDiagnosis::CalibrationBeforeChange(*store, plan, job, &row, &found, &error));
+  ASSERT_TRUE(found);
+  EXPECT_EQ(row.id, day_before);
+  // Earlier than every calibration: none; without a change: none asked for.
+  job.change_from = kJune9 - 3 * kDayS;
+  plan = NightlyDiagnosis::PlanFor(DiagnosisConfig{}, nullptr, job);
+  ASSERT_TRUE(plan.since_change);
+  ASSERT_TRUE(NightlyDiagnosis::CalibrationBeforeChange(*store, plan, job, &row, &found, &error));
+  EXPECT_FALSE(found);
+  job.change_from = 0;
+  plan = NightlyDiagnosis::PlanFor(DiagnosisConfig{}, nullptr, job);
+  ASSERT_TRUE(NightlyDiagnosis::CalibrationBeforeChange(*store, plan, job, &row, &found, &error));
+  EXPECT_FALSE(found);
 }
 
 }  // namespace

@@ -58,8 +58,8 @@ bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
   progress("diagnosis: " + std::to_string(train_days) + " training days, " +
            std::to_string(heldout_days) + " held-out days, step " + FixedDecimals(r.step_s, 0) +
            " s; " +
-           (options.reference_params ? "the base model " + r.base_variant + " keeps the parameters of " +
-                                           options.reference_name
+           (options.reference_params ? "the base model " + r.base_variant +
+                                           " keeps the parameters of " + options.reference_name
                                      : "fitting the base model " + r.base_variant));
   IdentSummary base_fit;
   if (options.reference_params) {

@@ -71,8 +71,7 @@ class NightlyDiagnosis {
   // *found false without one, or when the plan is not on the days since a
   // change.
   static bool CalibrationBeforeChange(Store& store, const Plan& plan, const Job& job,
-                                      Store::CalibrationRow* row, bool* found,
-                                      std::string* error);
+                                      Store::CalibrationRow* row, bool* found, std::string* error);
 
   // state_dir holds reports/ and the child's scratch folder diagnosis/.
   explicit NightlyDiagnosis(std::filesystem::path state_dir) : state_dir_(std::move(state_dir)) {}

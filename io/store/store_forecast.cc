@@ -239,8 +239,8 @@ bool Store::AcceptedCalibrationById(std::int64_t id, CalibrationRow* row, bool* 
   return ReadAcceptedCalibration("id = ?", id, row, found, error);
 }
 
-bool Store::ReadAcceptedCalibration(const char* condition, std::int64_t value,
-                                    CalibrationRow* row, bool* found, std::string* error) {
+bool Store::ReadAcceptedCalibration(const char* condition, std::int64_t value, CalibrationRow* row,
+                                    bool* found, std::string* error) {
   Impl& db = *impl_;
   std::lock_guard lock(db.mutex);
   CalibrationRow result;

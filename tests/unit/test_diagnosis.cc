@@ -19,8 +19,8 @@
 #include "core/data/resample.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/diagnosis/diagnosis_stats.h"
-#include "core/diagnosis/stages.h"
 #include "core/diagnosis/gap_localisation.h"
+#include "core/diagnosis/stages.h"
 #include "core/fit/identification.h"
 #include "core/model/thermal_model.h"
 #include "core/model/variant.h"
@@ -460,8 +460,9 @@ TEST_F(DiagnoseCli, BadInputExitsWithTwoAndSaysWhy) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("--against-calibration: only with --db"), std::string::npos) << run.err;
   std::ofstream(dir_ / "before.json") << R"({"variant": "2N1Ccolwr", "params": {}})";
-  run = testing::RunPvtwin(dir_, "diagnose --config " + PlantConfig() +
-                                     " --csv no_wind.csv --variant 1N1C --against-params before.json");
+  run = testing::RunPvtwin(dir_,
+                           "diagnose --config " + PlantConfig() +
+                               " --csv no_wind.csv --variant 1N1C --against-params before.json");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("before.json: parameters of 2N1Ccolwr, but the diagnosis's base model "
                          "is 1N1C"),
@@ -631,7 +632,6 @@ TEST(Extrapolation, RowsInsideTheTrainingRangeOfEveryExtrapolatedDriver) {
   EXPECT_EQ(diagnosis_stages::RowsInsideTrainingRange(d, {}), std::vector<std::uint8_t>(6, 1));
 }
 
-
 // ---------------------------------------------------------------------------
 // Against the plant before a change (DiagnosisOptions::reference_params): an
 // inverter that clips from day 10 on the example plant, whose truth has an
@@ -678,8 +678,8 @@ TEST(DiagnosisAgainstThePlantBefore, OnlyTheEffectsOwnParametersAreFitted) {
   o.reference_params = reference.params;
   o.reference_name = "the fit of the 10 days before";
   DiagnosisResult r;
-  ASSERT_TRUE(Diagnose(clipped.Between(change_s, clipped.time_s.back() + 1), plant, base, o, &r,
-                       &error))
+  ASSERT_TRUE(
+      Diagnose(clipped.Between(change_s, clipped.time_s.back() + 1), plant, base, o, &r, &error))
       << error;
   ASSERT_FALSE(r.ladder.empty());
   EXPECT_EQ(r.ladder[0].params, reference.params);  // the base is not re-fitted
@@ -694,7 +694,8 @@ TEST(DiagnosisAgainstThePlantBefore, OnlyTheEffectsOwnParametersAreFitted) {
     }
     for (std::size_t p = 0; p < kNumParams; ++p) {
       if (!used.test(p)) continue;
-      EXPECT_EQ(t.params[p], reference.params[p]) << t.name << " " << Info(static_cast<Param>(p)).name;
+      EXPECT_EQ(t.params[p], reference.params[p])
+          << t.name << " " << Info(static_cast<Param>(p)).name;
     }
   }
   EXPECT_TRUE(clipping_tried);

@@ -148,7 +148,6 @@ TEST(NightlyDiagnosisPlan, TheWindowHoldsWholeLocalSolarDays) {
   EXPECT_GT(plan.window_start, job.change_from);
 }
 
-
 class CalibrationBeforeChangeTest : public testing::TempDirTest {};
 
 // The plant before a change is the calibration whose window ended before the

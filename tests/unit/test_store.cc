@@ -510,8 +510,8 @@ TEST_F(StoreTest, LatestAcceptedCalibrationIsTheNewestAcceptedRun) {
   EXPECT_EQ(row.reason, "first calibration");
   ASSERT_TRUE(store->AcceptedCalibrationById(worse.id, &row, &found, &error)) << error;
   EXPECT_FALSE(found);
-  ASSERT_TRUE(store->LatestAcceptedCalibrationBefore(kJune1_2024UtcS + 86400 - 1, &row, &found,
-                                                     &error))
+  ASSERT_TRUE(
+      store->LatestAcceptedCalibrationBefore(kJune1_2024UtcS + 86400 - 1, &row, &found, &error))
       << error;
   ASSERT_TRUE(found);
   EXPECT_EQ(row.id, first.id);

@@ -2,6 +2,7 @@
 #include <map>
 
 #include "core/common/calendar.h"
+#include "core/data/resample.h"
 #include "core/diagnosis/stages.h"
 
 namespace pvtwin::diagnosis_stages {
@@ -70,7 +71,12 @@ bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
     r.notes.push_back("the base model " + r.base_variant + " keeps the parameters of " +
                       options.reference_name +
                       " (the plant before the change); each candidate fits only the parameters "
-                      "its effect adds: which effect explains what changed");
+                      "its effect adds: which effect explains what changed" +
+                      (options.reference_days != nullptr
+                           ? "; those parameters are also fitted on the days of the reference, "
+                             "and a candidate counts with its gain beyond what it gains with "
+                             "them (an effect the plant had before explains no change)"
+                           : ""));
   } else {
     RangedFit ranged =
         IdentifyInRanges(base_train.drivers, base_train.meas, StartParams(plant), options);
@@ -104,6 +110,29 @@ bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
     r.ladder.push_back(step);
   }
   fit->params = base_fit.params;
+  return true;
+}
+
+bool PrepareReferenceDays(const DiagnosisOptions& options, double step_s, const Plant& plant,
+                          const ModelSpec& base, ReferenceDays* out, std::string* error) {
+  const Series& given = *options.reference_days;
+  std::string why;
+  if (given.step_s == step_s) {
+    out->series = given;
+  } else if (!Resample(given, step_s, &out->series, &why)) {
+    *error = "reference_days: " + why;
+    return false;
+  }
+  if (out->series.size() == 0) {
+    *error = "reference_days: no rows at the step of " + FixedDecimals(step_s, 0) + " s";
+    return false;
+  }
+  // The days-since-cleaning clock counts from their own first row.
+  if (!PreparePart(out->series, plant, base, out->series.time_s.front(), {}, &out->base, &why)) {
+    *error = "reference_days: " + (why.empty() ? "cannot be prepared" : why);
+    return false;
+  }
+  Simulate(out->base.drivers, *options.reference_params, &out->base_sim);
   return true;
 }
 

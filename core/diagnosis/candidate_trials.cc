@@ -2,7 +2,9 @@
 #include <atomic>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "core/common/calendar.h"
 #include "core/common/threads.h"
@@ -244,8 +246,12 @@ struct FormFit {
 
 // Re-identifies `spec` on the training days from the current model's
 // parameters (and the module's start from the base model's residuals).
+// With `before` (the form's parameters of the plant before a change), the
+// fit also starts from them and keeps the lower training cost: the effect
+// as it was is one state the days since may show, and a fit from the
+// residuals alone can end in another local minimum (an obstacle's box).
 FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectModule& effect,
-                const ModelSpec& spec) {
+                const ModelSpec& spec, const std::optional<ParamVector>& before) {
   FormFit f;
   const Plant& plant = *in.plant;
   if (!PreparePart(in.split->train_series, plant, spec, in.split->data_start_s, in.split->cleanings,
@@ -274,6 +280,14 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
     return f;
   }
   RangedFit ranged = IdentifyInRanges(f.train.drivers, f.train.meas, start, own);
+  if (before) {
+    RangedFit from_before = IdentifyInRanges(f.train.drivers, f.train.meas, *before, own);
+    if (from_before.fit.ok &&
+        (!ranged.fit.ok || from_before.fit.final_cost_w_m2 < ranged.fit.final_cost_w_m2)) {
+      from_before.fit.runtime_s += ranged.fit.runtime_s;
+      ranged = std::move(from_before);
+    }
+  }
   f.fit = std::move(ranged.fit);
   f.refitted = std::move(ranged.refitted);
   return f;
@@ -287,11 +301,92 @@ struct ScoredForm {
   Part heldout;
   Score score;
   double objective_w = kNaN;  // SelectionObjectiveW of score; NaN: not scored
+  // What the model selection compares (ladder.cc): objective_w, plus with
+  // reference days what the form gains with its parameters of before.
+  double selection_w = kNaN;
+  // With reference days: the held-out score with the form's own parameters
+  // as the plant before the change had them (empty: no such fit), and at
+  // the first step that fit (BeforeChangeKey, parameters; key "" = none).
+  Score before_change;
+  std::optional<ParamVector> before_change_params;  // what before_change was scored with
+  std::pair<std::string, ParamVector> before_change_fit;
 };
 
+// The parameters a form adds to the model it is added to: those its fit
+// against the plant before a change frees (FitForm).
+std::bitset<kNumParams> OwnParams(const ModelSpec& spec, const LadderModel& current) {
+  return DefaultFreeParams(spec) & ~UsedParams(current.spec);
+}
+
+// The form's own parameters fitted on the reference days with the rest of
+// the model held at the current one (the plant before the change), started
+// as the fit on the training days is: from the base model's residuals there.
+bool FitOnReferenceDays(const TrialInputs& in, const LadderModel& current,
+                        const EffectModule& effect, const ModelSpec& spec, ParamVector* out) {
+  const ReferenceDays& ref = *in.reference;
+  Part part;
+  std::string why;
+  if (!PreparePart(ref.series, *in.plant, spec, ref.series.time_s.front(), {}, &part, &why)) {
+    return false;
+  }
+  ParamVector start = MergedStart(*in.plant, current.spec, current.params);
+  if (effect.start_from_residuals != nullptr) {
+    effect.start_from_residuals(ResidualsForStart(ref.base.drivers, ref.base_sim, ref.base.meas),
+                                &start);
+  }
+  DiagnosisOptions own = *in.options;
+  own.ident.free = OwnParams(spec, current);
+  const RangedFit ranged = IdentifyInRanges(part.drivers, part.meas, start, own);
+  if (!ranged.fit.ok) return false;
+  *out = ranged.fit.params;
+  return true;
+}
+
+// The form's parameters as the plant before the change had them
+// (DiagnosisOptions::reference_days): its own fitted on the reference days
+// at the first ladder step (*fit_out: that fit, for the later steps), taken
+// from that fit at later steps (the plant before had none of the effects
+// accepted since), the rest the current model's. Empty when the form has
+// no parameters of its own (it is itself as it was before) or no such fit.
+std::optional<ParamVector> ParamsBeforeChange(const TrialInputs& in, const LadderModel& current,
+                                              const EffectCandidate& c, const NamedForm& form,
+                                              std::pair<std::string, ParamVector>* fit_out) {
+  const std::bitset<kNumParams> own = OwnParams(form.spec, current);
+  if (own.none()) return std::nullopt;
+  const std::string key = BeforeChangeKey(c.name, form.form);
+  ParamVector before{};
+  if (in.before_change != nullptr) {
+    const auto it = in.before_change->find(key);
+    if (it == in.before_change->end()) return std::nullopt;
+    before = it->second;
+  } else {
+    if (!FitOnReferenceDays(in, current, *c.module, form.spec, &before)) return std::nullopt;
+    *fit_out = {key, before};
+  }
+  ParamVector params = MergedStart(*in.plant, current.spec, current.params);
+  for (std::size_t p = 0; p < kNumParams; ++p) {
+    if (own.test(p)) params[p] = before[p];
+  }
+  return params;
+}
+
+// f's held-out score as the plant before the change had the form: with
+// `before` (ParamsBeforeChange), else, for a form without parameters of its
+// own, the form itself.
+void ScoreBeforeChange(const TrialInputs& in, const LadderModel& current,
+                       const std::optional<ParamVector>& before, ScoredForm* f) {
+  if (OwnParams(f->form.spec, current).none()) {
+    f->before_change = f->score;
+    f->before_change_params = f->fit.fit.params;
+  } else if (before) {
+    f->before_change = ScoreHeldout(f->heldout, *before, in.base->units, in.plant->area_m2);
+    f->before_change_params = *before;
+  }
+}
+
 // Fits and scores every form of the candidate; *best is the form with the
-// lowest held-out objective of the model selection (the first form when none
-// was scored, so that its failure is reported).
+// lowest held-out objective of the model selection (ScoredForm::selection_w;
+// the first form when none was scored, so that its failure is reported).
 std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderModel& current,
                                          const EffectCandidate& c, std::size_t* best) {
   const std::vector<NamedForm> forms =
@@ -301,11 +396,16 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
     inside = RowsInsideTrainingRange(in.base->heldout.drivers, *in.extrapolation);
   }
   std::vector<ScoredForm> out(forms.size());
+  const double current_w = SelectionObjectiveW(current.score, inside);
   *best = 0;
   for (std::size_t k = 0; k < forms.size(); ++k) {
     ScoredForm& f = out[k];
     f.form = forms[k];
-    f.fit = FitForm(in, current, *c.module, f.form.spec);
+    std::optional<ParamVector> before;
+    if (in.reference != nullptr) {
+      before = ParamsBeforeChange(in, current, c, f.form, &f.before_change_fit);
+    }
+    f.fit = FitForm(in, current, *c.module, f.form.spec, before);
     std::string why;
     if (!f.fit.failure.empty()) continue;
     if (!PreparePart(in.split->heldout_series, *in.plant, f.form.spec, in.split->data_start_s,
@@ -316,7 +416,13 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
     if (!f.fit.fit.ok) continue;
     f.score = ScoreHeldout(f.heldout, f.fit.fit.params, in.base->units, in.plant->area_m2);
     f.objective_w = SelectionObjectiveW(f.score, inside);
-    if (!std::isfinite(out[*best].objective_w) || f.objective_w < out[*best].objective_w) {
+    f.selection_w = f.objective_w;
+    if (in.reference != nullptr) {
+      ScoreBeforeChange(in, current, before, &f);
+      const double before_change_w = SelectionObjectiveW(f.before_change, inside);
+      if (before_change_w < current_w) f.selection_w += current_w - before_change_w;
+    }
+    if (!std::isfinite(out[*best].selection_w) || f.selection_w < out[*best].selection_w) {
       *best = k;
     }
   }
@@ -331,7 +437,8 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
 // held-out tests of that form.
 void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
                   EffectCandidate* candidate, EffectTrial* trial, Score* score,
-                  std::vector<Score>* form_scores) {
+                  std::vector<Score>* form_scores, std::vector<Score>* before_change_scores,
+                  std::vector<std::pair<std::string, ParamVector>>* before_change_fits) {
   EffectCandidate& c = *candidate;
   EffectTrial& t = *trial;
   const Plant& plant = *in.plant;
@@ -352,9 +459,19 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
     fit_runtime_s += f.fit.fit.runtime_s;
     t.forms.push_back({f.form.form, f.form.spec.Name(), std::isfinite(f.objective_w),
                        std::isfinite(f.objective_w) ? MaeSumW(f.score.errors) : kNaN});
-    if (std::isfinite(f.objective_w)) form_scores->push_back(std::move(f.score));
+    if (!f.before_change_fit.first.empty()) before_change_fits->push_back(f.before_change_fit);
   }
   ScoredForm& best_form = forms[chosen];
+  if (best_form.before_change.loss_w.size() == current_score.loss_w.size()) {
+    t.shrink_before_change_pct = 100.0 * (1.0 - best_form.before_change.errors.objective_w_m2() /
+                                                    current_score.errors.objective_w_m2());
+    t.params_before_change = best_form.before_change_params;
+  }
+  for (ScoredForm& f : forms) {
+    if (!std::isfinite(f.objective_w)) continue;
+    form_scores->push_back(std::move(f.score));
+    before_change_scores->push_back(std::move(f.before_change));
+  }
   c.spec = best_form.form.spec;
   c.form = best_form.form.form;
   t.form = c.form;
@@ -365,6 +482,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   if (!best.failure.empty()) {
     t.failure = best.failure;
     form_scores->clear();
+    before_change_scores->clear();
     return;
   }
   // Evidence on the base model's residuals (the gap being explained).
@@ -399,6 +517,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
   if (!std::isfinite((*score).errors.objective_w_m2())) {
     t.failure = "non-finite held-out outputs";
     form_scores->clear();
+    before_change_scores->clear();
     return;
   }
   t.fit_ok = true;
@@ -461,6 +580,24 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
        << "per " << test_unit << ": lower on " << t.test.positives << " of " << t.test.pairs
        << " (Wilcoxon p = " << PValue(t.test.wilcoxon_p) << ")";
     if (!t.signature_check.empty()) ev << "; " << t.signature_check;
+    if (std::isfinite(t.shrink_before_change_pct)) {
+      ev << "; with its own parameters as fitted on the days before the change";
+      if (t.params_before_change) {
+        std::string values;
+        for (const ParamEstimate& e : t.estimates) {
+          if (!e.free) continue;
+          const ParamInfo& info = Info(e.param);
+          values += std::string(values.empty() ? "" : ", ") + std::string(info.name) + " " +
+                    FixedDecimals(e.value, 3) + " since, " +
+                    FixedDecimals((*t.params_before_change)[static_cast<std::size_t>(e.param)], 3) +
+                    " before";
+        }
+        if (!values.empty()) ev << " (" << values << ")";
+      }
+      ev << " it " << (t.shrink_before_change_pct > 0.0 ? "lowers" : "changes")
+         << " the held-out error by " << FixedDecimals(t.shrink_before_change_pct, 1)
+         << " %: the model selection counts its gain beyond that";
+    }
     for (const RefittedParam& r : t.refitted) ev << "; " << RefittedSentence(r);
     for (const std::string& c : t.cautions) ev << "; against it: " << c;
   } else {
@@ -470,6 +607,10 @@ std::string EvidenceSentence(const EffectTrial& t, const EffectModule& effect, i
 }
 
 }  // namespace
+
+std::string BeforeChangeKey(const std::string& effect, const std::string& form) {
+  return effect + "/" + form;
+}
 
 // Controls of the evidence regression, per held-out row.
 std::vector<std::vector<double>> EvidenceControls(const Drivers& d) {
@@ -491,12 +632,14 @@ StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& cur
   out.trials.resize(candidates.size());
   out.scores.resize(candidates.size());
   out.form_scores.resize(candidates.size());
+  out.before_change_scores.resize(candidates.size());
+  out.before_change_fits.resize(candidates.size());
   std::atomic<std::size_t> next{0};
   std::atomic<int> done{0};
   auto worker = [&] {
     for (std::size_t k = next++; k < candidates.size(); k = next++) {
       TryCandidate(in, step, current, &candidates[k], &out.trials[k], &out.scores[k],
-                   &out.form_scores[k]);
+                   &out.form_scores[k], &out.before_change_scores[k], &out.before_change_fits[k]);
       const int finished = ++done;
       in.progress(ProgressLine(step, finished, candidates.size(), out.trials[k], in.test_unit));
     }

@@ -71,6 +71,12 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
       }
     }
   }
+  if (reference_days != nullptr && !reference_params.has_value()) {
+    out << "reference_days: only with reference_params (the days they were fitted on); ";
+  }
+  if (reference_days != nullptr && reference_days->size() < 2) {
+    out << "reference_days: " << reference_days->size() << " rows, must be at least 2; ";
+  }
   const std::vector<std::string> names = EffectNames();
   for (const std::string& e : effects) {
     if (std::find(names.begin(), names.end(), e) == names.end()) {
@@ -201,7 +207,14 @@ bool DiagnoseOnce(const Series& data_in, const Plant& plant, const ModelSpec& ba
         days);
   }
 
+  st::ReferenceDays reference_days;
+  if (options.reference_days != nullptr &&
+      !st::PrepareReferenceDays(options, data.step_s, plant, base, &reference_days, error)) {
+    return false;
+  }
+
   st::TrialInputs trials;
+  if (options.reference_days != nullptr) trials.reference = &reference_days;
   trials.data = &data;
   trials.split = &split;
   trials.plant = &plant;

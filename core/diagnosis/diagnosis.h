@@ -45,6 +45,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -159,6 +160,19 @@ struct DiagnosisOptions {
   // Where reference_params come from, for the notes ("calibration 12, window
   // 2025-05-26 to 2025-06-09").
   std::string reference_name;
+  // The days reference_params were fitted on (the calibration's window),
+  // only with reference_params. With them each candidate's own parameters
+  // are also fitted on those days (the rest held at reference_params): the
+  // effect as the plant had it before the change. The model selection then
+  // counts a candidate's gain on the held-out days beyond the better of the
+  // model without it and the model with it as it was before: an effect the
+  // plant has all along (an IAM the model lacks) gains as much with its
+  // parameters of before as with those of the days since, so it explains
+  // the structure, not the change; an effect that changed (an inverter that
+  // clips from the change on) gains nothing with its parameters of before.
+  // A form without parameters of its own cannot change and never counts.
+  // Empty: every candidate is judged against the model without it.
+  std::shared_ptr<const Series> reference_days;
   // Effects to try (names of the vocabulary); empty = every candidate.
   std::vector<std::string> effects;
   LocaliseOptions where;
@@ -240,6 +254,14 @@ struct EffectTrial {
   bool significant = false;
   int accepted_at_step = 0;           // ladder step (1, 2, …) that accepted it; 0 = not accepted
   double shrink_pct = 0.0;            // reduction of the held-out MAE(P_el) + MAE(Q_u)
+  // With DiagnosisOptions::reference_days: the reduction the effect gives
+  // with its own parameters as fitted on those days (the plant before the
+  // change), %; NaN without them. The model selection counts the gain
+  // beyond it.
+  double shrink_before_change_pct = std::nan("");
+  // … and the whole model's parameters it was scored with (its own as
+  // fitted on those days); empty without them.
+  std::optional<ParamVector> params_before_change;
   double heldout_mae_before_w = 0.0;  // MAE P_el + MAE Q_u, W, of tested_against
   double heldout_mae_after_w = 0.0;   // … with the effect
   PairedTest test;                    // over test units (per-unit objective), reported

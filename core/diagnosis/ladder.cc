@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <string>
 #include <tuple>
@@ -46,19 +47,34 @@ double Confidences(const TrialInputs& in, int step, const Score& current, StepTr
   // Per trial, every form that was scored: the form is chosen again in each
   // resample (the lowest objective of its forms), so that the confidence
   // holds the choice of the form as well as that of the effect.
+  // With reference days, beside each form: the form with its own parameters
+  // as the plant before the change had them (an empty UnitLoss: none). The
+  // form's objective in a resample then counts only its gain beyond the
+  // better of that and the current model (DiagnosisOptions::reference_days).
   std::vector<std::size_t> pool;
   std::vector<std::vector<UnitLoss>> losses(st->trials.size());
+  std::vector<std::vector<UnitLoss>> before_change(st->trials.size());
   for (std::size_t k = 0; k < st->trials.size(); ++k) {
     st->trials[k].confidence = 0.0;
     st->trials[k].confidence_beats = 0.0;
     if (!st->trials[k].fit_ok) continue;
     std::vector<const Score*> forms = {&st->scores[k]};
+    std::vector<const Score*> forms_before(1, nullptr);
     if (k < st->form_scores.size() && !st->form_scores[k].empty()) {
       forms.clear();
-      for (const Score& s : st->form_scores[k]) forms.push_back(&s);
+      forms_before.clear();
+      for (std::size_t j = 0; j < st->form_scores[k].size(); ++j) {
+        forms.push_back(&st->form_scores[k][j]);
+        forms_before.push_back(
+            j < st->before_change_scores[k].size() ? &st->before_change_scores[k][j] : nullptr);
+      }
     }
-    for (const Score* s : forms) {
-      if (s->loss_w.size() == current.loss_w.size()) losses[k].push_back(per_unit(*s));
+    for (std::size_t j = 0; j < forms.size(); ++j) {
+      if (forms[j]->loss_w.size() != current.loss_w.size()) continue;
+      losses[k].push_back(per_unit(*forms[j]));
+      const Score* b = forms_before[j];
+      before_change[k].push_back(
+          b != nullptr && b->loss_w.size() == current.loss_w.size() ? per_unit(*b) : UnitLoss{});
     }
     if (!losses[k].empty()) pool.push_back(k);
   }
@@ -88,8 +104,12 @@ double Confidences(const TrialInputs& in, int step, const Score& current, StepTr
     double best_objective = 0.0;
     for (const std::size_t k : pool) {
       double after = std::nan("");
-      for (const UnitLoss& form : losses[k]) {
-        const double o = objective(form);
+      for (std::size_t j = 0; j < losses[k].size(); ++j) {
+        double o = objective(losses[k][j]);
+        if (!before_change[k][j].loss.empty()) {
+          const double o_before = objective(before_change[k][j]);
+          if (o_before < before) o += before - o_before;
+        }
         if (!std::isnan(o) && !(o >= after)) after = o;  // the lowest finite
       }
       if (!(after <= keep * before)) continue;
@@ -249,12 +269,22 @@ LadderModel RunLadder(const TrialInputs& in, const ModelSpec& base, DiagnosisRes
                       "model's parameters that act there are not determined by the training "
                       "days");
   }
+  // The forms' fits on the reference days at the first step, for the later ones.
+  std::map<std::string, ParamVector> before_change;
+  TrialInputs step_in = in;
   for (int step = 1; step <= in.options->max_ladder_steps; ++step) {
-    StepTrials st = TryCandidates(in, step, current);
+    StepTrials st = TryCandidates(step_in, step, current);
+    if (step == 1 && in.reference != nullptr) {
+      for (const auto& fits : st.before_change_fits) {
+        before_change.insert(fits.begin(), fits.end());
+        r.identifications += static_cast<int>(fits.size());
+      }
+      step_in.before_change = &before_change;
+    }
     if (step == 1) r.skipped = st.skipped;
     if (st.candidates.empty()) break;
     r.identifications += static_cast<int>(st.candidates.size());
-    const double any_share = Confidences(in, step, current.score, &st);
+    const double any_share = Confidences(step_in, step, current.score, &st);
     const StepDecision decision = Decide(*in.options, any_share, &st);
     for (EffectTrial& t : st.trials) {
       if (t.fit_ok) {

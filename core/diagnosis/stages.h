@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -175,6 +176,20 @@ std::vector<SensorFinding> FindResidualSensorFaults(const Series& data, const Sp
 // irradiance, T_in − T_amb, flow.
 std::vector<std::vector<double>> EvidenceControls(const Drivers& d);
 
+// The days the reference parameters were fitted on (DiagnosisOptions::
+// reference_days) at the data's step, with the base model's outputs there:
+// a candidate's fit on them starts from the base model's residuals, as its
+// fit on the training days does.
+struct ReferenceDays {
+  Series series;
+  Part base;
+  SimOutputs base_sim;
+};
+// Prepares *out from options.reference_days (resampled to step_s) and the
+// reference parameters; false with *error when they cannot be prepared.
+bool PrepareReferenceDays(const DiagnosisOptions& options, double step_s, const Plant& plant,
+                          const ModelSpec& base, ReferenceDays* out, std::string* error);
+
 // What every ladder step's trials read.
 struct TrialInputs {
   const Series* data = nullptr;
@@ -188,7 +203,16 @@ struct TrialInputs {
   std::string test_unit;  // "day" or "hour"
   Progress progress;
   const std::vector<Extrapolation>* extrapolation = nullptr;  // FindExtrapolation's
+  // DiagnosisOptions::reference_days prepared for the base model; nullptr
+  // without them.
+  const ReferenceDays* reference = nullptr;
+  // The fits of each candidate form on reference_days at the first ladder
+  // step (BeforeChangeKey → the whole model's parameters), which later steps
+  // reuse: the plant before the change had none of the effects accepted since.
+  const std::map<std::string, ParamVector>* before_change = nullptr;
 };
+// The key of a candidate form's fit on the reference days: "effect/form".
+std::string BeforeChangeKey(const std::string& effect, const std::string& form);
 // A model on the ladder.
 struct LadderModel {
   ModelSpec spec;
@@ -203,6 +227,13 @@ struct StepTrials {
   // Per candidate: every form's held-out score (the chosen one among them);
   // the model selection takes the best form of each resample.
   std::vector<std::vector<Score>> form_scores;
+  // Per candidate, beside form_scores (with DiagnosisOptions::reference_days):
+  // each form's held-out score with its own parameters as fitted on the
+  // reference days, the rest as fitted since (an empty Score: no such fit).
+  std::vector<std::vector<Score>> before_change_scores;
+  // Per candidate, at the first step: each form's fit on the reference days
+  // (BeforeChangeKey, parameters), for TrialInputs::before_change.
+  std::vector<std::vector<std::pair<std::string, ParamVector>>> before_change_fits;
 };
 // Step `step` of the ladder: every candidate effect added to `current`,
 // re-identified on the training days and scored on the held-out days, with

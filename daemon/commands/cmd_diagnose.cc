@@ -273,6 +273,20 @@ bool AgainstModelBefore(const DiagnoseArgs& a, const Plant& plant, const ModelSp
       return false;
     }
     file.variant = row.variant;
+    // The days it was fitted on: each candidate's gain is judged beyond
+    // what it gains with its own parameters as fitted there
+    // (DiagnosisOptions::reference_days).
+    WindowData days;
+    if (!ReadWindowData(*store, row.window_start, row.window_end, &days, &error)) {
+      std::cerr << error << "\n";
+      return false;
+    }
+    if (days.rows.size() >= 2) {
+      options->reference_days = std::make_shared<const Series>(std::move(days.rows));
+    } else {
+      std::cerr << name << ": no rows of its window left in " << a.db
+                << "; each candidate is judged against the model without it\n";
+    }
   }
   if (!file.variant.empty() && file.variant != spec.Name()) {
     std::cerr << name << ": parameters of " << file.variant
@@ -598,7 +612,9 @@ void RegisterDiagnose(CLI::App& app) {
   cmd->add_option("--against-calibration", args->against_calibration,
                   "with --db: as --against-params, with the parameters of this accepted "
                   "calibration of the store (pvtwin run passes the one before a performance "
-                  "alarm's change)")
+                  "alarm's change); each effect's own parameters are also fitted on the days "
+                  "of its window, and an effect counts only with its gain beyond what it gains "
+                  "with them")
       ->check(CLI::PositiveNumber)
       ->default_str("none");
   cmd->callback([args] { SetExitCode(RunDiagnose(*args)); });

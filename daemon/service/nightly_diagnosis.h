@@ -79,8 +79,9 @@ class NightlyDiagnosis {
   // Starts the child when enabled, none is running and PlanFor says so, on
   // the days PlanFor gives. On the days since a change it judges the
   // effects against the plant before it (CalibrationBeforeChange; `diagnose
-  // --against-calibration`, DiagnosisOptions::reference_params), so that the
-  // structure the plant had all along does not compete with what changed.
+  // --against-calibration`, DiagnosisOptions::reference_params, and the days
+  // of its window, reference_days), so that the structure the plant had all
+  // along does not compete with what changed.
   void MaybeStart(const DiagnosisConfig& config, Store& store, const Job& job, const LogFn& log);
   // Non-blocking: a finished child's report is kept and its verdict logged;
   // a child past timeout_s is killed.

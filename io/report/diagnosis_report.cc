@@ -155,6 +155,9 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
     e["confidence_beats"] = Number(t.fit_ok ? t.confidence_beats : std::nan(""));
     if (t.sensor_fault) e["sensor_fault"] = true;
     e["shrink_pct"] = Number(t.fit_ok ? t.shrink_pct : std::nan(""));
+    if (t.fit_ok && std::isfinite(t.shrink_before_change_pct)) {
+      e["shrink_before_change_pct"] = Number(t.shrink_before_change_pct);
+    }
     e["heldout_mae_before_w"] = Number(t.heldout_mae_before_w);
     e["heldout_mae_after_w"] = Number(t.fit_ok ? t.heldout_mae_after_w : std::nan(""));
     e["evidence"] = t.evidence;

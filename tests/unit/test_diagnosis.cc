@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -26,7 +28,10 @@
 #include "core/model/variant.h"
 #include "core/synth/synthetic_plant.h"
 #include "io/files/csv.h"
+#include "io/files/params_json.h"
+#include "io/platform/time_format.h"
 #include "io/report/diagnosis_report.h"
+#include "io/store/store.h"
 #include "tests/support/fixtures.h"
 #include "tests/support/run_pvtwin.h"
 #include "tests/support/synthetic_series.h"
@@ -641,19 +646,25 @@ TEST(Extrapolation, RowsInsideTheTrainingRangeOfEveryExtrapolatedDriver) {
 // only its own parameters: the clipping candidate finds the truth's limit.
 // (Whether the verdict names it on so few days depends on their weather; the
 // weeks of doc/validation.md measure that.)
+// 16 days of the example plant with `truth` at 1 min from a local solar
+// midnight (seed 4), with the paper's corrections.
+Series ExamplePlantDays(const Plant& plant, const std::string& truth) {
+  SyntheticOptions synth;
+  std::string error;
+  EXPECT_TRUE(DefaultSyntheticOptions(plant, truth, 16, 4, &synth, &error)) << error;
+  synth.weather.start_time_s =
+      SolarDayStartS(synth.weather.start_time_s, SolarDayOffsetS(plant)) + kSecondsPerDay;
+  Series s = MakeSyntheticPlantData(plant, synth);
+  ApplyPaperCorrections(&s);
+  return s;
+}
+
 TEST(DiagnosisAgainstThePlantBefore, OnlyTheEffectsOwnParametersAreFitted) {
   const Plant plant = DesignExamplePlant();
-  const std::int64_t offset_s = SolarDayOffsetS(plant);
   auto make = [&](const std::string& truth) {
-    SyntheticOptions synth;
-    std::string error;
-    EXPECT_TRUE(DefaultSyntheticOptions(plant, truth, 16, 4, &synth, &error)) << error;
-    synth.weather.start_time_s =
-        SolarDayStartS(synth.weather.start_time_s, offset_s) + kSecondsPerDay;
-    Series s = MakeSyntheticPlantData(plant, synth);
-    ApplyPaperCorrections(&s);
     Series coarse;
-    EXPECT_TRUE(Resample(s, 300.0, &coarse, &error)) << error;
+    std::string error;
+    EXPECT_TRUE(Resample(ExamplePlantDays(plant, truth), 300.0, &coarse, &error)) << error;
     return coarse;
   };
   const std::string truth = testing::kExamplePlantTruth;
@@ -702,6 +713,118 @@ TEST(DiagnosisAgainstThePlantBefore, OnlyTheEffectsOwnParametersAreFitted) {
   EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(), [](const std::string& n) {
     return n.find("keeps the parameters of the fit of the 10 days before") != std::string::npos;
   }));
+
+  // With the days the reference was fitted on (DiagnosisOptions::
+  // reference_days), each candidate's own parameters are also fitted there.
+  // The truth's IAM is in the plant before and since: with its parameters of
+  // before it takes most of what it takes with those of the days since, and
+  // only the rest counts. The inverter's limit is not reached before the
+  // change: with its parameters of before the clipping candidate changes
+  // nothing, and all of its gain counts.
+  DiagnosisOptions with_days = o;
+  with_days.reference_days = std::make_shared<const Series>(before);
+  DiagnosisResult rd;
+  ASSERT_TRUE(Diagnose(clipped.Between(change_s, clipped.time_s.back() + 1), plant, base, with_days,
+                       &rd, &error))
+      << error;
+  auto trial = [](const DiagnosisResult& result, const std::string& name) {
+    const auto it = std::find_if(result.effects.begin(), result.effects.end(),
+                                 [&name](const EffectTrial& t) { return t.name == name; });
+    EXPECT_NE(it, result.effects.end()) << name;
+    return it == result.effects.end() ? EffectTrial{} : *it;
+  };
+  const EffectTrial clip = trial(rd, "pv_clipping");
+  const EffectTrial iam = trial(rd, "iam");
+  ASSERT_TRUE(clip.fit_ok && iam.fit_ok) << clip.failure << iam.failure;
+  EXPECT_NEAR(clip.shrink_before_change_pct, 0.0, 0.5) << clip.evidence;
+  ASSERT_TRUE(clip.params_before_change.has_value());
+  EXPECT_GT(ParamOf(*clip.params_before_change, Param::kPLimitWM2), 150.0) << clip.evidence;
+  EXPECT_GT(iam.shrink_pct, 1.0) << iam.evidence;
+  EXPECT_GT(iam.shrink_before_change_pct, 0.5 * iam.shrink_pct) << iam.evidence;
+  EXPECT_GT(clip.shrink_pct, 3.0) << clip.evidence;
+  // The selection counts only the change: the IAM, the best candidate
+  // without the days of the reference, loses its confidence.
+  const EffectTrial iam_refit = trial(r, "iam");
+  EXPECT_LT(iam.confidence, iam_refit.confidence);
+  std::printf(
+      "since the change: pv_clipping shrink %.1f %% (%.1f %% with its parameters of "
+      "before); iam %.1f %% (%.1f %%), confidence %.2f without the days of the "
+      "reference, %.2f with them\n",
+      clip.shrink_pct, clip.shrink_before_change_pct, iam.shrink_pct, iam.shrink_before_change_pct,
+      iam_refit.confidence, iam.confidence);
+
+  // The days of the reference go with its parameters only.
+  DiagnosisOptions days_alone;
+  days_alone.reference_days = with_days.reference_days;
+  std::string why;
+  EXPECT_FALSE(days_alone.IsValid(&why));
+  EXPECT_NE(why.find("reference_days: only with reference_params"), std::string::npos) << why;
+}
+
+// `pvtwin diagnose --db … --against-calibration ID` reads the days of that
+// calibration's window from the store as the days of the reference
+// (DiagnosisOptions::reference_days): every candidate's entry in report.json
+// holds its shrink with its own parameters as fitted there, and the notes say
+// so. The store holds the healthy plant for 10 days, then the clipping one.
+TEST_F(DiagnoseCli, AgainstACalibrationItsWindowIsTheDaysOfTheReference) {
+  const fs::path& dir = dir_;
+  const Plant plant = DesignExamplePlant();
+  const std::string truth = testing::kExamplePlantTruth;
+  Series healthy = ExamplePlantDays(plant, truth);
+  Series clipped = ExamplePlantDays(plant, truth + "+pv_clipping");
+  // The store keeps minute starts: every row later by under a minute.
+  const std::int64_t late_s = (60 - healthy.time_s.front() % 60) % 60;
+  for (Series* s : {&healthy, &clipped}) {
+    for (std::int64_t& t : s->time_s) t += late_s;
+  }
+  const std::int64_t start_s = healthy.time_s.front();
+  const std::int64_t change_s = start_s + 10 * kSecondsPerDay;
+  const std::int64_t end_s = clipped.time_s.back() + 60;
+  const ModelSpec base = testing::SpecOf(testing::kExampleDaemonModel);
+  const Series before = healthy.Between(start_s, change_s);
+  Drivers drivers;
+  std::string error;
+  ASSERT_TRUE(PrepareDrivers(before, plant, base, &drivers, &error)) << error;
+  const IdentSummary reference = Identify(drivers, MakeMeasurements(before, drivers),
+                                          StartParams(plant), DiagnosisIdentOptions());
+  ASSERT_TRUE(reference.ok) << reference.BriefReport();
+  std::int64_t id = 0;
+  {
+    std::unique_ptr<Store> store = Store::Open((dir / "t.db").string(), &error);
+    ASSERT_TRUE(store) << error;
+    ASSERT_TRUE(store->WriteMinutes(before, &error)) << error;
+    ASSERT_TRUE(store->WriteMinutes(clipped.Between(change_s, end_s), &error)) << error;
+    Store::CalibrationRow row;
+    row.run_at = change_s;
+    row.variant = base.Name();
+    row.window_start = start_s;
+    row.window_end = change_s;
+    row.status = "accepted";
+    row.accepted = true;
+    row.params_json = FormatParamsJson(base.Name(), reference.params, UsedParams(base), "");
+    ASSERT_TRUE(store->InsertCalibration(&row, &error)) << error;
+    id = row.id;
+  }
+  const testing::ProcessResult run = testing::RunPvtwin(
+      dir, "diagnose --config " + PlantConfig() + " --db t.db --variant " + base.Name() +
+               " --from " + FormatIsoUtc(change_s) + " --to " + FormatIsoUtc(end_s) +
+               " --train-days 2 --heldout-days 3 --step 300 --effects pv_clipping,iam "
+               "--against-calibration " +
+               std::to_string(id) + " --report out");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(testing::ReadFile(dir / "out" / "report.json"));
+  std::map<std::string, double> before_change;
+  for (const auto& e : j.at("effects")) {
+    if (e.contains("shrink_before_change_pct")) {
+      before_change[e.at("name").get<std::string>()] = e.at("shrink_before_change_pct");
+    }
+  }
+  ASSERT_EQ(before_change.size(), 2u) << j.at("effects").dump();
+  EXPECT_NEAR(before_change["pv_clipping"], 0.0, 0.5);
+  EXPECT_GT(before_change["iam"], 1.0);
+  EXPECT_NE(j.at("notes").dump().find("also fitted on the days of the reference"),
+            std::string::npos)
+      << j.at("notes").dump();
 }
 
 }  // namespace

@@ -127,6 +127,76 @@ const char* SkyName(SkyUsed sky) {
   return "measured";
 }
 
+// One entry of report.json's `effects`.
+Json EffectJson(const EffectTrial& t) {
+  Json e;
+  e["name"] = t.name;
+  e["significant"] = t.significant;
+  e["confidence"] = Number(t.fit_ok ? t.confidence : std::nan(""));
+  e["confidence_beats"] = Number(t.fit_ok ? t.confidence_beats : std::nan(""));
+  if (t.sensor_fault) e["sensor_fault"] = true;
+  e["shrink_pct"] = Number(t.fit_ok ? t.shrink_pct : std::nan(""));
+  if (t.fit_ok && std::isfinite(t.shrink_before_change_pct)) {
+    e["shrink_before_change_pct"] = Number(t.shrink_before_change_pct);
+  }
+  e["heldout_mae_before_w"] = Number(t.heldout_mae_before_w);
+  e["heldout_mae_after_w"] = Number(t.fit_ok ? t.heldout_mae_after_w : std::nan(""));
+  e["evidence"] = t.evidence;
+  e["refitted"] = RefittedJson(t.refitted);
+  e["variant"] = t.variant;
+  if (!t.form.empty()) e["form"] = t.form;
+  if (t.forms.size() > 1) {
+    Json forms = Json::array();
+    for (const EffectTrial::FormResult& f : t.forms) {
+      forms.push_back(Json{{"form", f.form},
+                           {"variant", f.variant},
+                           {"heldout_mae_after_w", Number(f.heldout_mae_after_w)}});
+    }
+    e["forms"] = forms;
+  }
+  e["tested_against"] = t.tested_against;
+  e["accepted_at_step"] = t.accepted_at_step;
+  e["p_value"] = Number(t.test.wilcoxon_p);
+  e["sign_test_p"] = Number(t.test.sign_p);
+  e["t_stat"] = Number(t.test.t_stat);
+  e["units_better"] = t.test.positives;
+  e["units"] = t.test.pairs;
+  e["evidence_r"] = Number(t.evidence_corr.r);
+  e["evidence_z"] = Number(t.evidence_corr.z);
+  e["evidence_output"] = t.evidence_output;
+  if (std::isfinite(t.sensor_estimate)) {
+    e["irradiance_bias_k"] = Number(t.sensor_estimate);
+    e["irradiance_bias_p"] = Number(t.sensor_p);
+  }
+  if (t.fit_ok) {
+    e["heldout_test"] = Json{{"kind", "loss_difference"},
+                             {"p", Number(t.heldout_test.p)},
+                             {"z", Number(t.heldout_test.z)},
+                             {"rows", t.heldout_test.rows},
+                             {"mean_loss_difference_w", Number(t.heldout_test.mean_difference)},
+                             {"bandwidth_rows", t.heldout_test.bandwidth_rows}};
+    e["mae_p_el_after_w"] = Number(t.mae_p_el_after_w);
+    e["mae_q_th_after_w"] = Number(t.mae_q_th_after_w);
+    e["days_better"] = t.days_improved;
+    Json params = Json::object();
+    for (const ParamEstimate& p : t.estimates) {
+      params[std::string(Info(p.param).name)] = Json{{"value", Number(p.value)},
+                                                     {"std_error", Number(StdErrorInUnit(p))},
+                                                     {"unit", std::string(Info(p.param).unit)}};
+    }
+    e["params"] = params;
+    if (!t.at_bounds.empty()) e["at_bounds"] = t.at_bounds;
+    if (!t.signature_check.empty()) e["signature_check"] = t.signature_check;
+    if (!t.rejected.empty()) e["rejected"] = t.rejected;
+    if (!t.cautions.empty()) e["cautions"] = t.cautions;
+  }
+  e["explanation"] = t.explanation;
+  if (!t.advice.empty()) e["advice"] = t.advice;
+  e["fit_ok"] = t.fit_ok;
+  if (!t.fit_ok) e["failure"] = t.failure;
+  return e;
+}
+
 }  // namespace
 
 std::string DiagnosisReportJson(const DiagnosisResult& r) {
@@ -147,74 +217,7 @@ std::string DiagnosisReportJson(const DiagnosisResult& r) {
   for (const GapRegion& g : r.where) where.push_back(RegionJson(g));
   j["where"] = where;
   Json effects = Json::array();
-  for (const EffectTrial& t : r.effects) {
-    Json e;
-    e["name"] = t.name;
-    e["significant"] = t.significant;
-    e["confidence"] = Number(t.fit_ok ? t.confidence : std::nan(""));
-    e["confidence_beats"] = Number(t.fit_ok ? t.confidence_beats : std::nan(""));
-    if (t.sensor_fault) e["sensor_fault"] = true;
-    e["shrink_pct"] = Number(t.fit_ok ? t.shrink_pct : std::nan(""));
-    if (t.fit_ok && std::isfinite(t.shrink_before_change_pct)) {
-      e["shrink_before_change_pct"] = Number(t.shrink_before_change_pct);
-    }
-    e["heldout_mae_before_w"] = Number(t.heldout_mae_before_w);
-    e["heldout_mae_after_w"] = Number(t.fit_ok ? t.heldout_mae_after_w : std::nan(""));
-    e["evidence"] = t.evidence;
-    e["refitted"] = RefittedJson(t.refitted);
-    e["variant"] = t.variant;
-    if (!t.form.empty()) e["form"] = t.form;
-    if (t.forms.size() > 1) {
-      Json forms = Json::array();
-      for (const EffectTrial::FormResult& f : t.forms) {
-        forms.push_back(Json{{"form", f.form},
-                             {"variant", f.variant},
-                             {"heldout_mae_after_w", Number(f.heldout_mae_after_w)}});
-      }
-      e["forms"] = forms;
-    }
-    e["tested_against"] = t.tested_against;
-    e["accepted_at_step"] = t.accepted_at_step;
-    e["p_value"] = Number(t.test.wilcoxon_p);
-    e["sign_test_p"] = Number(t.test.sign_p);
-    e["t_stat"] = Number(t.test.t_stat);
-    e["units_better"] = t.test.positives;
-    e["units"] = t.test.pairs;
-    e["evidence_r"] = Number(t.evidence_corr.r);
-    e["evidence_z"] = Number(t.evidence_corr.z);
-    e["evidence_output"] = t.evidence_output;
-    if (std::isfinite(t.sensor_estimate)) {
-      e["irradiance_bias_k"] = Number(t.sensor_estimate);
-      e["irradiance_bias_p"] = Number(t.sensor_p);
-    }
-    if (t.fit_ok) {
-      e["heldout_test"] = Json{{"kind", "loss_difference"},
-                               {"p", Number(t.heldout_test.p)},
-                               {"z", Number(t.heldout_test.z)},
-                               {"rows", t.heldout_test.rows},
-                               {"mean_loss_difference_w", Number(t.heldout_test.mean_difference)},
-                               {"bandwidth_rows", t.heldout_test.bandwidth_rows}};
-      e["mae_p_el_after_w"] = Number(t.mae_p_el_after_w);
-      e["mae_q_th_after_w"] = Number(t.mae_q_th_after_w);
-      e["days_better"] = t.days_improved;
-      Json params = Json::object();
-      for (const ParamEstimate& p : t.estimates) {
-        params[std::string(Info(p.param).name)] = Json{{"value", Number(p.value)},
-                                                       {"std_error", Number(StdErrorInUnit(p))},
-                                                       {"unit", std::string(Info(p.param).unit)}};
-      }
-      e["params"] = params;
-      if (!t.at_bounds.empty()) e["at_bounds"] = t.at_bounds;
-      if (!t.signature_check.empty()) e["signature_check"] = t.signature_check;
-      if (!t.rejected.empty()) e["rejected"] = t.rejected;
-      if (!t.cautions.empty()) e["cautions"] = t.cautions;
-    }
-    e["explanation"] = t.explanation;
-    if (!t.advice.empty()) e["advice"] = t.advice;
-    e["fit_ok"] = t.fit_ok;
-    if (!t.fit_ok) e["failure"] = t.failure;
-    effects.push_back(e);
-  }
+  for (const EffectTrial& t : r.effects) effects.push_back(EffectJson(t));
   j["effects"] = effects;
   j["verdict"] = r.verdict;
   if (!r.candidates.empty()) j["candidates"] = r.candidates;

@@ -396,7 +396,8 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
     inside = RowsInsideTrainingRange(in.base->heldout.drivers, *in.extrapolation);
   }
   std::vector<ScoredForm> out(forms.size());
-  const double current_w = SelectionObjectiveW(current.score, inside);
+  const Loss loss = SelectionLoss(*in.options);
+  const double current_w = SelectionObjectiveW(current.score, inside, loss);
   *best = 0;
   for (std::size_t k = 0; k < forms.size(); ++k) {
     ScoredForm& f = out[k];
@@ -415,11 +416,11 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
     }
     if (!f.fit.fit.ok) continue;
     f.score = ScoreHeldout(f.heldout, f.fit.fit.params, in.base->units, in.plant->area_m2);
-    f.objective_w = SelectionObjectiveW(f.score, inside);
+    f.objective_w = SelectionObjectiveW(f.score, inside, loss);
     f.selection_w = f.objective_w;
     if (in.reference != nullptr) {
       ScoreBeforeChange(in, current, before, &f);
-      const double before_change_w = SelectionObjectiveW(f.before_change, inside);
+      const double before_change_w = SelectionObjectiveW(f.before_change, inside, loss);
       if (before_change_w < current_w) f.selection_w += current_w - before_change_w;
     }
     if (!std::isfinite(out[*best].selection_w) || f.selection_w < out[*best].selection_w) {

@@ -48,6 +48,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/common/plant.h"
@@ -68,6 +69,14 @@ namespace pvtwin {
 // any extended fit (started from it) "improve" by converging further, which
 // is not an effect. `pvtwin-bench ident`: 1e-4 reaches the noise floor.
 IdentOptions DiagnosisIdentOptions();
+
+// The outputs whose held-out error the model selection compares
+// (DiagnosisOptions::selection_outputs).
+enum class SelectionOutputs { kBoth, kPEl, kQTh };
+
+// "both", "p_el", "q_th"; ParseSelectionOutputs: false for another text.
+std::string_view SelectionOutputsName(SelectionOutputs o);
+bool ParseSelectionOutputs(std::string_view text, SelectionOutputs* out);
 
 struct DiagnosisOptions {
   // Training days from the first day of data; 0 = two thirds of the days
@@ -173,6 +182,16 @@ struct DiagnosisOptions {
   // A form without parameters of its own cannot change and never counts.
   // Empty: every candidate is judged against the model without it.
   std::shared_ptr<const Series> reference_days;
+  // The outputs the model selection compares on the held-out days: both
+  // (the paper's objective, MAE P_el + MAE Q_u), or the one a performance
+  // alarm found changed. On the days since a change the question is which
+  // effect explains what changed: an effect that leaves that output as it
+  // was (a transport delay when the electricity fell) explains none of it,
+  // however much of the other output's error it takes. The daemon sets it
+  // to the outputs whose alarms dated the change (`pvtwin diagnose
+  // --objective p_el`). min_shrink_pct applies to it; shrink_pct and the
+  // report's errors stay those of both outputs.
+  SelectionOutputs selection_outputs = SelectionOutputs::kBoth;
   // Effects to try (names of the vocabulary); empty = every candidate.
   std::vector<std::string> effects;
   LocaliseOptions where;

@@ -17,7 +17,8 @@ namespace {
 // confidence_beats, and the share of resamples in which any trial beats the
 // current model by min_shrink_pct. The objective of a resample is the pooled
 // held-out objective of its units (sum of |e_P_el| + |e_Q_u| over their rows
-// / their rows), so with every unit once it is the paper's objective.
+// / their rows), so with every unit once it is the paper's objective; with
+// DiagnosisOptions::selection_outputs one output's |e| instead.
 double Confidences(const TrialInputs& in, int step, const Score& current, StepTrials* st) {
   const DiagnosisOptions& o = *in.options;
   const Units& unit_of = in.base->units;
@@ -34,12 +35,14 @@ double Confidences(const TrialInputs& in, int step, const Score& current, StepTr
   struct UnitLoss {
     std::vector<double> loss, rows;
   };
+  const Loss which = SelectionLoss(o);
   auto per_unit = [&](const Score& s) {
     UnitLoss u{std::vector<double>(units, 0.0), std::vector<double>(units, 0.0)};
-    for (std::size_t i = 0; i < s.loss_w.size() && i < unit_of.unit_of_row.size(); ++i) {
+    const std::vector<double>& loss = LossOf(s, which);
+    for (std::size_t i = 0; i < loss.size() && i < unit_of.unit_of_row.size(); ++i) {
       const int k = unit_of.unit_of_row[i];
-      if (k < 0 || !std::isfinite(s.loss_w[i]) || (!inside.empty() && inside[i] == 0)) continue;
-      u.loss[static_cast<std::size_t>(k)] += s.loss_w[i];
+      if (k < 0 || !std::isfinite(loss[i]) || (!inside.empty() && inside[i] == 0)) continue;
+      u.loss[static_cast<std::size_t>(k)] += loss[i];
       u.rows[static_cast<std::size_t>(k)] += 1.0;
     }
     return u;

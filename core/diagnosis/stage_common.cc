@@ -71,11 +71,29 @@ Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& 
 
 double MaeSumW(const ErrorMetrics& e) { return e.mae_p_el_w + e.mae_q_th_w; }
 
-double SelectionObjectiveW(const Score& score, const std::vector<std::uint8_t>& inside) {
+const std::vector<double>& LossOf(const Score& s, Loss which) {
+  return which == Loss::kPEl ? s.loss_p_el_w : which == Loss::kQTh ? s.loss_q_th_w : s.loss_w;
+}
+
+Loss SelectionLoss(const DiagnosisOptions& options) {
+  switch (options.selection_outputs) {
+    case SelectionOutputs::kPEl:
+      return Loss::kPEl;
+    case SelectionOutputs::kQTh:
+      return Loss::kQTh;
+    case SelectionOutputs::kBoth:
+      break;
+  }
+  return Loss::kSum;
+}
+
+double SelectionObjectiveW(const Score& score, const std::vector<std::uint8_t>& inside,
+                           Loss which) {
+  const std::vector<double>& loss = LossOf(score, which);
   double loss_w = 0.0, rows = 0.0;
-  for (std::size_t i = 0; i < score.loss_w.size(); ++i) {
-    if (!std::isfinite(score.loss_w[i]) || (!inside.empty() && inside[i] == 0)) continue;
-    loss_w += score.loss_w[i];
+  for (std::size_t i = 0; i < loss.size(); ++i) {
+    if (!std::isfinite(loss[i]) || (!inside.empty() && inside[i] == 0)) continue;
+    loss_w += loss[i];
     rows += 1.0;
   }
   return rows > 0.0 ? loss_w / rows : kNaN;
@@ -95,10 +113,8 @@ PairedTest CompareUnits(const Score& before, const Score& after) {
 
 LossDifferenceTest CompareLosses(const Score& before, const Score& after, const Part& heldout,
                                  double bandwidth_s, Loss which) {
-  auto pick = [which](const Score& s) -> const std::vector<double>& {
-    return which == Loss::kPEl ? s.loss_p_el_w : which == Loss::kQTh ? s.loss_q_th_w : s.loss_w;
-  };
-  return OneSidedLossDifferenceTest(pick(before), pick(after), heldout.drivers.time_s, bandwidth_s);
+  return OneSidedLossDifferenceTest(LossOf(before, which), LossOf(after, which),
+                                    heldout.drivers.time_s, bandwidth_s);
 }
 
 std::vector<double> Residual(const Measurements& m, const std::vector<double>& pred,

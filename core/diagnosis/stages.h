@@ -79,17 +79,23 @@ struct Score {
 Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& units,
                    double area_m2);
 
+// A per-row held-out loss of a Score: the sum |e_P_el| + |e_Q_u|, P_el's or Q_u's.
+enum class Loss { kSum, kPEl, kQTh };
+const std::vector<double>& LossOf(const Score& score, Loss which);
+// The loss the model selection compares (DiagnosisOptions::selection_outputs).
+Loss SelectionLoss(const DiagnosisOptions& options);
+
 // The pooled held-out objective of the model selection, W per row: the mean
-// of |e_P_el| + |e_Q_u| over the scored rows, only those with inside[i] ≠ 0
-// when `inside` is not empty (RowsInsideTrainingRange). NaN without rows.
-double SelectionObjectiveW(const Score& score, const std::vector<std::uint8_t>& inside);
+// of the loss `which` (|e_P_el| + |e_Q_u| for kSum) over the scored rows,
+// only those with inside[i] ≠ 0 when `inside` is not empty
+// (RowsInsideTrainingRange). NaN without rows.
+double SelectionObjectiveW(const Score& score, const std::vector<std::uint8_t>& inside, Loss which);
 
 // One-sided paired test of the per-unit objectives: is `after` lower?
 PairedTest CompareUnits(const Score& before, const Score& after);
 
 // One-sided held-out loss test (OneSidedLossDifferenceTest): is `after`'s
 // loss lower than `before`'s? `which`: the sum, P_el's or Q_u's loss.
-enum class Loss { kSum, kPEl, kQTh };
 LossDifferenceTest CompareLosses(const Score& before, const Score& after, const Part& heldout,
                                  double bandwidth_s, Loss which = Loss::kSum);
 

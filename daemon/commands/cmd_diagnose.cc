@@ -53,6 +53,7 @@ struct DiagnoseArgs {
   int threads = 0;
   std::string against_params;            // params.json of the plant before a change
   std::int64_t against_calibration = 0;  // with --db: that calibration's parameters
+  std::string objective = "both";        // DiagnosisOptions::selection_outputs
 };
 
 // The diagnosis of a series (from a CSV or the store): runs, prints the
@@ -328,6 +329,7 @@ int RunDiagnose(const DiagnoseArgs& a) {
   options.alpha = a.alpha;
   options.min_shrink_pct = a.min_shrink_pct;
   options.threads = a.threads;
+  ParseSelectionOutputs(a.objective, &options.selection_outputs);  // checked by the parser
   std::string why;
   if (!options.IsValid(&why)) {
     std::cerr << "diagnose: " << why << "\n";
@@ -617,6 +619,12 @@ void RegisterDiagnose(CLI::App& app) {
                   "with them")
       ->check(CLI::PositiveNumber)
       ->default_str("none");
+  cmd->add_option("--objective", args->objective,
+                  "the outputs whose held-out MAE the model selection compares: both (the "
+                  "paper's objective), or the one whose change is diagnosed, p_el or q_th "
+                  "(pvtwin run passes the output whose performance alarm dated the change)")
+      ->check(CLI::IsMember({"both", "p_el", "q_th"}))
+      ->capture_default_str();
   cmd->callback([args] { SetExitCode(RunDiagnose(*args)); });
 
   auto st = std::make_shared<SelftestArgs>();

@@ -127,17 +127,24 @@ void CheckPerformanceAlarm(Store& store, const DailyCheckInputs& in, std::int64_
 }  // namespace
 
 bool NewestChangeOnset(Store& store, const DailyCheckInputs& in, std::int64_t* onset_s,
-                       std::string* error) {
+                       std::string* error, std::string* outputs) {
   *onset_s = -1;
+  if (outputs != nullptr) outputs->clear();
   std::vector<DayPerformance> days;
   if (!store.ReadPerformanceDays(LookBackStart(in, IndexBandOptions{}), in.now_s / kDayS * kDayS,
                                  &days, error)) {
     return false;
   }
+  std::int64_t onset_el_s = -1, onset_th_s = -1;
   for (const bool thermal : {false, true}) {
     const std::vector<IndexDay> followed =
         FollowIndex(days, thermal, IndexBandOptions{}, CusumOptionsOf(*in.config));
-    *onset_s = std::max(*onset_s, ChangeOnsetS(followed));
+    (thermal ? onset_th_s : onset_el_s) = ChangeOnsetS(followed);
+  }
+  *onset_s = std::max(onset_el_s, onset_th_s);
+  if (outputs != nullptr && *onset_s >= 0) {
+    // An output whose own change began earlier did not change on the days since.
+    *outputs = onset_el_s == onset_th_s ? "both" : onset_el_s > onset_th_s ? "p_el" : "q_th";
   }
   return true;
 }

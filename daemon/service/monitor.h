@@ -34,7 +34,9 @@ std::vector<std::pair<int, std::string>> RunDailyChecks(Store& store, const Dail
 // The first day of the plant's newest change that a performance alarm saw
 // (ChangeOnsetS over the days the alarm looks back on, the later of the two
 // outputs'), -1 when neither alarmed there; false on a storage error.
+// *outputs (when given): the outputs whose alarms dated that change, in
+// `pvtwin diagnose --objective`'s words: "p_el", "q_th", "both" ("": none).
 bool NewestChangeOnset(Store& store, const DailyCheckInputs& in, std::int64_t* onset_s,
-                       std::string* error);
+                       std::string* error, std::string* outputs = nullptr);
 
 }  // namespace pvtwin::cli

@@ -143,6 +143,11 @@ void NightlyDiagnosis::MaybeStart(const DiagnosisConfig& config, Store& store, c
   } else if (plan.since_change) {
     against = ", the base re-fitted on them (no accepted calibration ends before the change)";
   }
+  if (plan.since_change && (job.change_outputs == "p_el" || job.change_outputs == "q_th")) {
+    argv.insert(argv.end(), {"--objective", job.change_outputs});
+    against += std::string(", judged on ") + (job.change_outputs == "p_el" ? "P_el" : "Q_u") +
+               ", the output whose alarm dated the change";
+  }
   if (!child_.Start(argv, (work / "diagnose.log").string(), &error)) {
     Event(store, "diagnosis_failed", "diagnosis not started: " + error, log);
     return;

@@ -33,6 +33,10 @@ class NightlyDiagnosis {
     // The first day of the plant's newest change that a performance alarm
     // saw (monitor.h NewestChangeOnset); 0 or less: none.
     std::int64_t change_from = 0;
+    // The outputs whose alarms dated that change ("p_el", "q_th", "both";
+    // NewestChangeOnset): the diagnosis of the days since judges the
+    // candidates on them (`diagnose --objective`). "": both.
+    std::string change_outputs;
     std::int64_t solar_offset_s = 0;  // SolarDayOffsetS of the plant
     SolarPositionInput site;          // SiteAtStandardPressure of the plant
   };

@@ -37,7 +37,7 @@ void Service::MaybeStartDiagnosis() {
   checks.config = &config_;
   checks.spec = spec_;
   checks.now_s = job.now_s;
-  if (!cli::NewestChangeOnset(*store_, checks, &job.change_from, &error)) {
+  if (!cli::NewestChangeOnset(*store_, checks, &job.change_from, &error, &job.change_outputs)) {
     LogToStderr(kErr, "diagnosis: the performance alarm's days not read: " + error);
   }
   diagnosis_->MaybeStart(config_.diagnosis, *store_, job, LogToStderr);

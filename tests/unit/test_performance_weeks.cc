@@ -33,6 +33,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "core/fit/identification.h"
 #include "core/synth/synthetic_plant.h"
@@ -78,8 +80,14 @@ struct RunFigures {
   // The change's first day as the daemon dates it each night
   // (NewestChangeOnset; -1: none), by the night's number (day scored + 1).
   std::vector<int> onset_by_night = std::vector<int>(kWeeksDays + 1, -1);
+  // … and the outputs whose alarms dated it ("p_el", "q_th", "both", "").
+  std::vector<std::string> outputs_by_night = std::vector<std::string>(kWeeksDays + 1);
   int OnsetAtFirstAlarm() const {
     return first_alarm_day < 0 ? -1 : onset_by_night[static_cast<std::size_t>(first_alarm_day + 1)];
+  }
+  std::string OutputsAtFirstAlarm() const {
+    return first_alarm_day < 0 ? ""
+                               : outputs_by_night[static_cast<std::size_t>(first_alarm_day + 1)];
   }
 };
 
@@ -108,7 +116,9 @@ RunFigures Monitor(const Series& data, const ParamVector& params, const Config& 
     in.now_s = kJune1_2024UtcS + night * kDayS + 2 * 3600;
     RunDailyChecks(*store, in);
     std::int64_t onset_s = -1;
-    EXPECT_TRUE(NewestChangeOnset(*store, in, &onset_s, &error)) << error;
+    EXPECT_TRUE(NewestChangeOnset(*store, in, &onset_s, &error,
+                                  &f.outputs_by_night[static_cast<std::size_t>(night)]))
+        << error;
     f.onset_by_night[static_cast<std::size_t>(night)] =
         onset_s < 0 ? -1 : static_cast<int>((onset_s - kJune1_2024UtcS) / kDayS);
   }
@@ -196,6 +206,10 @@ void CheckSeeds(const std::vector<std::uint64_t>& seeds, bool coverage) {
     // the diagnosis's window) neither before the switch nor after the alarm.
     EXPECT_GE(s.OnsetAtFirstAlarm(), kSwitchDay) << "seed " << seed;
     EXPECT_LE(s.OnsetAtFirstAlarm(), s.first_alarm_day) << "seed " << seed;
+    // The inverter's clipped power stays in the collector as heat: the
+    // electricity changed, the heat did not fall, and the diagnosis of the
+    // days since judges the candidates on P_el.
+    EXPECT_EQ(s.OutputsAtFirstAlarm(), "p_el") << "seed " << seed;
     banded_el += h.banded_el, hold_el += h.hold_el;
     banded_th += h.banded_th, hold_th += h.hold_th;
   }

@@ -226,6 +226,17 @@ std::vector<EffectCandidate> SelectCandidates(const TrialInputs& in, const Model
              options.effects.end();
     });
   }
+  // Against the plant before a change: only what can begin while the plant
+  // runs can be what changed.
+  if (options.reference_params) {
+    std::erase_if(candidates, [&skipped](const EffectCandidate& c) {
+      if (c.module->begins_in_operation) return false;
+      skipped.push_back({c.name,
+                         "a property of the collector's build, in the plant before the change "
+                         "as after it: it cannot be what changed"});
+      return true;
+    });
+  }
   // An effect that needs more training days than there are (a drift over days).
   std::erase_if(candidates, [&skipped, train_days](const EffectCandidate& c) {
     if (train_days >= c.module->min_train_days) return false;

@@ -162,8 +162,13 @@ struct DiagnosisOptions {
   // which structure the plant has and the model lacks: that structure is in
   // both states, and a base re-fitted on the few days since a change lets it
   // compete with the change (doc/validation.md, the weeks after an alarm).
-  // The daemon sets it to its accepted calibration of the window before a
-  // performance alarm's change (`pvtwin diagnose --against-calibration`).
+  // For the same reason only the effects that can begin while the plant runs
+  // are tried (EffectModule::begins_in_operation: clipping, shading,
+  // soiling, a sensor's or a clock's fault); a property of the collector's
+  // build (an IAM, a transport delay) is in both states and goes to
+  // `skipped`. The daemon sets it to its accepted calibration of the window
+  // before a performance alarm's change (`pvtwin diagnose
+  // --against-calibration`).
   // Empty: the base is fitted on the training days.
   std::optional<ParamVector> reference_params;
   // Where reference_params come from, for the notes ("calibration 12, window

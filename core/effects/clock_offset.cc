@@ -182,6 +182,8 @@ const EffectModule& ClockOffsetEffect() {
     m.source = "IEC 61724-1 (PV performance monitoring: synchronised time stamps of all channels)";
     m.params = EffectParams(Effect::kClockOffset);
     m.typical_truth = {{Param::kClockOffsetS, 300.0}};
+    // A logger restarted without time synchronisation, a time zone changed.
+    m.begins_in_operation = true;
     m.signature = "rate of change of the absorbed irradiance, W/m² per minute";
     m.advice =
         "Synchronise the loggers' clocks (NTP) and check their time zones; until then "

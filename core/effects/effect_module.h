@@ -180,6 +180,14 @@ struct EffectModule {
   std::vector<double> (*signature_values)(const Drivers& drivers, const SimOutputs& base) = nullptr;
 
   // --- Diagnosis ---
+  // Whether the effect can begin from one day to the next while the plant
+  // runs (an inverter limit set, an obstacle put up, dust after a dry spell,
+  // a sensor or logger clock that fails), and so be what a performance
+  // alarm dated. False for a property of the collector's build (its
+  // capacities, nodes, heat-loss and optical coefficients, pipe volume):
+  // it is in the plant before a change as after, so the diagnosis of a
+  // change (DiagnosisOptions::reference_params) does not try it.
+  bool begins_in_operation = false;
   // Fewest training days on which the effect can be seen, and why.
   int min_train_days = 0;
   std::string_view min_train_days_why;

@@ -165,6 +165,8 @@ const EffectModule& IrradianceBiasEffect() {
     m.params = EffectParams(Effect::kIrradianceBias);
     m.needs = {Channel::kGhiWM2, Channel::kDhiWM2};
     m.typical_truth = {{Param::kIrradianceBias, 0.06}};
+    // A pyranometer knocked out of level, soiled or exchanged.
+    m.begins_in_operation = true;
     m.signature = "transposed GHI/DHI minus measured plane-of-array irradiance, W/m²";
     m.advice =
         "Clean, level and recalibrate the plane-of-array pyranometer (or compare it with a "

@@ -138,6 +138,8 @@ const EffectModule& PvClippingEffect() {
         "Dobos 2014, PVWatts Version 5 Manual (NREL/TP-6A20-62641): P_ac = min(P_dc·η, P_ac0)";
     m.params = EffectParams(Effect::kPvClipping);
     m.typical_truth = {{Param::kPLimitWM2, 120.0}};
+    // An inverter replaced, re-rated or set to a feed-in limit.
+    m.begins_in_operation = true;
     m.signature = "base model P_el per m² (evidence above the limit)";
     m.advice =
         "Check the inverter's AC limit against the array: clipped electricity stays in "

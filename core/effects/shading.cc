@@ -468,6 +468,8 @@ const EffectModule& ShadingEffect() {
                        {Param::kShadeWidthRad, DegToRad(40.0)},
                        {Param::kShadeElevationRad, DegToRad(35.0)},
                        {Param::kShadeMismatch, 0.6}};
+    // Scaffolding, a parked vehicle, a new building or a crown in leaf.
+    m.begins_in_operation = true;
     // The window's far edge is not determined by summer data; the mismatch is.
     m.compared_param = Param::kShadeMismatch;
     m.signature = "beam irradiance in the plane, W/m² (localise by sun azimuth × elevation)";

@@ -114,6 +114,8 @@ const EffectModule& SoilingEffect() {
         "recovery: cleanings from the performance index)";
     m.params = EffectParams(Effect::kSoiling);
     m.typical_truth = {{Param::kSoilingPerDay, 0.004}};
+    // Dust after a dry spell, pollen, a nearby building site.
+    m.begins_in_operation = true;
     m.signature = "days since the last cleaning";
     m.advice =
         "Clean the collector front and log cleanings and heavy rain; the loss grows by "

@@ -609,8 +609,8 @@ void RegisterDiagnose(CLI::App& app) {
   cmd->add_option("--against-params", args->against_params,
                   "params.json of the plant before a change (as calibrate --out writes it): the "
                   "base model keeps these parameters, and each effect fits only its own, so the "
-                  "verdict says which effect explains what changed (default: fit the base on the "
-                  "training days)");
+                  "verdict says which effect explains what changed; only effects that can begin "
+                  "while the plant runs are tried (default: fit the base on the training days)");
   cmd->add_option("--against-calibration", args->against_calibration,
                   "with --db: as --against-params, with the parameters of this accepted "
                   "calibration of the store (pvtwin run passes the one before a performance "

@@ -239,9 +239,10 @@ bool DiagnoseOnce(const Series& data_in, const Plant& plant, const ModelSpec& ba
   if (options.selection_outputs != SelectionOutputs::kBoth) {
     r.notes.push_back(std::string("the model selection compares the held-out MAE of ") +
                       (options.selection_outputs == SelectionOutputs::kPEl ? "P_el" : "Q_u") +
-                      " only, the output whose change is diagnosed (an effect that leaves it as "
-                      "it was explains none of the change); the shrinks reported are those of "
-                      "MAE P_el + Q_u");
+                      " only at the first step, the output whose change is diagnosed (an "
+                      "effect that leaves it as it was explains none of the change), and MAE "
+                      "P_el + Q_u at later steps (the rest of the gap, which no alarm dated); "
+                      "the shrinks reported are those of MAE P_el + Q_u");
   }
 
   st::TrialInputs trials;

@@ -195,7 +195,9 @@ struct DiagnosisOptions {
   // however much of the other output's error it takes. The daemon sets it
   // to the outputs whose alarms dated the change (`pvtwin diagnose
   // --objective p_el`). min_shrink_pct applies to it; shrink_pct and the
-  // report's errors stay those of both outputs.
+  // report's errors stay those of both outputs. It holds for the first
+  // ladder step, whose effect explains the change; a later step explains
+  // the rest of the gap, which no alarm dated, and is judged on both.
   SelectionOutputs selection_outputs = SelectionOutputs::kBoth;
   // Effects to try (names of the vocabulary); empty = every candidate.
   std::vector<std::string> effects;

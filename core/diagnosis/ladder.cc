@@ -275,6 +275,12 @@ LadderModel RunLadder(const TrialInputs& in, const ModelSpec& base, DiagnosisRes
   // The forms' fits on the reference days at the first step, for the later ones.
   std::map<std::string, ParamVector> before_change;
   TrialInputs step_in = in;
+  // DiagnosisOptions::selection_outputs names the output a change showed
+  // on: the first step's effect is what explains it. What a later step adds
+  // explains the rest of the gap, which no alarm dated: it is judged as any
+  // diagnosis is, on the paper's objective of both outputs.
+  DiagnosisOptions later_steps = *in.options;
+  later_steps.selection_outputs = SelectionOutputs::kBoth;
   for (int step = 1; step <= in.options->max_ladder_steps; ++step) {
     StepTrials st = TryCandidates(step_in, step, current);
     if (step == 1 && in.reference != nullptr) {
@@ -310,6 +316,7 @@ LadderModel RunLadder(const TrialInputs& in, const ModelSpec& base, DiagnosisRes
       break;
     }
     if (best == st.trials.size()) break;
+    step_in.options = &later_steps;
     EffectTrial& chosen = st.trials[best];
     chosen.accepted_at_step = step;
     Accept(step, chosen, st.scores[best], &r);

@@ -621,8 +621,9 @@ void RegisterDiagnose(CLI::App& app) {
       ->default_str("none");
   cmd->add_option("--objective", args->objective,
                   "the outputs whose held-out MAE the model selection compares: both (the "
-                  "paper's objective), or the one whose change is diagnosed, p_el or q_th "
-                  "(pvtwin run passes the output whose performance alarm dated the change)")
+                  "paper's objective), or the one whose change is diagnosed, p_el or q_th, at "
+                  "the first ladder step, both at later ones (pvtwin run passes the output "
+                  "whose performance alarm dated the change)")
       ->check(CLI::IsMember({"both", "p_el", "q_th"}))
       ->capture_default_str();
   cmd->callback([args] { SetExitCode(RunDiagnose(*args)); });

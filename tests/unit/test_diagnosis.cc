@@ -827,6 +827,42 @@ TEST(DiagnosisSelection, JudgedOnPelAnEffectOnTheHeatAloneGainsNothing) {
   }));
 }
 
+// The output a change showed on judges the first step only. On the example
+// plant with an inverter that clips, judged on Q_u with min_shrink_pct 5 %,
+// the transport delay the daemon's model lacks is accepted first; the
+// clipping, which takes most of P_el's error and less than 5 % of Q_u's, is
+// accepted at the second step on both outputs' error.
+TEST(DiagnosisSelection, ALaterStepIsJudgedOnBothOutputs) {
+  const Plant plant = DesignExamplePlant();
+  const Series days =
+      ExamplePlantDays(plant, std::string(testing::kExamplePlantTruth) + "+pv_clipping");
+  const ModelSpec base = testing::SpecOf(testing::kExampleDaemonModel);
+  DiagnosisOptions o;
+  o.train_days = 10;
+  o.heldout_days = 6;
+  o.effects = {"pv_clipping", "transport_delay"};
+  o.max_ladder_steps = 2;
+  o.selection_outputs = SelectionOutputs::kQTh;
+  o.min_shrink_pct = 5.0;
+  DiagnosisResult r;
+  std::string error;
+  ASSERT_TRUE(Diagnose(days, plant, base, o, &r, &error)) << error;
+  std::vector<std::string> added;
+  for (const LadderStep& s : r.ladder) {
+    if (!s.added.empty()) added.push_back(s.added);
+  }
+  EXPECT_EQ(added, (std::vector<std::string>{"transport_delay", "pv_clipping"}));
+  for (const EffectTrial& t : r.effects) {
+    std::printf("%s at step %d: MAE P_el %.3f → %.3f W, Q_u %.3f → %.3f W\n", t.name.c_str(),
+                t.accepted_at_step, t.mae_p_el_before_w, t.mae_p_el_after_w, t.mae_q_th_before_w,
+                t.mae_q_th_after_w);
+    if (t.name == "pv_clipping") {
+      EXPECT_LT(t.mae_p_el_after_w, 0.7 * t.mae_p_el_before_w) << t.evidence;
+      EXPECT_GT(t.mae_q_th_after_w, 0.95 * t.mae_q_th_before_w) << t.evidence;
+    }
+  }
+}
+
 // `pvtwin diagnose --db … --against-calibration ID` reads the days of that
 // calibration's window from the store as the days of the reference
 // (DiagnosisOptions::reference_days): every candidate's entry in report.json

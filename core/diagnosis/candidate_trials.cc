@@ -247,6 +247,12 @@ std::vector<EffectCandidate> SelectCandidates(const TrialInputs& in, const Model
   return candidates;
 }
 
+// The parameters a form adds to the model it is added to: those its fit
+// against the plant before a change frees (FitForm).
+std::bitset<kNumParams> OwnParams(const ModelSpec& spec, const LadderModel& current) {
+  return DefaultFreeParams(spec) & ~UsedParams(current.spec);
+}
+
 // The fit of one form of a candidate on the training days.
 struct FormFit {
   Part train;
@@ -283,7 +289,7 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
   }
   // Against the plant before a change: only what the effect adds is fitted.
   DiagnosisOptions own = *in.options;
-  own.ident.free = DefaultFreeParams(spec) & ~UsedParams(current.spec);
+  own.ident.free = OwnParams(spec, current);
   if (own.ident.free.none()) {  // a form without parameters of its own
     f.fit.ok = true;
     f.fit.variant = spec.Name();
@@ -322,12 +328,6 @@ struct ScoredForm {
   std::optional<ParamVector> before_change_params;  // what before_change was scored with
   std::pair<std::string, ParamVector> before_change_fit;
 };
-
-// The parameters a form adds to the model it is added to: those its fit
-// against the plant before a change frees (FitForm).
-std::bitset<kNumParams> OwnParams(const ModelSpec& spec, const LadderModel& current) {
-  return DefaultFreeParams(spec) & ~UsedParams(current.spec);
-}
 
 // The form's own parameters fitted on the reference days with the rest of
 // the model held at the current one (the plant before the change), started
@@ -431,8 +431,8 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
     f.selection_w = f.objective_w;
     if (in.reference != nullptr) {
       ScoreBeforeChange(in, current, before, &f);
-      const double before_change_w = SelectionObjectiveW(f.before_change, inside, loss);
-      if (before_change_w < current_w) f.selection_w += current_w - before_change_w;
+      f.selection_w = CountedObjective(f.objective_w, current_w,
+                                       SelectionObjectiveW(f.before_change, inside, loss));
     }
     if (!std::isfinite(out[*best].selection_w) || f.selection_w < out[*best].selection_w) {
       *best = k;

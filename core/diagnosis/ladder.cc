@@ -110,8 +110,7 @@ double Confidences(const TrialInputs& in, int step, const Score& current, StepTr
       for (std::size_t j = 0; j < losses[k].size(); ++j) {
         double o = objective(losses[k][j]);
         if (!before_change[k][j].loss.empty()) {
-          const double o_before = objective(before_change[k][j]);
-          if (o_before < before) o += before - o_before;
+          o = CountedObjective(o, before, objective(before_change[k][j]));
         }
         if (!std::isnan(o) && !(o >= after)) after = o;  // the lowest finite
       }

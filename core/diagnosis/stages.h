@@ -90,6 +90,14 @@ Loss SelectionLoss(const DiagnosisOptions& options);
 // only those with inside[i] ≠ 0 when `inside` is not empty
 // (RowsInsideTrainingRange). NaN without rows.
 double SelectionObjectiveW(const Score& score, const std::vector<std::uint8_t>& inside, Loss which);
+// What the model selection counts of a candidate with its parameters of
+// before a change (DiagnosisOptions::reference_days): its objective plus
+// what it gains there over the current model, so that only its gain beyond
+// the better of the two counts; the objective itself when the form of
+// before is no better than the current model or was not scored (NaN).
+inline double CountedObjective(double objective, double current, double before_change) {
+  return before_change < current ? objective + (current - before_change) : objective;
+}
 
 // One-sided paired test of the per-unit objectives: is `after` lower?
 PairedTest CompareUnits(const Score& before, const Score& after);

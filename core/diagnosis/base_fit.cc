@@ -56,9 +56,18 @@ bool FitBase(const Split& split, const Plant& plant, const ModelSpec& base,
                       "one over " +
                       std::to_string(options.min_test_units) + "+ days");
   }
-  progress("diagnosis: " + std::to_string(train_days) + " training days, " +
-           std::to_string(heldout_days) + " held-out days, step " + FixedDecimals(r.step_s, 0) +
-           " s; " +
+  if (split.folds > 0) {
+    r.notes.push_back("each of the " + std::to_string(split.folds) +
+                      " days is held out in turn: a candidate's own parameters are fitted on the "
+                      "other " +
+                      std::to_string(split.folds - 1) +
+                      " days and it is scored on that day, so that every day is a held-out day");
+  }
+  progress("diagnosis: " +
+           (split.folds > 0 ? "each of " + std::to_string(heldout_days) + " days held out in turn"
+                            : std::to_string(train_days) + " training days, " +
+                                  std::to_string(heldout_days) + " held-out days") +
+           ", step " + FixedDecimals(r.step_s, 0) + " s; " +
            (options.reference_params ? "the base model " + r.base_variant +
                                            " keeps the parameters of " + options.reference_name
                                      : "fitting the base model " + r.base_variant));

@@ -259,7 +259,29 @@ struct FormFit {
   IdentSummary fit;
   std::vector<RefittedParam> refitted;  // parameters re-fitted in their physical range
   std::string failure;  // the part could not be prepared
+  // With Split::folds: per fold, the parameters fitted without its day.
+  std::vector<ParamVector> fold_params;
 };
+
+// `to` with the parameters in `own` taken from `from`.
+ParamVector WithOwn(ParamVector to, const ParamVector& from, const std::bitset<kNumParams>& own) {
+  for (std::size_t p = 0; p < kNumParams; ++p) {
+    if (own.test(p)) to[p] = from[p];
+  }
+  return to;
+}
+
+// Per fold of the ladder's current model: `params` (a form's whole model)
+// with the rest of the model as that fold's, its own parameters as given.
+std::vector<ParamVector> PerFold(const Plant& plant, const LadderModel& current,
+                                 const ModelSpec& spec, const ParamVector& params) {
+  std::vector<ParamVector> out;
+  const std::bitset<kNumParams> own = OwnParams(spec, current);
+  for (const ParamVector& fold : current.fold_params) {
+    out.push_back(WithOwn(MergedStart(plant, current.spec, fold), params, own));
+  }
+  return out;
+}
 
 // Re-identifies `spec` on the training days from the current model's
 // parameters (and the module's start from the base model's residuals).
@@ -267,6 +289,9 @@ struct FormFit {
 // fit also starts from them and keeps the lower training cost: the effect
 // as it was is one state the days since may show, and a fit from the
 // residuals alone can end in another local minimum (an obstacle's box).
+// With each day held out in turn (Split::folds), the same fit is also made
+// once per fold on the other days, from that fold's current model and from
+// the base model's residuals there (FormFit::fold_params).
 FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectModule& effect,
                 const ModelSpec& spec, const std::optional<ParamVector>& before) {
   FormFit f;
@@ -276,11 +301,17 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
     if (f.failure.empty()) f.failure = "the training days cannot be prepared";
     return f;
   }
-  ParamVector start = MergedStart(plant, current.spec, current.params);
-  if (effect.start_from_residuals != nullptr) {
-    effect.start_from_residuals(
-        ResidualsForStart(in.base->train.drivers, in.base->train_sim, in.base->train.meas), &start);
-  }
+  // The start: the current model, the effect's own from the base model's
+  // residuals on the rows fitted (`base_meas`).
+  auto start_from = [&](const ParamVector& current_params, const Measurements& base_meas) {
+    ParamVector start = MergedStart(plant, current.spec, current_params);
+    if (effect.start_from_residuals != nullptr) {
+      effect.start_from_residuals(
+          ResidualsForStart(in.base->train.drivers, in.base->train_sim, base_meas), &start);
+    }
+    return start;
+  };
+  const ParamVector start = start_from(current.params, in.base->train.meas);
   if (!in.options->reference_params) {
     RangedFit ranged = IdentifyInRanges(f.train.drivers, f.train.meas, start, *in.options);
     f.fit = std::move(ranged.fit);
@@ -290,20 +321,47 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
   // Against the plant before a change: only what the effect adds is fitted.
   DiagnosisOptions own = *in.options;
   own.ident.free = OwnParams(spec, current);
+  const std::vector<ParamVector> before_folds =
+      before ? PerFold(plant, current, spec, *before) : std::vector<ParamVector>{};
   if (own.ident.free.none()) {  // a form without parameters of its own
     f.fit.ok = true;
     f.fit.variant = spec.Name();
     f.fit.params = start;
+    for (const ParamVector& fold : current.fold_params) {
+      f.fold_params.push_back(MergedStart(plant, current.spec, fold));
+    }
     return f;
   }
-  RangedFit ranged = IdentifyInRanges(f.train.drivers, f.train.meas, start, own);
-  if (before) {
-    RangedFit from_before = IdentifyInRanges(f.train.drivers, f.train.meas, *before, own);
-    if (from_before.fit.ok &&
-        (!ranged.fit.ok || from_before.fit.final_cost_w_m2 < ranged.fit.final_cost_w_m2)) {
-      from_before.fit.runtime_s += ranged.fit.runtime_s;
-      ranged = std::move(from_before);
+  auto fit = [&](const Measurements& meas, const ParamVector& from,
+                 const ParamVector* from_before) {
+    RangedFit ranged = IdentifyInRanges(f.train.drivers, meas, from, own);
+    if (from_before != nullptr) {
+      RangedFit other = IdentifyInRanges(f.train.drivers, meas, *from_before, own);
+      if (other.fit.ok &&
+          (!ranged.fit.ok || other.fit.final_cost_w_m2 < ranged.fit.final_cost_w_m2)) {
+        other.fit.runtime_s += ranged.fit.runtime_s;
+        ranged = std::move(other);
+      }
     }
+    return ranged;
+  };
+  RangedFit ranged = fit(f.train.meas, start, before ? &*before : nullptr);
+  // Each day held out in turn: the fit of each fold reads the other days.
+  for (std::size_t d = 0; ranged.fit.ok && d < current.fold_params.size(); ++d) {
+    const int fold = static_cast<int>(d);
+    const RangedFit without =
+        fit(WithoutFold(f.train.meas, *in.split, fold),
+            start_from(current.fold_params[d], WithoutFold(in.base->train.meas, *in.split, fold)),
+            before ? &before_folds[d] : nullptr);
+    ranged.fit.runtime_s += without.fit.runtime_s;
+    if (!without.fit.ok) {
+      ranged.fit.ok = false;
+      ranged.fit.failure_reason = "the fit without the day " +
+                                  SolarDate(in.split->day_starts[d], in.split->offset_s) +
+                                  " failed: " + without.fit.failure_reason;
+      break;
+    }
+    f.fold_params.push_back(without.fit.params);
   }
   f.fit = std::move(ranged.fit);
   f.refitted = std::move(ranged.refitted);
@@ -390,7 +448,9 @@ void ScoreBeforeChange(const TrialInputs& in, const LadderModel& current,
     f->before_change = f->score;
     f->before_change_params = f->fit.fit.params;
   } else if (before) {
-    f->before_change = ScoreHeldout(f->heldout, *before, in.base->units, in.plant->area_m2);
+    f->before_change = ScoreModel(*in.split, f->heldout, *before,
+                                  PerFold(*in.plant, current, f->form.spec, *before),
+                                  in.base->units, in.plant->area_m2);
     f->before_change_params = *before;
   }
 }
@@ -426,7 +486,8 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
       continue;
     }
     if (!f.fit.fit.ok) continue;
-    f.score = ScoreHeldout(f.heldout, f.fit.fit.params, in.base->units, in.plant->area_m2);
+    f.score = ScoreModel(*in.split, f.heldout, f.fit.fit.params, f.fit.fold_params, in.base->units,
+                         in.plant->area_m2);
     f.objective_w = SelectionObjectiveW(f.score, inside, loss);
     f.selection_w = f.objective_w;
     if (in.reference != nullptr) {
@@ -450,7 +511,8 @@ std::vector<ScoredForm> FitAndScoreForms(const TrialInputs& in, const LadderMode
 void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
                   EffectCandidate* candidate, EffectTrial* trial, Score* score,
                   std::vector<Score>* form_scores, std::vector<Score>* before_change_scores,
-                  std::vector<std::pair<std::string, ParamVector>>* before_change_fits) {
+                  std::vector<std::pair<std::string, ParamVector>>* before_change_fits,
+                  std::vector<ParamVector>* fold_params) {
   EffectCandidate& c = *candidate;
   EffectTrial& t = *trial;
   const Plant& plant = *in.plant;
@@ -525,7 +587,8 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
     t.failure = "identification failed: " + fit.failure_reason;
     return;
   }
-  *score = ScoreHeldout(ho, fit.params, in.base->units, plant.area_m2);
+  *score = ScoreModel(*in.split, ho, fit.params, best.fold_params, in.base->units, plant.area_m2);
+  *fold_params = best.fold_params;
   if (!std::isfinite((*score).errors.objective_w_m2())) {
     t.failure = "non-finite held-out outputs";
     form_scores->clear();
@@ -646,12 +709,14 @@ StepTrials TryCandidates(const TrialInputs& in, int step, const LadderModel& cur
   out.form_scores.resize(candidates.size());
   out.before_change_scores.resize(candidates.size());
   out.before_change_fits.resize(candidates.size());
+  out.fold_params.resize(candidates.size());
   std::atomic<std::size_t> next{0};
   std::atomic<int> done{0};
   auto worker = [&] {
     for (std::size_t k = next++; k < candidates.size(); k = next++) {
       TryCandidate(in, step, current, &candidates[k], &out.trials[k], &out.scores[k],
-                   &out.form_scores[k], &out.before_change_scores[k], &out.before_change_fits[k]);
+                   &out.form_scores[k], &out.before_change_scores[k], &out.before_change_fits[k],
+                   &out.fold_params[k]);
       const int finished = ++done;
       in.progress(ProgressLine(step, finished, candidates.size(), out.trials[k], in.test_unit));
     }

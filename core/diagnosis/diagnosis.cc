@@ -134,7 +134,8 @@ std::string EffectWithoutFaultyDays(const Series& data, const Plant& plant, cons
                                     const diagnosis_stages::Split& split,
                                     const std::vector<SensorFinding>& steps, DiagnosisResult* r) {
   if (r->ladder.size() < 2) return "";
-  const std::int64_t heldout_start_s = split.day_starts[static_cast<std::size_t>(split.train_days)];
+  const std::int64_t heldout_start_s =
+      split.day_starts[static_cast<std::size_t>(split.FirstHeldoutDay())];
   const SensorFinding* first = nullptr;
   for (const SensorFinding& f : steps) {
     if ((f.kind != "offset_step" && f.kind != "scale") || f.from_s <= heldout_start_s) continue;
@@ -149,8 +150,10 @@ std::string EffectWithoutFaultyDays(const Series& data, const Plant& plant, cons
   std::string outcome = "no held-out day lies before it";
   if (clean_days > 0) {
     DiagnosisOptions before = options;
-    before.train_days = split.train_days;
-    before.heldout_days = clean_days;
+    if (split.folds == 0) {  // the same training days; else each day before it in turn
+      before.train_days = split.train_days;
+      before.heldout_days = clean_days;
+    }
     DiagnosisResult clean;
     std::string why;
     const bool ok = DiagnoseOnce(data.Slice(0, data.RowAtOrAfter(first->from_s)), plant, base,
@@ -280,7 +283,7 @@ bool DiagnoseOnce(const Series& data_in, const Plant& plant, const ModelSpec& ba
     r.separation.clear();
     for (EffectTrial& t : r.effects) t.accepted_at_step = 0;
     r.final_variant = base.Name();
-    final_model = st::LadderModel{base, base_fit.params, base_fit.score};
+    final_model = st::LadderModel{base, base_fit.params, base_fit.score, {}};
   }
   r.sensors.insert(r.sensors.begin(), std::make_move_iterator(steps.begin()),
                    std::make_move_iterator(steps.end()));

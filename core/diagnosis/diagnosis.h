@@ -6,6 +6,9 @@
 //  1. Split: the first train_days days of the data are the training days,
 //     the next heldout_days days the held-out days. Each part gets its own
 //     drivers; states start at the steady state of each part's first row.
+//     Against the plant before a change with neither given, each day is held
+//     out in turn instead: the base model is not fitted, and each candidate
+//     is fitted once per day on the other days and scored on that day.
 //  2. Base: identify the base variant on the training days (Identify from
 //     StartParams; against the plant before a change, keep
 //     DiagnosisOptions::reference_params instead) and simulate the held-out
@@ -80,7 +83,9 @@ bool ParseSelectionOutputs(std::string_view text, SelectionOutputs* out);
 
 struct DiagnosisOptions {
   // Training days from the first day of data; 0 = two thirds of the days
-  // (rounded, at least 1, leaving at least 1 held-out day).
+  // (rounded, at least 1, leaving at least 1 held-out day). With
+  // reference_params and both 0, every day is held out in turn (the
+  // candidates' own parameters fitted on the other days).
   int train_days = 0;
   // Held-out days after the training days; 0 = all remaining days.
   int heldout_days = 0;

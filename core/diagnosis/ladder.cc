@@ -260,6 +260,7 @@ LadderModel RunLadder(const TrialInputs& in, const ModelSpec& base, DiagnosisRes
   current.spec = base;
   current.params = in.base->params;
   current.score = in.base->score;
+  current.fold_params.assign(static_cast<std::size_t>(in.split->folds), in.base->params);
   if (in.extrapolation != nullptr && !in.extrapolation->empty()) {
     const std::vector<std::uint8_t> inside =
         RowsInsideTrainingRange(in.base->heldout.drivers, *in.extrapolation);
@@ -322,6 +323,7 @@ LadderModel RunLadder(const TrialInputs& in, const ModelSpec& base, DiagnosisRes
     current.spec = st.candidates[best].spec;
     current.params = chosen.params;
     current.score = std::move(st.scores[best]);
+    current.fold_params = std::move(st.fold_params[best]);
     in.progress("accepted +" + chosen.name + ": " + chosen.variant);
   }
   r.final_variant = current.spec.Name();

@@ -48,7 +48,7 @@ void BuildDays(const Split& split, const BaseFit& base, const LadderModel& final
                double area_m2, std::vector<DiagnosisDay>* days) {
   const Series& train_series = split.train_series;
   const Series& heldout_series = split.heldout_series;
-  const int train_days = split.train_days;
+  const int first_heldout = split.FirstHeldoutDay();
   const int heldout_days = split.heldout_days;
   const std::vector<std::int64_t>& day_starts = split.day_starts;
   const std::int64_t offset_s = split.offset_s;
@@ -56,11 +56,11 @@ void BuildDays(const Split& split, const BaseFit& base, const LadderModel& final
   const Part& base_heldout = base.heldout;
   const Score& base_score = base.score;
   const Score& current_score = final_model.score;
-  for (int k = 0; k < train_days + heldout_days; ++k) {
+  for (int k = 0; k < first_heldout + heldout_days; ++k) {
     DiagnosisDay day;
     day.start_s = day_starts[static_cast<std::size_t>(k)];
     day.date = SolarDate(day.start_s, offset_s);
-    day.heldout = k >= train_days;
+    day.heldout = k >= first_heldout;
     const Measurements& m = day.heldout ? base_heldout.meas : base_train.meas;
     const Series& s = day.heldout ? heldout_series : train_series;
     double base_sum = 0.0, final_sum = 0.0;

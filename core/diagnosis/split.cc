@@ -20,6 +20,26 @@ bool SplitDays(const Series& data, const Plant& plant, const DiagnosisOptions& o
              " local solar day; the diagnosis needs at least one training and one held-out day";
     return false;
   }
+  split->offset_s = offset_s;
+  split->day_starts = day_starts;
+  split->data_start_s = data.time_s.front();
+  split->cleanings = DetectCleanings(data, plant);
+  if (CrossFitted(options)) {
+    // Every day held out in turn: each fold trains on the other days.
+    split->folds = n_days;
+    split->train_days = n_days - 1;
+    split->heldout_days = n_days;
+    split->train_series = data;
+    split->heldout_series = data;
+    split->fold_of_row.resize(data.size());
+    std::size_t day = 0;
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      const std::int64_t d = SolarDayStartS(data.time_s[i], offset_s);
+      while (day_starts[day] != d) ++day;
+      split->fold_of_row[i] = static_cast<int>(day);
+    }
+    return true;
+  }
   int train_days = options.train_days;
   if (train_days == 0)
     train_days = std::clamp(static_cast<int>(std::lround(n_days * 2.0 / 3.0)), 1, n_days - 1);
@@ -34,17 +54,10 @@ bool SplitDays(const Series& data, const Plant& plant, const DiagnosisOptions& o
   const std::int64_t train_end_s = day_starts[static_cast<std::size_t>(train_days)];
   const std::int64_t heldout_end_s =
       day_starts[static_cast<std::size_t>(train_days + heldout_days - 1)] + kSecondsPerDay;
-  const std::int64_t data_start_s = data.time_s.front();
-  const Series train_series = data.Slice(0, data.RowAtOrAfter(train_end_s));
-  const Series heldout_series = data.Between(train_end_s, heldout_end_s);
-  split->offset_s = offset_s;
-  split->day_starts = day_starts;
   split->train_days = train_days;
   split->heldout_days = heldout_days;
-  split->data_start_s = data_start_s;
-  split->train_series = train_series;
-  split->heldout_series = heldout_series;
-  split->cleanings = DetectCleanings(data, plant);
+  split->train_series = data.Slice(0, data.RowAtOrAfter(train_end_s));
+  split->heldout_series = data.Between(train_end_s, heldout_end_s);
   return true;
 }
 

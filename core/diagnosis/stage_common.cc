@@ -1,4 +1,6 @@
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "core/diagnosis/stages.h"
 
@@ -28,8 +30,50 @@ bool PreparePart(const Series& s, const Plant& plant, const ModelSpec& spec,
 
 Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& units,
                    double area_m2) {
+  SimOutputs sim;
+  Simulate(heldout.drivers, params, &sim);
+  return ScoreSim(heldout, std::move(sim), units, area_m2);
+}
+
+Score ScoreModel(const Split& split, const Part& heldout, const ParamVector& params,
+                 const std::vector<ParamVector>& fold_params, const Units& units, double area_m2) {
+  if (fold_params.empty()) return ScoreHeldout(heldout, params, units, area_m2);
+  // Every fold's model runs over all days (its states pass through the
+  // other days as they would in operation); each row is taken from the
+  // model of its own fold.
+  SimOutputs all;
+  SimOutputs fold;
+  for (std::size_t d = 0; d < fold_params.size(); ++d) {
+    Simulate(heldout.drivers, fold_params[d], d == 0 ? &all : &fold);
+    if (d == 0) continue;
+    for (std::size_t i = 0; i < split.fold_of_row.size() && i < all.p_el_w.size(); ++i) {
+      if (split.fold_of_row[i] != static_cast<int>(d)) continue;
+      for (std::vector<double> SimOutputs::*out :
+           {&SimOutputs::p_el_w, &SimOutputs::q_th_w, &SimOutputs::t_pv_c, &SimOutputs::t_coll_c,
+            &SimOutputs::t_out_c}) {
+        if (i < (all.*out).size() && i < (fold.*out).size()) (all.*out)[i] = (fold.*out)[i];
+      }
+    }
+  }
+  return ScoreSim(heldout, std::move(all), units, area_m2);
+}
+
+bool CrossFitted(const DiagnosisOptions& options) {
+  return options.reference_params.has_value() && options.train_days == 0 &&
+         options.heldout_days == 0;
+}
+
+Measurements WithoutFold(const Measurements& m, const Split& split, int fold) {
+  Measurements out = m;
+  std::erase_if(out.rows, [&split, fold](std::uint32_t i) {
+    return i < split.fold_of_row.size() && split.fold_of_row[i] == fold;
+  });
+  return out;
+}
+
+Score ScoreSim(const Part& heldout, SimOutputs sim, const Units& units, double area_m2) {
   Score score;
-  Simulate(heldout.drivers, params, &score.sim);
+  score.sim = std::move(sim);
   score.errors = ComputeErrors(heldout.meas, score.sim, area_m2);
   const auto n_units = static_cast<std::size_t>(units.count);
   std::vector<double>& sum = score.unit_loss_w;

@@ -78,6 +78,8 @@ struct Score {
 
 Score ScoreHeldout(const Part& heldout, const ParamVector& params, const Units& units,
                    double area_m2);
+// The held-out scores of the outputs `sim` of a model on `heldout`.
+Score ScoreSim(const Part& heldout, SimOutputs sim, const Units& units, double area_m2);
 
 // A per-row held-out loss of a Score: the sum |e_P_el| + |e_Q_u|, P_el's or Q_u's.
 enum class Loss { kSum, kPEl, kQTh };
@@ -133,7 +135,26 @@ struct Split {
   Series train_series, heldout_series;
   // Cleanings the whole data show (DetectCleanings), for both parts.
   std::vector<Cleaning> cleanings;
+  // Each day held out in turn (against the plant before a change with the
+  // split left automatic, CrossFitted): both parts are all the data, a
+  // candidate is fitted once per fold, on every day but the fold's, and
+  // scored on the fold's day. folds = the days; fold_of_row[i] = row i's
+  // day (0, 1, …). folds = 0 and fold_of_row empty for one split.
+  int folds = 0;
+  std::vector<int> fold_of_row;
+  // The first held-out day of day_starts.
+  int FirstHeldoutDay() const { return folds > 0 ? 0 : train_days; }
 };
+// Whether every day is held out in turn: against the plant before a change
+// (DiagnosisOptions::reference_params), whose base model is not fitted, when
+// neither train_days nor heldout_days is given. Only a candidate's own
+// parameters are fitted there, on the other days since the change, so that
+// every day since is a held-out day: one day that cannot show the change (an
+// overcast day when an inverter clips) is then one of several units, not
+// the whole test.
+bool CrossFitted(const DiagnosisOptions& options);
+// m with the objective rows of fold `fold` removed (Split::fold_of_row).
+Measurements WithoutFold(const Measurements& m, const Split& split, int fold);
 bool SplitDays(const Series& data, const Plant& plant, const DiagnosisOptions& options,
                Split* split, std::string* error);
 
@@ -230,14 +251,22 @@ std::string BeforeChangeKey(const std::string& effect, const std::string& form);
 // A model on the ladder.
 struct LadderModel {
   ModelSpec spec;
-  ParamVector params{};
-  Score score;
+  ParamVector params{};  // with Split::folds, the fit on all days (reported)
+  Score score;           // with Split::folds, each day scored with its fold's parameters
+  // With Split::folds: per fold, the parameters fitted without its day.
+  std::vector<ParamVector> fold_params;
 };
+// The held-out score of `params` on `heldout`; with fold_params (Split::
+// folds), each row scored with the parameters of its fold.
+Score ScoreModel(const Split& split, const Part& heldout, const ParamVector& params,
+                 const std::vector<ParamVector>& fold_params, const Units& units, double area_m2);
 struct StepTrials {
   std::vector<EffectCandidate> candidates;
   std::vector<SkippedEffect> skipped;
   std::vector<EffectTrial> trials;  // per candidate
   std::vector<Score> scores;        // per candidate: its chosen form's
+  // Per candidate, with Split::folds: its chosen form's parameters per fold.
+  std::vector<std::vector<ParamVector>> fold_params;
   // Per candidate: every form's held-out score (the chosen one among them);
   // the model selection takes the best form of each resample.
   std::vector<std::vector<Score>> form_scores;

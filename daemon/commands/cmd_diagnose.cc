@@ -584,7 +584,9 @@ void RegisterDiagnose(CLI::App& app) {
                   "base model variant, e.g. 1N1Cwr (required with --csv; with --db the default is "
                   "[calibration] variant)");
   cmd->add_option("--train-days", args->train_days,
-                  "training days from the first day of data (default: two thirds of the days)")
+                  "training days from the first day of data (default: two thirds of the days; "
+                  "with --against-params or --against-calibration, each day is held out in "
+                  "turn, its effects fitted on the other days)")
       ->check(CLI::NonNegativeNumber)
       ->default_str("auto");
   cmd->add_option("--heldout-days", args->heldout_days,

@@ -792,6 +792,89 @@ TEST(DiagnosisAgainstThePlantBefore, OnlyTheEffectsOwnParametersAreFitted) {
   EXPECT_NE(why.find("reference_days: only with reference_params"), std::string::npos) << why;
 }
 
+// Each day since a change held out in turn (diagnosis_stages::CrossFitted):
+// an inverter clips from day 10 on the example plant, and of the three days
+// since, two are clear and the last is overcast, so that the limit (120
+// W/m², TruthParamsFor) binds on the clear days only. Held out alone, as one
+// split of the days since would hold it, the overcast day cannot show the
+// clipping: fitted on the two clear days, it gains nothing there. With each
+// day held out in turn, each clear day is scored by the limit fitted on the
+// other one, and the clipping is the verdict.
+TEST(DiagnosisAgainstThePlantBefore, EachDaySinceTheChangeIsHeldOutInTurn) {
+  const Plant plant = DesignExamplePlant();
+  const std::string truth = std::string(testing::kExamplePlantTruth) + "+pv_clipping";
+  SyntheticOptions synth;
+  std::string error;
+  ASSERT_TRUE(DefaultSyntheticOptions(plant, truth, 13, 4, &synth, &error)) << error;
+  synth.weather.start_time_s =
+      SolarDayStartS(synth.weather.start_time_s, SolarDayOffsetS(plant)) + kSecondsPerDay;
+  using enum DayType;
+  synth.weather.day_types = {kClear,        kBrokenClouds, kClear,        kOvercast, kClear,
+                             kBrokenClouds, kClear,        kBrokenClouds, kClear,    kOvercast,
+                             kClear,        kClear,        kOvercast};
+  // The inverter clips from the change on: the days before are the healthy
+  // plant's (the same weather without the clipping).
+  SyntheticOptions healthy_synth = synth;
+  ASSERT_TRUE(
+      DefaultSyntheticOptions(plant, testing::kExamplePlantTruth, 13, 4, &healthy_synth, &error))
+      << error;
+  healthy_synth.weather = synth.weather;
+  auto make = [&](const SyntheticOptions& o) {
+    Series s = MakeSyntheticPlantData(plant, o);
+    ApplyPaperCorrections(&s);
+    Series coarse;
+    EXPECT_TRUE(Resample(s, 300.0, &coarse, &error)) << error;
+    return coarse;
+  };
+  const Series healthy = make(healthy_synth);
+  const Series clipped = make(synth);
+  const std::int64_t change_s =
+      SolarDayStartS(healthy.time_s.front(), SolarDayOffsetS(plant)) + 10 * kSecondsPerDay;
+  const ModelSpec base = testing::SpecOf(testing::kExampleDaemonModel);
+  const IdentSummary reference =
+      FitOnDaysBefore(healthy.Between(healthy.time_s.front(), change_s), plant, base);
+  ASSERT_TRUE(reference.ok) << reference.BriefReport();
+  const Series since = clipped.Between(change_s, change_s + 3 * kSecondsPerDay);
+
+  DiagnosisOptions o;
+  o.effects = {"pv_clipping", "shading"};
+  o.max_ladder_steps = 1;
+  o.reference_params = reference.params;
+  o.reference_name = "the fit of the 10 days before";
+  DiagnosisOptions one_split = o;
+  one_split.train_days = 2;
+  one_split.heldout_days = 1;
+  DiagnosisResult in_turn, last_day;
+  ASSERT_TRUE(Diagnose(since, plant, base, o, &in_turn, &error)) << error;
+  ASSERT_TRUE(Diagnose(since, plant, base, one_split, &last_day, &error)) << error;
+  auto clipping = [](const DiagnosisResult& r) {
+    for (const EffectTrial& t : r.effects) {
+      if (t.name == "pv_clipping") return t;
+    }
+    ADD_FAILURE() << "pv_clipping not tried";
+    return EffectTrial{};
+  };
+  const EffectTrial turn = clipping(in_turn);
+  const EffectTrial last = clipping(last_day);
+  std::printf(
+      "clipping since the change: shrink %.1f %%, confidence %.2f with each day held out in "
+      "turn; %.1f %%, %.2f with the overcast day held out alone\n",
+      turn.shrink_pct, turn.confidence, last.shrink_pct, last.confidence);
+  // Every day since is a held-out day, and the notes say how.
+  ASSERT_EQ(in_turn.days.size(), 3u);
+  for (const DiagnosisDay& d : in_turn.days) EXPECT_TRUE(d.heldout) << d.date;
+  EXPECT_TRUE(std::any_of(in_turn.notes.begin(), in_turn.notes.end(), [](const std::string& n) {
+    return n.find("each of the 3 days is held out in turn") != std::string::npos;
+  }));
+  EXPECT_EQ(in_turn.verdict, "pv_clipping") << turn.evidence;
+  EXPECT_GE(turn.confidence, o.min_confidence) << turn.evidence;
+  // The limit reported is the fit on all three days: the truth's.
+  EXPECT_NEAR(ParamOf(turn.params, Param::kPLimitWM2), 120.0, 6.0) << turn.evidence;
+  // The overcast day alone: the clipping changes next to nothing there.
+  EXPECT_LT(last.shrink_pct, 1.0) << last.evidence;
+  EXPECT_NE(last_day.verdict, "pv_clipping") << last.evidence;
+}
+
 // The model selection on one output (DiagnosisOptions::selection_outputs):
 // the example plant's truth has a transport delay that the daemon's model
 // 2N1Ccolwr lacks. On both outputs' error the delay candidate beats the

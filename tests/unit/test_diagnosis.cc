@@ -792,6 +792,81 @@ TEST(DiagnosisAgainstThePlantBefore, OnlyTheEffectsOwnParametersAreFitted) {
   EXPECT_NE(why.find("reference_days: only with reference_params"), std::string::npos) << why;
 }
 
+// The cross-fit's bookkeeping (diagnosis_stages::CrossFitted): against a
+// reference with the split left automatic, each day is a fold; WithoutFold
+// drops exactly that day's objective rows, and ScoreModel scores each row
+// with the parameters of its own fold, as a simulation with those
+// parameters alone gives it.
+TEST(DiagnosisCrossFit, EachRowIsScoredWithTheParametersOfItsOwnDay) {
+  const Plant plant = DesignExamplePlant();
+  Series coarse;
+  std::string error;
+  ASSERT_TRUE(
+      Resample(ExamplePlantDays(plant, testing::kExamplePlantTruth), 300.0, &coarse, &error))
+      << error;
+  const std::int64_t first_day = SolarDayStartS(coarse.time_s.front(), SolarDayOffsetS(plant));
+  const Series data = coarse.Between(first_day, first_day + 3 * kSecondsPerDay);
+  const ModelSpec spec = testing::SpecOf(testing::kExampleDaemonModel);
+  DiagnosisOptions o;
+  o.reference_params = StartParams(plant);
+  ASSERT_TRUE(diagnosis_stages::CrossFitted(o));
+  diagnosis_stages::Split split;
+  ASSERT_TRUE(diagnosis_stages::SplitDays(data, plant, o, &split, &error)) << error;
+  ASSERT_EQ(split.folds, 3);
+  EXPECT_EQ(split.FirstHeldoutDay(), 0);
+  EXPECT_EQ(split.heldout_series.size(), data.size());
+  ASSERT_EQ(split.fold_of_row.size(), data.size());
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    EXPECT_EQ(split.fold_of_row[i], (data.time_s[i] - first_day) / kSecondsPerDay) << i;
+  }
+  // With a split given, one split as before.
+  DiagnosisOptions given = o;
+  given.train_days = 2;
+  EXPECT_FALSE(diagnosis_stages::CrossFitted(given));
+
+  diagnosis_stages::Part part;
+  ASSERT_TRUE(diagnosis_stages::PreparePart(split.heldout_series, plant, spec, split.data_start_s,
+                                            split.cleanings, &part, &error))
+      << error;
+  const Measurements without = diagnosis_stages::WithoutFold(part.meas, split, 1);
+  std::size_t in_fold = 0;
+  for (std::uint32_t i : part.meas.rows) in_fold += split.fold_of_row[i] == 1 ? 1 : 0;
+  EXPECT_GT(in_fold, 0u);
+  EXPECT_EQ(without.rows.size(), part.meas.rows.size() - in_fold);
+  for (std::uint32_t i : without.rows) EXPECT_NE(split.fold_of_row[i], 1) << i;
+
+  diagnosis_stages::Units units;
+  units.unit_of_row.assign(data.size(), -1);
+  for (std::uint32_t i : part.meas.rows) units.unit_of_row[i] = split.fold_of_row[i];
+  units.count = 3;
+  const ParamVector a = StartParams(plant);
+  ParamVector b = a, c = a;
+  b[static_cast<std::size_t>(Param::kEtaPvRef)] *= 0.8;
+  c[static_cast<std::size_t>(Param::kFTh)] *= 0.9;
+  const std::vector<ParamVector> folds = {a, b, c};
+  const diagnosis_stages::Score scored =
+      diagnosis_stages::ScoreModel(split, part, a, folds, units, plant.area_m2);
+  for (std::size_t d = 0; d < folds.size(); ++d) {
+    const diagnosis_stages::Score alone =
+        diagnosis_stages::ScoreHeldout(part, folds[d], units, plant.area_m2);
+    std::size_t compared = 0;
+    for (std::uint32_t i : part.meas.rows) {
+      if (split.fold_of_row[i] != static_cast<int>(d)) continue;
+      ++compared;
+      EXPECT_EQ(scored.sim.p_el_w[i], alone.sim.p_el_w[i]) << d << " " << i;
+      EXPECT_EQ(scored.sim.q_th_w[i], alone.sim.q_th_w[i]) << d << " " << i;
+    }
+    EXPECT_GT(compared, 0u) << d;
+    EXPECT_DOUBLE_EQ(scored.unit_loss_w[d], alone.unit_loss_w[d]) << d;
+  }
+  // The folds differ: a day scored with another fold's parameters differs.
+  const diagnosis_stages::Score all_a =
+      diagnosis_stages::ScoreHeldout(part, a, units, plant.area_m2);
+  EXPECT_NE(scored.unit_loss_w[1], all_a.unit_loss_w[1]);
+  EXPECT_NE(scored.unit_loss_w[2], all_a.unit_loss_w[2]);
+  EXPECT_DOUBLE_EQ(scored.unit_loss_w[0], all_a.unit_loss_w[0]);
+}
+
 // Each day since a change held out in turn (diagnosis_stages::CrossFitted):
 // an inverter clips from day 10 on the example plant, and of the three days
 // since, two are clear and the last is overcast, so that the limit (120

@@ -314,12 +314,25 @@ void HtmlVerdict(std::ostream& h, const DiagnosisResult& r) {
   for (const std::string& n : r.notes) h << "<p class='note'>" << XmlEscape(n) << "</p>\n";
 }
 
+// No training day: each day was held out in turn (against the plant before
+// a change), its effects fitted on the other days.
+bool EachDayHeldOutInTurn(const DiagnosisResult& r) {
+  return !r.days.empty() &&
+         std::all_of(r.days.begin(), r.days.end(), [](const DiagnosisDay& d) { return d.heldout; });
+}
+
 // Training and held-out days, the base model's held-out error and the noise floor.
 void HtmlErrorSummary(std::ostream& h, const DiagnosisResult& r) {
   std::size_t train = 0, heldout = 0;
   for (const DiagnosisDay& d : r.days) (d.heldout ? heldout : train)++;
-  h << "<p>Identified on " << train << " training days, scored on " << heldout
-    << " held-out days at a " << Fixed(r.step_s, 0) << " s step. Held-out error of the base model: "
+  if (EachDayHeldOutInTurn(r)) {
+    h << "<p>Each of the " << heldout
+      << " days held out in turn, its effects fitted on the other days";
+  } else {
+    h << "<p>Identified on " << train << " training days, scored on " << heldout
+      << " held-out days";
+  }
+  h << " at a " << Fixed(r.step_s, 0) << " s step. Held-out error of the base model: "
     << "MAE P<sub>el</sub> " << Fixed(r.gap.mae_p_el_w, 2) << " W (nMAE "
     << Fixed(100 * r.gap.nmae_p_el, 1) << " %), MAE Q<sub>u</sub> " << Fixed(r.gap.mae_q_th_w, 2)
     << " W (nMAE " << Fixed(100 * r.gap.nmae_q_th, 1) << " %). Sensor noise alone would give about "
@@ -347,8 +360,11 @@ void HtmlLadder(std::ostream& h, const DiagnosisResult& r) {
 
 // Every effect tried, the ones not tried, and what each means.
 void HtmlEffectsTested(std::ostream& h, const DiagnosisResult& r) {
+  const bool in_turn = EachDayHeldOutInTurn(r);
   h << "<h2>Effects tested</h2>\n<p>Each effect was added to the model, the model re-identified "
-    << "on the training days and scored on the held-out " << XmlEscape(r.test_unit)
+    << (in_turn ? "without each day in turn and scored on that day's "
+                : "on the training days and scored on the held-out ")
+    << XmlEscape(r.test_unit)
     << "s. Significant = named by the model selection: its confidence, the share of resamples "
     << "of the held-out " << XmlEscape(r.test_unit)
     << "s in which it is the best candidate and beats the model, reaches the threshold; p is the "

@@ -941,6 +941,10 @@ TEST(DiagnosisAgainstThePlantBefore, EachDaySinceTheChangeIsHeldOutInTurn) {
   EXPECT_TRUE(std::any_of(in_turn.notes.begin(), in_turn.notes.end(), [](const std::string& n) {
     return n.find("each of the 3 days is held out in turn") != std::string::npos;
   }));
+  const std::string html = DiagnosisReportHtml(in_turn);
+  EXPECT_NE(html.find("Each of the 3 days held out in turn"), std::string::npos);
+  EXPECT_EQ(html.find("Identified on 0 training days"), std::string::npos);
+  EXPECT_NE(DiagnosisReportHtml(last_day).find("Identified on 2 training days"), std::string::npos);
   EXPECT_EQ(in_turn.verdict, "pv_clipping") << turn.evidence;
   EXPECT_GE(turn.confidence, o.min_confidence) << turn.evidence;
   // The limit reported is the fit on all three days: the truth's.

@@ -327,9 +327,7 @@ FormFit FitForm(const TrialInputs& in, const LadderModel& current, const EffectM
     f.fit.ok = true;
     f.fit.variant = spec.Name();
     f.fit.params = start;
-    for (const ParamVector& fold : current.fold_params) {
-      f.fold_params.push_back(MergedStart(plant, current.spec, fold));
-    }
+    f.fold_params = PerFold(plant, current, spec, start);
     return f;
   }
   auto fit = [&](const Measurements& meas, const ParamVector& from,
@@ -432,11 +430,7 @@ std::optional<ParamVector> ParamsBeforeChange(const TrialInputs& in, const Ladde
     if (!FitOnReferenceDays(in, current, *c.module, form.spec, &before)) return std::nullopt;
     *fit_out = {key, before};
   }
-  ParamVector params = MergedStart(*in.plant, current.spec, current.params);
-  for (std::size_t p = 0; p < kNumParams; ++p) {
-    if (own.test(p)) params[p] = before[p];
-  }
-  return params;
+  return WithOwn(MergedStart(*in.plant, current.spec, current.params), before, own);
 }
 
 // f's held-out score as the plant before the change had the form: with
@@ -541,6 +535,8 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
                                                     current_score.errors.objective_w_m2());
     t.params_before_change = best_form.before_change_params;
   }
+  // The chosen form's held-out score, kept before the forms' scores move on.
+  Score chosen_score = best_form.score;
   for (ScoredForm& f : forms) {
     if (!std::isfinite(f.objective_w)) continue;
     form_scores->push_back(std::move(f.score));
@@ -587,7 +583,7 @@ void TryCandidate(const TrialInputs& in, int step, const LadderModel& current,
     t.failure = "identification failed: " + fit.failure_reason;
     return;
   }
-  *score = ScoreModel(*in.split, ho, fit.params, best.fold_params, in.base->units, plant.area_m2);
+  *score = std::move(chosen_score);
   *fold_params = best.fold_params;
   if (!std::isfinite((*score).errors.objective_w_m2())) {
     t.failure = "non-finite held-out outputs";
